@@ -1,0 +1,15 @@
+//! marionette: a data-oriented ECS simulation engine for human character motion.
+//!
+//! Three research systems in one engine: learned motor primitives (adjusted, connected,
+//! blended), choreography from motion segments, and physically simulated falls whose PD
+//! controllers a genetic algorithm evolves. Kernels are plain Rust over plain data; the ECS
+//! (`bevy_ecs`) is the wiring.
+//!
+//! Conventions: metres, seconds, radians inside (degrees only at the edges: files, reports,
+//! plots); Y is up, a character faces +Z and its left is +X (right-handed).
+
+pub mod bvh;
+pub mod dynamics;
+pub mod io;
+pub mod primitive;
+pub mod render;
