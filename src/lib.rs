@@ -11,5 +11,7 @@
 pub mod bvh;
 pub mod dynamics;
 pub mod io;
+pub mod model;
 pub mod primitive;
 pub mod render;
+pub mod skeleton;

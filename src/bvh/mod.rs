@@ -85,11 +85,10 @@ pub struct Bvh {
 impl Bvh {
     /// Number of frames of motion.
     pub fn frame_count(&self) -> usize {
-        if self.channel_count == 0 {
-            0
-        } else {
-            self.motion.len() / self.channel_count
-        }
+        self.motion
+            .len()
+            .checked_div(self.channel_count)
+            .unwrap_or(0)
     }
 
     /// The values of frame `f`.
