@@ -9,15 +9,18 @@
 //! axis `(a.x, −a.y, −a.z)` so that the same number means the same motion on both sides.
 //!
 //! - [`humanoid24`]: the 24-DOF model of the motor-primitive paper (SPEC §1).
+//! - [`ModelClip`]: a motion on a model (DOF angles plus root motion).
 //! - [`fall21`]: the 21-DOF, 15-link model of the falling paper (SPEC §3), with age-dependent
 //!   joint ranges in [`ranges`].
 
 mod definition;
 mod joint_angles;
+mod model_clip;
 pub mod ranges;
 
 pub use definition::{fall21, humanoid24};
-pub use joint_angles::{local_rotation, project_rotation};
+pub use joint_angles::{local_rotation, project_rotation, unwrap_near};
+pub use model_clip::ModelClip;
 
 use glam::{DQuat, DVec3};
 use serde::{Deserialize, Serialize};

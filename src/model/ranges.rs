@@ -45,13 +45,8 @@ pub enum RangeError {
         source: std::io::Error,
     },
     /// RON syntax or schema error, with line and column.
-    #[error("{path}:{line}:{column}: {message}")]
-    Parse {
-        path: String,
-        line: usize,
-        column: usize,
-        message: String,
-    },
+    #[error(transparent)]
+    Parse(#[from] crate::io::RonError),
     /// A version this build does not know.
     #[error("{path}: format_version {found} is newer than this build reads ({FORMAT_VERSION})")]
     Version { path: String, found: u32 },
@@ -88,12 +83,7 @@ impl RangeTable {
 
     /// Parses RON text; `origin` names the source in errors.
     pub fn parse(text: &str, origin: &str) -> Result<RangeTable, RangeError> {
-        let t: RangeTable = ron::from_str(text).map_err(|e| RangeError::Parse {
-            path: origin.to_string(),
-            line: e.span.start.line,
-            column: e.span.start.col,
-            message: e.code.to_string(),
-        })?;
+        let t: RangeTable = crate::io::parse_ron(text, origin)?;
         if t.format_version > FORMAT_VERSION {
             return Err(RangeError::Version {
                 path: origin.into(),
