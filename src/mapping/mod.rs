@@ -5,8 +5,10 @@
 //! hand, hip, knee, ankle, toe), the source joint or End Site that marks it. [`retarget`] turns a
 //! clip into the model's DOF angle trajectories plus root motion ([`ModelClip`]).
 
+mod fidelity;
 mod retarget;
 
+pub use fidelity::{EffectorError, effector_errors};
 pub use retarget::retarget;
 
 use std::collections::BTreeMap;
