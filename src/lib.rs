@@ -11,6 +11,7 @@
 pub mod bvh;
 pub mod clips;
 pub mod dynamics;
+pub mod ecs;
 pub mod io;
 pub mod mapping;
 pub mod model;
