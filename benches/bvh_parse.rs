@@ -4,6 +4,9 @@
 //! or `../shared/data`; when that is absent it says so and measures a generated file of the same
 //! size and shape (43 joints, 132 channels, values with about six significant digits) instead.
 //!
+//! `number_conversion_only` times just `str::parse::<f64>` over the file's motion values (split
+//! beforehand) with the same byte count, the floor `parse` can approach.
+//!
 //! Run: `cargo bench --bench bvh_parse`
 
 use std::hint::black_box;
@@ -91,6 +94,21 @@ fn bench(c: &mut Criterion) {
     g.throughput(Throughput::Bytes(bytes.len() as u64));
     g.bench_function("parse", |b| {
         b.iter(|| bvh::parse(black_box(&bytes)).unwrap())
+    });
+    // Baseline: only the text → f64 conversions of the motion values (tokens split beforehand),
+    // to show how much of `parse` is number conversion.
+    let text = std::str::from_utf8(&bytes).expect("UTF-8");
+    let motion_text = text.rsplit_once("Frame Time:").expect("MOTION block").1;
+    let tokens: Vec<&str> = motion_text.split_ascii_whitespace().skip(1).collect();
+    assert_eq!(tokens.len(), parsed.motion.len());
+    g.bench_function("number_conversion_only", |b| {
+        b.iter(|| {
+            let mut sum = 0.0;
+            for t in black_box(&tokens) {
+                sum += t.parse::<f64>().unwrap();
+            }
+            sum
+        })
     });
     let written = bvh::to_string(&parsed);
     g.throughput(Throughput::Bytes(written.len() as u64));
