@@ -19,6 +19,7 @@ use tiny_skia::Pixmap;
 use super::camera::{Camera, PanelLimits, View, scale_for};
 use super::canvas::{
     INK, INKS, Style, WHITE, blit, draw_figure, draw_key, key_width, new_pixmap, panel_background,
+    sheet_size,
 };
 use super::figure::{Track, validate_tracks};
 use super::text::{Align, Pen, ascent, draw_text, font};
@@ -32,6 +33,8 @@ const GAP: u32 = 8;
 const TRACK_GAP: u32 = 24;
 /// Steps of each white-to-ink ramp in the palette.
 const LEVELS: usize = 16;
+/// Most frames in one GIF (an hour at 25 frames per second).
+pub const MAX_GIF_FRAMES: usize = 90_000;
 /// Frames drawn and compressed per parallel batch (bounds memory).
 const CHUNK: usize = 48;
 /// The highest frame rate: GIF delays are whole hundredths of a second and viewers slow down
@@ -129,11 +132,13 @@ pub fn animation_gif(tracks: &[Track], fps: f64, path: &Path) -> Result<(), Rend
     let label_row = (style.text * 1.6) as u32;
     let footer = (style.small * 2.4) as u32;
     let block_w = cams[0].width + GAP + cams[1].width;
-    let n = tracks.len() as u32;
-    let row_w = n * block_w + (n - 1) * TRACK_GAP;
+    let n = tracks.len() as u64;
+    let row = n * block_w as u64 + (n - 1) * TRACK_GAP as u64;
+    let height = MARGIN + header + label_row + PANEL_HEIGHT + footer;
+    sheet_size(row + 2 * MARGIN as u64, height as u64)?;
+    let row_w = row as u32;
     let key_w = key_width(font, mpp, row_w as f64 * 0.6, style) as u32;
     let width = 2 * MARGIN + row_w.max(key_w);
-    let height = MARGIN + header + label_row + PANEL_HEIGHT + footer;
     let (Ok(w16), Ok(h16)) = (u16::try_from(width), u16::try_from(height)) else {
         return Err(RenderError::InvalidArgument(format!(
             "a {width}×{height} picture exceeds the GIF limit of 65535 pixels a side"
@@ -184,7 +189,13 @@ pub fn animation_gif(tracks: &[Track], fps: f64, path: &Path) -> Result<(), Rend
     );
 
     let duration = tracks.iter().map(Track::duration).fold(0.0, f64::max);
-    let frames = (duration * fps + 1e-9).floor() as usize + 1;
+    let steps = (duration * fps + 1e-9).floor();
+    if steps >= MAX_GIF_FRAMES as f64 {
+        return Err(RenderError::InvalidArgument(format!(
+            "{duration} s at {fps} frames per second is more than {MAX_GIF_FRAMES} GIF frames"
+        )));
+    }
+    let frames = steps as usize + 1;
     let lut = lookup();
     let time_base = MARGIN as f32 + ascent(font, style.text);
     let mut still = vec![0u8; (width * height) as usize];

@@ -61,6 +61,19 @@ pub(crate) fn new_pixmap(width: u32, height: u32, fill: [u8; 3]) -> Result<Pixma
     Ok(p)
 }
 
+/// Largest picture side (pixels).
+pub(crate) const MAX_SIDE: u64 = 32_000;
+
+/// Checks a picture size computed in u64 (so that no sum overflows) against [`MAX_SIDE`].
+pub(crate) fn sheet_size(width: u64, height: u64) -> Result<(u32, u32), RenderError> {
+    if width == 0 || height == 0 || width > MAX_SIDE || height > MAX_SIDE {
+        return Err(RenderError::InvalidArgument(format!(
+            "the picture would be {width}×{height} pixels; at most {MAX_SIDE} a side"
+        )));
+    }
+    Ok((width as u32, height as u32))
+}
+
 /// Line widths and text sizes for a panel `height` pixels high (about 1/120 of it for bones).
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Style {
@@ -83,7 +96,53 @@ impl Style {
     }
 }
 
+/// Clips segment a–b to the rectangle [lo.0, hi.0] × [lo.1, hi.1] (Liang–Barsky: with
+/// p(t) = a + t(b − a), keep the t ∈ [0, 1] where every bound holds). `None` if nothing is left
+/// or a coordinate is not finite. Keeps far-off points from reaching the rasteriser.
+pub(crate) fn clip_segment(
+    a: (f32, f32),
+    b: (f32, f32),
+    lo: (f32, f32),
+    hi: (f32, f32),
+) -> Option<((f32, f32), (f32, f32))> {
+    if ![a.0, a.1, b.0, b.1].iter().all(|v| v.is_finite()) {
+        return None;
+    }
+    let (dx, dy) = (b.0 - a.0, b.1 - a.1);
+    let (mut t0, mut t1) = (0.0f32, 1.0f32);
+    for (p, q) in [
+        (-dx, a.0 - lo.0),
+        (dx, hi.0 - a.0),
+        (-dy, a.1 - lo.1),
+        (dy, hi.1 - a.1),
+    ] {
+        if p == 0.0 {
+            if q < 0.0 {
+                return None;
+            }
+        } else {
+            let r = q / p;
+            if p < 0.0 {
+                t0 = t0.max(r);
+            } else {
+                t1 = t1.min(r);
+            }
+        }
+    }
+    (t0 <= t1).then(|| {
+        (
+            (a.0 + t0 * dx, a.1 + t0 * dy),
+            (a.0 + t1 * dx, a.1 + t1 * dy),
+        )
+    })
+}
+
+/// Strokes segment a–b, clipped to the pixmap grown by a 16-pixel border.
 fn line(pixmap: &mut Pixmap, a: (f32, f32), b: (f32, f32), width: f32, c: [u8; 3]) {
+    let (w, h) = (pixmap.width() as f32, pixmap.height() as f32);
+    let Some((a, b)) = clip_segment(a, b, (-16.0, -16.0), (w + 16.0, h + 16.0)) else {
+        return;
+    };
     let mut pb = PathBuilder::new();
     pb.move_to(a.0, a.1);
     pb.line_to(b.0, b.1);
@@ -103,7 +162,12 @@ fn rect(pixmap: &mut Pixmap, x: f32, y: f32, w: f32, h: f32, c: [u8; 3]) {
     }
 }
 
+/// Fills a disc of radius `r` at `at`, if it is on the pixmap.
 fn dot(pixmap: &mut Pixmap, at: (f32, f32), r: f32, c: [u8; 3]) {
+    let (w, h) = (pixmap.width() as f32, pixmap.height() as f32);
+    if !(at.0 > -r && at.1 > -r && at.0 < w + r && at.1 < h + r) {
+        return;
+    }
     if let Some(path) = PathBuilder::from_circle(at.0, at.1, r) {
         pixmap.fill_path(
             &path,
@@ -314,6 +378,22 @@ mod tests {
         assert_eq!(scale_length(0.01, 60.0), 0.5);
         assert_eq!(scale_length(0.01, 45.0), 0.2);
         assert_eq!(scale_length(0.01, 15.0), 0.1);
+    }
+
+    #[test]
+    fn segments_are_clipped_to_the_rectangle() {
+        let (lo, hi) = ((0.0, 0.0), (10.0, 10.0));
+        // Inside: unchanged.
+        assert_eq!(
+            clip_segment((1.0, 1.0), (9.0, 5.0), lo, hi),
+            Some(((1.0, 1.0), (9.0, 5.0)))
+        );
+        // Crossing: cut at x = 10.
+        let ((_, _), (x, y)) = clip_segment((5.0, 5.0), (1e14, 5.0), lo, hi).unwrap();
+        assert!((x - 10.0).abs() < 1e-3 && (y - 5.0).abs() < 1e-3);
+        // Outside or not finite: nothing.
+        assert_eq!(clip_segment((20.0, 0.0), (30.0, 5.0), lo, hi), None);
+        assert_eq!(clip_segment((1.0, 1.0), (f32::INFINITY, 5.0), lo, hi), None);
     }
 
     #[test]
