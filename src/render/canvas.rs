@@ -228,6 +228,8 @@ pub(crate) fn draw_figure(p: &mut Pixmap, cam: &Camera, track: &Track, k: usize,
     let px = |q: DVec3| cam.pixel(centre, cam.view.project(q));
     if cam.view.shows_floor() {
         floor_ticks(p, cam, centre);
+    } else {
+        floor_grid(p, cam, centre);
     }
     let sides = fig.sides();
     let mut bones: Vec<(f64, usize, usize)> = fig
@@ -255,6 +257,28 @@ fn floor_ticks(p: &mut Pixmap, cam: &Camera, centre: glam::DVec2) {
     for m in first..=last {
         let (x, _) = cam.pixel(centre, glam::DVec2::new(m as f64 * step, 0.0));
         line(p, (x, y0), (x, y0 + 5.0), 1.0, FLOOR);
+    }
+}
+
+/// Seen from above, the floor as a light grid of 0.5 m squares (it moves when the camera
+/// follows the root).
+fn floor_grid(p: &mut Pixmap, cam: &Camera, centre: glam::DVec2) {
+    let step = 0.5;
+    let (w, h) = (cam.width as f32, cam.height as f32);
+    for axis in 0..2 {
+        let half = [cam.width, cam.height][axis] as f64 * 0.5 * cam.mpp;
+        let first = ((centre[axis] - half) / step).floor() as i64;
+        let last = ((centre[axis] + half) / step).ceil() as i64;
+        for m in first..=last {
+            let mut q = centre;
+            q[axis] = m as f64 * step;
+            let (x, y) = cam.pixel(centre, q);
+            if axis == 0 {
+                line(p, (x, 0.0), (x, h), 1.0, FRAME);
+            } else {
+                line(p, (0.0, y), (w, y), 1.0, FRAME);
+            }
+        }
     }
 }
 
