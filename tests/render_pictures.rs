@@ -258,6 +258,40 @@ fn non_finite_and_miscounted_input_is_an_error_and_writes_nothing() {
 }
 
 #[test]
+fn extreme_but_finite_input_gives_a_picture_or_an_error_never_a_panic() {
+    let (fig, pose) = stick_man();
+    let mut far = pose.clone();
+    far[3] = DVec3::new(1e12, 1.4, -1e12); // a hand a billion kilometres away
+    let frames = vec![pose.clone(), far];
+    let t = Track {
+        figure: &fig,
+        frames: &frames,
+        label: "far".into(),
+        frame_time: 1e-300,
+    };
+    let dir = out_dir("extreme");
+    // The panel is capped, the far hand drawn off it: a picture of bounded size.
+    pose_png(&t, 1, &dir.join("far.png")).unwrap();
+    let (w, h) = png_size(&dir.join("far.png"));
+    assert!(w <= 2 * 4096 + 100 && h < 1000, "{w}×{h}");
+    animation_gif(std::slice::from_ref(&t), 25.0, &dir.join("far.gif")).unwrap();
+    // Too many columns or too long a GIF are errors.
+    assert!(matches!(
+        filmstrip_png(std::slice::from_ref(&t), 1_000_000, &dir.join("wide.png")),
+        Err(RenderError::InvalidArgument(_))
+    ));
+    let slow = Track {
+        frame_time: 1e300,
+        ..t
+    };
+    assert!(matches!(
+        animation_gif(std::slice::from_ref(&slow), 25.0, &dir.join("long.gif")),
+        Err(RenderError::InvalidArgument(_))
+    ));
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
 fn plot_of_two_series_writes_png_and_svg() {
     let p = Plot {
         title: "Pendulum".into(),

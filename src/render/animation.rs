@@ -4,8 +4,10 @@
 //! The drawing uses few colours ([`super::canvas::INKS`]) on white, and anti-aliasing mixes each
 //! of them with white, so the palette is the 16-step ramp from white to every ink. A 32×32×32
 //! lookup table maps 5-bit-per-channel RGB to the nearest palette entry once; each pixel then
-//! costs one table look-up. Frames are drawn, quantised and LZW-compressed in parallel (rayon),
-//! in chunks, and written in order.
+//! costs one table look-up. Frames are drawn and quantised in parallel (rayon), in chunks; each
+//! frame after the first stores only the rectangle that changed, unchanged pixels in it
+//! transparent (so most of the page is encoded once); the rectangles are LZW-compressed in
+//! parallel and written in order.
 
 use std::borrow::Cow;
 use std::path::Path;
@@ -17,6 +19,7 @@ use tiny_skia::Pixmap;
 use super::camera::{Camera, PanelLimits, View, scale_for};
 use super::canvas::{
     INK, INKS, Style, WHITE, blit, draw_figure, draw_key, key_width, new_pixmap, panel_background,
+    sheet_size,
 };
 use super::figure::{Track, validate_tracks};
 use super::text::{Align, Pen, ascent, draw_text, font};
@@ -30,6 +33,8 @@ const GAP: u32 = 8;
 const TRACK_GAP: u32 = 24;
 /// Steps of each white-to-ink ramp in the palette.
 const LEVELS: usize = 16;
+/// Most frames in one GIF (an hour at 25 frames per second).
+pub const MAX_GIF_FRAMES: usize = 90_000;
 /// Frames drawn and compressed per parallel batch (bounds memory).
 const CHUNK: usize = 48;
 /// The highest frame rate: GIF delays are whole hundredths of a second and viewers slow down
@@ -73,17 +78,23 @@ fn lookup() -> &'static [u8] {
     })
 }
 
-/// Palette indices of an opaque pixmap (premultiplied = straight colour when alpha is 255).
-fn quantise(p: &Pixmap, lut: &[u8]) -> Vec<u8> {
-    p.pixels()
-        .iter()
-        .map(|c| {
-            let key = ((c.red() as usize >> 3) << 10)
-                | ((c.green() as usize >> 3) << 5)
-                | (c.blue() as usize >> 3);
-            lut[key]
-        })
-        .collect()
+/// Palette index of an opaque pixel (premultiplied = straight colour when alpha is 255).
+fn index(c: tiny_skia::PremultipliedColorU8, lut: &[u8]) -> u8 {
+    lut[((c.red() as usize >> 3) << 10)
+        | ((c.green() as usize >> 3) << 5)
+        | (c.blue() as usize >> 3)]
+}
+
+/// Writes the palette indices of `src` into the `stride`-wide index image `dst` with the
+/// top-left corner at (`x`, `y`); `src` must lie inside `dst`.
+fn quantise_into(dst: &mut [u8], stride: usize, src: &Pixmap, x: u32, y: u32, lut: &[u8]) {
+    let w = src.width() as usize;
+    for (r, row) in src.pixels().chunks_exact(w).enumerate() {
+        let d0 = (y as usize + r) * stride + x as usize;
+        for (d, &c) in dst[d0..d0 + w].iter_mut().zip(row) {
+            *d = index(c, lut);
+        }
+    }
 }
 
 /// Delay of GIF frame `k` at `fps` in hundredths of a second, rounded so that the delays add
@@ -121,11 +132,13 @@ pub fn animation_gif(tracks: &[Track], fps: f64, path: &Path) -> Result<(), Rend
     let label_row = (style.text * 1.6) as u32;
     let footer = (style.small * 2.4) as u32;
     let block_w = cams[0].width + GAP + cams[1].width;
-    let n = tracks.len() as u32;
-    let row_w = n * block_w + (n - 1) * TRACK_GAP;
+    let n = tracks.len() as u64;
+    let row = n * block_w as u64 + (n - 1) * TRACK_GAP as u64;
+    let height = MARGIN + header + label_row + PANEL_HEIGHT + footer;
+    sheet_size(row + 2 * MARGIN as u64, height as u64)?;
+    let row_w = row as u32;
     let key_w = key_width(font, mpp, row_w as f64 * 0.6, style) as u32;
     let width = 2 * MARGIN + row_w.max(key_w);
-    let height = MARGIN + header + label_row + PANEL_HEIGHT + footer;
     let (Ok(w16), Ok(h16)) = (u16::try_from(width), u16::try_from(height)) else {
         return Err(RenderError::InvalidArgument(format!(
             "a {width}×{height} picture exceeds the GIF limit of 65535 pixels a side"
@@ -176,63 +189,147 @@ pub fn animation_gif(tracks: &[Track], fps: f64, path: &Path) -> Result<(), Rend
     );
 
     let duration = tracks.iter().map(Track::duration).fold(0.0, f64::max);
-    let frames = (duration * fps + 1e-9).floor() as usize + 1;
+    let steps = (duration * fps + 1e-9).floor();
+    if steps >= MAX_GIF_FRAMES as f64 {
+        return Err(RenderError::InvalidArgument(format!(
+            "{duration} s at {fps} frames per second is more than {MAX_GIF_FRAMES} GIF frames"
+        )));
+    }
+    let frames = steps as usize + 1;
     let lut = lookup();
     let time_base = MARGIN as f32 + ascent(font, style.text);
+    let mut still = vec![0u8; (width * height) as usize];
+    quantise_into(&mut still, width as usize, &sheet, 0, 0, lut);
+    // The strip that holds the time label.
+    let clock = tiny_skia::IntRect::from_xywh(0, 0, width, MARGIN + header)
+        .and_then(|r| sheet.clone_rect(r))
+        .ok_or_else(|| RenderError::Encode("empty GIF header".into()))?;
 
-    // One GIF frame, LZW-compressed, ready to write.
-    let render = |k: usize| -> Result<gif::Frame<'static>, RenderError> {
+    // Frame k: the still page with the clock and the panels drawn over it, as palette indices.
+    let render = |k: usize| -> Vec<u8> {
         let t = k as f64 / fps;
-        let mut img = sheet.clone();
+        let mut img = still.clone();
+        let mut strip = clock.clone();
         let label = format!("t = {t:.2} s");
-        draw_text(
-            &mut img,
-            font,
-            &label,
-            (MARGIN as f32, time_base),
-            Pen {
-                size: style.text,
-                rgb: INK,
-                align: Align::Left,
-            },
-        );
+        let pen = Pen {
+            size: style.text,
+            rgb: INK,
+            align: Align::Left,
+        };
+        draw_text(&mut strip, font, &label, (MARGIN as f32, time_base), pen);
+        quantise_into(&mut img, width as usize, &strip, 0, 0, lut);
         for (track, origin) in tracks.iter().zip(&origins) {
             let f = track.frame_at(t);
             for (v, cam) in cams.iter().enumerate() {
                 let mut panel = backgrounds[v].clone();
                 draw_figure(&mut panel, cam, track, f, style);
-                blit(&mut img, &panel, origin[v], panel_y);
+                quantise_into(&mut img, width as usize, &panel, origin[v], panel_y, lut);
             }
         }
-        let mut frame = gif::Frame {
-            width: w16,
-            height: h16,
-            delay: delay(k, fps),
-            buffer: Cow::Owned(quantise(&img, lut)),
-            ..gif::Frame::default()
-        };
-        frame.make_lzw_pre_encoded();
-        Ok(frame)
+        img
     };
 
-    let flat: Vec<u8> = palette().into_iter().flatten().collect();
+    let mut pal: Vec<u8> = palette().into_iter().flatten().collect();
+    pal.extend([255, 255, 255]); // TRANSPARENT: never drawn, marks unchanged pixels
     let gif_err = |e: gif::EncodingError| RenderError::Encode(format!("GIF: {e}"));
-    let mut encoder = gif::Encoder::new(Vec::new(), w16, h16, &flat).map_err(gif_err)?;
+    let mut encoder = gif::Encoder::new(Vec::new(), w16, h16, &pal).map_err(gif_err)?;
     encoder.set_repeat(gif::Repeat::Infinite).map_err(gif_err)?;
+    let (w, h) = (width as usize, height as usize);
+    let mut previous: Option<Vec<u8>> = None;
+    // A frame waits until the next one is known: an unchanged next frame only adds its delay.
+    let mut pending: Option<gif::Frame<'static>> = None;
     for start in (0..frames).step_by(CHUNK) {
         let end = (start + CHUNK).min(frames);
-        let batch: Vec<gif::Frame> = (start..end)
-            .into_par_iter()
-            .map(render)
-            .collect::<Result<_, _>>()?;
-        for frame in &batch {
-            encoder
-                .write_lzw_pre_encoded_frame(frame)
-                .map_err(gif_err)?;
+        let images: Vec<Vec<u8>> = (start..end).into_par_iter().map(render).collect();
+        let mut batch: Vec<Option<gif::Frame<'static>>> = Vec::with_capacity(images.len());
+        for (i, img) in images.into_iter().enumerate() {
+            let k = start + i;
+            let frame = match &previous {
+                None => Some(gif::Frame {
+                    width: w16,
+                    height: h16,
+                    buffer: Cow::Owned(img.clone()),
+                    ..gif::Frame::default()
+                }),
+                Some(prev) => changed_part(prev, &img, w, h),
+            };
+            batch.push(frame.map(|f| gif::Frame {
+                delay: delay(k, fps),
+                ..f
+            }));
+            previous = Some(img);
         }
+        batch
+            .par_iter_mut()
+            .flatten()
+            .for_each(|f| f.make_lzw_pre_encoded());
+        for (i, frame) in batch.into_iter().enumerate() {
+            match frame {
+                Some(f) => {
+                    if let Some(p) = pending.replace(f) {
+                        encoder.write_lzw_pre_encoded_frame(&p).map_err(gif_err)?;
+                    }
+                }
+                None => {
+                    if let Some(p) = pending.as_mut() {
+                        p.delay = p.delay.saturating_add(delay(start + i, fps));
+                    }
+                }
+            }
+        }
+    }
+    if let Some(p) = pending {
+        encoder.write_lzw_pre_encoded_frame(&p).map_err(gif_err)?;
     }
     let bytes = encoder.into_inner().map_err(gif_err)?;
     write(path, &bytes)
+}
+
+/// Palette index that marks a pixel as unchanged from the previous frame.
+const TRANSPARENT: u8 = (INKS.len() * LEVELS) as u8;
+
+/// The part of `next` (w×h palette indices) that differs from `prev`, as a frame over the
+/// bounding rectangle of the changed pixels, unchanged pixels inside it set to [`TRANSPARENT`]
+/// (drawn over the previous frame, which stays); `None` when nothing changed.
+fn changed_part(prev: &[u8], next: &[u8], w: usize, h: usize) -> Option<gif::Frame<'static>> {
+    let (mut x0, mut y0, mut x1, mut y1) = (w, h, 0, 0);
+    for y in 0..h {
+        let (a, b) = (&prev[y * w..(y + 1) * w], &next[y * w..(y + 1) * w]);
+        if a == b {
+            continue;
+        }
+        let first = a.iter().zip(b).position(|(p, q)| p != q)?;
+        let last = w
+            - 1
+            - a.iter()
+                .rev()
+                .zip(b.iter().rev())
+                .position(|(p, q)| p != q)?;
+        x0 = x0.min(first);
+        x1 = x1.max(last);
+        y0 = y0.min(y);
+        y1 = y1.max(y);
+    }
+    if x0 > x1 {
+        return None;
+    }
+    let mut buf = Vec::with_capacity((x1 - x0 + 1) * (y1 - y0 + 1));
+    for y in y0..=y1 {
+        for x in x0..=x1 {
+            let (p, q) = (prev[y * w + x], next[y * w + x]);
+            buf.push(if p == q { TRANSPARENT } else { q });
+        }
+    }
+    Some(gif::Frame {
+        left: x0 as u16,
+        top: y0 as u16,
+        width: (x1 - x0 + 1) as u16,
+        height: (y1 - y0 + 1) as u16,
+        transparent: Some(TRANSPARENT),
+        dispose: gif::DisposalMethod::Keep,
+        buffer: Cow::Owned(buf),
+        ..gif::Frame::default()
+    })
 }
 
 #[cfg(test)]
@@ -245,8 +342,8 @@ mod tests {
         assert!(pal.len() <= 256);
         let lut = lookup();
         for c in INKS.iter().chain([&WHITE]) {
-            let idx = lut
-                [((c[0] as usize >> 3) << 10) | ((c[1] as usize >> 3) << 5) | (c[2] as usize >> 3)];
+            let px = tiny_skia::PremultipliedColorU8::from_rgba(c[0], c[1], c[2], 255).unwrap();
+            let idx = index(px, lut);
             let p = pal[idx as usize];
             let err: i32 = (0..3)
                 .map(|i| (p[i] as i32 - c[i] as i32).abs())
@@ -257,6 +354,32 @@ mod tests {
                 assert_eq!(p, WHITE, "white background stays white");
             }
         }
+    }
+
+    #[test]
+    fn only_the_changed_rectangle_is_stored_and_the_rest_is_transparent() {
+        let (w, h) = (6, 4);
+        let prev = vec![0u8; w * h];
+        assert!(changed_part(&prev, &prev, w, h).is_none());
+        let mut next = prev.clone();
+        next[w + 2] = 5; // (2, 1)
+        next[2 * w + 4] = 7; // (4, 2)
+        let f = changed_part(&prev, &next, w, h).unwrap();
+        assert_eq!((f.left, f.top, f.width, f.height), (2, 1, 3, 2));
+        let t = TRANSPARENT;
+        assert_eq!(f.buffer.as_ref(), &[5, t, t, t, t, 7]);
+        assert_eq!(f.transparent, Some(TRANSPARENT));
+        // Replaying the rectangle over the previous frame gives the next one.
+        let mut replay = prev.clone();
+        for y in 0..f.height as usize {
+            for x in 0..f.width as usize {
+                let i = f.buffer[y * f.width as usize + x];
+                if i != TRANSPARENT {
+                    replay[(y + f.top as usize) * w + x + f.left as usize] = i;
+                }
+            }
+        }
+        assert_eq!(replay, next);
     }
 
     #[test]

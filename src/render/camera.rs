@@ -110,6 +110,10 @@ pub(crate) fn scale_for(tracks: &[Track], height: u32) -> (f64, f64) {
     ((h + 2.0 * pad) / height.max(1) as f64, pad)
 }
 
+/// Largest panel side (pixels) whatever the motion: a point very far from the rest is drawn off
+/// the panel rather than making a picture of millions of pixels.
+pub(crate) const MAX_PANEL: u32 = 4096;
+
 /// Size limits of a panel in pixels.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct PanelLimits {
@@ -159,9 +163,9 @@ impl Camera {
             // A following camera must still show every point around the root.
             let follow_size = ((2.0 * (reach[axis] + pad)) / mpp).ceil().max(lo as f64);
             if need <= hi as f64 || need <= follow_size {
-                size[axis] = (need.max(lo as f64)).min(u32::MAX as f64) as u32;
+                size[axis] = need.max(lo as f64).min(MAX_PANEL as f64) as u32;
             } else {
-                size[axis] = follow_size.min(u32::MAX as f64) as u32;
+                size[axis] = follow_size.min(MAX_PANEL as f64) as u32;
                 follow[axis] = true;
             }
         }

@@ -61,6 +61,19 @@ pub(crate) fn new_pixmap(width: u32, height: u32, fill: [u8; 3]) -> Result<Pixma
     Ok(p)
 }
 
+/// Largest picture side (pixels).
+pub(crate) const MAX_SIDE: u64 = 32_000;
+
+/// Checks a picture size computed in u64 (so that no sum overflows) against [`MAX_SIDE`].
+pub(crate) fn sheet_size(width: u64, height: u64) -> Result<(u32, u32), RenderError> {
+    if width == 0 || height == 0 || width > MAX_SIDE || height > MAX_SIDE {
+        return Err(RenderError::InvalidArgument(format!(
+            "the picture would be {width}×{height} pixels; at most {MAX_SIDE} a side"
+        )));
+    }
+    Ok((width as u32, height as u32))
+}
+
 /// Line widths and text sizes for a panel `height` pixels high (about 1/120 of it for bones).
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Style {
@@ -83,7 +96,51 @@ impl Style {
     }
 }
 
+/// Clips segment a–b to the rectangle [lo.0, hi.0] × [lo.1, hi.1] (Liang–Barsky: with
+/// p(t) = a + t(b − a), keep the t ∈ [0, 1] where every bound holds). `None` if nothing is left
+/// or a coordinate is not finite. Keeps far-off points from reaching the rasteriser.
+pub(crate) fn clip_segment(
+    a: (f32, f32),
+    b: (f32, f32),
+    lo: (f32, f32),
+    hi: (f32, f32),
+) -> Option<((f32, f32), (f32, f32))> {
+    if ![a.0, a.1, b.0, b.1].iter().all(|v| v.is_finite()) {
+        return None;
+    }
+    let (dx, dy) = (b.0 - a.0, b.1 - a.1);
+    let (mut t0, mut t1) = (0.0f32, 1.0f32);
+    for (p, q) in [
+        (-dx, a.0 - lo.0),
+        (dx, hi.0 - a.0),
+        (-dy, a.1 - lo.1),
+        (dy, hi.1 - a.1),
+    ] {
+        if p == 0.0 {
+            if q < 0.0 {
+                return None;
+            }
+        } else {
+            let r = q / p;
+            if p < 0.0 {
+                t0 = t0.max(r);
+            } else {
+                t1 = t1.min(r);
+            }
+        }
+    }
+    (t0 <= t1).then_some((
+        (a.0 + t0 * dx, a.1 + t0 * dy),
+        (a.0 + t1 * dx, a.1 + t1 * dy),
+    ))
+}
+
+/// Strokes segment a–b, clipped to the pixmap grown by a 16-pixel border.
 fn line(pixmap: &mut Pixmap, a: (f32, f32), b: (f32, f32), width: f32, c: [u8; 3]) {
+    let (w, h) = (pixmap.width() as f32, pixmap.height() as f32);
+    let Some((a, b)) = clip_segment(a, b, (-16.0, -16.0), (w + 16.0, h + 16.0)) else {
+        return;
+    };
     let mut pb = PathBuilder::new();
     pb.move_to(a.0, a.1);
     pb.line_to(b.0, b.1);
@@ -103,7 +160,12 @@ fn rect(pixmap: &mut Pixmap, x: f32, y: f32, w: f32, h: f32, c: [u8; 3]) {
     }
 }
 
+/// Fills a disc of radius `r` at `at`, if it is on the pixmap.
 fn dot(pixmap: &mut Pixmap, at: (f32, f32), r: f32, c: [u8; 3]) {
+    let (w, h) = (pixmap.width() as f32, pixmap.height() as f32);
+    if !(at.0 > -r && at.1 > -r && at.0 < w + r && at.1 < h + r) {
+        return;
+    }
     if let Some(path) = PathBuilder::from_circle(at.0, at.1, r) {
         pixmap.fill_path(
             &path,
@@ -166,6 +228,8 @@ pub(crate) fn draw_figure(p: &mut Pixmap, cam: &Camera, track: &Track, k: usize,
     let px = |q: DVec3| cam.pixel(centre, cam.view.project(q));
     if cam.view.shows_floor() {
         floor_ticks(p, cam, centre);
+    } else {
+        floor_grid(p, cam, centre);
     }
     let sides = fig.sides();
     let mut bones: Vec<(f64, usize, usize)> = fig
@@ -193,6 +257,28 @@ fn floor_ticks(p: &mut Pixmap, cam: &Camera, centre: glam::DVec2) {
     for m in first..=last {
         let (x, _) = cam.pixel(centre, glam::DVec2::new(m as f64 * step, 0.0));
         line(p, (x, y0), (x, y0 + 5.0), 1.0, FLOOR);
+    }
+}
+
+/// Seen from above, the floor as a light grid of 0.5 m squares (it moves when the camera
+/// follows the root).
+fn floor_grid(p: &mut Pixmap, cam: &Camera, centre: glam::DVec2) {
+    let step = 0.5;
+    let (w, h) = (cam.width as f32, cam.height as f32);
+    for axis in 0..2 {
+        let half = [cam.width, cam.height][axis] as f64 * 0.5 * cam.mpp;
+        let first = ((centre[axis] - half) / step).floor() as i64;
+        let last = ((centre[axis] + half) / step).ceil() as i64;
+        for m in first..=last {
+            let mut q = centre;
+            q[axis] = m as f64 * step;
+            let (x, y) = cam.pixel(centre, q);
+            if axis == 0 {
+                line(p, (x, 0.0), (x, h), 1.0, FRAME);
+            } else {
+                line(p, (0.0, y), (w, y), 1.0, FRAME);
+            }
+        }
     }
 }
 
@@ -314,6 +400,22 @@ mod tests {
         assert_eq!(scale_length(0.01, 60.0), 0.5);
         assert_eq!(scale_length(0.01, 45.0), 0.2);
         assert_eq!(scale_length(0.01, 15.0), 0.1);
+    }
+
+    #[test]
+    fn segments_are_clipped_to_the_rectangle() {
+        let (lo, hi) = ((0.0, 0.0), (10.0, 10.0));
+        // Inside: unchanged.
+        assert_eq!(
+            clip_segment((1.0, 1.0), (9.0, 5.0), lo, hi),
+            Some(((1.0, 1.0), (9.0, 5.0)))
+        );
+        // Crossing: cut at x = 10.
+        let ((_, _), (x, y)) = clip_segment((5.0, 5.0), (1e14, 5.0), lo, hi).unwrap();
+        assert!((x - 10.0).abs() < 1e-3 && (y - 5.0).abs() < 1e-3);
+        // Outside or not finite: nothing.
+        assert_eq!(clip_segment((20.0, 0.0), (30.0, 5.0), lo, hi), None);
+        assert_eq!(clip_segment((1.0, 1.0), (f32::INFINITY, 5.0), lo, hi), None);
     }
 
     #[test]

@@ -6,7 +6,7 @@ use std::path::Path;
 use super::camera::{Camera, PanelLimits, View, scale_for};
 use super::canvas::{
     INK, Style, WHITE, blit, draw_figure, draw_key, encode_png, key_width, new_pixmap,
-    panel_background,
+    panel_background, sheet_size,
 };
 use super::figure::{Track, validate_tracks};
 use super::text::{Align, Pen, ascent, draw_text, font};
@@ -69,11 +69,16 @@ pub fn filmstrip_view_png(
     let time_row = (style.small * 1.8) as u32;
     let label_row = (style.text * 1.7) as u32;
     let footer = (style.small * 2.6) as u32;
-    let row_w = n as u32 * cam.width + (n as u32 - 1) * GAP;
+    let row = n as u64 * cam.width as u64 + (n as u64 - 1) * GAP as u64;
+    let rows = tracks.len() as u64 * (label_row + cam.height + ROW_GAP) as u64;
+    sheet_size(
+        row + 2 * MARGIN as u64,
+        rows + (MARGIN + time_row + footer) as u64,
+    )?;
+    let row_w = row as u32;
     let key_w = key_width(font, mpp, row_w as f64 * 0.6, style) as u32;
     let width = 2 * MARGIN + row_w.max(key_w);
-    let rows_h = tracks.len() as u32 * (label_row + cam.height + ROW_GAP);
-    let height = MARGIN + time_row + rows_h + footer;
+    let height = MARGIN + time_row + rows as u32 + footer;
     let mut sheet = new_pixmap(width, height, WHITE)?;
 
     let x0 = MARGIN;

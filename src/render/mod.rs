@@ -31,7 +31,7 @@ mod text;
 
 use std::path::{Path, PathBuf};
 
-pub use animation::animation_gif;
+pub use animation::{MAX_GIF_FPS, MAX_GIF_FRAMES, animation_gif};
 pub use camera::View;
 pub use figure::{Figure, Side, Track, side_from_name};
 pub use filmstrip::{filmstrip_png, filmstrip_view_png};

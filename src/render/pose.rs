@@ -5,7 +5,7 @@ use std::path::Path;
 use super::camera::{Camera, PanelLimits, View, scale_for};
 use super::canvas::{
     INK, Style, WHITE, blit, draw_figure, draw_key, encode_png, key_width, new_pixmap,
-    panel_background,
+    panel_background, sheet_size,
 };
 use super::figure::Track;
 use super::text::{Align, Pen, ascent, draw_text, font};
@@ -44,10 +44,12 @@ pub fn pose_png(track: &Track, frame: usize, path: &Path) -> Result<(), RenderEr
 
     let header = (style.text * 2.0) as u32;
     let footer = (style.small * 2.6) as u32;
+    // Panels are at most MAX_PANEL wide, so these sums stay far below u32::MAX.
     let panels_w = cams[0].width + GAP + cams[1].width;
     let key_w = key_width(font, mpp, panels_w as f64 * 0.6, style) as u32;
     let width = 2 * MARGIN + panels_w.max(key_w);
     let height = MARGIN + header + PANEL_HEIGHT + footer + MARGIN / 2;
+    sheet_size(width as u64, height as u64)?;
     let mut sheet = new_pixmap(width, height, WHITE)?;
 
     let base = MARGIN as f32 + ascent(font, style.text);
