@@ -78,7 +78,7 @@ pub enum Regression {
 pub struct LearnConfig {
     /// DMP formulation (default: the paper's Ijspeert 2002).
     pub formulation: Formulation,
-    /// Number of kernels (default 12 per second, at least 10).
+    /// Number of kernels (default 25 per second, at least 20).
     pub kernels: KernelCount,
     /// Height at which neighbouring kernels cross, in (0, 1) (default 0.5).
     pub overlap: f64,
@@ -94,8 +94,8 @@ impl Default for LearnConfig {
         LearnConfig {
             formulation: Formulation::default(),
             kernels: KernelCount::PerSecond {
-                rate: 12.0,
-                min: 10,
+                rate: 25.0,
+                min: 20,
             },
             overlap: 0.5,
             regression: Regression::Ridge { lambda: 1e-6 },

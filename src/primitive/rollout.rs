@@ -94,7 +94,8 @@ fn forcing(
 }
 
 impl Rollout {
-    /// Starts playing `p` at t = 0 from the demonstrated start (θ = s, θ̇ = start_rate/τ), or from
+    /// Starts playing `p` at t = 0 from the demonstrated start (θ = s, θ̇ = k·start_rate/τ with k
+    /// the goal-scaling factor, so a new goal scales the whole demonstrated path), or from
     /// `start` (connect: θ and θ̇ of the previous motion). The start enters the spatial scaling
     /// k = (g − s)/A with s = the actual start angle.
     pub fn new(p: &Primitive, start: Option<&DofState>) -> Result<Rollout> {
@@ -102,9 +103,14 @@ impl Rollout {
         let dofs = p.dofs.len();
         let nk = p.basis.len();
         let (theta0, rate0): (Vec<f64>, Vec<f64>) = match start {
+            // The demonstrated start rate is part of the demonstrated path, so it scales with
+            // the goal like the rest of it: θ(t) − s scales by k exactly.
             None => (
                 p.dofs.iter().map(|d| d.start).collect(),
-                p.dofs.iter().map(|d| d.start_rate).collect(),
+                p.dofs
+                    .iter()
+                    .map(|d| d.start_rate * d.scaling.factor(d.goal, d.start))
+                    .collect(),
             ),
             Some(s) => {
                 if s.theta.len() != dofs || s.theta_dot.len() != dofs {
