@@ -52,6 +52,7 @@ pub use canonical::{CanonicalSystem, Phase};
 
 pub use dmp::{Formulation, SpatialScaling};
 pub use error::PrimitiveError;
+pub use events::{EventConfig, JumpEvents, find_jump_events};
 
 pub use learn::{KernelCount, LearnConfig, Regression};
 pub use primitive::{

@@ -94,3 +94,66 @@ pub fn knee_jump(peak_flexion: f64, duration: f64, fps: f64) -> Vec<f64> {
         })
         .collect()
 }
+
+/// A synthetic standing vertical jump sampled at `fps`: root height (m) and the lowest foot
+/// height (m) per frame, with the true event times.
+///
+/// Standing at 0.95 m until 0.5 s; a cosine crouch to 0.70 m at 0.9 s (Bend); a push (cubic
+/// Hermite) to take-off at 1.2 s at 1.00 m moving up at 2.5 m/s; a ballistic flight (g = 9.81)
+/// peaking at 1.2 + 2.5/g s (Leap) and landing at 1.0 m at 1.2 + 5/g s (Land); absorption to
+/// 0.80 m in 0.25 s, a rise back to 0.95 m in 0.5 s, standing until 3 s. Feet are at 0.08 m except
+/// in flight, where they rise with the root.
+pub fn jump_root_height(fps: f64) -> (Vec<f64>, Vec<f64>, super::events::JumpEvents) {
+    const G: f64 = 9.81;
+    let (stand, low, to_h, v0) = (0.95, 0.70, 1.00, 2.5);
+    let t_bend = 0.9;
+    let t_to = 1.2;
+    let t_flight = 2.0 * v0 / G;
+    let t_land = t_to + t_flight;
+    let hermite = |s: f64, p0: f64, m0: f64, p1: f64, m1: f64| {
+        let (s2, s3) = (s * s, s * s * s);
+        (2.0 * s3 - 3.0 * s2 + 1.0) * p0
+            + (s3 - 2.0 * s2 + s) * m0
+            + (-2.0 * s3 + 3.0 * s2) * p1
+            + (s3 - s2) * m1
+    };
+    let n = (3.0 * fps).round() as usize + 1;
+    let mut root = Vec::with_capacity(n);
+    let mut foot = Vec::with_capacity(n);
+    for k in 0..n {
+        let t = k as f64 / fps;
+        let y = if t < 0.5 {
+            stand
+        } else if t < t_bend {
+            let s = (t - 0.5) / (t_bend - 0.5);
+            stand - (stand - low) * 0.5 * (1.0 - (std::f64::consts::PI * s).cos())
+        } else if t < t_to {
+            let d = t_to - t_bend;
+            hermite((t - t_bend) / d, low, 0.0, to_h, v0 * d)
+        } else if t < t_land {
+            let u = t - t_to;
+            to_h + v0 * u - 0.5 * G * u * u
+        } else if t < t_land + 0.25 {
+            hermite((t - t_land) / 0.25, to_h, -v0 * 0.25, 0.80, 0.0)
+        } else if t < t_land + 0.75 {
+            let s = (t - t_land - 0.25) / 0.5;
+            0.80 + (stand - 0.80) * 0.5 * (1.0 - (std::f64::consts::PI * s).cos())
+        } else {
+            stand
+        };
+        root.push(y);
+        foot.push(if t >= t_to && t < t_land {
+            0.08 + (y - to_h)
+        } else {
+            0.08
+        });
+    }
+    let truth = super::events::JumpEvents {
+        start: 0.5,
+        bend: t_bend,
+        take_off: t_to,
+        leap: t_to + v0 / G,
+        land: t_land,
+    };
+    (root, foot, truth)
+}
