@@ -364,6 +364,7 @@ impl Primitive {
         /// Reads only the version, ignoring every other field, so a newer file is reported as
         /// such rather than as an unknown-field error.
         #[derive(Deserialize)]
+        #[serde(rename = "Primitive")]
         struct VersionProbe {
             format_version: u32,
         }
