@@ -123,10 +123,10 @@ impl ModelClip {
         names.extend(ROOT_CHANNELS.iter().map(|s| s.to_string()));
         let rv = self.root_rotation_vectors();
         let mut values = Vec::with_capacity(self.frame_count() * (d + 6));
-        for f in 0..self.frame_count() {
+        for (f, r) in rv.iter().enumerate() {
             values.extend_from_slice(self.frame_angles(f));
             let t = self.root_translation[f];
-            values.extend([t.x, t.y, t.z, rv[f].x, rv[f].y, rv[f].z]);
+            values.extend([t.x, t.y, t.z, r.x, r.y, r.z]);
         }
         Trajectory {
             dt: self.frame_time,

@@ -30,9 +30,9 @@ pub enum Scene {
     /// Load a clip, map it onto a model, play it through the ECS and render it.
     Show(ShowScene),
     /// The motor-primitive paper's high jump by extrapolation.
-    HighJump(HighJumpScene),
+    HighJump(Box<HighJumpScene>),
     /// The motor-primitive paper's jumping knee kick.
-    JumpingKneeKick(JumpingKneeKickScene),
+    JumpingKneeKick(Box<JumpingKneeKickScene>),
 }
 
 /// Why a scene could not be read or run.
