@@ -41,3 +41,31 @@ pub fn kinematics(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) {
 pub fn base_acceleration(model: &Model) -> MotionVec {
     MotionVec::new(glam::DVec3::ZERO, -model.gravity)
 }
+
+/// Mechanical energy `(T, V)` (J) of the tree: `T = Σ ½ v_iᵀ I_i v_i`,
+/// `V = −Σ m_i g·x_com,i` (zero potential at world height 0). Uses and overwrites `data`.
+pub fn mechanical_energy(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) -> (f64, f64) {
+    kinematics(model, data, q, v);
+    let mut t = 0.0;
+    let mut pot = 0.0;
+    for (i, b) in model.bodies.iter().enumerate() {
+        t += b.inertia.kinetic_energy(data.v[i]);
+        let com = data.pos[i] + data.rot[i] * b.inertia.com;
+        pot -= b.inertia.mass * model.gravity.dot(com);
+    }
+    (t, pot)
+}
+
+/// World position of body `i`'s point `p` (body coordinates) after [`kinematics`].
+#[inline]
+pub fn world_point(data: &Data, i: usize, p: glam::DVec3) -> glam::DVec3 {
+    data.pos[i] + data.rot[i] * p
+}
+
+/// World velocity of body `i`'s point `p` (body coordinates) after [`kinematics`]:
+/// `R (v + ω × p)`.
+#[inline]
+pub fn world_point_velocity(data: &Data, i: usize, p: glam::DVec3) -> glam::DVec3 {
+    let v = data.v[i];
+    data.rot[i] * (v.lin + v.ang.cross(p))
+}

@@ -9,6 +9,7 @@
 pub mod aba;
 pub mod crba;
 pub mod data;
+pub mod integrator;
 pub mod joint;
 pub mod kinematics;
 pub mod model;
@@ -18,6 +19,7 @@ pub mod spatial;
 pub use aba::{aba, aba_passes};
 pub use crba::{crba, forward_dynamics_crba};
 pub use data::Data;
+pub use integrator::{Dynamics, Integrator, IntegratorWorkspace};
 pub use joint::JointType;
 pub use kinematics::kinematics;
 pub use model::{Body, Model, ModelError};

@@ -179,6 +179,40 @@ impl Model {
         self.bodies.iter().position(|b| b.name == name)
     }
 
+    /// `out = q ⊞ z` joint by joint (see [`JointType::retract`]); `z` has size nv.
+    pub fn retract(&self, q: &[f64], z: &[f64], out: &mut [f64]) {
+        for (i, b) in self.bodies.iter().enumerate() {
+            let (iq, iv) = (self.q_idx[i], self.v_idx[i]);
+            let (nq, nv) = (b.joint.nq(), b.joint.nv());
+            b.joint
+                .retract(&q[iq..iq + nq], &z[iv..iv + nv], &mut out[iq..iq + nq]);
+        }
+    }
+
+    /// The chart rate `ż` at `q_stage = q₀ ⊞ z` under velocity `v` (see
+    /// [`JointType::chart_rate`]); all vectors but `q_stage` have size nv.
+    pub fn chart_rate(&self, q_stage: &[f64], z: &[f64], v: &[f64], zdot: &mut [f64]) {
+        for (i, b) in self.bodies.iter().enumerate() {
+            let (iq, iv) = (self.q_idx[i], self.v_idx[i]);
+            let (nq, nv) = (b.joint.nq(), b.joint.nv());
+            b.joint.chart_rate(
+                &q_stage[iq..iq + nq],
+                &z[iv..iv + nv],
+                &v[iv..iv + nv],
+                &mut zdot[iv..iv + nv],
+            );
+        }
+    }
+
+    /// The anatomical angle of every velocity DOF (rad; zeros for a free joint), size nv.
+    pub fn angles(&self, q: &[f64], out: &mut [f64]) {
+        for (i, b) in self.bodies.iter().enumerate() {
+            let (iq, iv) = (self.q_idx[i], self.v_idx[i]);
+            b.joint
+                .angles(&q[iq..iq + b.joint.nq()], &mut out[iv..iv + b.joint.nv()]);
+        }
+    }
+
     /// Total mass (kg).
     pub fn total_mass(&self) -> f64 {
         self.bodies.iter().map(|b| b.inertia.mass).sum()
