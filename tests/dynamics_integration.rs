@@ -314,7 +314,11 @@ fn implicit_damping_is_stable_where_explicit_euler_blows_up() {
             )
             .unwrap();
         }
-        v.iter().fold(0.0f64, |a, x| a.max(x.abs()))
+        // NaN-propagating max |v|: a diverged run reports NaN or a huge value.
+        v.iter().fold(
+            0.0f64,
+            |a, x| if x.is_nan() { f64::NAN } else { a.max(x.abs()) },
+        )
     };
     let implicit = run(true, q.clone());
     let explicit = run(false, q);
