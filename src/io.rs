@@ -55,3 +55,31 @@ mod tests {
         assert!(write_atomic(p, b"x").is_err());
     }
 }
+
+/// A RON syntax or schema error, located: `path:line:column: message`.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{path}:{line}:{column}: {message}")]
+pub struct RonError {
+    /// File (or other origin) of the text.
+    pub path: String,
+    /// 1-based line.
+    pub line: usize,
+    /// 1-based column.
+    pub column: usize,
+    /// What was wrong or expected (ron's message, naming the field).
+    pub message: String,
+}
+
+/// Parses RON text the way every marionette file is read: `Option` fields may be written
+/// without `Some(…)` (ron's `implicit_some`); errors carry `origin`, line and column.
+pub fn parse_ron<T: serde::de::DeserializeOwned>(text: &str, origin: &str) -> Result<T, RonError> {
+    ron::Options::default()
+        .with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME)
+        .from_str(text)
+        .map_err(|e| RonError {
+            path: origin.to_string(),
+            line: e.span.start.line,
+            column: e.span.start.col,
+            message: e.code.to_string(),
+        })
+}

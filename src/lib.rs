@@ -9,7 +9,11 @@
 //! plots); Y is up, a character faces +Z and its left is +X (right-handed).
 
 pub mod bvh;
+pub mod clips;
 pub mod dynamics;
 pub mod io;
+pub mod mapping;
+pub mod model;
 pub mod primitive;
 pub mod render;
+pub mod skeleton;

@@ -5,8 +5,13 @@
 //! block as one flat `frames × channel_count` array of the values as written (file units,
 //! degrees). Turning that into rotations and positions is [`crate::skeleton`]'s job.
 
-// mod parse; (reader: being written)
-// mod write; (writer: being written)
+mod error;
+mod parse;
+mod write;
+
+pub use error::{BvhError, BvhWarning};
+pub use parse::{parse, parse_file};
+pub use write::{to_string, to_string_with_precision, write_file};
 
 use glam::DVec3;
 
@@ -85,11 +90,10 @@ pub struct Bvh {
 impl Bvh {
     /// Number of frames of motion.
     pub fn frame_count(&self) -> usize {
-        if self.channel_count == 0 {
-            0
-        } else {
-            self.motion.len() / self.channel_count
-        }
+        self.motion
+            .len()
+            .checked_div(self.channel_count)
+            .unwrap_or(0)
     }
 
     /// The values of frame `f`.
@@ -110,5 +114,84 @@ impl Bvh {
     /// Index of the joint with this name.
     pub fn joint_index(&self, name: &str) -> Option<usize> {
         self.joints.iter().position(|j| j.name == name)
+    }
+
+    /// Checks that this value describes a well-formed BVH file, the invariants the reader
+    /// guarantees and the writer relies on:
+    ///
+    /// - at least one joint; every name non-empty, without a line feed or surrounding spaces;
+    /// - joints in depth-first file order: each joint's parent is on the path from a root to
+    ///   the joint before it (so the parent also comes first);
+    /// - `first_channel` of each joint is the sum of the channel counts before it, and
+    ///   `channel_count` the sum over all joints;
+    /// - `motion.len()` a multiple of `channel_count` (empty when there are no channels);
+    /// - `frame_time` positive and finite; every offset and motion value finite.
+    pub fn validate(&self) -> Result<(), BvhError> {
+        let invalid = |message: String| Err(BvhError::Invalid { message });
+        if self.joints.is_empty() {
+            return invalid("no joints".into());
+        }
+        let mut path: Vec<usize> = Vec::new();
+        let mut next_channel = 0usize;
+        for (i, j) in self.joints.iter().enumerate() {
+            let n = &j.name;
+            let spaces: &[char] = &[' ', '\t', '\r', '\x0b', '\x0c'];
+            if n.is_empty() || n.trim_matches(spaces) != n || n.contains('\n') {
+                return invalid(format!(
+                    "joint {i} name {n:?} is empty, has surrounding spaces or a line feed"
+                ));
+            }
+            while let Some(&top) = path.last() {
+                if j.parent == Some(top) {
+                    break;
+                }
+                path.pop();
+            }
+            if let Some(p) = j.parent
+                && path.last() != Some(&p)
+            {
+                return invalid(format!(
+                    "joint {i} `{n}` has parent {p}, which is not on the depth-first path to it \
+                     (joints must be in file order)"
+                ));
+            }
+            path.push(i);
+            if j.first_channel != next_channel {
+                return invalid(format!(
+                    "joint {i} `{n}` has first_channel {}, expected {next_channel}",
+                    j.first_channel
+                ));
+            }
+            next_channel += j.channels.len();
+            let end = j.end_site.unwrap_or(DVec3::ZERO);
+            if !j.offset.is_finite() || !end.is_finite() {
+                return invalid(format!("joint {i} `{n}` has a non-finite offset"));
+            }
+        }
+        if self.channel_count != next_channel {
+            return invalid(format!(
+                "channel_count is {}, but the joints have {next_channel} channels",
+                self.channel_count
+            ));
+        }
+        let frames_ok = if self.channel_count == 0 {
+            self.motion.is_empty()
+        } else {
+            self.motion.len().is_multiple_of(self.channel_count)
+        };
+        if !frames_ok {
+            return invalid(format!(
+                "motion has {} values, not a whole number of frames of {} channels",
+                self.motion.len(),
+                self.channel_count
+            ));
+        }
+        if !(self.frame_time.is_finite() && self.frame_time > 0.0) {
+            return invalid(format!("frame_time is {}, expected > 0", self.frame_time));
+        }
+        if let Some(k) = self.motion.iter().position(|v| !v.is_finite()) {
+            return invalid(format!("motion value {k} is {}", self.motion[k]));
+        }
+        Ok(())
     }
 }

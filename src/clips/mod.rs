@@ -1,0 +1,302 @@
+//! Keyframed clips authored by the project (`scenes/clips/*.ron`): the default data that the
+//! demos and tests use, so nothing from outside is needed.
+//!
+//! A keyframed clip gives, on one of the engine's models, DOF angles in degrees at key times;
+//! each DOF is interpolated over the keys that name it (monotone cubic, [`pchip`]). The root's
+//! horizontal path and turn are keyed too; its height is solved so that the lowest foot point
+//! touches the floor, except during the listed flight spans, where it follows a ballistic arc
+//! between take-off and landing heights (gravity 9.81 m/s²).
+
+mod pchip;
+
+pub use pchip::pchip;
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use glam::{DQuat, DVec3};
+use serde::{Deserialize, Serialize};
+
+use crate::model::{Model, ModelClip};
+use crate::skeleton::Transform;
+
+/// The RON format version this build reads.
+pub const FORMAT_VERSION: u32 = 1;
+
+/// Gravity used for flight arcs, m/s².
+pub const GRAVITY: f64 = 9.81;
+
+/// One key: a time and what is keyed at it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Key {
+    /// Time, seconds.
+    pub t: f64,
+    /// DOF angles at this key, degrees (anatomical sign).
+    #[serde(default)]
+    pub dofs: BTreeMap<String, f64>,
+    /// Root position along +Z (forward), metres.
+    #[serde(default)]
+    pub forward: Option<f64>,
+    /// Root position along +X (the figure's left), metres.
+    #[serde(default)]
+    pub lateral: Option<f64>,
+    /// Pelvis forward tilt (about +X), degrees.
+    #[serde(default)]
+    pub pitch: Option<f64>,
+    /// Pelvis turn to the left (about +Y), degrees.
+    #[serde(default)]
+    pub turn: Option<f64>,
+}
+
+/// A keyframed clip as written in its RON file.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct KeyframeClip {
+    /// Format version of the file.
+    pub format_version: u32,
+    /// Clip name.
+    pub name: String,
+    /// Model the DOF names belong to (`humanoid24` or `fall21`).
+    pub model: String,
+    /// Sampling rate of the generated clip, frames per second.
+    pub fps: f64,
+    /// Duration, seconds (frames cover `[0, duration)`).
+    pub duration: f64,
+    /// Standing height of the figure, metres (default: the model's 1.70 m).
+    #[serde(default)]
+    pub height: Option<f64>,
+    /// Airborne spans `(take_off_s, landing_s)`.
+    #[serde(default)]
+    pub flights: Vec<(f64, f64)>,
+    /// The keys, in increasing time.
+    pub keys: Vec<Key>,
+}
+
+/// Errors of keyframed clips.
+#[derive(Debug, thiserror::Error)]
+pub enum KeyframeError {
+    /// The file could not be read.
+    #[error("{path}: {source}")]
+    Io {
+        path: String,
+        source: std::io::Error,
+    },
+    /// RON syntax or schema error, with line and column.
+    #[error(transparent)]
+    Parse(#[from] crate::io::RonError),
+    /// Inconsistent content.
+    #[error("{path}: {message}")]
+    Content { path: String, message: String },
+}
+
+impl KeyframeClip {
+    /// Parses RON text and checks it; `origin` names the source in errors.
+    pub fn parse(text: &str, origin: &str) -> Result<KeyframeClip, KeyframeError> {
+        let c: KeyframeClip = crate::io::parse_ron(text, origin)?;
+        let bad = |message: String| {
+            Err(KeyframeError::Content {
+                path: origin.into(),
+                message,
+            })
+        };
+        if c.format_version > FORMAT_VERSION {
+            return bad(format!(
+                "format_version {} is newer than this build reads ({FORMAT_VERSION})",
+                c.format_version
+            ));
+        }
+        if !(c.fps.is_finite() && c.fps > 0.0 && c.duration.is_finite() && c.duration > 0.0) {
+            return bad(format!(
+                "fps and duration must be positive, found fps {} and duration {}",
+                c.fps, c.duration
+            ));
+        }
+        let model = Model::by_name(&c.model).map_err(|e| KeyframeError::Content {
+            path: origin.into(),
+            message: e.to_string(),
+        })?;
+        let mut last = f64::NEG_INFINITY;
+        for (i, k) in c.keys.iter().enumerate() {
+            if !(k.t.is_finite() && k.t > last) {
+                return bad(format!(
+                    "key {i}: time {} must be finite and after the previous key's {last}",
+                    k.t
+                ));
+            }
+            last = k.t;
+            for (name, v) in &k.dofs {
+                if model.dof_index(name).is_none() {
+                    return bad(format!(
+                        "key {i} (t = {}): '{name}' is not a DOF of {}",
+                        k.t, c.model
+                    ));
+                }
+                if !v.is_finite() {
+                    return bad(format!(
+                        "key {i} (t = {}): '{name}' is not a finite angle",
+                        k.t
+                    ));
+                }
+            }
+        }
+        for &(a, b) in &c.flights {
+            if !(a < b && a >= 0.0 && b <= c.duration) {
+                return bad(format!(
+                    "flight ({a}, {b}) must satisfy 0 <= take-off < landing <= duration"
+                ));
+            }
+        }
+        Ok(c)
+    }
+
+    /// Reads and checks a keyframed clip file.
+    pub fn load(path: &Path) -> Result<KeyframeClip, KeyframeError> {
+        let p = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|source| KeyframeError::Io {
+            path: p.clone(),
+            source,
+        })?;
+        KeyframeClip::parse(&text, &p)
+    }
+
+    /// Samples the clip at its frame rate into a motion on its model.
+    pub fn to_model_clip(&self) -> ModelClip {
+        let base = Model::by_name(&self.model).expect("checked in parse");
+        let model = match self.height {
+            Some(h) => base.scaled_to_height(h),
+            None => base,
+        };
+        let frames = (self.duration * self.fps).round().max(1.0) as usize;
+        let dt = 1.0 / self.fps;
+        let dofs = model.dofs.len();
+        // Per DOF (and root channel): the keys that name it.
+        let series = |pick: &dyn Fn(&Key) -> Option<f64>| -> (Vec<f64>, Vec<f64>) {
+            self.keys
+                .iter()
+                .filter_map(|k| pick(k).map(|v| (k.t, v)))
+                .unzip()
+        };
+        let dof_keys: Vec<(Vec<f64>, Vec<f64>)> = model
+            .dofs
+            .iter()
+            .map(|d| series(&|k: &Key| k.dofs.get(&d.name).map(|v| v.to_radians())))
+            .collect();
+        let fwd = series(&|k: &Key| k.forward);
+        let lat = series(&|k: &Key| k.lateral);
+        let pitch = series(&|k: &Key| k.pitch.map(f64::to_radians));
+        let turn = series(&|k: &Key| k.turn.map(f64::to_radians));
+        let at = |s: &(Vec<f64>, Vec<f64>), t: f64| pchip(&s.0, &s.1, t);
+
+        let mut clip = ModelClip {
+            model: model.clone(),
+            frame_time: dt,
+            root_translation: Vec::with_capacity(frames),
+            root_rotation: Vec::with_capacity(frames),
+            angles: Vec::with_capacity(frames * dofs),
+        };
+        let mut ground_y = Vec::with_capacity(frames);
+        let skeleton = model.skeleton();
+        let feet: Vec<usize> = skeleton
+            .joints
+            .iter()
+            .enumerate()
+            .filter(|(_, j)| j.name.ends_with("ankle"))
+            .map(|(i, _)| i)
+            .collect();
+        let mut rot = vec![DQuat::IDENTITY; skeleton.joints.len()];
+        let translations: Vec<DVec3> = skeleton.joints.iter().map(|j| j.offset).collect();
+        let mut g = vec![Transform::IDENTITY; skeleton.joints.len()];
+        for f in 0..frames {
+            let t = f as f64 * dt;
+            let angles: Vec<f64> = dof_keys.iter().map(|s| at(s, t)).collect();
+            let root_q =
+                DQuat::from_rotation_y(at(&turn, t)) * DQuat::from_rotation_x(at(&pitch, t));
+            model.local_rotations(&angles, &mut rot);
+            rot[0] = root_q;
+            let mut tr = translations.clone();
+            tr[0] = DVec3::ZERO;
+            crate::skeleton::forward_kinematics(&skeleton, &tr, &rot, &mut g);
+            // Lowest foot point (ankle joints and their End Sites, i.e. heel/ankle and toe).
+            let lowest = feet
+                .iter()
+                .flat_map(|&a| {
+                    let e = skeleton.joints[a].end_site.unwrap_or_default();
+                    [g[a].translation.y, (g[a].translation + g[a].rotation * e).y]
+                })
+                .fold(f64::INFINITY, f64::min);
+            ground_y.push(-lowest);
+            clip.root_translation
+                .push(DVec3::new(at(&lat, t), 0.0, at(&fwd, t)));
+            clip.root_rotation.push(root_q);
+            clip.angles.extend(angles);
+        }
+        // Heights: on the ground the lowest foot point touches y = 0; in flight a ballistic arc.
+        for f in 0..frames {
+            let t = f as f64 * dt;
+            let y = match self.flights.iter().find(|(a, b)| t > *a && t < *b) {
+                Some(&(a, b)) => {
+                    let fa = ((a / dt).round() as usize).min(frames - 1);
+                    let fb = ((b / dt).round() as usize).min(frames - 1);
+                    let u = (t - a) / (b - a);
+                    let chord = ground_y[fa] + u * (ground_y[fb] - ground_y[fa]);
+                    chord + 0.5 * GRAVITY * (t - a) * (b - t)
+                }
+                None => ground_y[f],
+            };
+            clip.root_translation[f].y = y;
+        }
+        clip
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const JUMP: &str = r#"(
+        format_version: 1, name: "t", model: "humanoid24", fps: 100.0, duration: 1.0,
+        flights: [(0.4, 0.7)],
+        keys: [
+            (t: 0.0, dofs: {"left_knee": 0.0, "right_knee": 0.0}, pitch: 0.0),
+            (t: 0.3, dofs: {"left_knee": 90.0, "right_knee": 90.0}, pitch: 20.0),
+            (t: 0.4, dofs: {"left_knee": 0.0, "right_knee": 0.0}, pitch: 0.0),
+            (t: 1.0, dofs: {"left_knee": 0.0, "right_knee": 0.0}),
+        ],
+    )"#;
+
+    #[test]
+    fn knee_keys_are_met_and_feet_touch_the_floor_outside_flight() {
+        let c = KeyframeClip::parse(JUMP, "jump").unwrap().to_model_clip();
+        let knee = c.model.dof_index("left_knee").unwrap();
+        assert_eq!(c.frame_count(), 100);
+        assert!((c.frame_angles(30)[knee].to_degrees() - 90.0).abs() < 1e-9);
+        // Crouched: root lower than standing; flight apex ≈ g T²/8 above take-off height.
+        let stand = c.root_translation[0].y;
+        assert!((stand - 0.53 * 1.70).abs() < 0.02, "{stand}");
+        assert!(c.root_translation[30].y < stand - 0.05);
+        let apex = c.root_translation[55].y;
+        assert!(
+            (apex - stand - GRAVITY * 0.09 / 8.0).abs() < 0.01,
+            "{apex} vs {stand}"
+        );
+    }
+
+    #[test]
+    fn bad_keys_are_named() {
+        let e = KeyframeClip::parse(
+            &JUMP.replace("\"right_knee\": 90.0", "\"right_kne\": 90.0"),
+            "j.ron",
+        )
+        .unwrap_err();
+        assert!(
+            e.to_string()
+                .contains("'right_kne' is not a DOF of humanoid24"),
+            "{e}"
+        );
+        let e = KeyframeClip::parse(&JUMP.replace("t: 0.3", "t: 0.5"), "j.ron").unwrap_err();
+        assert!(e.to_string().contains("key 2"), "{e}");
+        let e = KeyframeClip::parse(&JUMP.replace("fps:", "fpz:"), "j.ron").unwrap_err();
+        assert!(e.to_string().starts_with("j.ron:2:"), "{e}");
+    }
+}

@@ -1,0 +1,274 @@
+//! Mapping real skeletons onto the engine's models.
+//!
+//! A [`Mapping`] (a RON file a user can copy and edit, see `scenes/mappings/`) names, for each
+//! anatomical landmark (pelvis, waist, neck, head, and per side clavicle, shoulder, elbow, wrist,
+//! hand, hip, knee, ankle, toe), the source joint or End Site that marks it. [`retarget`] turns a
+//! clip into the model's DOF angle trajectories plus root motion ([`ModelClip`]).
+
+mod retarget;
+
+pub use retarget::retarget;
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+
+use crate::skeleton::Skeleton;
+
+/// The RON format version this build reads.
+pub const FORMAT_VERSION: u32 = 1;
+
+/// Landmarks every mapping must name.
+pub const LANDMARKS: [&str; 22] = [
+    "pelvis",
+    "waist",
+    "neck",
+    "head",
+    "left_clavicle",
+    "left_shoulder",
+    "left_elbow",
+    "left_wrist",
+    "left_hand",
+    "left_hip",
+    "left_knee",
+    "left_ankle",
+    "left_toe",
+    "right_clavicle",
+    "right_shoulder",
+    "right_elbow",
+    "right_wrist",
+    "right_hand",
+    "right_hip",
+    "right_knee",
+    "right_ankle",
+    "right_toe",
+];
+
+/// A skeleton mapping as written in its RON file.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Mapping {
+    /// Format version of the file.
+    pub format_version: u32,
+    /// Name of the source skeleton family.
+    pub name: String,
+    /// Joint names whose presence identifies this skeleton (all must be present).
+    pub detect: Vec<String>,
+    /// Landmark → source joint name, or `"<joint>:end"` for its End Site.
+    pub landmarks: BTreeMap<String, String>,
+}
+
+/// Errors of mappings.
+#[derive(Debug, thiserror::Error)]
+pub enum MappingError {
+    /// The file could not be read.
+    #[error("{path}: {source}")]
+    Io {
+        path: String,
+        source: std::io::Error,
+    },
+    /// RON syntax or schema error, with line and column.
+    #[error(transparent)]
+    Parse(#[from] crate::io::RonError),
+    /// A newer format.
+    #[error("{path}: format_version {found} is newer than this build reads ({FORMAT_VERSION})")]
+    Version { path: String, found: u32 },
+    /// A landmark missing from the file, or an unknown one.
+    #[error("mapping '{mapping}': {message}")]
+    Landmarks { mapping: String, message: String },
+    /// A landmark names a joint the skeleton does not have.
+    #[error(
+        "mapping '{mapping}': landmark '{landmark}' names '{joint}', which the skeleton does not have{hint}"
+    )]
+    MissingJoint {
+        mapping: String,
+        landmark: String,
+        joint: String,
+        hint: String,
+    },
+    /// No built-in mapping fits the skeleton.
+    #[error(
+        "no built-in mapping fits this skeleton (root '{root}'); built-in: {builtins}. Copy one of scenes/mappings/*.ron, name your joints in it and pass it with --mapping"
+    )]
+    NoMatch { root: String, builtins: String },
+}
+
+/// A landmark resolved on a skeleton: a joint, or a joint's End Site.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Landmark {
+    /// Joint index in the skeleton.
+    pub joint: usize,
+    /// True for the joint's End Site.
+    pub end_site: bool,
+}
+
+const BUILTIN: [(&str, &str); 3] = [
+    (
+        "cmu_cgspeed.ron",
+        include_str!("../../scenes/mappings/cmu_cgspeed.ron"),
+    ),
+    (
+        "cmu_acrnn.ron",
+        include_str!("../../scenes/mappings/cmu_acrnn.ron"),
+    ),
+    (
+        "bandai.ron",
+        include_str!("../../scenes/mappings/bandai.ron"),
+    ),
+];
+
+impl Mapping {
+    /// Parses RON text; `origin` names the source in errors.
+    pub fn parse(text: &str, origin: &str) -> Result<Mapping, MappingError> {
+        let m: Mapping = crate::io::parse_ron(text, origin)?;
+        if m.format_version > FORMAT_VERSION {
+            return Err(MappingError::Version {
+                path: origin.into(),
+                found: m.format_version,
+            });
+        }
+        for l in LANDMARKS {
+            if !m.landmarks.contains_key(l) {
+                return Err(MappingError::Landmarks {
+                    mapping: m.name.clone(),
+                    message: format!("landmark '{l}' is missing"),
+                });
+            }
+        }
+        if let Some(k) = m
+            .landmarks
+            .keys()
+            .find(|k| !LANDMARKS.contains(&k.as_str()))
+        {
+            return Err(MappingError::Landmarks {
+                mapping: m.name.clone(),
+                message: format!(
+                    "'{k}' is not a landmark; expected one of {}",
+                    LANDMARKS.join(", ")
+                ),
+            });
+        }
+        Ok(m)
+    }
+
+    /// Reads a mapping from a RON file.
+    pub fn load(path: &Path) -> Result<Mapping, MappingError> {
+        let p = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|source| MappingError::Io {
+            path: p.clone(),
+            source,
+        })?;
+        Mapping::parse(&text, &p)
+    }
+
+    /// The built-in mappings (`scenes/mappings/*.ron`, embedded in the program).
+    pub fn builtins() -> Vec<Mapping> {
+        BUILTIN
+            .iter()
+            .map(|(name, text)| Mapping::parse(text, name).expect("built-in mappings are valid"))
+            .collect()
+    }
+
+    /// The built-in mapping whose `detect` joints are all in `skeleton`.
+    pub fn detect(skeleton: &Skeleton) -> Result<Mapping, MappingError> {
+        Mapping::builtins()
+            .into_iter()
+            .find(|m| m.detect.iter().all(|d| skeleton.index(d).is_some()))
+            .ok_or_else(|| MappingError::NoMatch {
+                root: skeleton
+                    .joints
+                    .first()
+                    .map(|j| j.name.clone())
+                    .unwrap_or_default(),
+                builtins: BUILTIN
+                    .iter()
+                    .map(|(n, _)| *n)
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            })
+    }
+
+    /// Resolves a landmark's source name on `skeleton`.
+    pub fn resolve(&self, skeleton: &Skeleton, landmark: &str) -> Result<Landmark, MappingError> {
+        let source = &self.landmarks[landmark];
+        let (joint_name, end_site) = match source.strip_suffix(":end") {
+            Some(j) => (j, true),
+            None => (source.as_str(), false),
+        };
+        let missing = |hint: String| MappingError::MissingJoint {
+            mapping: self.name.clone(),
+            landmark: landmark.into(),
+            joint: source.clone(),
+            hint,
+        };
+        let joint = skeleton.index(joint_name).ok_or_else(|| {
+            let close: Vec<&str> = skeleton
+                .joints
+                .iter()
+                .map(|j| j.name.as_str())
+                .filter(|n| {
+                    n.to_lowercase()
+                        .contains(&joint_name.to_lowercase()[..joint_name.len().min(4)])
+                })
+                .take(5)
+                .collect();
+            missing(if close.is_empty() {
+                String::new()
+            } else {
+                format!(" (similar: {})", close.join(", "))
+            })
+        })?;
+        if end_site && skeleton.joints[joint].end_site.is_none() {
+            return Err(missing(" End Site (the joint has none)".into()));
+        }
+        Ok(Landmark { joint, end_site })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn builtins_parse_and_name_every_landmark() {
+        let b = Mapping::builtins();
+        assert_eq!(b.len(), 3);
+        for m in &b {
+            assert_eq!(m.landmarks.len(), LANDMARKS.len(), "{}", m.name);
+            // Left landmarks name left joints (a swapped mapping would be caught here).
+            for side in ["left", "right"] {
+                for part in ["shoulder", "hip", "ankle"] {
+                    let src = m.landmarks[&format!("{side}_{part}")].to_lowercase();
+                    let is_left =
+                        src.contains("left") || src.starts_with('l') || src.ends_with("_l");
+                    assert_eq!(
+                        is_left,
+                        side == "left",
+                        "{}: {side}_{part} -> {src}",
+                        m.name
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn errors_are_clear() {
+        let e = Mapping::parse(
+            "(format_version: 1, name: \"x\", detect: [], landmarks: {})",
+            "m.ron",
+        )
+        .unwrap_err();
+        assert!(
+            e.to_string().contains("landmark 'pelvis' is missing"),
+            "{e}"
+        );
+        let e = Mapping::parse(
+            "(format_version: 1,\n name: \"x\",\n detect: [],\n landmarkz: {})",
+            "m.ron",
+        )
+        .unwrap_err();
+        assert!(e.to_string().starts_with("m.ron:4:"), "{e}");
+    }
+}

@@ -1,0 +1,347 @@
+//! Retargeting a clip onto a model by landmarks: segment frames from landmark positions, then
+//! each joint's DOFs from its parent's achieved frame, root to leaves.
+//!
+//! For every model link a target orientation is built from the source's landmark positions: a
+//! *primary* direction matched exactly (the bone to its child, or the hip line for the pelvis)
+//! and a *hint* direction matched as well as the primary allows (the shin's bend for the thigh,
+//! the forearm's bend for the upper arm, the shoulder line for the chest, …). Joints are then
+//! visited parents first: the local target `L = G_parent⁻¹·T` is projected onto the joint's DOFs
+//! ([`project_rotation`]) and the achieved frame `G = G_parent·R(θ)` is passed on, so what a
+//! joint cannot do (e.g. waist twist) is taken up by the 3-DOF joints below it rather than
+//! accumulating. Bone lengths and structural offsets (pelvis→hip, chest→shoulder) are the
+//! median of the source's landmark geometry over the clip, so nothing depends on the source's
+//! rest pose or joint-frame conventions.
+
+use glam::{DMat3, DQuat, DVec3};
+
+use super::{Landmark, Mapping, MappingError};
+use crate::model::ModelClip;
+use crate::model::{JointKind, Model, local_rotation, project_rotation};
+use crate::skeleton::Clip;
+
+/// Which landmark an End Site of a model joint stands for.
+fn end_landmark(joint: &str) -> Option<String> {
+    let (side, role) = split_side(joint);
+    match role {
+        "neck" => Some("head".into()),
+        "wrist" => Some(format!("{side}hand")),
+        "ankle" => Some(format!("{side}toe")),
+        _ => None,
+    }
+}
+
+fn split_side(name: &str) -> (&str, &str) {
+    for p in ["left_", "right_"] {
+        if let Some(r) = name.strip_prefix(p) {
+            return (p, r);
+        }
+    }
+    ("", name)
+}
+
+/// Landmark positions of one frame, by landmark name.
+struct Points<'a> {
+    names: &'a [String],
+    pos: &'a [DVec3],
+}
+
+impl Points<'_> {
+    fn get(&self, name: &str) -> DVec3 {
+        let i = self
+            .names
+            .iter()
+            .position(|n| n == name)
+            .expect("landmark resolved");
+        self.pos[i]
+    }
+}
+
+/// Orthonormal basis (a, b⊥a, a×b⊥) as matrix columns; `None` if a or b⊥ is degenerate.
+fn basis(a: DVec3, b: DVec3) -> Option<DMat3> {
+    let a = a.try_normalize()?;
+    let b = (b - a * a.dot(b)).try_normalize()?;
+    Some(DMat3::from_cols(a, b, a.cross(b)))
+}
+
+/// Rotation taking `rest_primary` onto `primary` exactly and `rest_hint` as near `hint` as that
+/// allows; falls back to `fallback_hint` when `hint` is parallel to `primary`, and to `None` when
+/// `primary` is degenerate.
+fn frame_from(
+    primary: DVec3,
+    hint: DVec3,
+    fallback_hint: DVec3,
+    rest_primary: DVec3,
+    rest_hint: DVec3,
+) -> Option<DQuat> {
+    let rest = basis(rest_primary, rest_hint)?;
+    let now = basis(primary, hint).or_else(|| basis(primary, fallback_hint))?;
+    Some(DQuat::from_mat3(&(now * rest.transpose())).normalize())
+}
+
+/// Perpendicular part of `v` to unit `axis`, normalised (zero if degenerate).
+fn perp(v: DVec3, axis: DVec3) -> DVec3 {
+    (v - axis * axis.dot(v)).normalize_or_zero()
+}
+
+/// Target global orientation of model joint `j`'s link at one frame, or `None` when the source
+/// gives no direction for it (then the link keeps its parent's orientation).
+fn target_frame(
+    model: &Model,
+    j: usize,
+    p: &Points,
+    targets: &[Option<DQuat>],
+    rest_dirs: &[DVec3],
+) -> Option<DQuat> {
+    let joint = &model.joints[j];
+    let (side, role) = split_side(&joint.name);
+    let l = |name: &str| p.get(&format!("{side}{name}"));
+    let parent_frame = joint
+        .parent
+        .and_then(|q| targets[q])
+        .unwrap_or(DQuat::IDENTITY);
+    match role {
+        "pelvis" => frame_from(
+            p.get("left_hip") - p.get("right_hip"),
+            p.get("waist") - p.get("pelvis"),
+            DVec3::Y,
+            DVec3::X,
+            DVec3::Y,
+        ),
+        "waist" => frame_from(
+            p.get("neck") - p.get("waist"),
+            p.get("left_shoulder") - p.get("right_shoulder"),
+            parent_frame * DVec3::X,
+            DVec3::Y,
+            DVec3::X,
+        ),
+        "neck" => frame_from(
+            p.get("head") - l("neck"),
+            parent_frame * DVec3::X,
+            parent_frame * DVec3::Z,
+            DVec3::Y,
+            DVec3::X,
+        ),
+        "clavicle" => frame_from(
+            l("shoulder") - l("clavicle"),
+            parent_frame * DVec3::Z,
+            parent_frame * DVec3::Y,
+            rest_dirs[j],
+            DVec3::Z,
+        ),
+        "shoulder" => {
+            let upper = l("elbow") - l("shoulder");
+            let u = upper.normalize_or_zero();
+            // The forearm's bend says where the upper arm's front is; when the elbow is straight
+            // the chest's front decides.
+            let chest = targets[model.joint_index("waist")?].unwrap_or(DQuat::IDENTITY);
+            let hint = perp(l("wrist") - l("elbow"), u) + 0.2 * perp(chest * DVec3::Z, u);
+            frame_from(upper, hint, chest * DVec3::Y, DVec3::NEG_Y, DVec3::Z)
+        }
+        "elbow" => frame_from(
+            l("wrist") - l("elbow"),
+            parent_frame * DVec3::Z,
+            parent_frame * DVec3::X,
+            DVec3::NEG_Y,
+            DVec3::Z,
+        ),
+        "wrist" => frame_from(
+            l("hand") - l("wrist"),
+            parent_frame * DVec3::Z,
+            parent_frame * DVec3::X,
+            rest_dirs[j],
+            DVec3::Z,
+        ),
+        "hip" => {
+            let thigh = l("knee") - l("hip");
+            let t = thigh.normalize_or_zero();
+            // Knee flexion moves the shin backward; with a straight knee the foot points forward.
+            let hint = -perp(l("ankle") - l("knee"), t) + 0.1 * perp(l("toe") - l("ankle"), t);
+            frame_from(thigh, hint, parent_frame * DVec3::Z, DVec3::NEG_Y, DVec3::Z)
+        }
+        "knee" => frame_from(
+            l("ankle") - l("knee"),
+            parent_frame * DVec3::Z,
+            parent_frame * DVec3::X,
+            DVec3::NEG_Y,
+            DVec3::Z,
+        ),
+        "ankle" => frame_from(
+            l("toe") - l("ankle"),
+            parent_frame * DVec3::X,
+            parent_frame * DVec3::Y,
+            rest_dirs[j],
+            DVec3::X,
+        ),
+        _ => None,
+    }
+}
+
+/// Maps `clip` onto `model` through `mapping`: DOF angle trajectories (radians, unwrapped over
+/// time), root translation (the pelvis landmark, metres) and root orientation, on a copy of the
+/// model whose offsets are the source's (median landmark geometry).
+pub fn retarget(clip: &Clip, mapping: &Mapping, model: &Model) -> Result<ModelClip, MappingError> {
+    // Landmarks this model needs: one per joint, plus those of End Sites, plus the hints'.
+    let mut names: Vec<String> = vec![];
+    let mut need = |n: String| {
+        if !names.contains(&n) {
+            names.push(n);
+        }
+    };
+    for j in &model.joints {
+        need(j.name.clone());
+        if let Some(e) = end_landmark(&j.name) {
+            need(e);
+        }
+    }
+    for n in [
+        "left_hip",
+        "right_hip",
+        "waist",
+        "neck",
+        "head",
+        "left_shoulder",
+        "right_shoulder",
+    ] {
+        need(n.into());
+    }
+    for side in ["left_", "right_"] {
+        for n in ["elbow", "wrist", "hand", "knee", "ankle", "toe"] {
+            need(format!("{side}{n}"));
+        }
+    }
+    let resolved: Vec<Landmark> = names
+        .iter()
+        .map(|n| mapping.resolve(&clip.skeleton, n))
+        .collect::<Result<_, _>>()?;
+
+    // Landmark positions for every frame.
+    let frames = clip.frame_count();
+    let k = names.len();
+    let mut positions = Vec::with_capacity(frames * k);
+    let mut g = vec![];
+    for f in 0..frames {
+        clip.globals(f, &mut g);
+        for lm in &resolved {
+            let t = g[lm.joint];
+            let e = if lm.end_site {
+                clip.skeleton.joints[lm.joint].end_site.unwrap_or_default()
+            } else {
+                DVec3::ZERO
+            };
+            positions.push(t.translation + t.rotation * e);
+        }
+    }
+
+    // Rest primary directions of links whose bone is not straight down (clavicle, hand, foot).
+    let n = model.joints.len();
+    let mut rest_dirs = vec![DVec3::NEG_Y; n];
+    for (j, joint) in model.joints.iter().enumerate() {
+        if let Some(c) = model.joints.iter().position(|c| c.parent == Some(j)) {
+            rest_dirs[j] = model.joints[c].offset.normalize_or(DVec3::NEG_Y);
+        }
+        if let Some(e) = joint.end_site {
+            rest_dirs[j] = e.normalize_or(DVec3::NEG_Y);
+        }
+    }
+
+    // Target frames per frame and link.
+    let mut targets = vec![None; frames * n];
+    let mut row = vec![None; n];
+    for f in 0..frames {
+        let p = Points {
+            names: &names,
+            pos: &positions[f * k..(f + 1) * k],
+        };
+        for j in 0..n {
+            let t = target_frame(model, j, &p, &row, &rest_dirs);
+            row[j] = t;
+        }
+        targets[f * n..(f + 1) * n].copy_from_slice(&row);
+    }
+
+    // Offsets and end sites: median of the landmark geometry in the parent's target frame.
+    let index = |name: &str| names.iter().position(|x| x == name).expect("needed above");
+    let mut mapped_model = model.clone();
+    for j in 0..n {
+        let me = index(&model.joints[j].name);
+        if let Some(pj) = model.joints[j].parent {
+            let parent = index(&model.joints[pj].name);
+            mapped_model.joints[j].offset = median_local(frames, |f| {
+                let q = targets[f * n + pj]?;
+                Some(q.inverse() * (positions[f * k + me] - positions[f * k + parent]))
+            })
+            .unwrap_or(model.joints[j].offset);
+        }
+        if let Some(e) = end_landmark(&model.joints[j].name) {
+            let end = index(&e);
+            mapped_model.joints[j].end_site = median_local(frames, |f| {
+                let q = targets[f * n + j]?;
+                Some(q.inverse() * (positions[f * k + end] - positions[f * k + me]))
+            })
+            .or(model.joints[j].end_site);
+        }
+    }
+    let pelvis_lm = index(&model.joints[0].name);
+    mapped_model.height = height_of(&mapped_model);
+
+    // DOF angles, parents first, from the achieved parent frame.
+    let dofs = model.dofs.len();
+    let mut angles = vec![0.0; frames * dofs];
+    let mut root_rotation = Vec::with_capacity(frames);
+    let mut root_translation = Vec::with_capacity(frames);
+    let mut achieved = vec![DQuat::IDENTITY; n];
+    for f in 0..frames {
+        for j in 0..n {
+            let joint = &model.joints[j];
+            let parent = joint.parent.map_or(DQuat::IDENTITY, |p| achieved[p]);
+            let target = targets[f * n + j].unwrap_or(parent);
+            if joint.kind == JointKind::Free {
+                achieved[j] = target;
+                continue;
+            }
+            let axes = model.joint_axes(j);
+            let local = parent.inverse() * target;
+            let m = joint.dofs.len();
+            let mut out = [0.0; 3];
+            if m > 0 {
+                let first = joint.dofs[0];
+                let prev = (f > 0)
+                    .then(|| angles[(f - 1) * dofs + first..(f - 1) * dofs + first + m].to_vec());
+                project_rotation(joint.kind, &axes, local, prev.as_deref(), &mut out[..m]);
+                angles[f * dofs + first..f * dofs + first + m].copy_from_slice(&out[..m]);
+            }
+            achieved[j] = parent * local_rotation(joint.kind, &axes, &out[..m]);
+        }
+        root_rotation.push(achieved[0]);
+        root_translation.push(positions[f * k + pelvis_lm]);
+    }
+    Ok(ModelClip {
+        model: mapped_model,
+        frame_time: clip.frame_time,
+        root_translation,
+        root_rotation,
+        angles,
+    })
+}
+
+/// Componentwise median of the vectors `sample(f)` over frames (skipping `None`).
+fn median_local(frames: usize, sample: impl Fn(usize) -> Option<DVec3>) -> Option<DVec3> {
+    let v: Vec<DVec3> = (0..frames).filter_map(sample).collect();
+    if v.is_empty() {
+        return None;
+    }
+    let med = |c: usize| {
+        let mut x: Vec<f64> = v.iter().map(|p| p[c]).collect();
+        x.sort_by(f64::total_cmp);
+        x[x.len() / 2]
+    };
+    Some(DVec3::new(med(0), med(1), med(2)))
+}
+
+/// Standing height of a model in its rest pose (top point minus lowest point), metres.
+fn height_of(model: &Model) -> f64 {
+    let pts = model.skeleton().rest_points();
+    let hi = pts.iter().map(|p| p.y).fold(f64::MIN, f64::max);
+    let lo = pts.iter().map(|p| p.y).fold(f64::MAX, f64::min);
+    hi - lo
+}

@@ -1,0 +1,188 @@
+//! The engine's humanoid models: joint trees whose joints carry named, anatomical degrees of
+//! freedom (DOFs).
+//!
+//! Frame: Y up, the figure faces +Z, its left is +X, metres. In the rest pose (every DOF zero) the
+//! figure stands straight with arms hanging at its sides, palms facing the thighs, feet forward,
+//! and every joint frame is aligned with the world, so a DOF axis is one vector valid in the
+//! parent's and the child's frame. Each axis is oriented so that a positive angle is the named
+//! anatomical motion (flexion, abduction, external rotation, …); the left side uses the mirrored
+//! axis `(a.x, −a.y, −a.z)` so that the same number means the same motion on both sides.
+//!
+//! - [`humanoid24`]: the 24-DOF model of the motor-primitive paper (SPEC §1).
+//! - [`ModelClip`]: a motion on a model (DOF angles plus root motion).
+//! - [`fall21`]: the 21-DOF, 15-link model of the falling paper (SPEC §3), with age-dependent
+//!   joint ranges in [`ranges`].
+
+mod definition;
+mod joint_angles;
+mod model_clip;
+pub mod ranges;
+
+pub use definition::{fall21, humanoid24};
+pub use joint_angles::{local_rotation, project_rotation, unwrap_near};
+pub use model_clip::ModelClip;
+
+use glam::{DQuat, DVec3};
+use serde::{Deserialize, Serialize};
+
+use crate::skeleton::{Joint, Skeleton};
+
+/// How a model joint moves relative to its parent.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum JointKind {
+    /// The floating base: 3 translations and an orientation (a quaternion), not model DOFs.
+    Free,
+    /// Spherical joint, 3 DOFs: the angles are the rotation-vector components along its three
+    /// orthonormal axes, `q = exp((θ₁a₁ + θ₂a₂ + θ₃a₃)/2)`; no gimbal lock.
+    Ball,
+    /// Universal joint, 2 DOFs: `R = R(a₁, θ₁)·R(a₂, θ₂)`, `a₁` the parent-side axis.
+    Universal,
+    /// Revolute (pin) joint, 1 DOF: `R = R(a, θ)`.
+    Pin,
+    /// Rigidly attached: no DOF.
+    Fixed,
+}
+
+impl JointKind {
+    /// Number of model DOFs the joint carries (the floating base carries none: root motion is
+    /// kept apart from the DOFs).
+    pub fn dof_count(self) -> usize {
+        match self {
+            JointKind::Free | JointKind::Fixed => 0,
+            JointKind::Pin => 1,
+            JointKind::Universal => 2,
+            JointKind::Ball => 3,
+        }
+    }
+}
+
+/// One degree of freedom: a named anatomical angle about an axis (radians inside).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Dof {
+    /// Anatomical name, e.g. `left_knee`, `right_hip_flexion`.
+    pub name: String,
+    /// Index of the joint that carries it in [`Model::joints`].
+    pub joint: usize,
+    /// Unit rotation axis in rest (world-aligned) coordinates; positive angle = the named motion.
+    pub axis: DVec3,
+}
+
+/// One joint of a model, which also names the link (segment) that hangs from it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ModelJoint {
+    /// Joint name, e.g. `left_knee`.
+    pub name: String,
+    /// Name of the link moved by this joint, e.g. `left_shin`.
+    pub link: String,
+    /// Parent joint index; `None` for the root (pelvis).
+    pub parent: Option<usize>,
+    /// How it moves.
+    pub kind: JointKind,
+    /// Position relative to the parent joint in the rest pose, metres.
+    pub offset: DVec3,
+    /// Indices of its DOFs in [`Model::dofs`], in axis order.
+    pub dofs: Vec<usize>,
+    /// End point of a terminal link (head top, hand, toe), relative to the joint, metres.
+    pub end_site: Option<DVec3>,
+}
+
+/// A humanoid model: joints in depth-first order (each parent before its children) and the DOFs
+/// they carry, in joint order.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Model {
+    /// `humanoid24` or `fall21`.
+    pub name: String,
+    /// Standing height the offsets were made for, metres.
+    pub height: f64,
+    /// Joints, parents first.
+    pub joints: Vec<ModelJoint>,
+    /// DOFs in joint order.
+    pub dofs: Vec<Dof>,
+}
+
+/// Errors about models.
+#[derive(Debug, thiserror::Error)]
+pub enum ModelError {
+    /// The name is not one of the engine's models.
+    #[error("unknown model '{0}': expected one of humanoid24, fall21")]
+    Unknown(String),
+}
+
+impl Model {
+    /// The engine's model with this name (`humanoid24` or `fall21`), at the reference height.
+    pub fn by_name(name: &str) -> Result<Model, ModelError> {
+        match name {
+            "humanoid24" => Ok(humanoid24()),
+            "fall21" => Ok(fall21()),
+            other => Err(ModelError::Unknown(other.to_string())),
+        }
+    }
+
+    /// Index of the DOF with this name.
+    pub fn dof_index(&self, name: &str) -> Option<usize> {
+        self.dofs.iter().position(|d| d.name == name)
+    }
+
+    /// Index of the joint with this name.
+    pub fn joint_index(&self, name: &str) -> Option<usize> {
+        self.joints.iter().position(|j| j.name == name)
+    }
+
+    /// DOF names in model order.
+    pub fn dof_names(&self) -> Vec<String> {
+        self.dofs.iter().map(|d| d.name.clone()).collect()
+    }
+
+    /// The axes of joint `j`'s DOFs, in order.
+    pub fn joint_axes(&self, j: usize) -> Vec<DVec3> {
+        self.joints[j]
+            .dofs
+            .iter()
+            .map(|&d| self.dofs[d].axis)
+            .collect()
+    }
+
+    /// A copy with every offset and end site scaled so that the standing height is `height` m.
+    pub fn scaled_to_height(&self, height: f64) -> Model {
+        let s = height / self.height;
+        let mut m = self.clone();
+        m.height = height;
+        for j in &mut m.joints {
+            j.offset *= s;
+            j.end_site = j.end_site.map(|e| e * s);
+        }
+        m
+    }
+
+    /// The model as a plain skeleton (same joint names, parents, offsets and end sites), for
+    /// forward kinematics, pictures and BVH output.
+    pub fn skeleton(&self) -> Skeleton {
+        Skeleton {
+            joints: self
+                .joints
+                .iter()
+                .map(|j| Joint {
+                    name: j.name.clone(),
+                    parent: j.parent,
+                    offset: j.offset,
+                    end_site: j.end_site,
+                })
+                .collect(),
+        }
+    }
+
+    /// Local rotations of every joint (root's is identity) for the DOF angles `angles`
+    /// (radians, model order); writes into `out` (one per joint).
+    pub fn local_rotations(&self, angles: &[f64], out: &mut [DQuat]) {
+        for (j, joint) in self.joints.iter().enumerate() {
+            let n = joint.dofs.len();
+            let mut axes = [DVec3::ZERO; 3];
+            let mut a = [0.0; 3];
+            for (k, &d) in joint.dofs.iter().enumerate() {
+                axes[k] = self.dofs[d].axis;
+                a[k] = angles[d];
+            }
+            out[j] = local_rotation(joint.kind, &axes[..n], &a[..n]);
+        }
+    }
+}
