@@ -7,18 +7,25 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod aba;
+pub mod contact;
 pub mod crba;
 pub mod data;
+pub mod fall;
+pub mod human;
 pub mod integrator;
 pub mod joint;
 pub mod kinematics;
+pub mod limits;
 pub mod model;
+pub mod pd;
+pub mod push;
 pub mod rnea;
 pub mod spatial;
 
 pub use aba::{aba, aba_passes};
 pub use crba::{crba, forward_dynamics_crba};
 pub use data::Data;
+pub use fall::{FallConfig, FallFrame, FallResult, SimError, simulate_fall};
 pub use integrator::{Dynamics, Integrator, IntegratorWorkspace};
 pub use joint::JointType;
 pub use kinematics::kinematics;
