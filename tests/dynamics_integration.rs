@@ -45,8 +45,8 @@ impl Dynamics for Passive<'_> {
         implicit_dt: Option<f64>,
         qdd: &mut [f64],
     ) -> Result<(), Infallible> {
-        for k in 0..v.len() {
-            self.tau[k] = -self.damping[k] * v[k];
+        for ((t, d), x) in self.tau.iter_mut().zip(&self.damping).zip(v) {
+            *t = -d * x;
         }
         match implicit_dt {
             None => {
@@ -328,7 +328,7 @@ fn implicit_damping_is_stable_where_explicit_euler_blows_up() {
         "implicit: {implicit}"
     );
     assert!(
-        !(explicit < 1e3),
+        explicit.is_nan() || explicit > 1e3,
         "explicit Euler should diverge: {explicit}"
     );
 }

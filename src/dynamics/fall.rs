@@ -600,7 +600,7 @@ pub fn build_fall(cfg: &FallConfig) -> Result<FallParts, SimError> {
     if !(c.damping_per_kg >= 0.0 && c.tangential_damping_per_kg >= 0.0 && c.friction >= 0.0) {
         return Err(cfg_err("contact", "damping and friction must be ≥ 0"));
     }
-    if !((c.floor_normal.length() - 1.0).abs() < 1e-9) {
+    if c.floor_normal.is_nan() || (c.floor_normal.length() - 1.0).abs() >= 1e-9 {
         return Err(cfg_err("contact.floor_normal", "must be a unit vector"));
     }
     for (f, x) in [
@@ -978,7 +978,7 @@ pub fn record_phase(
     } else {
         recorder.rest_since = None;
     }
-    if state.steps % recorder.every == 0 {
+    if state.steps.is_multiple_of(recorder.every) {
         recorder.frames.push(frame(b, state, sc));
     }
     Ok(())
@@ -1032,30 +1032,36 @@ pub fn record_initial(parts: &mut FallParts) {
     recorder.frames.push(f);
 }
 
-/// Collects the result of a finished run.
-pub fn finish(parts: &FallParts) -> FallResult {
-    let b = &parts.body.body;
-    let d = &parts.damage;
-    let damage = d.weights.iter().zip(&d.peak).map(|(w, f)| w * f).sum();
-    let end = parts.state.time_s;
-    let rest_time_s = parts
-        .recorder
+/// Collects the result of a finished run from its components; the damage is
+/// `D = Σ w_i f_i` (eq. 5.1).
+pub fn finish(
+    body: &BodyModel,
+    state: &JointState,
+    limits: &JointLimits,
+    damage: &DamageRecord,
+    recorder: &Recorder,
+) -> FallResult {
+    let b = &body.body;
+    let d = damage;
+    let total = d.weights.iter().zip(&d.peak).map(|(w, f)| w * f).sum();
+    let end = state.time_s;
+    let rest_time_s = recorder
         .rest_since
-        .filter(|&t0| end - t0 >= parts.recorder.rest_hold);
+        .filter(|&t0| end - t0 >= recorder.rest_hold);
     FallResult {
         dof_names: b.figure.dof_names(),
         link_names: b.link_names.clone(),
-        frames: parts.recorder.frames.clone(),
-        record_hz: parts.recorder.hz,
-        damage,
+        frames: recorder.frames.clone(),
+        record_hz: recorder.hz,
+        damage: total,
         peak_vertical_force_n: d.peak.clone(),
         impulse_n_s: d.impulse.clone(),
         max_penetration_m: d.max_penetration,
-        max_limit_excursion_rad: parts.limits.max_excursion.clone(),
+        max_limit_excursion_rad: limits.max_excursion.clone(),
         came_to_rest: rest_time_s.is_some(),
         rest_time_s,
-        steps: parts.state.steps,
-        dt_s: parts.recorder.dt,
+        steps: state.steps,
+        dt_s: recorder.dt,
     }
 }
 
@@ -1066,5 +1072,11 @@ pub fn simulate_fall(config: &FallConfig) -> Result<FallResult, SimError> {
     for _ in 0..parts.recorder.total_steps {
         step_fall(&mut parts)?;
     }
-    Ok(finish(&parts))
+    Ok(finish(
+        &parts.body,
+        &parts.state,
+        &parts.limits,
+        &parts.damage,
+        &parts.recorder,
+    ))
 }

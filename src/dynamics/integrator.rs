@@ -69,6 +69,7 @@ impl IntegratorWorkspace {
 }
 
 /// Advances `(q, v)` from time `t` by `h` seconds with `scheme`.
+#[allow(clippy::too_many_arguments)]
 pub fn step<D: Dynamics>(
     scheme: Integrator,
     model: &Model,

@@ -10,6 +10,7 @@ pub mod aba;
 pub mod contact;
 pub mod crba;
 pub mod data;
+pub mod ecs;
 pub mod fall;
 pub mod human;
 pub mod integrator;
