@@ -215,6 +215,68 @@ impl ContactModel {
         }
     }
 
+    /// [`update_anchors`](Self::update_anchors) then [`apply`](Self::apply) in one pass over the
+    /// corners (the step-start evaluation): same results, corner positions computed once.
+    pub fn update_and_apply(
+        &self,
+        data: &Data,
+        state: &mut ContactState,
+        f_ext: &mut [ForceVec],
+        normal: &mut [f64],
+    ) -> f64 {
+        let p = &self.params;
+        let n = p.floor_normal;
+        let mut deepest: f64 = 0.0;
+        for (i, corners) in self.corners.iter().enumerate() {
+            normal[i] = 0.0;
+            let rot = data.rot[i];
+            let pos = data.pos[i];
+            let (c, r) = self.bounds[i];
+            if n.dot(pos + rot * c) - p.floor_height > r {
+                state.anchors[i * 8..i * 8 + 8].fill(None);
+                continue;
+            }
+            let v = data.v[i];
+            let m = self.masses[i];
+            let mut f_body = ForceVec::ZERO;
+            for (k, &cl) in corners.iter().enumerate() {
+                let x = pos + rot * cl;
+                let z = n.dot(x) - p.floor_height;
+                let slot = &mut state.anchors[i * 8 + k];
+                if z >= 0.0 {
+                    *slot = None;
+                    continue;
+                }
+                let xd = rot * (v.lin + v.ang.cross(cl));
+                let on_floor = x - n * z;
+                match *slot {
+                    None => *slot = Some(on_floor),
+                    Some(a) => {
+                        let zd = n.dot(xd);
+                        let fnorm =
+                            (-p.stiffness_per_kg * m * z - p.damping_per_kg * m * zd).max(0.0);
+                        let d = x - a;
+                        let stretch = d - n * n.dot(d);
+                        let max_stretch = p.friction * fnorm / (p.tangential_stiffness_per_kg * m);
+                        let s = stretch.length();
+                        if s > max_stretch {
+                            let keep = if s > 0.0 { max_stretch / s } else { 0.0 };
+                            *slot = Some(on_floor - stretch * keep);
+                        }
+                    }
+                }
+                if let Some((fnorm, ft, z)) = self.corner_force(i, x, xd, *slot) {
+                    deepest = deepest.max(-z);
+                    normal[i] += fnorm;
+                    let f_world = n * fnorm + ft;
+                    f_body += ForceVec::at_point(rot.transpose() * f_world, cl);
+                }
+            }
+            f_ext[i] += f_body;
+        }
+        deepest
+    }
+
     /// An upper bound on the contact natural frequency of link `i` (rad/s) and its damping ratio:
     /// with `w = 1/m + max_c λ_max([r_c]×ᵀ I_c⁻¹ [r_c]×)` the largest inverse effective mass at a
     /// corner of the free link (the tree only adds mass), four corners down give

@@ -419,6 +419,12 @@ pub struct Scratch {
     pub angles: Vec<f64>,
     /// Per-link normal forces (scratch).
     pub normal: Vec<f64>,
+    /// `data` holds the kinematics of the state after this many steps (a cache the record and
+    /// contact phases share; cleared when the integrator overwrites `data`).
+    pub kinematics_at_step: Option<u64>,
+    /// `data` and `f_ext` hold the step-start kinematics and contact forces, so the integrator's
+    /// first evaluation (always at the step-start state) reuses them.
+    pub step_start_ready: bool,
 }
 
 /// All components of one falling character.
@@ -734,6 +740,8 @@ pub fn build_fall(cfg: &FallConfig) -> Result<FallParts, SimError> {
                 armature: vec![0.0; nv],
                 angles: vec![0.0; nv],
                 normal: vec![0.0; nl],
+                kinematics_at_step: None,
+                step_start_ready: false,
             },
             iws: IntegratorWorkspace::new(&body.model),
             error: None,
@@ -777,10 +785,16 @@ impl Dynamics for FallDynamics<'_> {
     ) -> Result<(), SimError> {
         let model = &self.body.model;
         let ws = &mut *self.ws;
-        kinematics(model, &mut ws.data, q, v);
-        ws.f_ext.fill(ForceVec::ZERO);
-        self.contact_model
-            .apply(&ws.data, &self.contact.state, &mut ws.f_ext, &mut ws.normal);
+        if ws.step_start_ready {
+            // First evaluation of the step: the contact phase already computed kinematics and
+            // contact forces at exactly this state.
+            ws.step_start_ready = false;
+        } else {
+            kinematics(model, &mut ws.data, q, v);
+            ws.f_ext.fill(ForceVec::ZERO);
+            self.contact_model
+                .apply(&ws.data, &self.contact.state, &mut ws.f_ext, &mut ws.normal);
+        }
         let push = &self.contact.push;
         if push.active(t) {
             let i = self.contact.push_link;
@@ -862,12 +876,17 @@ pub fn contact_phase(
 ) {
     let ws = &mut ws.scratch;
     let model = &body.body.model;
-    kinematics(model, &mut ws.data, &state.q, &state.v);
-    body.contact.update_anchors(&ws.data, &mut contact.state);
+    if ws.kinematics_at_step != Some(state.steps) {
+        kinematics(model, &mut ws.data, &state.q, &state.v);
+    }
     ws.f_ext.fill(ForceVec::ZERO);
-    contact.penetration =
-        body.contact
-            .apply(&ws.data, &contact.state, &mut ws.f_ext, &mut contact.normal);
+    contact.penetration = body.contact.update_and_apply(
+        &ws.data,
+        &mut contact.state,
+        &mut ws.f_ext,
+        &mut contact.normal,
+    );
+    ws.step_start_ready = true;
     for i in 0..contact.normal.len() {
         let f = contact.normal[i];
         damage.peak[i] = damage.peak[i].max(f);
@@ -894,6 +913,8 @@ pub fn dynamics_phase(
         steps,
     } = state;
     let Workspace { scratch, iws, .. } = ws;
+    // The stages overwrite `data`: the cached kinematics will no longer match any state.
+    scratch.kinematics_at_step = None;
     let mut dynm = FallDynamics {
         body: b,
         contact_model: &body.contact,
@@ -934,6 +955,7 @@ pub fn record_phase(
     let sc = &mut ws.scratch;
     let t = state.time_s;
     kinematics(model, &mut sc.data, &state.q, &state.v);
+    sc.kinematics_at_step = Some(state.steps);
     let mut ke = 0.0;
     for i in 0..model.nbodies() {
         let (p, vel) = (sc.data.pos[i], sc.data.v[i]);
@@ -1028,6 +1050,7 @@ pub fn record_initial(parts: &mut FallParts) {
         ..
     } = parts;
     kinematics(&body.body.model, &mut ws.scratch.data, &state.q, &state.v);
+    ws.scratch.kinematics_at_step = Some(state.steps);
     let f = frame(&body.body, state, &mut ws.scratch);
     recorder.frames.push(f);
 }

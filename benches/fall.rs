@@ -1,0 +1,31 @@
+//! One 3-second pushed fall of the fall21 human (the paper's experiment, elderly ranges, default
+//! step 0.5 ms with semi-implicit Euler and implicit joint damping): wall time per fall; steps
+//! per second = 6000 / time. Also RK4 at the same step for comparison.
+//! Run: `cargo bench --bench fall`.
+
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use marionette::dynamics::Integrator;
+use marionette::dynamics::fall::{FallConfig, simulate_fall};
+use marionette::model::ranges::AgeGroup;
+use std::hint::black_box;
+use std::time::Duration;
+
+fn bench_fall(c: &mut Criterion) {
+    let cfg = FallConfig::paper(AgeGroup::Elderly);
+    let steps = (cfg.duration_s / cfg.dt_s).round() as u64;
+    let mut g = c.benchmark_group("fall_3s");
+    g.sample_size(20).measurement_time(Duration::from_secs(8));
+    g.throughput(Throughput::Elements(steps));
+    g.bench_function("semi_implicit_euler_dt0.5ms", |b| {
+        b.iter(|| black_box(simulate_fall(black_box(&cfg)).expect("fall").damage))
+    });
+    let mut rk = cfg.clone();
+    rk.integrator = Integrator::Rk4;
+    g.bench_function("rk4_dt0.5ms", |b| {
+        b.iter(|| black_box(simulate_fall(black_box(&rk)).expect("fall").damage))
+    });
+    g.finish();
+}
+
+criterion_group!(benches, bench_fall);
+criterion_main!(benches);
