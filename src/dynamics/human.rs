@@ -132,6 +132,9 @@ pub enum HumanError {
     /// The figure model has a joint kind the dynamics does not support here.
     #[error("joint '{0}' is Fixed; the fall21 dynamics expects movable joints only")]
     FixedJoint(String),
+    /// The figure model has a link this body has no anthropometric row for.
+    #[error("link '{0}' is not a fall21 link (no anthropometric data)")]
+    UnknownLink(String),
     /// The assembled tree is invalid.
     #[error(transparent)]
     Model(#[from] ModelError),
@@ -296,14 +299,7 @@ pub fn fall21_body(height: f64, mass: f64, g: f64) -> Result<HumanBody, HumanErr
                     },
                 )
             }
-            other => {
-                // Not a fall21 link: give it nothing rather than guess.
-                return Err(HumanError::Model(ModelError::BadInertia {
-                    body: bodies.len(),
-                    name: other.to_string(),
-                    mass: 0.0,
-                }));
-            }
+            _ => return Err(HumanError::UnknownLink(j.link.clone())),
         };
         let axes: Vec<DVec3> = j.dofs.iter().map(|&d| fig.dofs[d].axis).collect();
         let joint = match j.kind {
