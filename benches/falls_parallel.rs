@@ -21,6 +21,12 @@ fn bench_parallel(c: &mut Criterion) {
             cfg
         })
         .collect();
+    // Every fall must succeed, or the bench would time error paths.
+    let failures: Vec<String> = run_parallel(&configs)
+        .into_iter()
+        .filter_map(|r| r.err().map(|e| e.to_string()))
+        .collect();
+    assert!(failures.is_empty(), "falls failed: {failures:?}");
     let mut g = c.benchmark_group("falls_parallel_64");
     g.sample_size(10).measurement_time(Duration::from_secs(20));
     g.throughput(Throughput::Elements(configs.len() as u64));

@@ -46,7 +46,7 @@ pub fn aba_passes(
     for i in 0..n {
         let inertia = &model.bodies[i].inertia;
         let vi = data.v[i];
-        data.ia[i] = inertia.to_blocks();
+        data.ia[i] = model.inertia_blocks[i];
         data.pa[i] = vi.cross_force(inertia.apply(vi)) - f_ext[i];
     }
     for i in (0..n).rev() {

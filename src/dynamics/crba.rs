@@ -39,7 +39,7 @@ pub fn crba<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> &'d [f64] {
     let nv = model.nv;
     let n = model.nbodies();
     for i in 0..n {
-        data.ic[i] = model.bodies[i].inertia.to_blocks();
+        data.ic[i] = model.inertia_blocks[i];
     }
     for i in (0..n).rev() {
         if let Some(p) = model.bodies[i].parent {

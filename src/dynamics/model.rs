@@ -6,7 +6,7 @@
 //! and free joints carry unit quaternions (4 numbers) for 3 rotational velocities.
 
 use super::joint::JointType;
-use super::spatial::{Inertia, SpatialTransform};
+use super::spatial::{ArticulatedInertia, Inertia, SpatialTransform};
 use glam::DVec3;
 use thiserror::Error;
 
@@ -88,6 +88,9 @@ pub struct Model {
     pub nq: usize,
     /// Size of the velocity vector (degrees of freedom).
     pub nv: usize,
+    /// Each body's rigid inertia as 3×3 blocks, derived from `bodies` at construction (the
+    /// articulated-body algorithm starts from these; rebuild the model after editing inertias).
+    pub inertia_blocks: Vec<ArticulatedInertia>,
 }
 
 impl Model {
@@ -148,7 +151,9 @@ impl Model {
             nq += b.joint.nq();
             nv += b.joint.nv();
         }
+        let inertia_blocks = bodies.iter().map(|b| b.inertia.to_blocks()).collect();
         Ok(Self {
+            inertia_blocks,
             bodies,
             gravity,
             q_idx,
