@@ -142,6 +142,21 @@ impl Model {
             .collect()
     }
 
+    /// Rest direction of joint `j`'s link: towards its first child, or its End Site; straight
+    /// down for a link with neither.
+    pub fn link_direction(&self, j: usize) -> DVec3 {
+        let end = self.joints[j].end_site;
+        let child = self
+            .joints
+            .iter()
+            .find(|c| c.parent == Some(j))
+            .map(|c| c.offset);
+        child
+            .or(end)
+            .and_then(|v| v.try_normalize())
+            .unwrap_or(DVec3::NEG_Y)
+    }
+
     /// A copy with every offset and end site scaled so that the standing height is `height` m.
     pub fn scaled_to_height(&self, height: f64) -> Model {
         let s = height / self.height;

@@ -68,6 +68,23 @@ impl ModelClip {
         out
     }
 
+    /// The frames whose times lie in `[start_s, end_s)`; `None` if that is empty.
+    pub fn window(&self, start_s: f64, end_s: f64) -> Option<ModelClip> {
+        let first = (start_s / self.frame_time).round().max(0.0) as usize;
+        let last = ((end_s / self.frame_time).round().max(0.0) as usize).min(self.frame_count());
+        if first >= last {
+            return None;
+        }
+        let d = self.dof_count();
+        Some(ModelClip {
+            model: self.model.clone(),
+            frame_time: self.frame_time,
+            root_translation: self.root_translation[first..last].to_vec(),
+            root_rotation: self.root_rotation[first..last].to_vec(),
+            angles: self.angles[first * d..last * d].to_vec(),
+        })
+    }
+
     /// The motion as a plain clip on the model's skeleton (for FK, pictures and BVH output).
     pub fn to_clip(&self) -> Clip {
         let skeleton = self.model.skeleton();

@@ -1,1 +1,62 @@
-//! (module under construction in a parallel branch)
+//! Motor primitives: Ijspeert-style dynamical movement primitives (DMPs) learned from joint-angle
+//! trajectories, adjusted (goal, duration), connected and blended (SPEC §1, the paper
+//! `primitive-blending.ja.txt`).
+//!
+//! The kernel works on plain data and knows nothing about skeletons:
+//!
+//! - in: a [`Trajectory`] — a time step `dt` (s), DOF names and `frames × dofs` values (radians, or
+//!   metres for the root translation DOFs), row-major;
+//! - out: a [`Primitive`] (one DMP per DOF sharing one canonical phase), rollouts as
+//!   [`Trajectory`] or [`Samples`] at requested times, blends, sequences and jump events.
+//!
+//! **Root motion** is carried as six ordinary DOFs named [`ROOT_DOF_NAMES`]: translation
+//! `root_tx, root_ty, root_tz` (metres) and the root orientation as a rotation vector
+//! `root_rx, root_ry, root_rz` (radians; the caller keeps it continuous, i.e. unwrapped). They share
+//! the canonical phase with the joint DOFs and are learned, adjusted and blended like them.
+//!
+//! **Shared canonical phase.** The paper's canonical variable x runs from s to g of each DOF and
+//! enters the kernels only through x̃ = (x − s)/(g − s). For the second-order system
+//! `τ v̇ = α_v(β_v(g − x) − v), τ ẋ = v` the normalised x̃ obeys the same equation with s = 0, g = 1,
+//! independently of s and g, so one phase x̃ ∈ [0, 1] is computed once for all DOFs
+//! ([`CanonicalSystem`]); the paper's per-DOF canonical velocity is v = (g − s)·ṽ, with ṽ the shared
+//! phase velocity. This is exactly the paper's equations for every DOF and removes the g = s division.
+//!
+//! **Time.** τ is the movement duration in seconds. All dynamics are integrated in normalised time
+//! u = t/τ ∈ [0, 1] over the movement, so playing a primitive at τ′ = 2τ traces the same path in
+//! twice the time (velocities halve). See [`rollout`] for the integrator.
+//!
+//! Files: [`canonical`] (shared phase), [`basis`] (kernels), [`dmp`] (one-DOF transformation system,
+//! formulations), [`learn`] (LWR and ridge), [`rollout`] (fixed-step integrator), [`primitive`]
+//! (multi-DOF primitive, adjust, RON io), [`connect`], [`blend`], [`events`], [`ecs`].
+
+pub mod basis;
+pub mod blend;
+pub mod canonical;
+pub mod connect;
+pub mod dmp;
+pub mod ecs;
+pub mod error;
+pub mod events;
+pub mod learn;
+#[allow(clippy::module_inception)] // the brief names the file `primitive/primitive.rs`
+pub mod primitive;
+pub mod rollout;
+pub mod synthetic;
+pub mod trajectory;
+
+pub use basis::Basis;
+pub use blend::{Arrangement, BlendPlacement, BlendResult, Gamma, Relearn, blend};
+pub use connect::{Connected, Junction, connect};
+
+pub use canonical::{CanonicalSystem, Phase};
+
+pub use dmp::{Formulation, SpatialScaling};
+pub use error::PrimitiveError;
+pub use events::{EventConfig, JumpEvents, find_jump_events};
+
+pub use learn::{KernelCount, LearnConfig, Regression};
+pub use primitive::{
+    DofFit, DofPrimitive, FitReport, Learned, PRIMITIVE_FORMAT_VERSION, Primitive, ROOT_DOF_NAMES,
+};
+pub use rollout::{DofState, Rollout, Samples};
+pub use trajectory::{DofUnit, Trajectory};

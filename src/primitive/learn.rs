@@ -1,0 +1,378 @@
+//! Learning the DMP weights of every DOF from a demonstration: the paper's locally weighted
+//! regression and a regularised (ridge) least-squares fit of all kernels jointly.
+//!
+//! For each DOF the demonstration θ_d(u) (u = t/τ, τ = the clip's duration) gives the forcing
+//! target F_target(u) of the formulation ([`Formulation::forcing_target`]; for 2002, z_demo is
+//! integrated with [`integrate_z_demo`]). The model is F(u) = gate(u)·h(x(u)), h = Σψ_i w_i/Σψ_i,
+//! with the gate and kernel coordinate from the shared canonical phase (weights at the
+//! demonstration's amplitude, see [`super::dmp`]).
+//!
+//! - **LWR** (the paper): each kernel on its own,
+//!   `w_i = Σ_t ψ_i(t) gate_t F_t / Σ_t ψ_i(t) gate_t²`.
+//! - **Ridge**: all kernels jointly, minimising `Σ_t (F_t − Σ_i Φ_ti w_i)² + λ Σ_i (ΦᵀΦ)_ii w_i²`
+//!   with `Φ_ti = gate_t ψ_i(t)/Σ_kψ_k(t)`; the penalty is scaled by each kernel's own energy
+//!   so λ is dimensionless and late kernels (tiny gate) are not crushed. Solved by Cholesky, one
+//!   factorisation for all DOFs.
+//!
+//! Derivatives of the demonstration are central differences in u (second-order one-sided at the
+//! ends); a clip that starts mid-motion keeps its initial velocity as the DMP's initial state
+//! (`start_rate` = θ′(0) = τθ̇(0)).
+
+use serde::{Deserialize, Serialize};
+
+use super::basis::Basis;
+use super::dmp::{Formulation, SpatialScaling, integrate_z_demo};
+use super::error::{PrimitiveError, Result, require_positive};
+use super::primitive::DofPrimitive;
+use super::trajectory::Trajectory;
+
+/// How many kernels a primitive gets.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub enum KernelCount {
+    /// Exactly this many (≥ 2).
+    Fixed(usize),
+    /// `ceil(rate · duration)` kernels, at least `min` (≥ 2).
+    PerSecond {
+        /// Kernels per second of demonstration.
+        rate: f64,
+        /// Lower bound.
+        min: usize,
+    },
+}
+
+impl KernelCount {
+    /// The kernel count for a demonstration lasting `duration` seconds.
+    pub fn count(&self, duration: f64) -> Result<usize> {
+        let n = match *self {
+            KernelCount::Fixed(n) => n,
+            KernelCount::PerSecond { rate, min } => {
+                require_positive("kernels.rate", rate)?;
+                ((rate * duration).ceil() as usize).max(min)
+            }
+        };
+        if n < 2 {
+            return Err(PrimitiveError::InvalidParameter {
+                field: "kernels".into(),
+                reason: format!("need at least 2 kernels, got {n}"),
+            });
+        }
+        Ok(n)
+    }
+}
+
+/// The regression used to fit the weights.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub enum Regression {
+    /// The paper's locally weighted regression, each kernel independently.
+    LocallyWeighted,
+    /// Ridge least squares over all kernels jointly; `lambda` is the relative penalty (≥ 0).
+    Ridge {
+        /// Penalty relative to each kernel's energy (ΦᵀΦ)_ii; 1e−6 is a light touch.
+        lambda: f64,
+    },
+}
+
+/// Everything learning needs besides the demonstration.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LearnConfig {
+    /// DMP formulation (default: the paper's Ijspeert 2002).
+    pub formulation: Formulation,
+    /// Number of kernels (default 25 per second, at least 20).
+    pub kernels: KernelCount,
+    /// Height at which neighbouring kernels cross, in (0, 1) (default 0.5).
+    pub overlap: f64,
+    /// Regression (default ridge, λ = 1e−6).
+    pub regression: Regression,
+    /// A DOF with |g − s| < `degenerate_fraction` × (its demonstrated range) is learned unscaled
+    /// (see [`SpatialScaling::Unscaled`]); default 0.1.
+    pub degenerate_fraction: f64,
+}
+
+impl Default for LearnConfig {
+    fn default() -> Self {
+        LearnConfig {
+            formulation: Formulation::default(),
+            kernels: KernelCount::PerSecond {
+                rate: 25.0,
+                min: 20,
+            },
+            overlap: 0.5,
+            regression: Regression::Ridge { lambda: 1e-6 },
+            degenerate_fraction: 0.1,
+        }
+    }
+}
+
+/// First and second derivatives of samples spaced `h` apart: central differences inside,
+/// second-order one-sided at the ends (needs at least 4 samples).
+pub fn derivatives(x: &[f64], h: f64, d1: &mut [f64], d2: &mut [f64]) {
+    let n = x.len();
+    debug_assert!(n >= 4);
+    let (i1, i2) = (0.5 / h, 1.0 / (h * h));
+    for k in 1..n - 1 {
+        d1[k] = (x[k + 1] - x[k - 1]) * i1;
+        d2[k] = (x[k + 1] - 2.0 * x[k] + x[k - 1]) * i2;
+    }
+    d1[0] = (-3.0 * x[0] + 4.0 * x[1] - x[2]) * i1;
+    d1[n - 1] = (3.0 * x[n - 1] - 4.0 * x[n - 2] + x[n - 3]) * i1;
+    d2[0] = (2.0 * x[0] - 5.0 * x[1] + 4.0 * x[2] - x[3]) * i2;
+    d2[n - 1] = (2.0 * x[n - 1] - 5.0 * x[n - 2] + 4.0 * x[n - 3] - x[n - 4]) * i2;
+}
+
+/// Learns one [`DofPrimitive`] per DOF of `demo` on `basis`: start s = first frame, goal g = last
+/// frame, start rate θ′(0), spatial scaling (degenerate DOFs unscaled) and weights by the
+/// configured regression. `demo` must have at least 4 frames.
+pub fn learn_dofs(
+    demo: &Trajectory,
+    basis: &Basis,
+    config: &LearnConfig,
+) -> Result<Vec<DofPrimitive>> {
+    demo.validate()?;
+    let n = demo.frames();
+    if n < 4 {
+        return Err(PrimitiveError::InvalidTrajectory {
+            what: format!("need at least 4 frames to learn, got {n}"),
+        });
+    }
+    let f = config.formulation;
+    f.validate()?;
+    let canonical = f.canonical();
+    let nk = basis.len();
+    let dofs = demo.dofs();
+    let du = 1.0 / (n - 1) as f64;
+
+    // Forcing targets, frames × dofs (DOF-major for the regression: dofs × frames).
+    let mut targets = vec![0.0; dofs * n];
+    let mut out = Vec::with_capacity(dofs);
+    let mut col = vec![0.0; n];
+    let (mut d1, mut d2, mut zd) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+    let phases: Vec<_> = (0..n).map(|k| canonical.phase(k as f64 * du)).collect();
+    for j in 0..dofs {
+        for (k, c) in col.iter_mut().enumerate() {
+            *c = demo.values[k * dofs + j];
+        }
+        derivatives(&col, du, &mut d1, &mut d2);
+        let (s, g) = (col[0], col[n - 1]);
+        let (lo, hi) = col
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+                (a.min(*v), b.max(*v))
+            });
+        let range = hi - lo;
+        let scaling = if f.scales_with_goal()
+            && (g - s).abs() >= (config.degenerate_fraction * range).max(1e-9)
+        {
+            SpatialScaling::GoalMinusStart { reference: g - s }
+        } else {
+            SpatialScaling::Unscaled
+        };
+        if let Formulation::Ijspeert2002 {
+            alpha_z, beta_z, ..
+        } = f
+        {
+            integrate_z_demo(alpha_z, beta_z, g, &col, du, d1[0], &mut zd);
+        }
+        let t = &mut targets[j * n..(j + 1) * n];
+        for k in 0..n {
+            t[k] = f.forcing_target(col[k], d1[k], d2[k], zd[k], g, s, phases[k].x);
+        }
+        out.push(DofPrimitive {
+            name: demo.names[j].clone(),
+            start: s,
+            goal: g,
+            start_rate: d1[0],
+            scaling,
+            weights: vec![0.0; nk],
+        });
+    }
+
+    let weights = match config.regression {
+        Regression::LocallyWeighted => lwr(basis, &phases, &targets, dofs),
+        Regression::Ridge { lambda } => {
+            if !(lambda >= 0.0 && lambda.is_finite()) {
+                return Err(PrimitiveError::InvalidParameter {
+                    field: "regression.lambda".into(),
+                    reason: format!("must be ≥ 0 and finite, got {lambda}"),
+                });
+            }
+            ridge(basis, &phases, &targets, dofs, lambda)?
+        }
+    };
+    for (j, d) in out.iter_mut().enumerate() {
+        d.weights.copy_from_slice(&weights[j * nk..(j + 1) * nk]);
+    }
+    Ok(out)
+}
+
+/// The paper's LWR: `w_i = Σ_t ψ_i gate F / Σ_t ψ_i gate²` per kernel and DOF. `targets` is
+/// dofs × frames; returns dofs × kernels.
+fn lwr(
+    basis: &Basis,
+    phases: &[super::canonical::Phase],
+    targets: &[f64],
+    dofs: usize,
+) -> Vec<f64> {
+    let nk = basis.len();
+    let n = phases.len();
+    let mut num = vec![0.0; dofs * nk];
+    let mut den = vec![0.0; nk];
+    let mut psi = vec![0.0; nk];
+    for (k, p) in phases.iter().enumerate() {
+        basis.activations(p.x, &mut psi);
+        for i in 0..nk {
+            let a = psi[i] * p.gate;
+            if a == 0.0 {
+                continue;
+            }
+            den[i] += a * p.gate;
+            for j in 0..dofs {
+                num[j * nk + i] += a * targets[j * n + k];
+            }
+        }
+    }
+    for j in 0..dofs {
+        for i in 0..nk {
+            num[j * nk + i] = if den[i] > 1e-300 {
+                num[j * nk + i] / den[i]
+            } else {
+                0.0
+            };
+        }
+    }
+    num
+}
+
+/// Ridge least squares over all kernels (see module docs). Returns dofs × kernels.
+fn ridge(
+    basis: &Basis,
+    phases: &[super::canonical::Phase],
+    targets: &[f64],
+    dofs: usize,
+    lambda: f64,
+) -> Result<Vec<f64>> {
+    let nk = basis.len();
+    let n = phases.len();
+    let mut ata = vec![0.0; nk * nk];
+    let mut atb = vec![0.0; nk * dofs]; // kernels × dofs
+    let mut phi = vec![0.0; nk];
+    for (k, p) in phases.iter().enumerate() {
+        let r = basis.normalized(p.x, &mut phi);
+        for v in &mut phi[r.clone()] {
+            *v *= p.gate;
+        }
+        for a in r.clone() {
+            let pa = phi[a];
+            if pa == 0.0 {
+                continue;
+            }
+            for b in a..r.end {
+                ata[a * nk + b] += pa * phi[b];
+            }
+            let row = &mut atb[a * dofs..(a + 1) * dofs];
+            for (j, x) in row.iter_mut().enumerate() {
+                *x += pa * targets[j * n + k];
+            }
+        }
+    }
+    let max_diag = (0..nk).map(|i| ata[i * nk + i]).fold(0.0f64, f64::max);
+    if max_diag <= 0.0 {
+        return Ok(vec![0.0; dofs * nk]);
+    }
+    for i in 0..nk {
+        ata[i * nk + i] += lambda * ata[i * nk + i] + 1e-12 * max_diag;
+        for b in 0..i {
+            ata[i * nk + b] = ata[b * nk + i];
+        }
+    }
+    let l = cholesky(&mut ata, nk).ok_or_else(|| PrimitiveError::InvalidParameter {
+        field: "regression.lambda".into(),
+        reason: "normal equations not positive definite; increase lambda".into(),
+    })?;
+    // Solve L Lᵀ W = B for each DOF column.
+    let mut w = vec![0.0; dofs * nk];
+    let mut y = vec![0.0; nk];
+    for j in 0..dofs {
+        for i in 0..nk {
+            let mut s = atb[i * dofs + j];
+            for m in 0..i {
+                s -= l[i * nk + m] * y[m];
+            }
+            y[i] = s / l[i * nk + i];
+        }
+        for i in (0..nk).rev() {
+            let mut s = y[i];
+            for m in i + 1..nk {
+                s -= l[m * nk + i] * w[j * nk + m];
+            }
+            w[j * nk + i] = s / l[i * nk + i];
+        }
+    }
+    Ok(w)
+}
+
+/// In-place Cholesky A = L Lᵀ of a symmetric n × n matrix (row-major); returns L (lower) or
+/// `None` if A is not positive definite.
+fn cholesky(a: &mut [f64], n: usize) -> Option<&[f64]> {
+    for i in 0..n {
+        for j in 0..=i {
+            let mut s = a[i * n + j];
+            for k in 0..j {
+                s -= a[i * n + k] * a[j * n + k];
+            }
+            if i == j {
+                if s <= 0.0 || !s.is_finite() {
+                    return None;
+                }
+                a[i * n + i] = s.sqrt();
+            } else {
+                a[i * n + j] = s / a[j * n + j];
+            }
+        }
+        for j in i + 1..n {
+            a[i * n + j] = 0.0;
+        }
+    }
+    Some(a)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn derivatives_are_exact_for_cubics() {
+        let h = 0.01;
+        let x: Vec<f64> = (0..50)
+            .map(|k| (k as f64 * h).powi(2) * 3.0 + k as f64 * h)
+            .collect();
+        let (mut d1, mut d2) = (vec![0.0; 50], vec![0.0; 50]);
+        derivatives(&x, h, &mut d1, &mut d2);
+        for k in 0..50 {
+            let u = k as f64 * h;
+            assert!((d1[k] - (6.0 * u + 1.0)).abs() < 1e-9, "k={k}");
+            assert!((d2[k] - 6.0).abs() < 1e-6, "k={k}: {}", d2[k]);
+        }
+    }
+
+    #[test]
+    fn cholesky_solves_a_known_system() {
+        let mut a = vec![4.0, 2.0, 2.0, 3.0];
+        let l = cholesky(&mut a, 2).unwrap().to_vec();
+        assert!((l[0] - 2.0).abs() < 1e-15 && (l[2] - 1.0).abs() < 1e-15);
+        assert!((l[3] - 2f64.sqrt()).abs() < 1e-15);
+        let mut b = vec![1.0, 2.0, 2.0, 1.0];
+        assert!(cholesky(&mut b, 2).is_none());
+    }
+
+    #[test]
+    fn kernel_count_follows_duration() {
+        let k = KernelCount::PerSecond {
+            rate: 10.0,
+            min: 10,
+        };
+        assert_eq!(k.count(0.5).unwrap(), 10);
+        assert_eq!(k.count(8.325).unwrap(), 84);
+        assert!(KernelCount::Fixed(1).count(1.0).is_err());
+    }
+}

@@ -1,0 +1,92 @@
+//! Connecting: each primitive starts from the state the previous one ended in, with no jump in
+//! angle or velocity at the junctions.
+
+use marionette::primitive::synthetic::smooth_humanoid24;
+use marionette::primitive::{LearnConfig, Primitive, PrimitiveError, Trajectory, connect};
+
+const DEG: f64 = std::f64::consts::PI / 180.0;
+
+fn clip_primitive(seed: u64, first: usize, last: usize) -> Primitive {
+    let full = smooth_humanoid24(1000, 120.0, seed).unwrap();
+    Primitive::learn(
+        &format!("clip{seed}"),
+        &full.slice_frames(first, last).unwrap(),
+        &LearnConfig::default(),
+    )
+    .unwrap()
+    .primitive
+}
+
+#[test]
+fn a_sequence_has_no_jump_at_its_junctions() {
+    let seq = [
+        clip_primitive(1, 0, 150),
+        clip_primitive(2, 200, 380),
+        clip_primitive(3, 600, 700),
+    ];
+    // Played alone, each starts far from where the previous ended: a naive concatenation jumps.
+    let naive_jump = {
+        let end = seq[0].sample(&[seq[0].duration], None).unwrap();
+        let start = seq[1].sample(&[0.0], None).unwrap();
+        end.values
+            .iter()
+            .zip(&start.values)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max)
+    };
+    assert!(
+        naive_jump > 5.0 * DEG,
+        "test motions too similar: {}",
+        naive_jump / DEG
+    );
+
+    let dt = 1.0 / 120.0;
+    let c = connect(&seq, dt, None).unwrap();
+    assert_eq!(c.junctions.len(), 2);
+    for j in &c.junctions {
+        eprintln!(
+            "junction at {:.4} s: max angle jump {:.3e} rad, max velocity jump {:.3e} rad/s",
+            j.time, j.max_angle_jump, j.max_velocity_jump
+        );
+        assert!(j.max_angle_jump < 1e-12 && j.max_velocity_jump < 1e-9);
+    }
+    let total: f64 = seq.iter().map(|p| p.duration).sum();
+    assert_eq!(
+        c.trajectory.frames(),
+        (total / dt + 1e-6).floor() as usize + 1
+    );
+    // On the sampled trajectory the junction frames step no more than their neighbours do
+    // (a velocity-continuous curve), for every DOF.
+    for jn in &c.junctions {
+        let k = (jn.time / dt).round() as usize;
+        for d in 0..c.trajectory.dofs() {
+            let step = |i: usize| c.trajectory.value(i + 1, d) - c.trajectory.value(i, d);
+            let across = step(k - 1).abs().max(step(k).abs());
+            let around = step(k - 3).abs().max(step(k + 2).abs());
+            assert!(
+                across <= 2.0 * around + 0.02 * DEG,
+                "dof {d} at {} s: step {across} vs {around}",
+                jn.time
+            );
+        }
+    }
+}
+
+#[test]
+fn connecting_different_models_or_nothing_is_an_error() {
+    let a = clip_primitive(1, 0, 150);
+    let demo = Trajectory::from_columns(
+        1.0 / 120.0,
+        vec!["left_knee".into()],
+        &[(0..50).map(|k| k as f64 * 0.01).collect()],
+    )
+    .unwrap();
+    let b = Primitive::learn("knee", &demo, &LearnConfig::default())
+        .unwrap()
+        .primitive;
+    assert!(matches!(
+        connect(&[a, b], 0.01, None),
+        Err(PrimitiveError::DofMismatch { .. })
+    ));
+    assert!(connect(&[], 0.01, None).is_err());
+}
