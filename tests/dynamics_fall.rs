@@ -153,3 +153,19 @@ fn config_round_trips_through_ron() {
     let back: FallConfig = ron::from_str(&text).unwrap();
     assert_eq!(back, cfg);
 }
+
+#[test]
+fn a_partial_scene_takes_the_paper_defaults() {
+    let text = "(dt_s: 0.00025, integrator: Rk4, ranges: Builtin(adult), push: (link: \"torso\", \
+                point: (0.0, 0.3, 0.0), direction: (0.0, 0.0, -1.0), force_n: 800.0, start_s: 0.1, \
+                duration_s: 0.1))";
+    let cfg: FallConfig = ron::from_str(text).unwrap();
+    assert_eq!(cfg.dt_s, 0.00025);
+    assert_eq!(cfg.integrator, Integrator::Rk4);
+    assert_eq!(cfg.push.force_n, 800.0);
+    assert_eq!(cfg.kp, FallConfig::default().kp);
+    let bad = ron::from_str::<FallConfig>("(dt: 0.001)")
+        .unwrap_err()
+        .to_string();
+    assert!(bad.contains("dt"), "{bad}");
+}

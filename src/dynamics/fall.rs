@@ -35,8 +35,10 @@ pub enum Ranges {
 }
 
 /// Everything that defines one pushed fall. Angles in degrees, per fall21 DOF in model order.
+/// In a scene file every field may be left out: it then takes its value from
+/// [`FallConfig::paper`] for the elderly group (`FallConfig::default()`).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, default)]
 pub struct FallConfig {
     /// Standing height (m).
     pub height_m: f64,
@@ -164,6 +166,13 @@ impl FallConfig {
             rest_kinetic_energy_j: 1.0,
             rest_hold_s: 0.3,
         }
+    }
+}
+
+impl Default for FallConfig {
+    /// The paper's experiment for the elderly group.
+    fn default() -> Self {
+        Self::paper(AgeGroup::Elderly)
     }
 }
 

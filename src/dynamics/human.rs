@@ -406,6 +406,31 @@ mod tests {
     }
 
     #[test]
+    fn standing_centre_of_mass_is_at_the_anthropometric_height() {
+        // Whole-body centre of mass of an upright adult: about 0.55–0.57 of stature (Winter,
+        // Biomechanics and Motor Control of Human Movement).
+        let h = 1.70;
+        let b = fall21_body(h, 65.0, 9.81).unwrap();
+        let mut q = b.configuration(
+            &[0.0; 21],
+            DVec3::new(0.0, 0.530 * h, 0.0),
+            glam::DQuat::IDENTITY,
+        );
+        q[1] = 0.530 * h;
+        let mut data = super::super::data::Data::new(&b.model);
+        super::super::kinematics::kinematics(&b.model, &mut data, &q, &[0.0; 27]);
+        let mut c = DVec3::ZERO;
+        for (i, body) in b.model.bodies.iter().enumerate() {
+            c += (data.pos[i] + data.rot[i] * body.inertia.com) * body.inertia.mass;
+        }
+        let c = c / b.model.total_mass();
+        let ratio = c.y / h;
+        println!("COM at {ratio:.4} of stature");
+        assert!((0.54..0.58).contains(&ratio), "COM at {ratio} of stature");
+        assert!(c.x.abs() < 1e-9, "left-right symmetric: {}", c.x);
+    }
+
+    #[test]
     fn dof_map_follows_the_figure_model() {
         let b = fall21_body(1.70, 65.0, 9.81).unwrap();
         assert_eq!(b.dof_v.len(), 21);
