@@ -1112,3 +1112,57 @@ pub fn simulate_fall(config: &FallConfig) -> Result<FallResult, SimError> {
         &parts.recorder,
     ))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Largest |x| after `n` steps of `ẍ = −ω²x − 2ζωẋ` from x = 1 with the given scheme.
+    fn oscillate(integrator: Integrator, omega: f64, zeta: f64, h: f64, n: usize) -> f64 {
+        let f = |x: f64, v: f64| -omega * omega * x - 2.0 * zeta * omega * v;
+        let (mut x, mut v) = (1.0f64, 0.0f64);
+        let mut peak: f64 = 0.0;
+        for _ in 0..n {
+            match integrator {
+                Integrator::SemiImplicitEuler { .. } => {
+                    v += h * f(x, v);
+                    x += h * v;
+                }
+                Integrator::Rk4 => {
+                    let (k1x, k1v) = (v, f(x, v));
+                    let (k2x, k2v) = (v + 0.5 * h * k1v, f(x + 0.5 * h * k1x, v + 0.5 * h * k1v));
+                    let (k3x, k3v) = (v + 0.5 * h * k2v, f(x + 0.5 * h * k2x, v + 0.5 * h * k2v));
+                    let (k4x, k4v) = (v + h * k3v, f(x + h * k3x, v + h * k3v));
+                    x += h / 6.0 * (k1x + 2.0 * k2x + 2.0 * k3x + k4x);
+                    v += h / 6.0 * (k1v + 2.0 * k2v + 2.0 * k3v + k4v);
+                }
+            }
+            peak = peak.max(x.abs());
+        }
+        peak
+    }
+
+    #[test]
+    fn the_step_bound_separates_stable_from_unstable() {
+        let euler = Integrator::SemiImplicitEuler {
+            implicit_damping: false,
+        };
+        for zeta in [0.0, 0.3, 1.0, 3.0] {
+            let b = stable_step(euler, 100.0, zeta);
+            assert!(
+                oscillate(euler, 100.0, zeta, 0.99 * b, 20_000) < 10.0,
+                "ζ={zeta}"
+            );
+            assert!(
+                oscillate(euler, 100.0, zeta, 1.02 * b, 20_000) > 1e3,
+                "ζ={zeta}"
+            );
+            // RK4's bound is conservative: stable at it.
+            let r = stable_step(Integrator::Rk4, 100.0, zeta);
+            assert!(
+                oscillate(Integrator::Rk4, 100.0, zeta, r, 20_000) <= 1.0 + 1e-9,
+                "ζ={zeta}"
+            );
+        }
+    }
+}
