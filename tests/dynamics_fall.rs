@@ -51,6 +51,13 @@ fn pushed_from_the_front_the_elderly_figure_falls_backward_and_rests() {
     let r = simulate_fall(&cfg).unwrap();
     check_fell_backward_and_rested(&r);
     assert_eq!(r.frames[0].angles.len(), 21);
+    // The record as a fall21 clip: 60 Hz over 3 s, every DOF.
+    let clip = r.to_model_clip();
+    assert_eq!(clip.frame_count(), 181);
+    assert_eq!(clip.dof_count(), 21);
+    assert_eq!(clip.frame_angles(90), &r.frames[90].angles[..]);
+    // Frames are recorded every 1/60 s.
+    assert!((r.frames[60].time_s - 1.0).abs() < 1e-9);
 }
 
 #[test]

@@ -198,7 +198,7 @@ pub struct FallResult {
     pub dof_names: Vec<String>,
     /// Link names, matching the per-link vectors.
     pub link_names: Vec<String>,
-    /// Frames at `record_hz`.
+    /// Frames at `record_hz`: frame `k` is the state at the step nearest to `k / record_hz`.
     pub frames: Vec<FallFrame>,
     /// Frame rate of `frames` (Hz).
     pub record_hz: f64,
@@ -220,6 +220,26 @@ pub struct FallResult {
     pub steps: u64,
     /// Time step (s).
     pub dt_s: f64,
+    /// Standing height of the simulated subject (m).
+    pub height_m: f64,
+}
+
+impl FallResult {
+    /// The recorded motion as a clip on the fall21 model (scaled to the subject's height), ready
+    /// for BVH output and pictures.
+    pub fn to_model_clip(&self) -> crate::model::ModelClip {
+        crate::model::ModelClip {
+            model: crate::model::fall21().scaled_to_height(self.height_m),
+            frame_time: 1.0 / self.record_hz,
+            root_translation: self.frames.iter().map(|f| f.root_position).collect(),
+            root_rotation: self.frames.iter().map(|f| f.root_orientation).collect(),
+            angles: self
+                .frames
+                .iter()
+                .flat_map(|f| f.angles.iter().copied())
+                .collect(),
+        }
+    }
 }
 
 /// Why a fall could not be simulated.
@@ -380,8 +400,9 @@ pub struct DamageRecord {
 /// The recorder component: frames and rest detection.
 #[derive(Component, Clone, Debug, PartialEq)]
 pub struct Recorder {
-    /// Record every this many steps.
-    pub every: u64,
+    /// Index of the next frame to record; frame `k` is the state at the step nearest to
+    /// `k / hz` (within half a step).
+    pub next_frame: u64,
     /// Frames so far.
     pub frames: Vec<FallFrame>,
     /// Rest threshold (J).
@@ -691,7 +712,7 @@ pub fn build_fall(cfg: &FallConfig) -> Result<FallParts, SimError> {
 
     let nl = body.link_names.len();
     let nv = body.model.nv;
-    let every = ((1.0 / (cfg.record_hz * cfg.dt_s)).round() as u64).max(1);
+    let frames = (cfg.duration_s * cfg.record_hz).floor() as usize + 1;
     let total_steps = (cfg.duration_s / cfg.dt_s).round() as u64;
     let body = Arc::new(body);
     let parts = FallParts {
@@ -730,8 +751,8 @@ pub fn build_fall(cfg: &FallConfig) -> Result<FallParts, SimError> {
             max_penetration: 0.0,
         },
         recorder: Recorder {
-            every,
-            frames: Vec::with_capacity((total_steps / every + 2) as usize),
+            next_frame: 0,
+            frames: Vec::with_capacity(frames),
             rest_energy: cfg.rest_kinetic_energy_j,
             rest_since: None,
             rest_hold: cfg.rest_hold_s,
@@ -1009,10 +1030,16 @@ pub fn record_phase(
     } else {
         recorder.rest_since = None;
     }
-    if state.steps.is_multiple_of(recorder.every) {
+    if state.steps >= frame_step(recorder, recorder.next_frame) {
         recorder.frames.push(frame(b, state, sc));
+        recorder.next_frame += 1;
     }
     Ok(())
+}
+
+/// The step at which frame `k` is taken: the one nearest to `k / hz`.
+fn frame_step(rec: &Recorder, k: u64) -> u64 {
+    (k as f64 / (rec.hz * rec.dt)).round() as u64
 }
 
 fn frame(b: &HumanBody, state: &JointState, sc: &mut Scratch) -> FallFrame {
@@ -1062,6 +1089,7 @@ pub fn record_initial(parts: &mut FallParts) {
     ws.scratch.kinematics_at_step = Some(state.steps);
     let f = frame(&body.body, state, &mut ws.scratch);
     recorder.frames.push(f);
+    recorder.next_frame = 1;
 }
 
 /// Collects the result of a finished run from its components; the damage is
@@ -1094,6 +1122,7 @@ pub fn finish(
         rest_time_s,
         steps: state.steps,
         dt_s: recorder.dt,
+        height_m: b.figure.height,
     }
 }
 
