@@ -6,10 +6,12 @@
 //! from the command line (`--set clip.end_s=2.5`) so a parameter can be swept without editing
 //! files.
 
+mod fall;
 mod primitives;
 mod show;
 mod source;
 
+pub use fall::{Body, Controller, FallScene, Simulation, fall_report, run_fall, simulate_in_world};
 pub use primitives::{
     HighJumpScene, JumpingKneeKickScene, PrimitiveRender, run_high_jump, run_jumping_knee_kick,
 };
@@ -33,6 +35,8 @@ pub enum Scene {
     HighJump(Box<HighJumpScene>),
     /// The motor-primitive paper's jumping knee kick.
     JumpingKneeKick(Box<JumpingKneeKickScene>),
+    /// The falling paper's pushed figure.
+    Fall(Box<FallScene>),
 }
 
 /// Why a scene could not be read or run.
@@ -80,6 +84,7 @@ impl Scene {
             Scene::Show(s) => &s.name,
             Scene::HighJump(s) => &s.name,
             Scene::JumpingKneeKick(s) => &s.name,
+            Scene::Fall(s) => &s.name,
         }
     }
 
@@ -88,6 +93,7 @@ impl Scene {
             Scene::Show(s) => s.format_version,
             Scene::HighJump(s) => s.format_version,
             Scene::JumpingKneeKick(s) => s.format_version,
+            Scene::Fall(s) => s.format_version,
         }
     }
 
@@ -186,6 +192,7 @@ pub fn run(scene: &Scene, base: &Path, out_dir: &Path) -> Result<serde_json::Val
         Scene::Show(s) => run_show(s, base, out_dir)?,
         Scene::HighJump(s) => run_high_jump(s, base, out_dir)?,
         Scene::JumpingKneeKick(s) => run_jumping_knee_kick(s, base, out_dir)?,
+        Scene::Fall(s) => run_fall(s, base, out_dir)?,
     };
     if let Some(o) = report.as_object_mut() {
         o.insert("scene".into(), scene.name().into());
