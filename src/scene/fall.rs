@@ -139,7 +139,7 @@ impl FallScene {
             c.mass_kg = b.mass_kg;
         }
         if let Some(p) = &self.contact {
-            c.contact = p.clone();
+            c.contact = *p;
         }
         let names = fall21().dof_names();
         override_per_dof(
