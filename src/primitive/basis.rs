@@ -110,36 +110,106 @@ impl Basis {
     }
 
     /// Normalised activations ψ_i(x)/Σ_k ψ_k(x) written into `out` (length N); returns the index
-    /// range outside which they are below 1e−16 (and written as 0).
-    ///
-    /// Computed as exp(e_min − e_i) with e_i = (x − c_i)²/(2σ_i²), which leaves the ratio unchanged
-    /// and never divides 0 by 0, however far x is from every centre.
+    /// range outside which they are below 1e−16 (and written as 0). For repeated evaluation use
+    /// [`Basis::kernels`].
     pub fn normalized(&self, x: f64, out: &mut [f64]) -> std::ops::Range<usize> {
+        let k = self.kernels();
+        let r = k.normalized(x, out);
+        out[..r.start].fill(0.0);
+        out[r.end..].fill(0.0);
+        r
+    }
+
+    /// A fast evaluator of these kernels (precomputed 1/(2σ_i²)).
+    pub fn kernels(&self) -> Kernels {
+        Kernels {
+            centres: self.centres.clone(),
+            half_inv_var: self.widths.iter().map(|s| 0.5 / (s * s)).collect(),
+        }
+    }
+}
+
+/// The kernels of a [`Basis`] prepared for fast repeated evaluation.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Kernels {
+    centres: Vec<f64>,
+    /// 1/(2σ_i²).
+    half_inv_var: Vec<f64>,
+}
+
+impl Kernels {
+    /// Number of kernels.
+    pub fn len(&self) -> usize {
+        self.centres.len()
+    }
+
+    /// True if there are no kernels.
+    pub fn is_empty(&self) -> bool {
+        self.centres.is_empty()
+    }
+
+    /// Normalised activations ψ_i(x)/Σ_k ψ_k(x) for the kernels in the returned index range,
+    /// written into `out[range]` (entries outside the range are left untouched: their
+    /// activations are below 1e−16). Computed as exp(e_min − e_i), e_i = (x − c_i)²/(2σ_i²),
+    /// which leaves the ratio unchanged and never divides 0 by 0, however far x is from every
+    /// centre.
+    pub fn normalized(&self, x: f64, out: &mut [f64]) -> std::ops::Range<usize> {
+        let n = self.centres.len();
+        let out = &mut out[..n];
         let mut e_min = f64::INFINITY;
-        for ((o, c), s) in out.iter_mut().zip(&self.centres).zip(&self.widths) {
-            let d = (x - c) / s;
-            *o = 0.5 * d * d;
+        for ((o, c), h) in out.iter_mut().zip(&self.centres).zip(&self.half_inv_var) {
+            let d = x - c;
+            *o = d * d * h;
             e_min = e_min.min(*o);
         }
-        let (mut lo, mut hi) = (usize::MAX, 0);
+        let lo = out.iter().position(|e| *e - e_min < CUTOFF).unwrap_or(0);
+        let hi = n - out
+            .iter()
+            .rev()
+            .position(|e| *e - e_min < CUTOFF)
+            .unwrap_or(0);
+        let w = &mut out[lo..hi];
         let mut sum = 0.0;
-        for (i, o) in out.iter_mut().enumerate() {
-            let d = *o - e_min;
-            if d < CUTOFF {
-                *o = (-d).exp();
-                sum += *o;
-                lo = lo.min(i);
-                hi = i + 1;
-            } else {
-                *o = 0.0;
-            }
+        for o in w.iter_mut() {
+            *o = exp_neg((*o - e_min).min(700.0));
+            sum += *o;
         }
         let inv = 1.0 / sum;
-        for o in &mut out[lo..hi] {
+        for o in w.iter_mut() {
             *o *= inv;
         }
         lo..hi
     }
+}
+
+/// e^{−d} for 0 ≤ d ≤ 700, to within 2 ulp: d·log₂e is split into an integer k and a remainder
+/// r ∈ [−ln2/2, ln2/2] (round-to-nearest by the 1.5·2⁵² trick), e^r by its degree-12 Taylor
+/// polynomial (truncation < 2e−16), and 2^k put into the exponent bits. Branch-free, so a loop
+/// of it vectorises.
+#[inline(always)]
+pub fn exp_neg(d: f64) -> f64 {
+    const MAGIC: f64 = 6_755_399_441_055_744.0; // 1.5·2⁵²
+    const LN2_HI: f64 = 0.693_147_180_369_123_816_49;
+    const LN2_LO: f64 = 1.908_214_929_270_587_7e-10;
+    let x = -d;
+    let t = x * std::f64::consts::LOG2_E + MAGIC;
+    let k = t - MAGIC;
+    let ki = (t.to_bits() as i64).wrapping_sub(MAGIC.to_bits() as i64);
+    let r = (x - k * LN2_HI) - k * LN2_LO;
+    let mut p = 1.0 / 479_001_600.0;
+    p = p * r + 1.0 / 39_916_800.0;
+    p = p * r + 1.0 / 3_628_800.0;
+    p = p * r + 1.0 / 362_880.0;
+    p = p * r + 1.0 / 40_320.0;
+    p = p * r + 1.0 / 5_040.0;
+    p = p * r + 1.0 / 720.0;
+    p = p * r + 1.0 / 120.0;
+    p = p * r + 1.0 / 24.0;
+    p = p * r + 1.0 / 6.0;
+    p = p * r + 0.5;
+    p = p * r + 1.0;
+    p = p * r + 1.0;
+    p * f64::from_bits(((ki + 1023) as u64) << 52)
 }
 
 #[cfg(test)]
@@ -175,6 +245,18 @@ mod tests {
             assert!(!r.is_empty());
             assert!(psi.iter().all(|p| p.is_finite()));
         }
+    }
+
+    #[test]
+    fn fast_exp_matches_std_exp() {
+        let mut worst = 0.0f64;
+        for i in 0..=700_000 {
+            let d = i as f64 * 1e-3;
+            let (a, b) = (exp_neg(d), (-d).exp());
+            worst = worst.max(((a - b) / b).abs());
+        }
+        assert!(worst < 5e-16, "relative error {worst}");
+        assert_eq!(exp_neg(0.0), 1.0);
     }
 
     #[test]

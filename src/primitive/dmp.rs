@@ -151,6 +151,7 @@ impl Formulation {
     /// The state derivative (θ′, z′) in normalised time, for goal `g`, start `s`, first-order
     /// phase value `phase_x` (used by Hoffmann's `−K(g − θ₀)s`) and gated, scaled forcing `f`.
     #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
     pub fn derivative(
         &self,
         theta: f64,
@@ -163,12 +164,12 @@ impl Formulation {
         match *self {
             Formulation::Ijspeert2002 {
                 alpha_z, beta_z, ..
-            } => (z + f, alpha_z * (beta_z * (g - theta) - z)),
+            } => deriv_2002(alpha_z, beta_z, theta, z, g, f),
             Formulation::Ijspeert2013 {
                 alpha_z, beta_z, ..
-            } => (z, alpha_z * (beta_z * (g - theta) - z) + f),
+            } => deriv_2013(alpha_z, beta_z, theta, z, g, f),
             Formulation::Hoffmann2009 { k, d, .. } => {
-                (z, k * (g - theta) - d * z - k * (g - s) * phase_x + k * f)
+                deriv_hoffmann(k, d, theta, z, g, s, phase_x, f)
             }
         }
     }
@@ -198,6 +199,34 @@ impl Formulation {
             }
         }
     }
+}
+
+/// Ijspeert 2002: (θ′, z′) = (z + F, α_z(β_z(g − θ) − z)).
+#[inline(always)]
+pub fn deriv_2002(alpha_z: f64, beta_z: f64, theta: f64, z: f64, g: f64, f: f64) -> (f64, f64) {
+    (z + f, alpha_z * (beta_z * (g - theta) - z))
+}
+
+/// Ijspeert 2013: (θ′, z′) = (z, α_z(β_z(g − θ) − z) + F).
+#[inline(always)]
+pub fn deriv_2013(alpha_z: f64, beta_z: f64, theta: f64, z: f64, g: f64, f: f64) -> (f64, f64) {
+    (z, alpha_z * (beta_z * (g - theta) - z) + f)
+}
+
+/// Hoffmann 2009: (θ′, z′) = (z, K(g − θ) − Dz − K(g − θ₀)s + K F), with s the phase.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+pub fn deriv_hoffmann(
+    k: f64,
+    d: f64,
+    theta: f64,
+    z: f64,
+    g: f64,
+    s0: f64,
+    s: f64,
+    f: f64,
+) -> (f64, f64) {
+    (z, k * (g - theta) - d * z - k * (g - s0) * s + k * f)
 }
 
 /// How a DOF's forcing follows a change of goal or start.

@@ -142,7 +142,7 @@ pub fn learn_dofs(
     let dofs = demo.dofs();
     let du = 1.0 / (n - 1) as f64;
 
-    // Forcing targets, frames × dofs (DOF-major for the regression: dofs × frames).
+    // Forcing targets, frames × dofs (row-major, so each frame's targets are contiguous).
     let mut targets = vec![0.0; dofs * n];
     let mut out = Vec::with_capacity(dofs);
     let mut col = vec![0.0; n];
@@ -173,9 +173,9 @@ pub fn learn_dofs(
         {
             integrate_z_demo(alpha_z, beta_z, g, &col, du, d1[0], &mut zd);
         }
-        let t = &mut targets[j * n..(j + 1) * n];
         for k in 0..n {
-            t[k] = f.forcing_target(col[k], d1[k], d2[k], zd[k], g, s, phases[k].x);
+            targets[k * dofs + j] =
+                f.forcing_target(col[k], d1[k], d2[k], zd[k], g, s, phases[k].x);
         }
         out.push(DofPrimitive {
             name: demo.names[j].clone(),
@@ -200,13 +200,15 @@ pub fn learn_dofs(
         }
     };
     for (j, d) in out.iter_mut().enumerate() {
-        d.weights.copy_from_slice(&weights[j * nk..(j + 1) * nk]);
+        for (i, w) in d.weights.iter_mut().enumerate() {
+            *w = weights[i * dofs + j];
+        }
     }
     Ok(out)
 }
 
 /// The paper's LWR: `w_i = Σ_t ψ_i gate F / Σ_t ψ_i gate²` per kernel and DOF. `targets` is
-/// dofs × frames; returns dofs × kernels.
+/// frames × dofs; returns kernels × dofs.
 fn lwr(
     basis: &Basis,
     phases: &[super::canonical::Phase],
@@ -214,36 +216,35 @@ fn lwr(
     dofs: usize,
 ) -> Vec<f64> {
     let nk = basis.len();
-    let n = phases.len();
-    let mut num = vec![0.0; dofs * nk];
+    let mut num = vec![0.0; nk * dofs];
     let mut den = vec![0.0; nk];
     let mut psi = vec![0.0; nk];
     for (k, p) in phases.iter().enumerate() {
         basis.activations(p.x, &mut psi);
+        let row = &targets[k * dofs..(k + 1) * dofs];
         for i in 0..nk {
             let a = psi[i] * p.gate;
             if a == 0.0 {
                 continue;
             }
             den[i] += a * p.gate;
-            for j in 0..dofs {
-                num[j * nk + i] += a * targets[j * n + k];
+            for (x, t) in num[i * dofs..(i + 1) * dofs].iter_mut().zip(row) {
+                *x += a * t;
             }
         }
     }
-    for j in 0..dofs {
-        for i in 0..nk {
-            num[j * nk + i] = if den[i] > 1e-300 {
-                num[j * nk + i] / den[i]
-            } else {
-                0.0
-            };
+    for i in 0..nk {
+        let inv = if den[i] > 1e-300 { 1.0 / den[i] } else { 0.0 };
+        for x in &mut num[i * dofs..(i + 1) * dofs] {
+            *x *= inv;
         }
     }
     num
 }
 
-/// Ridge least squares over all kernels (see module docs). Returns dofs × kernels.
+/// Ridge least squares over all kernels (see module docs). `targets` is frames × dofs; returns
+/// kernels × dofs. ΦᵀΦ is banded (each frame touches only the kernels near its phase), so it is
+/// factorised by a banded Cholesky.
 fn ridge(
     basis: &Basis,
     phases: &[super::canonical::Phase],
@@ -252,26 +253,31 @@ fn ridge(
     lambda: f64,
 ) -> Result<Vec<f64>> {
     let nk = basis.len();
-    let n = phases.len();
+    let kernels = basis.kernels();
     let mut ata = vec![0.0; nk * nk];
     let mut atb = vec![0.0; nk * dofs]; // kernels × dofs
     let mut phi = vec![0.0; nk];
+    let mut band = 0usize;
     for (k, p) in phases.iter().enumerate() {
-        let r = basis.normalized(p.x, &mut phi);
+        if p.gate == 0.0 {
+            continue;
+        }
+        let r = kernels.normalized(p.x, &mut phi);
+        band = band.max(r.end - r.start);
         for v in &mut phi[r.clone()] {
             *v *= p.gate;
         }
+        let row = &targets[k * dofs..(k + 1) * dofs];
         for a in r.clone() {
             let pa = phi[a];
-            if pa == 0.0 {
-                continue;
+            for (x, y) in ata[a * nk + a..a * nk + r.end]
+                .iter_mut()
+                .zip(&phi[a..r.end])
+            {
+                *x += pa * y;
             }
-            for b in a..r.end {
-                ata[a * nk + b] += pa * phi[b];
-            }
-            let row = &mut atb[a * dofs..(a + 1) * dofs];
-            for (j, x) in row.iter_mut().enumerate() {
-                *x += pa * targets[j * n + k];
+            for (x, t) in atb[a * dofs..(a + 1) * dofs].iter_mut().zip(row) {
+                *x += pa * t;
             }
         }
     }
@@ -281,59 +287,75 @@ fn ridge(
     }
     for i in 0..nk {
         ata[i * nk + i] += lambda * ata[i * nk + i] + 1e-12 * max_diag;
-        for b in 0..i {
+        for b in i.saturating_sub(band)..i {
             ata[i * nk + b] = ata[b * nk + i];
         }
     }
-    let l = cholesky(&mut ata, nk).ok_or_else(|| PrimitiveError::InvalidParameter {
-        field: "regression.lambda".into(),
-        reason: "normal equations not positive definite; increase lambda".into(),
-    })?;
-    // Solve L Lᵀ W = B for each DOF column.
-    let mut w = vec![0.0; dofs * nk];
-    let mut y = vec![0.0; nk];
-    for j in 0..dofs {
-        for i in 0..nk {
-            let mut s = atb[i * dofs + j];
-            for m in 0..i {
-                s -= l[i * nk + m] * y[m];
+    let bw = band.max(1);
+    if !banded_cholesky(&mut ata, nk, bw) {
+        return Err(PrimitiveError::InvalidParameter {
+            field: "regression.lambda".into(),
+            reason: "normal equations not positive definite; increase lambda".into(),
+        });
+    }
+    let l = &ata;
+    // Solve L Lᵀ W = B for all DOF columns at once (rows of B are contiguous).
+    let mut w = atb;
+    for i in 0..nk {
+        let (done, rest) = w.split_at_mut(i * dofs);
+        let wi = &mut rest[..dofs];
+        for m in i.saturating_sub(bw)..i {
+            let lim = l[i * nk + m];
+            for (x, y) in wi.iter_mut().zip(&done[m * dofs..(m + 1) * dofs]) {
+                *x -= lim * y;
             }
-            y[i] = s / l[i * nk + i];
         }
-        for i in (0..nk).rev() {
-            let mut s = y[i];
-            for m in i + 1..nk {
-                s -= l[m * nk + i] * w[j * nk + m];
+        let inv = 1.0 / l[i * nk + i];
+        for x in wi.iter_mut() {
+            *x *= inv;
+        }
+    }
+    for i in (0..nk).rev() {
+        let (head, tail) = w.split_at_mut((i + 1) * dofs);
+        let wi = &mut head[i * dofs..];
+        for m in i + 1..(i + 1 + bw).min(nk) {
+            let lmi = l[m * nk + i];
+            let off = (m - i - 1) * dofs;
+            for (x, y) in wi.iter_mut().zip(&tail[off..off + dofs]) {
+                *x -= lmi * y;
             }
-            w[j * nk + i] = s / l[i * nk + i];
+        }
+        let inv = 1.0 / l[i * nk + i];
+        for x in wi.iter_mut() {
+            *x *= inv;
         }
     }
     Ok(w)
 }
 
-/// In-place Cholesky A = L Lᵀ of a symmetric n × n matrix (row-major); returns L (lower) or
-/// `None` if A is not positive definite.
-fn cholesky(a: &mut [f64], n: usize) -> Option<&[f64]> {
+/// In-place Cholesky A = L Lᵀ of a symmetric positive-definite n × n matrix (row-major) whose
+/// entries vanish more than `bw` off the diagonal; L (lower, same band) overwrites A's lower
+/// triangle. Returns false if A is not positive definite.
+fn banded_cholesky(a: &mut [f64], n: usize, bw: usize) -> bool {
     for i in 0..n {
-        for j in 0..=i {
+        let lo_i = i.saturating_sub(bw);
+        for j in lo_i..=i {
+            let lo = lo_i.max(j.saturating_sub(bw));
             let mut s = a[i * n + j];
-            for k in 0..j {
+            for k in lo..j {
                 s -= a[i * n + k] * a[j * n + k];
             }
             if i == j {
                 if s <= 0.0 || !s.is_finite() {
-                    return None;
+                    return false;
                 }
                 a[i * n + i] = s.sqrt();
             } else {
                 a[i * n + j] = s / a[j * n + j];
             }
         }
-        for j in i + 1..n {
-            a[i * n + j] = 0.0;
-        }
     }
-    Some(a)
+    true
 }
 
 #[cfg(test)]
@@ -356,13 +378,18 @@ mod tests {
     }
 
     #[test]
-    fn cholesky_solves_a_known_system() {
-        let mut a = vec![4.0, 2.0, 2.0, 3.0];
-        let l = cholesky(&mut a, 2).unwrap().to_vec();
-        assert!((l[0] - 2.0).abs() < 1e-15 && (l[2] - 1.0).abs() < 1e-15);
-        assert!((l[3] - 2f64.sqrt()).abs() < 1e-15);
+    fn banded_cholesky_factors_a_tridiagonal_matrix() {
+        // A = L Lᵀ with L = [[2,0,0],[1,√2,0],[0,1,1]] → A = [[4,2,0],[2,3,√2],[0,√2,2]].
+        let r2 = 2f64.sqrt();
+        let mut a = vec![4.0, 2.0, 0.0, 2.0, 3.0, r2, 0.0, r2, 2.0];
+        assert!(banded_cholesky(&mut a, 3, 1));
+        let l = [2.0, 1.0, r2, 1.0, 1.0];
+        let got = [a[0], a[3], a[4], a[7], a[8]];
+        for (x, y) in got.iter().zip(&l) {
+            assert!((x - y).abs() < 1e-14, "{got:?}");
+        }
         let mut b = vec![1.0, 2.0, 2.0, 1.0];
-        assert!(cholesky(&mut b, 2).is_none());
+        assert!(!banded_cholesky(&mut b, 2, 1));
     }
 
     #[test]

@@ -9,9 +9,9 @@
 //! activations. Because steps are fixed in u, playing at τ′ = kτ and sampling at k·t performs
 //! exactly the same arithmetic: the same path, k times slower.
 
-use super::basis::Basis;
+use super::basis::Kernels;
 use super::canonical::CanonicalSystem;
-use super::dmp::Formulation;
+use super::dmp::{Formulation, deriv_2002, deriv_2013, deriv_hoffmann};
 use super::error::{PrimitiveError, Result, require_finite};
 use super::primitive::Primitive;
 
@@ -43,11 +43,10 @@ pub struct Samples {
 pub struct Rollout {
     formulation: Formulation,
     canonical: CanonicalSystem,
-    basis: Basis,
+    kernels: Kernels,
     tau: f64,
     h_max: f64,
-    nk: usize,
-    /// dofs × kernels.
+    /// kernels × dofs (kernel-major: one kernel's weights for all DOFs are contiguous).
     weights: Vec<f64>,
     goal: Vec<f64>,
     start: Vec<f64>,
@@ -64,33 +63,63 @@ pub struct Rollout {
 }
 
 /// Gated, scaled forcing of every DOF at normalised time u into `out`; returns the phase x.
+/// F_j = gate · k_j · Σ_i ψ̂_i w_ij with ψ̂ the normalised activations (one evaluation for all DOFs).
 #[allow(clippy::too_many_arguments)]
 fn forcing(
     canonical: &CanonicalSystem,
-    basis: &Basis,
+    kernels: &Kernels,
     weights: &[f64],
     scale: &[f64],
-    nk: usize,
     psi: &mut [f64],
     u: f64,
     out: &mut [f64],
 ) -> f64 {
     let p = canonical.phase(u);
+    out.fill(0.0);
     if p.gate == 0.0 {
-        out.fill(0.0);
         return p.x;
     }
-    let r = basis.normalized(p.x, psi);
-    let act = &psi[r.clone()];
-    for (j, o) in out.iter_mut().enumerate() {
-        let w = &weights[j * nk + r.start..j * nk + r.end];
-        let mut h = 0.0;
-        for (a, b) in act.iter().zip(w) {
-            h += a * b;
+    let d = out.len();
+    let r = kernels.normalized(p.x, psi);
+    for i in r {
+        let a = psi[i];
+        for (o, w) in out.iter_mut().zip(&weights[i * d..(i + 1) * d]) {
+            *o += a * w;
         }
-        *o = p.gate * scale[j] * h;
+    }
+    for (o, k) in out.iter_mut().zip(scale) {
+        *o *= p.gate * k;
     }
     p.x
+}
+
+/// One classical RK4 step of size h for every DOF of the linear transformation system
+/// (θ′, z′) = deriv(θ, z, g, s, x, F), with F and x at the step's start, middle and end.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn rk4_all<D: Fn(f64, f64, f64, f64, f64, f64) -> (f64, f64)>(
+    deriv: D,
+    h: f64,
+    x: [f64; 3],
+    theta: &mut [f64],
+    z: &mut [f64],
+    goal: &[f64],
+    start: &[f64],
+    f0: &[f64],
+    fm: &[f64],
+    f1: &[f64],
+) {
+    let hh = 0.5 * h;
+    let h6 = h / 6.0;
+    for j in 0..theta.len() {
+        let (th, zz, g, s) = (theta[j], z[j], goal[j], start[j]);
+        let k1 = deriv(th, zz, g, s, x[0], f0[j]);
+        let k2 = deriv(th + hh * k1.0, zz + hh * k1.1, g, s, x[1], fm[j]);
+        let k3 = deriv(th + hh * k2.0, zz + hh * k2.1, g, s, x[1], fm[j]);
+        let k4 = deriv(th + h * k3.0, zz + h * k3.1, g, s, x[2], f1[j]);
+        theta[j] = th + h6 * (k1.0 + 2.0 * (k2.0 + k3.0) + k4.0);
+        z[j] = zz + h6 * (k1.1 + 2.0 * (k2.1 + k3.1) + k4.1);
+    }
 }
 
 impl Rollout {
@@ -137,18 +166,19 @@ impl Rollout {
             .zip(&theta0)
             .map(|(d, s)| d.scaling.factor(d.goal, *s))
             .collect();
-        let mut weights = Vec::with_capacity(dofs * nk);
-        for d in &p.dofs {
-            weights.extend_from_slice(&d.weights);
+        let mut weights = vec![0.0; nk * dofs];
+        for (j, d) in p.dofs.iter().enumerate() {
+            for (i, w) in d.weights.iter().enumerate() {
+                weights[i * dofs + j] = *w;
+            }
         }
         let canonical = p.formulation.canonical();
         let mut r = Rollout {
             formulation: p.formulation,
             canonical,
-            basis: p.basis.clone(),
+            kernels: p.basis.kernels(),
             tau: p.duration,
             h_max: (1.0f64 / 500.0).min(0.25 / (nk.max(2) - 1) as f64),
-            nk,
             weights,
             goal: p.dofs.iter().map(|d| d.goal).collect(),
             start: theta0.clone(),
@@ -164,10 +194,9 @@ impl Rollout {
         };
         r.x_now = forcing(
             &r.canonical,
-            &r.basis,
+            &r.kernels,
             &r.weights,
             &r.scale,
-            nk,
             &mut r.psi,
             0.0,
             &mut r.f_now,
@@ -249,38 +278,70 @@ impl Rollout {
     /// One RK4 step from u = a to u = b.
     fn step(&mut self, a: f64, b: f64) {
         let h = b - a;
-        let nk = self.nk;
         let xm = forcing(
             &self.canonical,
-            &self.basis,
+            &self.kernels,
             &self.weights,
             &self.scale,
-            nk,
             &mut self.psi,
             a + 0.5 * h,
             &mut self.f_mid,
         );
         let x1 = forcing(
             &self.canonical,
-            &self.basis,
+            &self.kernels,
             &self.weights,
             &self.scale,
-            nk,
             &mut self.psi,
             b,
             &mut self.f_end,
         );
-        let x0 = self.x_now;
-        let f = self.formulation;
-        let hh = 0.5 * h;
-        for j in 0..self.theta.len() {
-            let (th, z, g, s) = (self.theta[j], self.z[j], self.goal[j], self.start[j]);
-            let k1 = f.derivative(th, z, g, s, x0, self.f_now[j]);
-            let k2 = f.derivative(th + hh * k1.0, z + hh * k1.1, g, s, xm, self.f_mid[j]);
-            let k3 = f.derivative(th + hh * k2.0, z + hh * k2.1, g, s, xm, self.f_mid[j]);
-            let k4 = f.derivative(th + h * k3.0, z + h * k3.1, g, s, x1, self.f_end[j]);
-            self.theta[j] = th + h / 6.0 * (k1.0 + 2.0 * (k2.0 + k3.0) + k4.0);
-            self.z[j] = z + h / 6.0 * (k1.1 + 2.0 * (k2.1 + k3.1) + k4.1);
+        let x = [self.x_now, xm, x1];
+        let (th, z) = (&mut self.theta, &mut self.z);
+        let (g, s) = (&self.goal, &self.start);
+        let (f0, fm, f1) = (&self.f_now, &self.f_mid, &self.f_end);
+        // The formulation is matched once per step, not per DOF.
+        match self.formulation {
+            Formulation::Ijspeert2002 {
+                alpha_z, beta_z, ..
+            } => rk4_all(
+                |th, z, g, _s, _x, f| deriv_2002(alpha_z, beta_z, th, z, g, f),
+                h,
+                x,
+                th,
+                z,
+                g,
+                s,
+                f0,
+                fm,
+                f1,
+            ),
+            Formulation::Ijspeert2013 {
+                alpha_z, beta_z, ..
+            } => rk4_all(
+                |th, z, g, _s, _x, f| deriv_2013(alpha_z, beta_z, th, z, g, f),
+                h,
+                x,
+                th,
+                z,
+                g,
+                s,
+                f0,
+                fm,
+                f1,
+            ),
+            Formulation::Hoffmann2009 { k, d, .. } => rk4_all(
+                |th, z, g, s, x, f| deriv_hoffmann(k, d, th, z, g, s, x, f),
+                h,
+                x,
+                th,
+                z,
+                g,
+                s,
+                f0,
+                fm,
+                f1,
+            ),
         }
         std::mem::swap(&mut self.f_now, &mut self.f_end);
         self.x_now = x1;
