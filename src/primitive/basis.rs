@@ -122,9 +122,18 @@ impl Basis {
 
     /// A fast evaluator of these kernels (precomputed 1/(2σ_i²)).
     pub fn kernels(&self) -> Kernels {
+        let c = &self.centres;
+        let direction = if c.windows(2).all(|w| w[0] < w[1]) {
+            1
+        } else if c.windows(2).all(|w| w[0] > w[1]) {
+            -1
+        } else {
+            0
+        };
         Kernels {
             centres: self.centres.clone(),
             half_inv_var: self.widths.iter().map(|s| 0.5 / (s * s)).collect(),
+            direction,
         }
     }
 }
@@ -135,6 +144,8 @@ pub struct Kernels {
     centres: Vec<f64>,
     /// 1/(2σ_i²).
     half_inv_var: Vec<f64>,
+    /// +1 if the centres increase strictly, −1 if they decrease strictly, 0 otherwise.
+    direction: i8,
 }
 
 impl Kernels {
@@ -153,27 +164,74 @@ impl Kernels {
     /// activations are below 1e−16). Computed as exp(e_min − e_i), e_i = (x − c_i)²/(2σ_i²),
     /// which leaves the ratio unchanged and never divides 0 by 0, however far x is from every
     /// centre.
+    ///
+    /// With monotone centres (as [`Basis::even_in_time`] places them) the window is found by
+    /// bisection and grown from the nearest centre until e_i − e_min exceeds the cut-off
+    /// (neighbouring widths vary smoothly, so e grows away from x); otherwise all kernels are
+    /// scanned.
     pub fn normalized(&self, x: f64, out: &mut [f64]) -> std::ops::Range<usize> {
         let n = self.centres.len();
-        let out = &mut out[..n];
-        let mut e_min = f64::INFINITY;
-        for ((o, c), h) in out.iter_mut().zip(&self.centres).zip(&self.half_inv_var) {
-            let d = x - c;
-            *o = d * d * h;
-            e_min = e_min.min(*o);
-        }
-        let lo = out.iter().position(|e| *e - e_min < CUTOFF).unwrap_or(0);
-        let hi = n - out
-            .iter()
-            .rev()
-            .position(|e| *e - e_min < CUTOFF)
-            .unwrap_or(0);
+        let e = |i: usize| {
+            let d = x - self.centres[i];
+            d * d * self.half_inv_var[i]
+        };
+        let (lo, hi, e_min) = if self.direction == 0 || n < 3 {
+            let out = &mut out[..n];
+            for (i, o) in out.iter_mut().enumerate() {
+                *o = e(i);
+            }
+            let mut e_min = f64::INFINITY;
+            for v in out.iter() {
+                e_min = if *v < e_min { *v } else { e_min };
+            }
+            let lo = out.iter().position(|v| *v - e_min < CUTOFF).unwrap_or(0);
+            let hi = n - out
+                .iter()
+                .rev()
+                .position(|v| *v - e_min < CUTOFF)
+                .unwrap_or(0);
+            (lo, hi, e_min)
+        } else {
+            let j = if self.direction > 0 {
+                self.centres.partition_point(|c| *c < x)
+            } else {
+                self.centres.partition_point(|c| *c > x)
+            };
+            let (mut lo, mut hi) = (j.saturating_sub(1), (j + 1).min(n));
+            if lo >= hi {
+                lo = hi - 1;
+            }
+            let mut e_min = f64::INFINITY;
+            for (i, o) in out.iter_mut().enumerate().take(hi).skip(lo) {
+                *o = e(i);
+                e_min = if *o < e_min { *o } else { e_min };
+            }
+            while lo > 0 {
+                let v = e(lo - 1);
+                if v - e_min >= CUTOFF {
+                    break;
+                }
+                lo -= 1;
+                out[lo] = v;
+                e_min = if v < e_min { v } else { e_min };
+            }
+            while hi < n {
+                let v = e(hi);
+                if v - e_min >= CUTOFF {
+                    break;
+                }
+                out[hi] = v;
+                e_min = if v < e_min { v } else { e_min };
+                hi += 1;
+            }
+            (lo, hi, e_min)
+        };
         let w = &mut out[lo..hi];
-        let mut sum = 0.0;
+        // Inside the window 0 ≤ e_i − e_min < CUTOFF, within exp_neg's domain.
         for o in w.iter_mut() {
-            *o = exp_neg((*o - e_min).min(700.0));
-            sum += *o;
+            *o = exp_neg(*o - e_min);
         }
+        let sum: f64 = w.iter().sum();
         let inv = 1.0 / sum;
         for o in w.iter_mut() {
             *o *= inv;
@@ -189,7 +247,7 @@ impl Kernels {
 #[inline(always)]
 pub fn exp_neg(d: f64) -> f64 {
     const MAGIC: f64 = 6_755_399_441_055_744.0; // 1.5·2⁵²
-    const LN2_HI: f64 = 0.693_147_180_369_123_816_49;
+    const LN2_HI: f64 = 0.693_147_180_369_123_8;
     const LN2_LO: f64 = 1.908_214_929_270_587_7e-10;
     let x = -d;
     let t = x * std::f64::consts::LOG2_E + MAGIC;
@@ -244,6 +302,32 @@ mod tests {
             assert!((s - 1.0).abs() < 1e-12, "x={x}: sum {s}");
             assert!(!r.is_empty());
             assert!(psi.iter().all(|p| p.is_finite()));
+        }
+    }
+
+    #[test]
+    fn windowed_activations_equal_a_full_scan() {
+        for sys in [
+            CanonicalSystem::SecondOrder {
+                alpha_v: 25.0,
+                beta_v: 6.25,
+            },
+            CanonicalSystem::FirstOrder { alpha_s: 4.6 },
+        ] {
+            let b = Basis::even_in_time(&sys, 40, 0.5).unwrap();
+            let fast = b.kernels();
+            let mut full = fast.clone();
+            full.direction = 0;
+            let (mut p, mut q) = (vec![0.0; 40], vec![0.0; 40]);
+            for k in 0..=3000 {
+                let x = sys.phase(k as f64 / 2000.0).x;
+                let r1 = fast.normalized(x, &mut p);
+                let r2 = full.normalized(x, &mut q);
+                assert_eq!(r1, r2, "x={x}");
+                for i in r1 {
+                    assert!((p[i] - q[i]).abs() < 1e-15);
+                }
+            }
         }
     }
 

@@ -254,30 +254,37 @@ impl SpatialScaling {
     }
 }
 
-/// The paper's learning state z_demo: integrates `z′ = α_z(β_z(g − θ_demo(u)) − z)`, z(0) = `z0`,
-/// along demonstration samples `theta` spaced `du` apart in normalised time. Between samples θ is
-/// taken linear, for which the step is exact:
+/// The paper's learning state z_demo for `goals.len()` DOFs at once: integrates
+/// `z′ = α_z(β_z(g − θ_demo(u)) − z)`, z(0) = `z0`, along demonstration samples `theta`
+/// (frames × dofs, row-major) spaced `du` apart in normalised time; `out` has the same layout.
+/// Between samples θ is taken linear, for which the step is exact:
 /// `z_{k+1} = e^{−a h} z_k + b[(g − θ_k)(1 − e^{−ah})/a − (θ_{k+1} − θ_k)(h/a − (1 − e^{−ah})/a²)/h]`
 /// with a = α_z, b = α_zβ_z, h = du.
 pub fn integrate_z_demo(
     alpha_z: f64,
     beta_z: f64,
-    g: f64,
+    goals: &[f64],
     theta: &[f64],
     du: f64,
-    z0: f64,
+    z0: &[f64],
     out: &mut [f64],
 ) {
+    let dofs = goals.len();
+    let n = theta.len() / dofs;
     let a = alpha_z;
     let b = alpha_z * beta_z;
     let e = (-a * du).exp();
-    let i0 = (1.0 - e) / a;
-    let i1 = (du / a - (1.0 - e) / (a * a)) / du;
-    let mut z = z0;
-    for k in 0..theta.len() {
-        out[k] = z;
-        if k + 1 < theta.len() {
-            z = e * z + b * ((g - theta[k]) * i0 - (theta[k + 1] - theta[k]) * i1);
+    let i0 = b * (1.0 - e) / a;
+    let i1 = b * (du / a - (1.0 - e) / (a * a)) / du;
+    out[..dofs].copy_from_slice(z0);
+    for k in 0..n - 1 {
+        let (done, rest) = out.split_at_mut((k + 1) * dofs);
+        let z = &done[k * dofs..];
+        let next = &mut rest[..dofs];
+        let th = &theta[k * dofs..(k + 1) * dofs];
+        let th1 = &theta[(k + 1) * dofs..(k + 2) * dofs];
+        for j in 0..dofs {
+            next[j] = e * z[j] + (goals[j] - th[j]) * i0 - (th1[j] - th[j]) * i1;
         }
     }
 }
@@ -294,7 +301,7 @@ mod tests {
         let du = 0.1;
         let theta: Vec<f64> = (0..n).map(|k| 0.3 + 0.7 * k as f64 * du).collect();
         let mut z = vec![0.0; n];
-        integrate_z_demo(a, bz, g, &theta, du, 0.4, &mut z);
+        integrate_z_demo(a, bz, &[g], &theta, du, &[0.4], &mut z);
         let f = |u: f64, z: f64| a * (bz * (g - (0.3 + 0.7 * u)) - z);
         let (mut zz, h) = (0.4, 1e-4);
         for step in 0..10_000 {

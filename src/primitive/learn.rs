@@ -104,20 +104,31 @@ impl Default for LearnConfig {
     }
 }
 
-/// First and second derivatives of samples spaced `h` apart: central differences inside,
-/// second-order one-sided at the ends (needs at least 4 samples).
-pub fn derivatives(x: &[f64], h: f64, d1: &mut [f64], d2: &mut [f64]) {
-    let n = x.len();
+/// First and second derivatives of `dofs` signals sampled `h` apart, stored row-major
+/// (`x[k * dofs + j]`, at least 4 frames): central differences inside, second-order one-sided
+/// at the ends. Results use the same layout. All DOFs of a frame are processed together.
+pub fn derivatives(x: &[f64], dofs: usize, h: f64, d1: &mut [f64], d2: &mut [f64]) {
+    let n = x.len() / dofs;
     debug_assert!(n >= 4);
     let (i1, i2) = (0.5 / h, 1.0 / (h * h));
+    let row = |k: usize| &x[k * dofs..(k + 1) * dofs];
     for k in 1..n - 1 {
-        d1[k] = (x[k + 1] - x[k - 1]) * i1;
-        d2[k] = (x[k + 1] - 2.0 * x[k] + x[k - 1]) * i2;
+        let (a, b, c) = (row(k - 1), row(k), row(k + 1));
+        let o1 = &mut d1[k * dofs..(k + 1) * dofs];
+        let o2 = &mut d2[k * dofs..(k + 1) * dofs];
+        for j in 0..dofs {
+            o1[j] = (c[j] - a[j]) * i1;
+            o2[j] = (c[j] - 2.0 * b[j] + a[j]) * i2;
+        }
     }
-    d1[0] = (-3.0 * x[0] + 4.0 * x[1] - x[2]) * i1;
-    d1[n - 1] = (3.0 * x[n - 1] - 4.0 * x[n - 2] + x[n - 3]) * i1;
-    d2[0] = (2.0 * x[0] - 5.0 * x[1] + 4.0 * x[2] - x[3]) * i2;
-    d2[n - 1] = (2.0 * x[n - 1] - 5.0 * x[n - 2] + 4.0 * x[n - 3] - x[n - 4]) * i2;
+    for j in 0..dofs {
+        let (x0, x1, x2, x3) = (row(0)[j], row(1)[j], row(2)[j], row(3)[j]);
+        d1[j] = (-3.0 * x0 + 4.0 * x1 - x2) * i1;
+        d2[j] = (2.0 * x0 - 5.0 * x1 + 4.0 * x2 - x3) * i2;
+        let (y0, y1, y2, y3) = (row(n - 1)[j], row(n - 2)[j], row(n - 3)[j], row(n - 4)[j]);
+        d1[(n - 1) * dofs + j] = (3.0 * y0 - 4.0 * y1 + y2) * i1;
+        d2[(n - 1) * dofs + j] = (2.0 * y0 - 5.0 * y1 + 4.0 * y2 - y3) * i2;
+    }
 }
 
 /// Learns one [`DofPrimitive`] per DOF of `demo` on `basis`: start s = first frame, goal g = last
@@ -142,51 +153,67 @@ pub fn learn_dofs(
     let dofs = demo.dofs();
     let du = 1.0 / (n - 1) as f64;
 
-    // Forcing targets, frames × dofs (row-major, so each frame's targets are contiguous).
-    let mut targets = vec![0.0; dofs * n];
-    let mut out = Vec::with_capacity(dofs);
-    let mut col = vec![0.0; n];
-    let (mut d1, mut d2, mut zd) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
-    let phases: Vec<_> = (0..n).map(|k| canonical.phase(k as f64 * du)).collect();
-    for j in 0..dofs {
-        for (k, c) in col.iter_mut().enumerate() {
-            *c = demo.values[k * dofs + j];
+    // Everything below is frames × dofs, row-major: each frame's DOFs are contiguous, so every
+    // per-frame loop runs over all DOFs at once.
+    let x = &demo.values;
+    let mut d1 = vec![0.0; dofs * n];
+    let mut d2 = vec![0.0; dofs * n];
+    derivatives(x, dofs, du, &mut d1, &mut d2);
+    let starts = &x[..dofs];
+    let goals = &x[(n - 1) * dofs..];
+    let mut lo = starts.to_vec();
+    let mut hi = starts.to_vec();
+    for row in x.chunks_exact(dofs) {
+        for j in 0..dofs {
+            lo[j] = if row[j] < lo[j] { row[j] } else { lo[j] };
+            hi[j] = if row[j] > hi[j] { row[j] } else { hi[j] };
         }
-        derivatives(&col, du, &mut d1, &mut d2);
-        let (s, g) = (col[0], col[n - 1]);
-        let (lo, hi) = col
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
-                (a.min(*v), b.max(*v))
-            });
-        let range = hi - lo;
-        let scaling = if f.scales_with_goal()
-            && (g - s).abs() >= (config.degenerate_fraction * range).max(1e-9)
-        {
-            SpatialScaling::GoalMinusStart { reference: g - s }
-        } else {
-            SpatialScaling::Unscaled
-        };
-        if let Formulation::Ijspeert2002 {
-            alpha_z, beta_z, ..
-        } = f
-        {
-            integrate_z_demo(alpha_z, beta_z, g, &col, du, d1[0], &mut zd);
-        }
-        for k in 0..n {
-            targets[k * dofs + j] =
-                f.forcing_target(col[k], d1[k], d2[k], zd[k], g, s, phases[k].x);
-        }
-        out.push(DofPrimitive {
-            name: demo.names[j].clone(),
-            start: s,
-            goal: g,
-            start_rate: d1[0],
-            scaling,
-            weights: vec![0.0; nk],
-        });
     }
+    let mut zd = vec![0.0; dofs * n];
+    if let Formulation::Ijspeert2002 {
+        alpha_z, beta_z, ..
+    } = f
+    {
+        integrate_z_demo(alpha_z, beta_z, goals, x, du, &d1[..dofs], &mut zd);
+    }
+    let phases: Vec<_> = (0..n).map(|k| canonical.phase(k as f64 * du)).collect();
+    let mut targets = vec![0.0; dofs * n];
+    for (k, p) in phases.iter().enumerate() {
+        let r = k * dofs..(k + 1) * dofs;
+        let (th, a, b, z, t) = (
+            &x[r.clone()],
+            &d1[r.clone()],
+            &d2[r.clone()],
+            &zd[r.clone()],
+            &mut targets[r],
+        );
+        for j in 0..dofs {
+            t[j] = f.forcing_target(th[j], a[j], b[j], z[j], goals[j], starts[j], p.x);
+        }
+    }
+    let out: Vec<DofPrimitive> = (0..dofs)
+        .map(|j| {
+            let (s, g) = (starts[j], goals[j]);
+            let range = hi[j] - lo[j];
+            let scaling = if f.scales_with_goal()
+                && (g - s).abs() >= (config.degenerate_fraction * range).max(1e-9)
+            {
+                SpatialScaling::GoalMinusStart { reference: g - s }
+            } else {
+                SpatialScaling::Unscaled
+            };
+            DofPrimitive {
+                name: demo.names[j].clone(),
+                start: s,
+                goal: g,
+                start_rate: d1[j],
+                scaling,
+                weights: vec![0.0; nk],
+            }
+        })
+        .collect();
 
+    let mut out = out;
     let weights = match config.regression {
         Regression::LocallyWeighted => lwr(basis, &phases, &targets, dofs),
         Regression::Ridge { lambda } => {
@@ -369,7 +396,7 @@ mod tests {
             .map(|k| (k as f64 * h).powi(2) * 3.0 + k as f64 * h)
             .collect();
         let (mut d1, mut d2) = (vec![0.0; 50], vec![0.0; 50]);
-        derivatives(&x, h, &mut d1, &mut d2);
+        derivatives(&x, 1, h, &mut d1, &mut d2);
         for k in 0..50 {
             let u = k as f64 * h;
             assert!((d1[k] - (6.0 * u + 1.0)).abs() < 1e-9, "k={k}");
