@@ -27,7 +27,7 @@
 //!
 //! Files: [`canonical`] (shared phase), [`basis`] (kernels), [`dmp`] (one-DOF transformation system,
 //! formulations), [`learn`] (LWR and ridge), [`rollout`] (fixed-step integrator), [`primitive`]
-//! (multi-DOF primitive, adjust, RON io), [`connect`], [`blend`], [`events`], [`ecs`].
+//! (multi-DOF primitive, adjust, RON io), [`mod@connect`], [`mod@blend`], [`events`], [`ecs`].
 
 pub mod basis;
 pub mod blend;

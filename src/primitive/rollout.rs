@@ -7,7 +7,7 @@
 //! (K = α_zβ_z, D = α_z for Ijspeert 2002/2013; K, D for Hoffmann 2009), with the input
 //! B F̃ = (F, 0) for 2002 (forcing in the velocity equation), (0, F) for 2013 and
 //! (0, K(F − (g − θ₀)s)) for Hoffmann. To reach a requested time, the interval Δu is cut into
-//! `ceil(Δu / h_max)` equal sub-steps, `h_max = min(1/1000, 1/(4(N − 1)))` (N kernels: at least
+//! `ceil(Δu / h_max)` equal sub-steps, `h_max = min(1/500, 1/(4(N − 1)))` (N kernels: at least
 //! four sub-steps per kernel spacing), and each sub-step is integrated **exactly** for an input
 //! that is linear across the sub-step (first-order hold):
 //! `x₁ = Φx₀ + (Ψ₁ − Ψ₂/h)B F̃₀ + (Ψ₂/h)B F̃₁`, with `Φ = e^{Ah}`, `Ψ₁ = ∫₀ʰe^{Aσ}dσ`,
@@ -254,7 +254,7 @@ impl Rollout {
             canonical,
             kernels: p.basis.kernels(),
             tau: p.duration,
-            h_max: (1.0f64 / 1000.0).min(0.25 / (nk.max(2) - 1) as f64),
+            h_max: (1.0f64 / 500.0).min(0.25 / (nk.max(2) - 1) as f64),
             weights,
             goal: p.dofs.iter().map(|d| d.goal).collect(),
             start: theta0.clone(),
