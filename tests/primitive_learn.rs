@@ -192,3 +192,36 @@ fn root_motion_comes_along_and_is_reported_in_millimetres() {
     assert!((y_max - apex).abs() < 0.003, "apex {y_max} vs {apex}");
     assert!((k_max as f64 / 120.0 - truth.leap).abs() < 0.02);
 }
+
+#[test]
+fn learning_a_primitives_own_rollout_reproduces_it() {
+    let demo = smooth_humanoid24(600, 120.0, 5).unwrap();
+    for formulation in [
+        Formulation::default(),
+        Formulation::ijspeert2013(),
+        Formulation::hoffmann2009(),
+    ] {
+        let cfg = LearnConfig {
+            formulation,
+            ..LearnConfig::default()
+        };
+        let p = Primitive::learn("a", &demo, &cfg).unwrap().primitive;
+        let roll = p.rollout(demo.dt, None).unwrap();
+        let again = Primitive::learn("b", &roll, &cfg).unwrap();
+        let max = again.fit.max_angle_rmse_deg().unwrap();
+        assert!(max < 0.01, "{}: RMSE {max} deg", formulation.name());
+        for (a, b) in p.dofs.iter().zip(&again.primitive.dofs) {
+            // The rollout ends where the demonstration did, up to the fit error at the last frame.
+            assert!((a.goal - b.goal).abs() < 1e-3 && (a.start - b.start).abs() < 1e-12);
+            assert_eq!(
+                std::mem::discriminant(&a.scaling),
+                std::mem::discriminant(&b.scaling)
+            );
+        }
+    }
+    let bad = LearnConfig {
+        degenerate_fraction: -1.0,
+        ..LearnConfig::default()
+    };
+    assert!(Primitive::learn("x", &demo, &bad).is_err());
+}

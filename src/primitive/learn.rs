@@ -148,6 +148,12 @@ pub fn learn_dofs(
     }
     let f = config.formulation;
     f.validate()?;
+    if !(config.degenerate_fraction >= 0.0 && config.degenerate_fraction.is_finite()) {
+        return Err(PrimitiveError::InvalidParameter {
+            field: "degenerate_fraction".into(),
+            reason: format!("must be ≥ 0 and finite, got {}", config.degenerate_fraction),
+        });
+    }
     let canonical = f.canonical();
     let nk = basis.len();
     let dofs = demo.dofs();
