@@ -277,7 +277,8 @@ fn lwr(
 
 /// Ridge least squares over all kernels (see module docs). `targets` is frames × dofs; returns
 /// kernels × dofs. ΦᵀΦ is banded (each frame touches only the kernels near its phase), so it is
-/// factorised by a banded Cholesky.
+/// accumulated in band storage and factorised by a banded Cholesky: memory and time grow
+/// linearly with the number of kernels.
 fn ridge(
     basis: &Basis,
     phases: &[super::canonical::Phase],
@@ -287,25 +288,33 @@ fn ridge(
 ) -> Result<Vec<f64>> {
     let nk = basis.len();
     let kernels = basis.kernels();
-    let mut ata = vec![0.0; nk * nk];
-    let mut atb = vec![0.0; nk * dofs]; // kernels × dofs
+    // Pass 1: the design rows Φ_t· (gated normalised activations) of every frame, compactly.
     let mut phi = vec![0.0; nk];
-    let mut band = 0usize;
+    // (frame, first kernel of its window, its activations in `acts`).
+    let mut rows: Vec<(usize, usize, std::ops::Range<usize>)> = Vec::with_capacity(phases.len());
+    let mut acts: Vec<f64> = Vec::with_capacity(phases.len() * 16);
+    let mut band = 1usize;
     for (k, p) in phases.iter().enumerate() {
         if p.gate == 0.0 {
             continue;
         }
         let r = kernels.normalized(p.x, &mut phi);
         band = band.max(r.end - r.start);
-        for v in &mut phi[r.clone()] {
-            *v *= p.gate;
-        }
+        let at = acts.len();
+        acts.extend(phi[r.clone()].iter().map(|v| v * p.gate));
+        rows.push((k, r.start, at..acts.len()));
+    }
+    // Pass 2: ΦᵀΦ in upper band storage, ab[a·band + (b − a)] for a ≤ b < a + band, and ΦᵀF.
+    let mut ab = vec![0.0; nk * band];
+    let mut atb = vec![0.0; nk * dofs]; // kernels × dofs
+    for (k, a0, r) in &rows {
+        let act = &acts[r.clone()];
         let row = &targets[k * dofs..(k + 1) * dofs];
-        for a in r.clone() {
-            let pa = phi[a];
-            for (x, y) in ata[a * nk + a..a * nk + r.end]
+        for (ia, pa) in act.iter().enumerate() {
+            let a = a0 + ia;
+            for (x, y) in ab[a * band..a * band + (act.len() - ia)]
                 .iter_mut()
-                .zip(&phi[a..r.end])
+                .zip(&act[ia..])
             {
                 *x += pa * y;
             }
@@ -314,36 +323,32 @@ fn ridge(
             }
         }
     }
-    let max_diag = (0..nk).map(|i| ata[i * nk + i]).fold(0.0f64, f64::max);
+    let max_diag = (0..nk).map(|i| ab[i * band]).fold(0.0f64, f64::max);
     if max_diag <= 0.0 {
         return Ok(vec![0.0; dofs * nk]);
     }
     for i in 0..nk {
-        ata[i * nk + i] += lambda * ata[i * nk + i] + 1e-12 * max_diag;
-        for b in i.saturating_sub(band)..i {
-            ata[i * nk + b] = ata[b * nk + i];
-        }
+        ab[i * band] += lambda * ab[i * band] + 1e-12 * max_diag;
     }
-    let bw = band.max(1);
-    if !banded_cholesky(&mut ata, nk, bw) {
-        return Err(PrimitiveError::InvalidParameter {
-            field: "regression.lambda".into(),
-            reason: "normal equations not positive definite; increase lambda".into(),
-        });
-    }
-    let l = &ata;
+    let l = banded_cholesky(&ab, nk, band).ok_or_else(|| PrimitiveError::InvalidParameter {
+        field: "regression.lambda".into(),
+        reason: "normal equations not positive definite; increase lambda".into(),
+    })?;
+    let bw = band - 1;
+    // L in lower band storage: l[i·band + (i − j)] for i − bw ≤ j ≤ i.
+    let lij = |i: usize, j: usize| l[i * band + (i - j)];
     // Solve L Lᵀ W = B for all DOF columns at once (rows of B are contiguous).
     let mut w = atb;
     for i in 0..nk {
         let (done, rest) = w.split_at_mut(i * dofs);
         let wi = &mut rest[..dofs];
         for m in i.saturating_sub(bw)..i {
-            let lim = l[i * nk + m];
+            let c = lij(i, m);
             for (x, y) in wi.iter_mut().zip(&done[m * dofs..(m + 1) * dofs]) {
-                *x -= lim * y;
+                *x -= c * y;
             }
         }
-        let inv = 1.0 / l[i * nk + i];
+        let inv = 1.0 / lij(i, i);
         for x in wi.iter_mut() {
             *x *= inv;
         }
@@ -352,13 +357,13 @@ fn ridge(
         let (head, tail) = w.split_at_mut((i + 1) * dofs);
         let wi = &mut head[i * dofs..];
         for m in i + 1..(i + 1 + bw).min(nk) {
-            let lmi = l[m * nk + i];
+            let c = lij(m, i);
             let off = (m - i - 1) * dofs;
             for (x, y) in wi.iter_mut().zip(&tail[off..off + dofs]) {
-                *x -= lmi * y;
+                *x -= c * y;
             }
         }
-        let inv = 1.0 / l[i * nk + i];
+        let inv = 1.0 / lij(i, i);
         for x in wi.iter_mut() {
             *x *= inv;
         }
@@ -366,29 +371,30 @@ fn ridge(
     Ok(w)
 }
 
-/// In-place Cholesky A = L Lᵀ of a symmetric positive-definite n × n matrix (row-major) whose
-/// entries vanish more than `bw` off the diagonal; L (lower, same band) overwrites A's lower
-/// triangle. Returns false if A is not positive definite.
-fn banded_cholesky(a: &mut [f64], n: usize, bw: usize) -> bool {
+/// Cholesky A = L Lᵀ of a symmetric positive-definite n × n matrix given in upper band storage
+/// (`ab[a·band + (b − a)]` = A_ab for a ≤ b < a + band). Returns L in lower band storage
+/// (`l[i·band + (i − j)]` = L_ij for i − band < j ≤ i), or `None` if A is not positive definite.
+fn banded_cholesky(ab: &[f64], n: usize, band: usize) -> Option<Vec<f64>> {
+    let bw = band - 1;
+    let mut l = vec![0.0; n * band];
     for i in 0..n {
         let lo_i = i.saturating_sub(bw);
         for j in lo_i..=i {
-            let lo = lo_i.max(j.saturating_sub(bw));
-            let mut s = a[i * n + j];
-            for k in lo..j {
-                s -= a[i * n + k] * a[j * n + k];
+            let mut s = ab[j * band + (i - j)];
+            for k in lo_i.max(j.saturating_sub(bw))..j {
+                s -= l[i * band + (i - k)] * l[j * band + (j - k)];
             }
             if i == j {
                 if s <= 0.0 || !s.is_finite() {
-                    return false;
+                    return None;
                 }
-                a[i * n + i] = s.sqrt();
+                l[i * band] = s.sqrt();
             } else {
-                a[i * n + j] = s / a[j * n + j];
+                l[i * band + (i - j)] = s / l[j * band];
             }
         }
     }
-    true
+    Some(l)
 }
 
 #[cfg(test)]
@@ -414,15 +420,16 @@ mod tests {
     fn banded_cholesky_factors_a_tridiagonal_matrix() {
         // A = L Lᵀ with L = [[2,0,0],[1,√2,0],[0,1,1]] → A = [[4,2,0],[2,3,√2],[0,√2,2]].
         let r2 = 2f64.sqrt();
-        let mut a = vec![4.0, 2.0, 0.0, 2.0, 3.0, r2, 0.0, r2, 2.0];
-        assert!(banded_cholesky(&mut a, 3, 1));
-        let l = [2.0, 1.0, r2, 1.0, 1.0];
-        let got = [a[0], a[3], a[4], a[7], a[8]];
-        for (x, y) in got.iter().zip(&l) {
-            assert!((x - y).abs() < 1e-14, "{got:?}");
+        // Upper band storage, band 2: rows (A_aa, A_a,a+1).
+        let ab = vec![4.0, 2.0, 3.0, r2, 2.0, 0.0];
+        let l = banded_cholesky(&ab, 3, 2).unwrap();
+        // Lower band storage: rows (L_ii, L_i,i−1).
+        let expect = [2.0, 0.0, r2, 1.0, 1.0, 1.0];
+        for (x, y) in l.iter().zip(&expect) {
+            assert!((x - y).abs() < 1e-14, "{l:?}");
         }
-        let mut b = vec![1.0, 2.0, 2.0, 1.0];
-        assert!(!banded_cholesky(&mut b, 2, 1));
+        // [[1, 2], [2, 1]] is not positive definite.
+        assert!(banded_cholesky(&[1.0, 2.0, 1.0, 0.0], 2, 2).is_none());
     }
 
     #[test]
