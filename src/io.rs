@@ -71,10 +71,14 @@ pub struct RonError {
 }
 
 /// Parses RON text the way every marionette file is read: `Option` fields may be written
-/// without `Some(…)` (ron's `implicit_some`); errors carry `origin`, line and column.
+/// without `Some(…)` (ron's `implicit_some`) and a variant holding a struct as `Variant(a: 1)`
+/// (`unwrap_variant_newtypes`); errors carry `origin`, line and column.
 pub fn parse_ron<T: serde::de::DeserializeOwned>(text: &str, origin: &str) -> Result<T, RonError> {
     ron::Options::default()
-        .with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME)
+        .with_default_extension(
+            ron::extensions::Extensions::IMPLICIT_SOME
+                | ron::extensions::Extensions::UNWRAP_VARIANT_NEWTYPES,
+        )
         .from_str(text)
         .map_err(|e| RonError {
             path: origin.to_string(),

@@ -8,12 +8,15 @@
 //! Conventions: metres, seconds, radians inside (degrees only at the edges: files, reports,
 //! plots); Y is up, a character faces +Z and its left is +X (right-handed).
 
+pub mod analysis;
 pub mod bvh;
 pub mod clips;
 pub mod dynamics;
+pub mod ecs;
 pub mod io;
 pub mod mapping;
 pub mod model;
 pub mod primitive;
 pub mod render;
+pub mod scene;
 pub mod skeleton;

@@ -855,3 +855,26 @@ fn parse_file_errors_name_the_file() {
     assert!(e.to_string().contains("missing.bvh"), "{e}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn a_value_or_a_frame_missing_from_the_jumps_file() {
+    let Some(dir) = data_dir() else { return };
+    let text = std::fs::read_to_string(dir.join("cmu/cmu_01_01_forward_jumps.bvh")).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines.len(), 2939);
+    // Line 188 is frame 1; drop its last value.
+    let mut short = lines.clone();
+    short[187] = lines[187].trim_end().rsplit_once(' ').unwrap().0;
+    let e = fails(short.join("\n"), 188, &[]);
+    assert_eq!(
+        e.to_string(),
+        "line 188: expected 96 numbers in frame 1, found 95 (a BVH frame is exactly one line of values)"
+    );
+    // The last frame (line 2939) missing altogether.
+    let cut = lines[..2938].join("\n") + "\n";
+    fails(
+        cut,
+        2939,
+        &["ends after 2751 of the 2752 frames declared on line 186"],
+    );
+}

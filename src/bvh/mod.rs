@@ -4,6 +4,22 @@
 //! before its children), each joint's OFFSET, CHANNELS and optional End Site, and the MOTION
 //! block as one flat `frames × channel_count` array of the values as written (file units,
 //! degrees). Turning that into rotations and positions is [`crate::skeleton`]'s job.
+//!
+//! [`parse`] / [`parse_file`] read any skeleton (any channel order and count, End Sites,
+//! several roots, LF or CRLF); malformed input gives a [`BvhError`] naming the line, never a
+//! panic. [`to_string`] / [`write_file`] write text that reads back to identical values.
+//!
+//! ```
+//! use marionette::bvh;
+//! let text = "HIERARCHY\nROOT Hips\n{\n\tOFFSET 0 0 0\n\tCHANNELS 3 Zrotation Xrotation Yrotation\n\
+//!             \tEnd Site\n\t{\n\t\tOFFSET 0 1 0\n\t}\n}\nMOTION\nFrames: 1\nFrame Time: .0083333\n\
+//!             10 -0 1e-06\n";
+//! let (b, warnings) = bvh::parse(text.as_bytes())?;
+//! assert!(warnings.is_empty());
+//! assert_eq!((b.frame_count(), b.channel_count, b.frame(0)[0]), (1, 3, 10.0));
+//! assert_eq!(bvh::parse(bvh::to_string(&b).as_bytes())?.0, b);
+//! # Ok::<(), bvh::BvhError>(())
+//! ```
 
 mod error;
 mod parse;

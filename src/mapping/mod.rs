@@ -5,8 +5,10 @@
 //! hand, hip, knee, ankle, toe), the source joint or End Site that marks it. [`retarget`] turns a
 //! clip into the model's DOF angle trajectories plus root motion ([`ModelClip`]).
 
+mod fidelity;
 mod retarget;
 
+pub use fidelity::{EffectorError, effector_errors};
 pub use retarget::retarget;
 
 use std::collections::BTreeMap;
@@ -103,7 +105,15 @@ pub struct Landmark {
     pub end_site: bool,
 }
 
-const BUILTIN: [(&str, &str); 3] = [
+const BUILTIN: [(&str, &str); 5] = [
+    (
+        "marionette_humanoid24.ron",
+        include_str!("../../scenes/mappings/marionette_humanoid24.ron"),
+    ),
+    (
+        "marionette_fall21.ron",
+        include_str!("../../scenes/mappings/marionette_fall21.ron"),
+    ),
     (
         "cmu_cgspeed.ron",
         include_str!("../../scenes/mappings/cmu_cgspeed.ron"),
@@ -233,7 +243,7 @@ mod tests {
     #[test]
     fn builtins_parse_and_name_every_landmark() {
         let b = Mapping::builtins();
-        assert_eq!(b.len(), 3);
+        assert_eq!(b.len(), 5);
         for m in &b {
             assert_eq!(m.landmarks.len(), LANDMARKS.len(), "{}", m.name);
             // Left landmarks name left joints (a swapped mapping would be caught here).

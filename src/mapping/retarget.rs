@@ -137,12 +137,13 @@ fn target_frame(
             let hint = perp(l("wrist") - l("elbow"), u) + 0.2 * perp(chest * DVec3::Z, u);
             frame_from(upper, hint, chest * DVec3::Y, DVec3::NEG_Y, DVec3::Z)
         }
+        // A hinge's hint is its own axis in the parent (lateral): valid at any bend, even past 90°.
         "elbow" => frame_from(
             l("wrist") - l("elbow"),
-            parent_frame * DVec3::Z,
             parent_frame * DVec3::X,
+            parent_frame * DVec3::Z,
             DVec3::NEG_Y,
-            DVec3::Z,
+            DVec3::X,
         ),
         "wrist" => frame_from(
             l("hand") - l("wrist"),
@@ -160,10 +161,10 @@ fn target_frame(
         }
         "knee" => frame_from(
             l("ankle") - l("knee"),
-            parent_frame * DVec3::Z,
             parent_frame * DVec3::X,
+            parent_frame * DVec3::Z,
             DVec3::NEG_Y,
-            DVec3::Z,
+            DVec3::X,
         ),
         "ankle" => frame_from(
             l("toe") - l("ankle"),
@@ -232,17 +233,9 @@ pub fn retarget(clip: &Clip, mapping: &Mapping, model: &Model) -> Result<ModelCl
         }
     }
 
-    // Rest primary directions of links whose bone is not straight down (clavicle, hand, foot).
+    // Rest directions of the links (the clavicle's, hand's and foot's are not straight down).
     let n = model.joints.len();
-    let mut rest_dirs = vec![DVec3::NEG_Y; n];
-    for (j, joint) in model.joints.iter().enumerate() {
-        if let Some(c) = model.joints.iter().position(|c| c.parent == Some(j)) {
-            rest_dirs[j] = model.joints[c].offset.normalize_or(DVec3::NEG_Y);
-        }
-        if let Some(e) = joint.end_site {
-            rest_dirs[j] = e.normalize_or(DVec3::NEG_Y);
-        }
-    }
+    let rest_dirs: Vec<DVec3> = (0..n).map(|j| model.link_direction(j)).collect();
 
     // Target frames per frame and link.
     let mut targets = vec![None; frames * n];
@@ -307,7 +300,14 @@ pub fn retarget(clip: &Clip, mapping: &Mapping, model: &Model) -> Result<ModelCl
                 let first = joint.dofs[0];
                 let prev = (f > 0)
                     .then(|| angles[(f - 1) * dofs + first..(f - 1) * dofs + first + m].to_vec());
-                project_rotation(joint.kind, &axes, local, prev.as_deref(), &mut out[..m]);
+                project_rotation(
+                    joint.kind,
+                    &axes,
+                    rest_dirs[j],
+                    local,
+                    prev.as_deref(),
+                    &mut out[..m],
+                );
                 angles[f * dofs + first..f * dofs + first + m].copy_from_slice(&out[..m]);
             }
             achieved[j] = parent * local_rotation(joint.kind, &axes, &out[..m]);

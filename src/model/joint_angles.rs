@@ -33,15 +33,17 @@ pub fn unwrap_near(a: f64, reference: f64) -> f64 {
 /// the result continuous over time (no ±2π jumps, no rotation-vector flips).
 ///
 /// - Pin: the twist of `q` about the axis (swing–twist decomposition), `θ = 2·atan2(q⃗·a, q_w)`.
-/// - Universal: the first two angles of the Tait–Bryan decomposition
-///   `R = R(a₁,θ₁)R(a₂,θ₂)R(a₁×a₂,θ₃)`; θ₃ (a motion the joint cannot make) is dropped. When the
-///   link's bone is perpendicular to a₁ and a₂ or along a₂, the dropped rotation does not move
-///   the bone, so its direction is matched exactly.
+/// - Universal with the link's rest direction `bone` along a₂ (bend then twist, an elbow): θ₁
+///   bends the link onto its current direction, θ₂ is the remaining twist about it.
+/// - Universal with `bone` across both axes (waist, clavicle, a 2-DOF hip): the first two angles
+///   of the Tait–Bryan decomposition `R = R(a₁,θ₁)R(a₂,θ₂)R(a₁×a₂,θ₃)`; θ₃, a twist about the
+///   link the joint cannot make, is dropped, so the link's direction is matched exactly.
 /// - Ball: the rotation vector `log(q)` along the three axes, taking of `v` and `v − 2π·v̂` the
 ///   one nearer `previous`.
 pub fn project_rotation(
     kind: JointKind,
     axes: &[DVec3],
+    bone: DVec3,
     q: DQuat,
     previous: Option<&[f64]>,
     out: &mut [f64],
@@ -59,19 +61,41 @@ pub fn project_rotation(
         JointKind::Universal => {
             let a1 = axes[0].normalize();
             let a2 = axes[1].normalize();
+            let (p0, p1) = previous.map_or((0.0, 0.0), |p| (p[0], p[1]));
+            let b0 = bone.normalize_or(DVec3::NEG_Y);
+            if b0.dot(a2).abs() > 0.9 {
+                // Bend, then twist about the link (an elbow): the bend is the angle about a₁ that
+                // takes the link's rest direction to its current one, the twist what remains
+                // about a₂. Exact for the link's direction at any twist.
+                let d = q * b0;
+                let d_perp = d - a1 * a1.dot(d);
+                let b_perp = b0 - a1 * a1.dot(b0);
+                let t1 = a1.dot(b_perp.cross(d_perp)).atan2(b_perp.dot(d_perp));
+                let rest = DQuat::from_axis_angle(a1, t1).inverse() * q;
+                let t2 = 2.0 * rest.xyz().dot(a2).atan2(rest.w);
+                out[0] = unwrap_near(t1, p0);
+                out[1] = unwrap_near(t2, p1);
+                return;
+            }
             let a3 = a1.cross(a2);
             let basis = DMat3::from_cols(a1, a2, a3);
             // R expressed in the joint's axis basis: R' = Bᵀ R B = Rx(θ1) Ry(θ2) Rz(θ3).
             let r = basis.transpose() * DMat3::from_quat(q) * basis;
             // Element (row i, column j) is r.col(j)[i].
-            let r02 = r.z_axis.x;
-            let r12 = r.z_axis.y;
-            let r22 = r.z_axis.z;
-            let t1 = (-r12).atan2(r22);
-            let t2 = r02.clamp(-1.0, 1.0).asin();
-            let (p0, p1) = previous.map_or((0.0, 0.0), |p| (p[0], p[1]));
-            out[0] = unwrap_near(t1, p0);
-            out[1] = unwrap_near(t2, p1);
+            let t1 = (-r.z_axis.y).atan2(r.z_axis.z);
+            let t2 = r.z_axis.x.clamp(-1.0, 1.0).asin();
+            // Both decompositions (θ₁, θ₂) and (θ₁+π, π−θ₂) point a₃ the same way; take the one
+            // nearer the previous frame so the angles stay continuous.
+            let a = (unwrap_near(t1, p0), unwrap_near(t2, p1));
+            let b = (unwrap_near(t1 + PI, p0), unwrap_near(PI - t2, p1));
+            let dist = |x: (f64, f64)| (x.0 - p0).powi(2) + (x.1 - p1).powi(2);
+            let best = if previous.is_some() && dist(b) < dist(a) {
+                b
+            } else {
+                a
+            };
+            out[0] = best.0;
+            out[1] = best.1;
         }
         JointKind::Ball => {
             let q = if q.w < 0.0 { -q } else { q };
@@ -107,7 +131,7 @@ mod tests {
     fn roundtrip(kind: JointKind, axes: &[DVec3], angles: &[f64]) -> Vec<f64> {
         let q = local_rotation(kind, axes, angles);
         let mut out = vec![0.0; angles.len()];
-        project_rotation(kind, axes, q, Some(angles), &mut out);
+        project_rotation(kind, axes, DVec3::NEG_Y, q, Some(angles), &mut out);
         out
     }
 
@@ -140,11 +164,25 @@ mod tests {
         let q =
             local_rotation(JointKind::Universal, &axes, &[0.4, -0.3]) * DQuat::from_rotation_y(0.8);
         let mut out = [0.0; 2];
-        project_rotation(JointKind::Universal, &axes, q, None, &mut out);
+        project_rotation(JointKind::Universal, &axes, DVec3::Y, q, None, &mut out);
         assert!(
             (out[0] - 0.4).abs() < 1e-12 && (out[1] + 0.3).abs() < 1e-12,
             "{out:?}"
         );
+    }
+
+    #[test]
+    fn universal_with_a_large_second_angle_keeps_the_link_pointing_the_same_way() {
+        // Elbow: flexion then pronation about the forearm; pronation past 90° must not be read
+        // as the other branch with a 180° third rotation (which would flip the forearm).
+        let axes = [DVec3::NEG_X, DVec3::Y];
+        let q =
+            local_rotation(JointKind::Universal, &axes, &[0.8, 2.4]) * DQuat::from_rotation_z(0.1);
+        let bone = DVec3::NEG_Y;
+        let mut out = [0.0; 2];
+        project_rotation(JointKind::Universal, &axes, DVec3::NEG_Y, q, None, &mut out);
+        let forearm = local_rotation(JointKind::Universal, &axes, &out) * DVec3::NEG_Y;
+        assert!(forearm.angle_between(q * bone) < 0.101, "{out:?}");
     }
 
     #[test]
@@ -160,7 +198,14 @@ mod tests {
             let a = i as f64 * 0.05; // up to 4 rad
             let q = local_rotation(JointKind::Ball, &axes, &[a, 0.0, 0.0]);
             let mut out = [0.0; 3];
-            project_rotation(JointKind::Ball, &axes, q, Some(&prev), &mut out);
+            project_rotation(
+                JointKind::Ball,
+                &axes,
+                DVec3::NEG_Y,
+                q,
+                Some(&prev),
+                &mut out,
+            );
             assert!((out[0] - a).abs() < 1e-9, "step {i}: {a} -> {out:?}");
             prev = out;
         }

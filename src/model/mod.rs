@@ -20,7 +20,7 @@ pub mod ranges;
 
 pub use definition::{fall21, humanoid24};
 pub use joint_angles::{local_rotation, project_rotation, unwrap_near};
-pub use model_clip::ModelClip;
+pub use model_clip::{ModelClip, ROOT_CHANNELS};
 
 use glam::{DQuat, DVec3};
 use serde::{Deserialize, Serialize};
@@ -140,6 +140,21 @@ impl Model {
             .iter()
             .map(|&d| self.dofs[d].axis)
             .collect()
+    }
+
+    /// Rest direction of joint `j`'s link: towards its first child, or its End Site; straight
+    /// down for a link with neither.
+    pub fn link_direction(&self, j: usize) -> DVec3 {
+        let end = self.joints[j].end_site;
+        let child = self
+            .joints
+            .iter()
+            .find(|c| c.parent == Some(j))
+            .map(|c| c.offset);
+        child
+            .or(end)
+            .and_then(|v| v.try_normalize())
+            .unwrap_or(DVec3::NEG_Y)
     }
 
     /// A copy with every offset and end site scaled so that the standing height is `height` m.

@@ -201,8 +201,11 @@ fn forcing(
 impl Rollout {
     /// Starts playing `p` at t = 0 from the demonstrated start (θ = s, θ̇ = k·start_rate/τ with k
     /// the goal-scaling factor, so a new goal scales the whole demonstrated path), or from
-    /// `start` (connect: θ and θ̇ of the previous motion). The start enters the spatial scaling
-    /// k = (g − s)/A with s = the actual start angle.
+    /// `start` (connect: θ and θ̇ of the previous motion). The spatial scaling k = (g − s)/A
+    /// keeps the primitive's own s: a connected primitive starting elsewhere follows its own
+    /// course, and the transformation system's spring–damper pulls the state onto it (the
+    /// paper's connection), instead of rescaling the whole motion by how far the hand-over
+    /// state is from s (which, for a DOF whose g − s is small, would blow the motion up).
     pub fn new(p: &Primitive, start: Option<&DofState>) -> Result<Rollout> {
         p.validate()?;
         let dofs = p.dofs.len();
@@ -239,8 +242,7 @@ impl Rollout {
         let scale: Vec<f64> = p
             .dofs
             .iter()
-            .zip(&theta0)
-            .map(|(d, s)| d.scaling.factor(d.goal, *s))
+            .map(|d| d.scaling.factor(d.goal, d.start))
             .collect();
         let mut weights = vec![0.0; nk * dofs];
         for (j, d) in p.dofs.iter().enumerate() {

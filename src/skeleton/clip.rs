@@ -253,11 +253,19 @@ impl Clip {
         })
     }
 
-    /// The clip as BVH content: the root gets 6 channels (`Xposition Yposition Zposition
-    /// Zrotation Xrotation Yrotation`), other joints 3 rotation channels in ZXY order, plus
-    /// position channels where a joint's translation ever differs from its offset. Metres.
+    /// The clip as BVH content with rotation channels in ZXY order (see
+    /// [`Clip::to_bvh_with_order`]).
     pub fn to_bvh(&self) -> Bvh {
-        const ZXY: [usize; 3] = [2, 0, 1];
+        self.to_bvh_with_order([2, 0, 1])
+    }
+
+    /// The clip as BVH content: every joint gets 3 rotation channels in `order` (axes 0 = X,
+    /// 1 = Y, 2 = Z, e.g. `[2, 0, 1]` for `Zrotation Xrotation Yrotation`), preceded by 3
+    /// position channels on the root and wherever a joint's translation ever differs from its
+    /// offset. Metres, degrees.
+    pub fn to_bvh_with_order(&self, order: [usize; 3]) -> Bvh {
+        let rot_channel =
+            |a: usize| [Channel::Xrotation, Channel::Yrotation, Channel::Zrotation][a];
         let n = self.joint_count();
         let frames = self.frame_count();
         let moving: Vec<bool> = (0..n)
@@ -276,7 +284,7 @@ impl Clip {
             if moving[j] {
                 channels.extend([Channel::Xposition, Channel::Yposition, Channel::Zposition]);
             }
-            channels.extend([Channel::Zrotation, Channel::Xrotation, Channel::Yrotation]);
+            channels.extend(order.map(rot_channel));
             let count = channels.len();
             joints.push(BvhJoint {
                 name: sj.name.clone(),
@@ -295,7 +303,7 @@ impl Clip {
                     let t = self.translations[f * n + j];
                     motion.extend([t.x, t.y, t.z]);
                 }
-                let e = quat_to_euler(ZXY, self.rotations[f * n + j]);
+                let e = quat_to_euler(order, self.rotations[f * n + j]);
                 motion.extend(e.iter().map(|a| a.to_degrees()));
             }
         }

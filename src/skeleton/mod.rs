@@ -91,4 +91,12 @@ impl Skeleton {
         self.points(&g, &mut pts);
         pts
     }
+
+    /// A stick figure for [`crate::render`]: point names and parents (joints, then End Sites).
+    pub fn figure(&self) -> crate::render::Figure {
+        crate::render::Figure {
+            names: self.point_names(),
+            parents: self.point_parents(),
+        }
+    }
 }

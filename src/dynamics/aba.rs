@@ -1,0 +1,157 @@
+//! The articulated-body algorithm (Featherstone 2008, §7.3, `FDab`): forward dynamics
+//! `q̈ = FD(q, q̇, τ, f_ext)` in O(n).
+//!
+//! Pass 1 ([`kinematics`]): `Xup, S, v, c`. Pass 2 (leaves → root):
+//! `U = I^A S`, `D = Sᵀ U`, `u = τ − Sᵀ p^A`, and for a body with a parent
+//! `I^a = I^A − U D⁻¹ Uᵀ`, `p^a = p^A + I^a c + U D⁻¹ u`, accumulated into the parent as
+//! `Xupᵀ I^a Xup` and `Xupᵀ p^a`. Pass 3 (root → leaves): `a' = Xup a_λ + c`,
+//! `q̈ = D⁻¹(u − Uᵀ a')`, `a = a' + S q̈`. A free root has `S = 1₆`, so its acceleration is
+//! `a = (I^A)⁻¹(τ − p^A)` (Featherstone's floating-base variant, `FDfb`).
+
+use super::data::Data;
+use super::joint::JointType;
+use super::kinematics::{base_acceleration, kinematics};
+use super::model::Model;
+use super::spatial::ForceVec;
+use glam::{DMat3, DVec3};
+
+/// Forward dynamics: returns `q̈` (size nv, in `data.qdd`) for configuration `q` (nq), velocity
+/// `v` (nv), joint forces `tau` (nv; N·m, or the free root's `[n; f]` in body coordinates) and
+/// external forces `f_ext` on each body (body coordinates).
+pub fn aba<'d>(
+    model: &Model,
+    data: &'d mut Data,
+    q: &[f64],
+    v: &[f64],
+    tau: &[f64],
+    f_ext: &[ForceVec],
+) -> &'d [f64] {
+    kinematics(model, data, q, v);
+    aba_passes(model, data, tau, f_ext, None);
+    &data.qdd
+}
+
+/// Passes 2 and 3 of the ABA on kinematics already in `data`. `armature` (size nv, N·m·s²)
+/// is added to each joint's `D`, so that the algorithm solves `(H + diag(armature)) q̈ = τ − C`;
+/// the integrator uses it to take joint damping implicitly (armature = `dt·k_v`).
+pub fn aba_passes(
+    model: &Model,
+    data: &mut Data,
+    tau: &[f64],
+    f_ext: &[ForceVec],
+    armature: Option<&[f64]>,
+) {
+    let n = model.nbodies();
+    debug_assert_eq!(f_ext.len(), n);
+    for i in 0..n {
+        let inertia = &model.bodies[i].inertia;
+        let vi = data.v[i];
+        data.ia[i] = model.inertia_blocks[i];
+        data.pa[i] = vi.cross_force(inertia.apply(vi)) - f_ext[i];
+    }
+    for i in (0..n).rev() {
+        let body = &model.bodies[i];
+        let iv = model.v_idx[i];
+        let ia = data.ia[i];
+        let pa = data.pa[i];
+        let arm = |k: usize| armature.map_or(0.0, |a| a[iv + k]);
+        match body.joint {
+            JointType::Pin { .. } => {
+                let s = data.s[i][0];
+                let u = ia.apply(s);
+                let d = s.dot(u) + arm(0);
+                let uu = tau[iv] - s.dot(pa);
+                let dinv = 1.0 / d;
+                data.u[i][0] = u;
+                data.dinv[i].x_axis.x = dinv;
+                data.uu[i].x = uu;
+                if let Some(p) = body.parent {
+                    let mut ia_a = ia;
+                    ia_a.sub_outer(u, dinv);
+                    let pa_a = pa + ia_a.apply(data.c[i]) + u * (dinv * uu);
+                    let x = data.xup[i];
+                    data.ia[p] += ia_a.transform_to_parent(&x);
+                    data.pa[p] += x.inv_apply_force(pa_a);
+                }
+            }
+            JointType::Universal { .. } | JointType::Ball { .. } => {
+                let nv = body.joint.nv();
+                let mut u = [ForceVec::ZERO; 3];
+                let mut d = DMat3::IDENTITY;
+                let mut uu = DVec3::ZERO;
+                for k in 0..nv {
+                    u[k] = ia.apply(data.s[i][k]);
+                    uu[k] = tau[iv + k] - data.s[i][k].dot(pa);
+                }
+                for r in 0..nv {
+                    for k in 0..nv {
+                        let mut e = data.s[i][r].dot(u[k]);
+                        if r == k {
+                            e += arm(k);
+                        }
+                        d.col_mut(k)[r] = e;
+                    }
+                }
+                let dinv = d.inverse();
+                data.u[i] = u;
+                data.dinv[i] = dinv;
+                data.uu[i] = uu;
+                if let Some(p) = body.parent {
+                    let mut ia_a = ia;
+                    ia_a.sub_u_dinv_ut(&u[..nv], &dinv);
+                    let w = dinv * uu;
+                    let mut pa_a = pa + ia_a.apply(data.c[i]);
+                    for k in 0..nv {
+                        pa_a += u[k] * w[k];
+                    }
+                    let x = data.xup[i];
+                    data.ia[p] += ia_a.transform_to_parent(&x);
+                    data.pa[p] += x.inv_apply_force(pa_a);
+                }
+            }
+            JointType::Free => {}
+        }
+    }
+    let a0 = base_acceleration(model);
+    for i in 0..n {
+        let body = &model.bodies[i];
+        let iv = model.v_idx[i];
+        let a_parent = match body.parent {
+            Some(p) => data.a[p],
+            None => a0,
+        };
+        let a_prime = data.xup[i].apply_motion(a_parent) + data.c[i];
+        match body.joint {
+            JointType::Pin { .. } => {
+                let qdd = data.dinv[i].x_axis.x * (data.uu[i].x - data.u[i][0].dot_motion(a_prime));
+                data.qdd[iv] = qdd;
+                data.a[i] = a_prime + data.s[i][0] * qdd;
+            }
+            JointType::Universal { .. } | JointType::Ball { .. } => {
+                let nv = body.joint.nv();
+                let mut r = DVec3::ZERO;
+                for k in 0..nv {
+                    r[k] = data.uu[i][k] - data.u[i][k].dot_motion(a_prime);
+                }
+                let qdd = data.dinv[i] * r;
+                let mut a = a_prime;
+                for k in 0..nv {
+                    data.qdd[iv + k] = qdd[k];
+                    a += data.s[i][k] * qdd[k];
+                }
+                data.a[i] = a;
+            }
+            JointType::Free => {
+                let f = ForceVec::new(
+                    DVec3::new(tau[iv], tau[iv + 1], tau[iv + 2]),
+                    DVec3::new(tau[iv + 3], tau[iv + 4], tau[iv + 5]),
+                ) - data.pa[i];
+                let a = data.ia[i].solve(f);
+                let qdd = a - a_prime;
+                data.qdd[iv..iv + 3].copy_from_slice(&qdd.ang.to_array());
+                data.qdd[iv + 3..iv + 6].copy_from_slice(&qdd.lin.to_array());
+                data.a[i] = a;
+            }
+        }
+    }
+}

@@ -1,0 +1,445 @@
+//! The fall21 human as an articulated body: the joint tree, DOF names, axes and offsets of
+//! [`crate::model::fall21`] (scaled to the subject's height), with segment masses, centres of mass
+//! and inertias from **de Leva (1996)**, *Adjustments to Zatsiorsky–Seluyanov's segment inertia
+//! parameters*, J. Biomech. 29(9):1223–1230, Table 4 (males: stature 1741 mm, 73.0 kg), scaled
+//! to the subject's height `H` and mass `M`: `m_i = μ_i M`, lengths `ℓ_i = ℓ_i,ref · H / 1.741`,
+//! `I = m (r ℓ)²` with the table's radii of gyration `r` (sagittal, transverse, longitudinal).
+//!
+//! The 15 links: pelvis (de Leva's lower trunk), torso (upper + middle trunk), head (head + neck),
+//! and per side upper arm, forearm, hand, thigh, shank, foot. Each link also carries a box for
+//! floor contact (SPEC §3: "a box on each link").
+
+use super::joint::JointType;
+use super::model::{Body, Model, ModelError};
+use super::spatial::{Inertia, SpatialTransform};
+use crate::model::{self as figure, JointKind};
+use glam::{DMat3, DVec3};
+
+/// Stature of de Leva's male reference subject (m).
+pub const DE_LEVA_STATURE: f64 = 1.741;
+
+/// One row of de Leva (1996) Table 4 (males): length (mm), mass (% of body mass), centre of
+/// mass (% of length from the proximal end point) and radii of gyration (% of length) about the
+/// sagittal (medio-lateral), transverse (antero-posterior) and longitudinal axes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SegmentRow {
+    /// Segment length between de Leva's end points (mm).
+    pub length_mm: f64,
+    /// Mass as a percentage of body mass.
+    pub mass_pct: f64,
+    /// Centre of mass, percent of the length from the proximal end point.
+    pub com_pct: f64,
+    /// Radius of gyration about the sagittal (medio-lateral) axis, percent of length.
+    pub r_sagittal_pct: f64,
+    /// Radius of gyration about the transverse (antero-posterior) axis, percent of length.
+    pub r_transverse_pct: f64,
+    /// Radius of gyration about the longitudinal axis, percent of length.
+    pub r_longitudinal_pct: f64,
+}
+
+const fn row(length_mm: f64, mass_pct: f64, com_pct: f64, rs: f64, rt: f64, rl: f64) -> SegmentRow {
+    SegmentRow {
+        length_mm,
+        mass_pct,
+        com_pct,
+        r_sagittal_pct: rs,
+        r_transverse_pct: rt,
+        r_longitudinal_pct: rl,
+    }
+}
+
+/// Head + neck (vertex → cervicale).
+pub const DE_LEVA_HEAD: SegmentRow = row(242.9, 6.94, 59.76, 36.2, 37.6, 31.2);
+/// Upper trunk (cervicale → xiphion).
+pub const DE_LEVA_UPPER_TRUNK: SegmentRow = row(242.1, 15.96, 50.66, 50.5, 32.0, 46.5);
+/// Middle trunk (xiphion → omphalion).
+pub const DE_LEVA_MIDDLE_TRUNK: SegmentRow = row(215.5, 16.33, 45.02, 48.2, 38.3, 46.8);
+/// Lower trunk (omphalion → hip-joint centres).
+pub const DE_LEVA_LOWER_TRUNK: SegmentRow = row(145.7, 11.17, 61.15, 61.5, 55.1, 58.7);
+/// Upper arm (shoulder → elbow joint centre).
+pub const DE_LEVA_UPPER_ARM: SegmentRow = row(281.7, 2.71, 57.72, 28.5, 26.9, 15.8);
+/// Forearm (elbow → wrist joint centre).
+pub const DE_LEVA_FOREARM: SegmentRow = row(268.9, 1.62, 45.74, 27.6, 26.5, 12.1);
+/// Hand (wrist joint centre → 3rd metacarpale).
+pub const DE_LEVA_HAND: SegmentRow = row(86.2, 0.61, 79.00, 62.8, 51.3, 40.1);
+/// Thigh (hip → knee joint centre).
+pub const DE_LEVA_THIGH: SegmentRow = row(422.2, 14.16, 40.95, 32.9, 32.9, 14.9);
+/// Shank (knee joint centre → lateral malleolus).
+pub const DE_LEVA_SHANK: SegmentRow = row(434.0, 4.33, 44.59, 25.5, 24.9, 10.3);
+/// Foot (heel → tip of the longest toe).
+pub const DE_LEVA_FOOT: SegmentRow = row(258.1, 1.37, 44.15, 25.7, 24.5, 12.4);
+
+/// A contact box on a link: centre and half-extents in the link frame (m).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LinkBox {
+    /// Centre in the link frame (m).
+    pub center: DVec3,
+    /// Half edge lengths along the link axes (m).
+    pub half: DVec3,
+}
+
+impl LinkBox {
+    /// The 8 corners in the link frame.
+    pub fn corners(&self) -> [DVec3; 8] {
+        let mut out = [DVec3::ZERO; 8];
+        for (k, o) in out.iter_mut().enumerate() {
+            let s = DVec3::new(
+                if k & 1 == 0 { -1.0 } else { 1.0 },
+                if k & 2 == 0 { -1.0 } else { 1.0 },
+                if k & 4 == 0 { -1.0 } else { 1.0 },
+            );
+            *o = self.center + s * self.half;
+        }
+        out
+    }
+
+    /// Radius of the sphere about the centre that holds the box (m).
+    pub fn radius(&self) -> f64 {
+        self.half.length()
+    }
+}
+
+/// The fall21 human ready to simulate.
+#[derive(Clone, Debug)]
+pub struct HumanBody {
+    /// The articulated body (bodies = fall21 joints/links in the same order; body 0 = pelvis).
+    pub model: Model,
+    /// The figure model it was built from, scaled to the subject's height.
+    pub figure: figure::Model,
+    /// Contact box of each link.
+    pub boxes: Vec<LinkBox>,
+    /// For each fall21 DOF (model order), its index in the velocity vector `v`.
+    pub dof_v: Vec<usize>,
+    /// Link names in body order.
+    pub link_names: Vec<String>,
+}
+
+/// Errors building the human body.
+#[derive(Debug, thiserror::Error)]
+pub enum HumanError {
+    /// Height or mass out of a plausible human range.
+    #[error("subject {what} = {value} is outside the supported range {lo}..{hi}")]
+    Subject {
+        /// "height_m" or "mass_kg".
+        what: &'static str,
+        /// Value given.
+        value: f64,
+        /// Lower bound.
+        lo: f64,
+        /// Upper bound.
+        hi: f64,
+    },
+    /// The figure model has a joint kind the dynamics does not support here.
+    #[error("joint '{0}' is Fixed; the fall21 dynamics expects movable joints only")]
+    FixedJoint(String),
+    /// The figure model has a link this body has no anthropometric row for.
+    #[error("link '{0}' is not a fall21 link (no anthropometric data)")]
+    UnknownLink(String),
+    /// The assembled tree is invalid.
+    #[error(transparent)]
+    Model(#[from] ModelError),
+}
+
+/// Inertia of a straight segment along `dir` (unit, from its proximal point `p0`) from a table
+/// row, with the longitudinal radius about `long_axis` (link axes X, Y, Z).
+fn segment(
+    row: &SegmentRow,
+    mass: f64,
+    h: f64,
+    p0: DVec3,
+    dir: DVec3,
+    long_axis: usize,
+) -> Inertia {
+    let len = row.length_mm / 1000.0 * h / DE_LEVA_STATURE;
+    let m = row.mass_pct / 100.0 * mass;
+    let com = p0 + dir * (row.com_pct / 100.0 * len);
+    let i = |r_pct: f64| m * (r_pct / 100.0 * len).powi(2);
+    // Vertical segments: X sagittal axis, Z transverse, Y longitudinal. Foot: Z longitudinal,
+    // Y transverse.
+    let d = if long_axis == 1 {
+        DVec3::new(
+            i(row.r_sagittal_pct),
+            i(row.r_longitudinal_pct),
+            i(row.r_transverse_pct),
+        )
+    } else {
+        DVec3::new(
+            i(row.r_sagittal_pct),
+            i(row.r_transverse_pct),
+            i(row.r_longitudinal_pct),
+        )
+    };
+    Inertia::new(m, com, DMat3::from_diagonal(d))
+}
+
+/// Sum of rigid inertias expressed in one frame (parallel-axis theorem).
+fn combine(a: Inertia, b: Inertia) -> Inertia {
+    let m = a.mass + b.mass;
+    let c = (a.com * a.mass + b.com * b.mass) / m;
+    let shift = |x: &Inertia| {
+        let d = x.com - c;
+        x.inertia_com
+            + (DMat3::IDENTITY * d.length_squared() - super::spatial::outer(d, d)) * x.mass
+    };
+    Inertia::new(m, c, shift(&a) + shift(&b))
+}
+
+/// Builds the fall21 human of standing height `height` (m) and mass `mass` (kg) under gravity
+/// `(0, −g, 0)`.
+pub fn fall21_body(height: f64, mass: f64, g: f64) -> Result<HumanBody, HumanError> {
+    if !(1.0..=2.3).contains(&height) {
+        return Err(HumanError::Subject {
+            what: "height_m",
+            value: height,
+            lo: 1.0,
+            hi: 2.3,
+        });
+    }
+    if !(20.0..=200.0).contains(&mass) {
+        return Err(HumanError::Subject {
+            what: "mass_kg",
+            value: mass,
+            lo: 20.0,
+            hi: 200.0,
+        });
+    }
+    let fig = figure::fall21().scaled_to_height(height);
+    let h = height;
+    let down = -DVec3::Y;
+    let mut bodies = Vec::with_capacity(fig.joints.len());
+    let mut boxes = Vec::with_capacity(fig.joints.len());
+    for j in &fig.joints {
+        let link = j
+            .link
+            .trim_start_matches("left_")
+            .trim_start_matches("right_");
+        let child_offset = |name: &str| {
+            fig.joints
+                .iter()
+                .find(|c| {
+                    c.parent.is_some_and(|p| fig.joints[p].name == j.name) && c.name.ends_with(name)
+                })
+                .map(|c| c.offset)
+        };
+        let (inertia, bx) = match link {
+            "pelvis" => {
+                let top = DVec3::new(
+                    0.0,
+                    DE_LEVA_LOWER_TRUNK.length_mm / 1000.0 * h / DE_LEVA_STATURE,
+                    0.0,
+                );
+                (
+                    segment(&DE_LEVA_LOWER_TRUNK, mass, h, top, down, 1),
+                    LinkBox {
+                        center: DVec3::new(0.0, 0.02 * h, 0.0),
+                        half: DVec3::new(0.095, 0.05, 0.06) * h,
+                    },
+                )
+            }
+            "torso" => {
+                let neck = child_offset("neck").unwrap_or(DVec3::new(0.0, 0.23 * h, 0.0));
+                let upt = segment(&DE_LEVA_UPPER_TRUNK, mass, h, neck, down, 1);
+                let l_upt = DE_LEVA_UPPER_TRUNK.length_mm / 1000.0 * h / DE_LEVA_STATURE;
+                let mpt = segment(&DE_LEVA_MIDDLE_TRUNK, mass, h, neck + down * l_upt, down, 1);
+                (
+                    combine(upt, mpt),
+                    LinkBox {
+                        center: neck * 0.5,
+                        half: DVec3::new(0.10 * h, neck.y * 0.5, 0.06 * h),
+                    },
+                )
+            }
+            "head" => {
+                let l = DE_LEVA_HEAD.length_mm / 1000.0 * h / DE_LEVA_STATURE;
+                let top = j.end_site.unwrap_or(DVec3::new(0.0, l, 0.0));
+                (
+                    segment(&DE_LEVA_HEAD, mass, h, DVec3::new(0.0, l, 0.0), down, 1),
+                    LinkBox {
+                        center: DVec3::new(0.0, top.y * 0.5, 0.01 * h),
+                        half: DVec3::new(0.045 * h, top.y * 0.5, 0.055 * h),
+                    },
+                )
+            }
+            "upper_arm" | "forearm" | "thigh" | "shin" => {
+                let (row, width, child) = match link {
+                    "upper_arm" => (&DE_LEVA_UPPER_ARM, 0.05, "elbow"),
+                    "forearm" => (&DE_LEVA_FOREARM, 0.04, "wrist"),
+                    "thigh" => (&DE_LEVA_THIGH, 0.08, "knee"),
+                    _ => (&DE_LEVA_SHANK, 0.06, "ankle"),
+                };
+                let end = child_offset(child).unwrap_or(DVec3::new(0.0, -0.2 * h, 0.0));
+                (
+                    segment(row, mass, h, DVec3::ZERO, down, 1),
+                    LinkBox {
+                        center: end * 0.5,
+                        half: DVec3::new(width * h * 0.5, end.length() * 0.5, width * h * 0.5),
+                    },
+                )
+            }
+            "hand" => {
+                let end = j.end_site.unwrap_or(DVec3::new(0.0, -0.108 * h, 0.0));
+                (
+                    segment(&DE_LEVA_HAND, mass, h, DVec3::ZERO, down, 1),
+                    LinkBox {
+                        center: end * 0.5,
+                        half: DVec3::new(0.01 * h, end.length() * 0.5, 0.025 * h),
+                    },
+                )
+            }
+            "foot" => {
+                let toe = j.end_site.unwrap_or(DVec3::new(0.0, -0.039 * h, 0.117 * h));
+                let l = DE_LEVA_FOOT.length_mm / 1000.0 * h / DE_LEVA_STATURE;
+                let heel = DVec3::new(0.0, toe.y * 0.5, toe.z - l);
+                let fwd = DVec3::Z;
+                (
+                    segment(&DE_LEVA_FOOT, mass, h, heel, fwd, 2),
+                    LinkBox {
+                        center: DVec3::new(0.0, toe.y * 0.5, toe.z - l * 0.5),
+                        half: DVec3::new(0.03 * h, -toe.y * 0.5, l * 0.5),
+                    },
+                )
+            }
+            _ => return Err(HumanError::UnknownLink(j.link.clone())),
+        };
+        let axes: Vec<DVec3> = j.dofs.iter().map(|&d| fig.dofs[d].axis).collect();
+        let joint = match j.kind {
+            JointKind::Free => JointType::Free,
+            JointKind::Ball => JointType::Ball {
+                axes: DMat3::from_cols(axes[0], axes[1], axes[2]),
+            },
+            JointKind::Universal => JointType::Universal {
+                axis1: axes[0],
+                axis2: axes[1],
+            },
+            JointKind::Pin => JointType::Pin { axis: axes[0] },
+            JointKind::Fixed => return Err(HumanError::FixedJoint(j.name.clone())),
+        };
+        let x_tree = if j.parent.is_some() {
+            SpatialTransform::translation(j.offset)
+        } else {
+            SpatialTransform::IDENTITY
+        };
+        bodies.push(Body {
+            name: j.link.clone(),
+            joint_name: j.name.clone(),
+            parent: j.parent,
+            joint,
+            x_tree,
+            inertia,
+        });
+        boxes.push(bx);
+    }
+    let model = Model::new(bodies, DVec3::new(0.0, -g, 0.0))?;
+    let dof_v = fig
+        .dofs
+        .iter()
+        .map(|d| {
+            let j = d.joint;
+            let k = fig.joints[j]
+                .dofs
+                .iter()
+                .position(|&x| fig.dofs[x].name == d.name)
+                .unwrap_or(0);
+            model.v_idx[j] + k
+        })
+        .collect();
+    let link_names = fig.joints.iter().map(|j| j.link.clone()).collect();
+    Ok(HumanBody {
+        model,
+        figure: fig,
+        boxes,
+        dof_v,
+        link_names,
+    })
+}
+
+impl HumanBody {
+    /// A configuration `q` with the DOF angles `angles` (rad, fall21 model order) and the pelvis
+    /// at `root_pos` with orientation `root_rot`.
+    pub fn configuration(
+        &self,
+        angles: &[f64],
+        root_pos: DVec3,
+        root_rot: glam::DQuat,
+    ) -> Vec<f64> {
+        let mut q = self.model.neutral();
+        q[0..3].copy_from_slice(&root_pos.to_array());
+        let r = root_rot.normalize();
+        q[3..7].copy_from_slice(&[r.x, r.y, r.z, r.w]);
+        for (j, joint) in self.figure.joints.iter().enumerate() {
+            let b = &self.model.bodies[j];
+            let n = joint.dofs.len();
+            if n == 0 {
+                continue;
+            }
+            let mut a = [0.0; 3];
+            for (k, &d) in joint.dofs.iter().enumerate() {
+                a[k] = angles[d];
+            }
+            let iq = self.model.q_idx[j];
+            b.joint.set_angles(&a[..n], &mut q[iq..iq + b.joint.nq()]);
+        }
+        q
+    }
+
+    /// Index of the link named `name`.
+    pub fn link_index(&self, name: &str) -> Option<usize> {
+        self.link_names.iter().position(|n| n == name)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn de_leva_masses_sum_to_the_body_mass() {
+        let b = fall21_body(1.70, 65.0, 9.81).unwrap();
+        assert_eq!(b.model.nbodies(), 15);
+        assert_eq!(b.model.nv, 27);
+        assert_eq!(b.model.nq, 29);
+        assert!(
+            (b.model.total_mass() - 65.0).abs() < 1e-9,
+            "{}",
+            b.model.total_mass()
+        );
+    }
+
+    #[test]
+    fn standing_centre_of_mass_is_at_the_anthropometric_height() {
+        // Whole-body centre of mass of an upright adult: about 0.55–0.57 of stature (Winter,
+        // Biomechanics and Motor Control of Human Movement).
+        let h = 1.70;
+        let b = fall21_body(h, 65.0, 9.81).unwrap();
+        let mut q = b.configuration(
+            &[0.0; 21],
+            DVec3::new(0.0, 0.530 * h, 0.0),
+            glam::DQuat::IDENTITY,
+        );
+        q[1] = 0.530 * h;
+        let mut data = super::super::data::Data::new(&b.model);
+        super::super::kinematics::kinematics(&b.model, &mut data, &q, &[0.0; 27]);
+        let mut c = DVec3::ZERO;
+        for (i, body) in b.model.bodies.iter().enumerate() {
+            c += (data.pos[i] + data.rot[i] * body.inertia.com) * body.inertia.mass;
+        }
+        let c = c / b.model.total_mass();
+        let ratio = c.y / h;
+        println!("COM at {ratio:.4} of stature");
+        assert!((0.54..0.58).contains(&ratio), "COM at {ratio} of stature");
+        assert!(c.x.abs() < 1e-9, "left-right symmetric: {}", c.x);
+    }
+
+    #[test]
+    fn dof_map_follows_the_figure_model() {
+        let b = fall21_body(1.70, 65.0, 9.81).unwrap();
+        assert_eq!(b.dof_v.len(), 21);
+        let knee = b.figure.dof_index("right_knee").unwrap();
+        let shin = b.link_index("right_shin").unwrap();
+        assert_eq!(b.dof_v[knee], b.model.v_idx[shin]);
+        // Every velocity DOF past the root is hit exactly once.
+        let mut seen = b.dof_v.clone();
+        seen.sort();
+        assert_eq!(seen, (6..27).collect::<Vec<_>>());
+    }
+}

@@ -1,0 +1,71 @@
+//! Forward kinematics (the first pass shared by ABA and RNEA): joint transforms `Xup`, motion
+//! subspaces, body velocities `v_i = Xup_i v_λ(i) + v_J`, velocity products
+//! `c_i = c_J + v_i ×m v_J`, and world poses of every body.
+
+use super::data::Data;
+use super::model::Model;
+use super::spatial::MotionVec;
+
+/// Fills `data.xup, s, v, c, rot, pos` for configuration `q` (size nq) and velocity `v` (size nv).
+#[inline]
+pub fn kinematics(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) {
+    debug_assert_eq!(q.len(), model.nq);
+    debug_assert_eq!(v.len(), model.nv);
+    for (i, body) in model.bodies.iter().enumerate() {
+        let (iq, iv) = (model.q_idx[i], model.v_idx[i]);
+        let j = &body.joint;
+        let (xj, vj, cj) = j.jcalc(&q[iq..iq + j.nq()], &v[iv..iv + j.nv()], &mut data.s[i]);
+        let xup = xj * body.x_tree;
+        data.xup[i] = xup;
+        match body.parent {
+            Some(p) => {
+                let vi = xup.apply_motion(data.v[p]) + vj;
+                data.v[i] = vi;
+                data.c[i] = cj + vi.cross_motion(vj);
+                let rp = data.rot[p];
+                data.rot[i] = rp * xup.rot.transpose();
+                data.pos[i] = data.pos[p] + rp * xup.trans;
+            }
+            None => {
+                data.v[i] = vj;
+                data.c[i] = cj + vj.cross_motion(vj);
+                data.rot[i] = xup.rot.transpose();
+                data.pos[i] = xup.trans;
+            }
+        }
+    }
+}
+
+/// The spatial gravity acceleration `a₀ = [0; −g]` that ABA and RNEA give the fixed base.
+#[inline]
+pub fn base_acceleration(model: &Model) -> MotionVec {
+    MotionVec::new(glam::DVec3::ZERO, -model.gravity)
+}
+
+/// Mechanical energy `(T, V)` (J) of the tree: `T = Σ ½ v_iᵀ I_i v_i`,
+/// `V = −Σ m_i g·x_com,i` (zero potential at world height 0). Uses and overwrites `data`.
+pub fn mechanical_energy(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) -> (f64, f64) {
+    kinematics(model, data, q, v);
+    let mut t = 0.0;
+    let mut pot = 0.0;
+    for (i, b) in model.bodies.iter().enumerate() {
+        t += b.inertia.kinetic_energy(data.v[i]);
+        let com = data.pos[i] + data.rot[i] * b.inertia.com;
+        pot -= b.inertia.mass * model.gravity.dot(com);
+    }
+    (t, pot)
+}
+
+/// World position of body `i`'s point `p` (body coordinates) after [`kinematics`].
+#[inline]
+pub fn world_point(data: &Data, i: usize, p: glam::DVec3) -> glam::DVec3 {
+    data.pos[i] + data.rot[i] * p
+}
+
+/// World velocity of body `i`'s point `p` (body coordinates) after [`kinematics`]:
+/// `R (v + ω × p)`.
+#[inline]
+pub fn world_point_velocity(data: &Data, i: usize, p: glam::DVec3) -> glam::DVec3 {
+    let v = data.v[i];
+    data.rot[i] * (v.lin + v.ang.cross(p))
+}

@@ -1,0 +1,225 @@
+//! The immutable kinematic tree (Featherstone's `model`: `parent`, `jtype`, `Xtree`, `I`),
+//! apart from the scratch workspace [`Data`](super::data::Data) as in Pinocchio.
+//!
+//! Bodies are numbered depth-first, every parent before its children; body `i` is moved by joint
+//! `i`. Configuration `q` (size `nq`) and velocity `v` (size `nv`) differ in size because ball
+//! and free joints carry unit quaternions (4 numbers) for 3 rotational velocities.
+
+use super::joint::JointType;
+use super::spatial::{ArticulatedInertia, Inertia, SpatialTransform};
+use glam::DVec3;
+use thiserror::Error;
+
+/// An invalid model description: which body and what is wrong.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum ModelError {
+    /// A body's parent index is not an earlier body.
+    #[error(
+        "body {body} ('{name}'): parent {parent} is not an earlier body (parents must precede children)"
+    )]
+    BadParent {
+        /// Body index.
+        body: usize,
+        /// Body name.
+        name: String,
+        /// The offending parent index.
+        parent: usize,
+    },
+    /// A floating base anywhere but at the root.
+    #[error("body {body} ('{name}'): a free joint is only allowed on the root body 0")]
+    FreeNotRoot {
+        /// Body index.
+        body: usize,
+        /// Body name.
+        name: String,
+    },
+    /// A joint axis is not a unit vector, or a ball's axes are not orthonormal.
+    #[error("body {body} ('{name}'): joint axes must be unit length (and orthonormal for a ball)")]
+    BadAxis {
+        /// Body index.
+        body: usize,
+        /// Body name.
+        name: String,
+    },
+    /// A non-positive or non-finite mass or an inertia that is not positive definite.
+    #[error("body {body} ('{name}'): mass {mass} kg or its inertia is not positive/finite")]
+    BadInertia {
+        /// Body index.
+        body: usize,
+        /// Body name.
+        name: String,
+        /// The mass given.
+        mass: f64,
+    },
+    /// The model has no bodies.
+    #[error("the model has no bodies")]
+    Empty,
+}
+
+/// One body of the tree and the joint that connects it to its parent.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Body {
+    /// Name (the link name, e.g. "torso").
+    pub name: String,
+    /// Name of the joint that moves this body (e.g. "waist").
+    pub joint_name: String,
+    /// Parent body index; `None` for the root (its joint connects to the fixed world frame).
+    pub parent: Option<usize>,
+    /// The joint type and axes.
+    pub joint: JointType,
+    /// `Xtree`: transform from the parent body frame to this joint's frame at `q = 0`.
+    pub x_tree: SpatialTransform,
+    /// Rigid-body inertia in the body frame.
+    pub inertia: Inertia,
+}
+
+/// The immutable kinematic tree.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Model {
+    /// Bodies in depth-first order, parents first.
+    pub bodies: Vec<Body>,
+    /// Gravity acceleration in world coordinates (m/s²), e.g. `(0, −9.81, 0)`.
+    pub gravity: DVec3,
+    /// Offset of each joint's block in `q`.
+    pub q_idx: Vec<usize>,
+    /// Offset of each joint's block in `v`.
+    pub v_idx: Vec<usize>,
+    /// Size of the configuration vector.
+    pub nq: usize,
+    /// Size of the velocity vector (degrees of freedom).
+    pub nv: usize,
+    /// Each body's rigid inertia as 3×3 blocks, derived from `bodies` at construction (the
+    /// articulated-body algorithm starts from these; rebuild the model after editing inertias).
+    pub inertia_blocks: Vec<ArticulatedInertia>,
+}
+
+impl Model {
+    /// Builds and validates a model from bodies in depth-first order.
+    pub fn new(bodies: Vec<Body>, gravity: DVec3) -> Result<Self, ModelError> {
+        if bodies.is_empty() {
+            return Err(ModelError::Empty);
+        }
+        let mut q_idx = Vec::with_capacity(bodies.len());
+        let mut v_idx = Vec::with_capacity(bodies.len());
+        let (mut nq, mut nv) = (0, 0);
+        for (i, b) in bodies.iter().enumerate() {
+            if let Some(p) = b.parent
+                && p >= i
+            {
+                return Err(ModelError::BadParent {
+                    body: i,
+                    name: b.name.clone(),
+                    parent: p,
+                });
+            }
+            if matches!(b.joint, JointType::Free) && (i != 0 || b.parent.is_some()) {
+                return Err(ModelError::FreeNotRoot {
+                    body: i,
+                    name: b.name.clone(),
+                });
+            }
+            if !b.joint.axes_valid() {
+                return Err(ModelError::BadAxis {
+                    body: i,
+                    name: b.name.clone(),
+                });
+            }
+            let ic = b.inertia.inertia_com;
+            let sym = (ic - ic.transpose())
+                .abs()
+                .to_cols_array()
+                .iter()
+                .sum::<f64>()
+                < 1e-9;
+            let pd = ic.x_axis.x > 0.0
+                && ic.x_axis.x * ic.y_axis.y - ic.x_axis.y * ic.y_axis.x > 0.0
+                && ic.determinant() > 0.0;
+            let ok = b.inertia.mass.is_finite()
+                && b.inertia.mass > 0.0
+                && sym
+                && pd
+                && b.inertia.com.is_finite();
+            if !ok {
+                return Err(ModelError::BadInertia {
+                    body: i,
+                    name: b.name.clone(),
+                    mass: b.inertia.mass,
+                });
+            }
+            q_idx.push(nq);
+            v_idx.push(nv);
+            nq += b.joint.nq();
+            nv += b.joint.nv();
+        }
+        let inertia_blocks = bodies.iter().map(|b| b.inertia.to_blocks()).collect();
+        Ok(Self {
+            inertia_blocks,
+            bodies,
+            gravity,
+            q_idx,
+            v_idx,
+            nq,
+            nv,
+        })
+    }
+
+    /// Number of bodies.
+    #[inline]
+    pub fn nbodies(&self) -> usize {
+        self.bodies.len()
+    }
+
+    /// The neutral configuration: zero angles, identity quaternions, free base at the origin.
+    pub fn neutral(&self) -> Vec<f64> {
+        let mut q = vec![0.0; self.nq];
+        for (i, b) in self.bodies.iter().enumerate() {
+            b.joint
+                .neutral(&mut q[self.q_idx[i]..self.q_idx[i] + b.joint.nq()]);
+        }
+        q
+    }
+
+    /// Index of the body named `name`.
+    pub fn body_index(&self, name: &str) -> Option<usize> {
+        self.bodies.iter().position(|b| b.name == name)
+    }
+
+    /// `out = q ⊞ z` joint by joint (see [`JointType::retract`]); `z` has size nv.
+    pub fn retract(&self, q: &[f64], z: &[f64], out: &mut [f64]) {
+        for (i, b) in self.bodies.iter().enumerate() {
+            let (iq, iv) = (self.q_idx[i], self.v_idx[i]);
+            let (nq, nv) = (b.joint.nq(), b.joint.nv());
+            b.joint
+                .retract(&q[iq..iq + nq], &z[iv..iv + nv], &mut out[iq..iq + nq]);
+        }
+    }
+
+    /// The chart rate `ż` at `q_stage = q₀ ⊞ z` under velocity `v` (see
+    /// [`JointType::chart_rate`]); all vectors but `q_stage` have size nv.
+    pub fn chart_rate(&self, q_stage: &[f64], z: &[f64], v: &[f64], zdot: &mut [f64]) {
+        for (i, b) in self.bodies.iter().enumerate() {
+            let (iq, iv) = (self.q_idx[i], self.v_idx[i]);
+            let (nq, nv) = (b.joint.nq(), b.joint.nv());
+            b.joint.chart_rate(
+                &q_stage[iq..iq + nq],
+                &z[iv..iv + nv],
+                &v[iv..iv + nv],
+                &mut zdot[iv..iv + nv],
+            );
+        }
+    }
+
+    /// The anatomical angle of every velocity DOF (rad; zeros for a free joint), size nv.
+    pub fn angles(&self, q: &[f64], out: &mut [f64]) {
+        for (i, b) in self.bodies.iter().enumerate() {
+            let (iq, iv) = (self.q_idx[i], self.v_idx[i]);
+            b.joint
+                .angles(&q[iq..iq + b.joint.nq()], &mut out[iv..iv + b.joint.nv()]);
+        }
+    }
+
+    /// Total mass (kg).
+    pub fn total_mass(&self) -> f64 {
+        self.bodies.iter().map(|b| b.inertia.mass).sum()
+    }
+}

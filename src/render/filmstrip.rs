@@ -1,0 +1,150 @@
+//! A filmstrip: N evenly spaced instants of one or more motions in one PNG, one row per track,
+//! the time of each column above it, like the sequence figures in the papers.
+
+use std::path::Path;
+
+use super::camera::{Camera, PanelLimits, View, scale_for};
+use super::canvas::{
+    INK, Style, WHITE, blit, draw_figure, draw_key, encode_png, key_width, new_pixmap,
+    panel_background, sheet_size,
+};
+use super::figure::{Track, validate_tracks};
+use super::text::{Align, Pen, ascent, draw_text, font};
+use super::{RenderError, require_extension, write};
+
+/// Height of each cell (pixels).
+const CELL_HEIGHT: u32 = 220;
+const MARGIN: u32 = 16;
+/// Gap between cells of a row, and between rows (pixels).
+const GAP: u32 = 6;
+const ROW_GAP: u32 = 10;
+
+/// [`filmstrip_view_png`] in the left side view, where falls, steps and jumps read best.
+pub fn filmstrip_png(tracks: &[Track], n: usize, path: &Path) -> Result<(), RenderError> {
+    filmstrip_view_png(tracks, n, View::Side, path)
+}
+
+/// The instants of a filmstrip of `n` columns over `duration` seconds: t_j = duration · j/(n − 1)
+/// for j = 0 … n − 1 (just t = 0 when n = 1).
+pub(crate) fn column_times(duration: f64, n: usize) -> Vec<f64> {
+    if n == 1 {
+        return vec![0.0];
+    }
+    (0..n)
+        .map(|j| duration * j as f64 / (n - 1) as f64)
+        .collect()
+}
+
+/// Draws `n` evenly spaced instants of every track as a PNG at `path`, one row per track (its
+/// label above it), in `view`. Columns share one time t_j = T · j/(n − 1), T the longest
+/// track's duration, written above each column; a shorter track holds its last frame. All cells
+/// share one scale and one framing of the whole motion, so positions compare across the page;
+/// a motion that travels further than a cell shows follows the root, with floor ticks every
+/// 0.5 m. Footer: 1 m scale bar and left/right colour key.
+pub fn filmstrip_view_png(
+    tracks: &[Track],
+    n: usize,
+    view: View,
+    path: &Path,
+) -> Result<(), RenderError> {
+    require_extension(path, "png")?;
+    validate_tracks(tracks)?;
+    if n == 0 {
+        return Err(RenderError::InvalidArgument(
+            "a filmstrip needs at least one column".into(),
+        ));
+    }
+    let font = font()?;
+    let (mpp, pad) = scale_for(tracks, CELL_HEIGHT);
+    let limits = PanelLimits {
+        height: CELL_HEIGHT,
+        min_width: CELL_HEIGHT * 9 / 20,
+        max_width: CELL_HEIGHT * 9 / 10,
+    };
+    let cam = Camera::fit(tracks, view, mpp, pad, limits);
+    let style = Style::for_height(CELL_HEIGHT.max(cam.height));
+    let duration = tracks.iter().map(Track::duration).fold(0.0, f64::max);
+    let times = column_times(duration, n);
+
+    let time_row = (style.small * 1.8) as u32;
+    let label_row = (style.text * 1.7) as u32;
+    let footer = (style.small * 2.6) as u32;
+    let row = n as u64 * cam.width as u64 + (n as u64 - 1) * GAP as u64;
+    let rows = tracks.len() as u64 * (label_row + cam.height + ROW_GAP) as u64;
+    sheet_size(
+        row + 2 * MARGIN as u64,
+        rows + (MARGIN + time_row + footer) as u64,
+    )?;
+    let row_w = row as u32;
+    let key_w = key_width(font, mpp, row_w as f64 * 0.6, style) as u32;
+    let width = 2 * MARGIN + row_w.max(key_w);
+    let height = MARGIN + time_row + rows as u32 + footer;
+    let mut sheet = new_pixmap(width, height, WHITE)?;
+
+    let x0 = MARGIN;
+    let mut y = MARGIN;
+    let time_base = y as f32 + ascent(font, style.small);
+    for (j, t) in times.iter().enumerate() {
+        let cx = (x0 + j as u32 * (cam.width + GAP)) as f32 + cam.width as f32 * 0.5;
+        let s = format!("t = {t:.2} s");
+        draw_text(
+            &mut sheet,
+            font,
+            &s,
+            (cx, time_base),
+            Pen {
+                size: style.small,
+                rgb: INK,
+                align: Align::Centre,
+            },
+        );
+    }
+    y += time_row;
+    // The view's name only in each row's first cell.
+    let first = panel_background(&cam, font, style, true)?;
+    let rest = panel_background(&cam, font, style, false)?;
+    for track in tracks {
+        let base = y as f32 + ascent(font, style.text);
+        draw_text(
+            &mut sheet,
+            font,
+            &track.label,
+            (x0 as f32, base),
+            Pen {
+                size: style.text,
+                rgb: INK,
+                align: Align::Left,
+            },
+        );
+        y += label_row;
+        for (j, &t) in times.iter().enumerate() {
+            let mut cell = if j == 0 { first.clone() } else { rest.clone() };
+            draw_figure(&mut cell, &cam, track, track.frame_at(t), style);
+            blit(&mut sheet, &cell, x0 + j as u32 * (cam.width + GAP), y);
+        }
+        y += cam.height + ROW_GAP;
+    }
+    let key_base = y as f32 + style.small * 1.2;
+    draw_key(
+        &mut sheet,
+        font,
+        x0 as f32,
+        key_base,
+        mpp,
+        row_w as f64 * 0.6,
+        style,
+    );
+    write(path, &encode_png(&sheet)?)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn columns_span_the_whole_duration_evenly() {
+        assert_eq!(column_times(2.0, 5), vec![0.0, 0.5, 1.0, 1.5, 2.0]);
+        assert_eq!(column_times(2.0, 1), vec![0.0]);
+        assert_eq!(column_times(0.0, 3), vec![0.0, 0.0, 0.0]);
+    }
+}

@@ -1,0 +1,349 @@
+//! Line plots (joint angles, fitness per generation, head height over time …) with plotters:
+//! title, axis labels, legend, and vertical event markers with labels; PNG or SVG by extension.
+
+use std::path::Path;
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use super::text::register_plot_font;
+use super::{RenderError, extension, write};
+
+/// One named curve: points (x, y) in the plot's units, drawn in order.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Series {
+    /// Legend entry.
+    pub name: String,
+    /// The points (x, y), joined by straight lines in the given order.
+    pub points: Vec<(f64, f64)>,
+}
+
+/// A line plot: curves sharing axes, plus labelled vertical lines at chosen x (events such as
+/// "push", "contact", "beat").
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Plot {
+    /// Title above the plot.
+    pub title: String,
+    /// Label of the x axis, with units (e.g. "time (s)").
+    pub x_label: String,
+    /// Label of the y axis, with units (e.g. "left knee flexion (°)").
+    pub y_label: String,
+    /// The curves.
+    pub series: Vec<Series>,
+    /// Vertical dashed lines at x with a label each.
+    pub markers: Vec<(f64, String)>,
+}
+
+/// Size of a plot (pixels; the SVG's nominal size).
+const SIZE: (u32, u32) = (900, 540);
+
+/// Supersampling factor of PNG plots (per axis).
+const SUPERSAMPLE: u32 = 2;
+
+/// Averages each k×k block of an RGB image of (w·k)×(h·k) pixels into one opaque RGBA pixel.
+fn downsample(rgb: &[u8], w: usize, h: usize, k: usize) -> Vec<u8> {
+    let mut out = Vec::with_capacity(w * h * 4);
+    let row = w * k * 3;
+    for y in 0..h {
+        for x in 0..w {
+            let mut acc = [0u32; 3];
+            for dy in 0..k {
+                let base = (y * k + dy) * row + x * k * 3;
+                for dx in 0..k {
+                    for c in 0..3 {
+                        acc[c] += rgb[base + dx * 3 + c] as u32;
+                    }
+                }
+            }
+            let n = (k * k) as u32;
+            out.extend(acc.map(|a| ((a + n / 2) / n) as u8));
+            out.push(255);
+        }
+    }
+    out
+}
+
+/// Okabe–Ito colours, distinguishable with colour-vision deficiencies, in order of use.
+const COLOURS: [RGBColor; 8] = [
+    RGBColor(0, 114, 178),
+    RGBColor(213, 94, 0),
+    RGBColor(0, 158, 115),
+    RGBColor(204, 121, 167),
+    RGBColor(86, 180, 233),
+    RGBColor(230, 159, 0),
+    RGBColor(0, 0, 0),
+    RGBColor(240, 228, 66),
+];
+
+/// Draws `plot` to `path`: PNG for `.png`, SVG for `.svg`. The axes span the data (and the
+/// markers) with a 5 % margin; series cycle through eight colour-blind-safe colours, with dots
+/// at the points when a series has at most 40 of them; the legend goes to the corner with the
+/// fewest data points; text uses the bundled DejaVu Sans.
+pub fn plot(plot: &Plot, path: &Path) -> Result<(), RenderError> {
+    let ext = extension(path);
+    if ext != "png" && ext != "svg" {
+        return Err(RenderError::UnsupportedExtension {
+            path: path.to_path_buf(),
+            extension: ext,
+            expected: ".png or .svg",
+        });
+    }
+    validate(plot)?;
+    register_plot_font()?;
+    let (w, h) = SIZE;
+    let bytes = if ext == "svg" {
+        let mut svg = String::new();
+        {
+            let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
+            draw(plot, &root, 1)?;
+            root.present().map_err(plot_err)?;
+        }
+        svg.into_bytes()
+    } else {
+        // plotters' bitmap lines are not anti-aliased: draw at SUPERSAMPLE× the size and
+        // average each SUPERSAMPLE² block of pixels.
+        let k = SUPERSAMPLE;
+        let mut rgb = vec![0u8; (w * h * 3 * k * k) as usize];
+        {
+            let root = BitMapBackend::with_buffer(&mut rgb, (w * k, h * k)).into_drawing_area();
+            draw(plot, &root, k)?;
+            root.present().map_err(plot_err)?;
+        }
+        let rgba = downsample(&rgb, w as usize, h as usize, k as usize);
+        let size = tiny_skia::IntSize::from_wh(w, h)
+            .ok_or_else(|| RenderError::Encode("empty plot size".into()))?;
+        let pixmap = tiny_skia::Pixmap::from_vec(rgba, size)
+            .ok_or_else(|| RenderError::Encode("plot buffer of the wrong size".into()))?;
+        super::canvas::encode_png(&pixmap)?
+    };
+    write(path, &bytes)
+}
+
+fn plot_err<E: std::fmt::Display>(e: E) -> RenderError {
+    RenderError::Encode(format!("plot: {e}"))
+}
+
+/// Requires some data and only finite numbers.
+fn validate(plot: &Plot) -> Result<(), RenderError> {
+    if plot.series.iter().all(|s| s.points.is_empty()) {
+        return Err(RenderError::Empty(format!(
+            "plot '{}' has no data points",
+            plot.title
+        )));
+    }
+    for s in &plot.series {
+        if let Some(i) = s
+            .points
+            .iter()
+            .position(|(x, y)| !(x.is_finite() && y.is_finite()))
+        {
+            return Err(RenderError::NonFinitePlot {
+                plot: plot.title.clone(),
+                series: s.name.clone(),
+                index: i,
+                x: s.points[i].0,
+                y: s.points[i].1,
+            });
+        }
+    }
+    if let Some(i) = plot.markers.iter().position(|(x, _)| !x.is_finite()) {
+        return Err(RenderError::NonFinitePlot {
+            plot: plot.title.clone(),
+            series: "markers".into(),
+            index: i,
+            x: plot.markers[i].0,
+            y: 0.0,
+        });
+    }
+    Ok(())
+}
+
+/// The range [lo, hi] widened by `margin` of its width on each side; a zero-width range becomes
+/// lo ± max(0.5, 5 % of |lo|).
+pub(crate) fn padded(lo: f64, hi: f64, margin: f64) -> (f64, f64) {
+    if hi - lo <= f64::EPSILON * lo.abs().max(1.0) {
+        let d = (lo.abs() * 0.05).max(0.5);
+        return (lo - d, hi + d);
+    }
+    let d = (hi - lo) * margin;
+    (lo - d, hi + d)
+}
+
+/// The legend corner with the fewest data points in the 40 % × 35 % box next to it.
+fn legend_corner(plot: &Plot, x: (f64, f64), y: (f64, f64)) -> SeriesLabelPosition {
+    let fx = |v: f64| (v - x.0) / (x.1 - x.0);
+    let fy = |v: f64| (v - y.0) / (y.1 - y.0);
+    let corners = [
+        (SeriesLabelPosition::UpperRight, true, true),
+        (SeriesLabelPosition::UpperLeft, false, true),
+        (SeriesLabelPosition::LowerRight, true, false),
+        (SeriesLabelPosition::LowerLeft, false, false),
+    ];
+    let count = |right: bool, upper: bool| {
+        plot.series
+            .iter()
+            .flat_map(|s| &s.points)
+            .filter(|&&(px, py)| {
+                let (u, v) = (fx(px), fy(py));
+                (if right { u > 0.6 } else { u < 0.4 }) && (if upper { v > 0.65 } else { v < 0.35 })
+            })
+            .count()
+    };
+    let mut best = (usize::MAX, SeriesLabelPosition::UpperRight);
+    for (pos, right, upper) in corners {
+        let c = count(right, upper);
+        if c < best.0 {
+            best = (c, pos);
+        }
+    }
+    best.1
+}
+
+/// Draws the plot on `root`, every length and font size multiplied by `k` (supersampling).
+fn draw<DB: DrawingBackend>(
+    plot: &Plot,
+    root: &DrawingArea<DB, Shift>,
+    k: u32,
+) -> Result<(), RenderError> {
+    let ki = k as i32;
+    let font = |size: u32| ("sans-serif", size * k);
+    root.fill(&WHITE).map_err(plot_err)?;
+    let pts = || plot.series.iter().flat_map(|s| s.points.iter().copied());
+    let xs = pts().map(|p| p.0).chain(plot.markers.iter().map(|m| m.0));
+    let (x_lo, x_hi) = xs.fold((f64::INFINITY, f64::NEG_INFINITY), |a, v| {
+        (a.0.min(v), a.1.max(v))
+    });
+    let (y_lo, y_hi) = pts().fold((f64::INFINITY, f64::NEG_INFINITY), |a, p| {
+        (a.0.min(p.1), a.1.max(p.1))
+    });
+    let x = padded(x_lo, x_hi, 0.02);
+    let mut y = padded(y_lo, y_hi, 0.06);
+    if !plot.markers.is_empty() {
+        // Head-room for the marker labels along the top.
+        y.1 += (y.1 - y.0) * 0.08;
+    }
+    let mut chart = ChartBuilder::on(root)
+        .caption(&plot.title, font(26).into_font().color(&BLACK))
+        .margin(18 * k)
+        .x_label_area_size(56 * k)
+        .y_label_area_size(84 * k)
+        .build_cartesian_2d(x.0..x.1, y.0..y.1)
+        .map_err(plot_err)?;
+    chart
+        .configure_mesh()
+        .x_desc(plot.x_label.as_str())
+        .y_desc(plot.y_label.as_str())
+        .axis_desc_style(font(19))
+        .label_style(font(16))
+        .bold_line_style(RGBColor(225, 225, 225).stroke_width(k))
+        .light_line_style(RGBColor(245, 245, 245).stroke_width(k))
+        .axis_style(RGBColor(90, 90, 90).stroke_width(k))
+        .max_light_lines(3)
+        .draw()
+        .map_err(plot_err)?;
+
+    let grey = RGBColor(110, 110, 110);
+    for (i, (mx, label)) in plot.markers.iter().enumerate() {
+        chart
+            .draw_series(DashedLineSeries::new(
+                [(*mx, y.0), (*mx, y.1)],
+                6 * k,
+                4 * k,
+                grey.stroke_width(k),
+            ))
+            .map_err(plot_err)?;
+        // Stagger labels over three rows so that close events stay readable.
+        let row = (i % 3) as i32;
+        let text = EmptyElement::at((*mx, y.1))
+            + Text::new(
+                label.clone(),
+                (4 * ki, (4 + 18 * row) * ki),
+                font(15).into_font().color(&grey),
+            );
+        chart.draw_series(std::iter::once(text)).map_err(plot_err)?;
+    }
+
+    for (i, s) in plot.series.iter().enumerate() {
+        let c = COLOURS[i % COLOURS.len()];
+        let style = c.stroke_width(2 * k);
+        chart
+            .draw_series(LineSeries::new(s.points.iter().copied(), style))
+            .map_err(plot_err)?
+            .label(s.name.as_str())
+            .legend(move |(lx, ly)| {
+                PathElement::new(vec![(lx, ly), (lx + 24 * ki, ly)], c.stroke_width(3 * k))
+            });
+        if s.points.len() <= 40 {
+            chart
+                .draw_series(s.points.iter().map(|&p| Circle::new(p, 3 * ki, c.filled())))
+                .map_err(plot_err)?;
+        }
+    }
+    chart
+        .configure_series_labels()
+        .position(legend_corner(plot, x, y))
+        .margin(12 * k)
+        .legend_area_size(34 * k)
+        .background_style(WHITE.mix(0.9))
+        .border_style(RGBColor(160, 160, 160).stroke_width(k))
+        .label_font(font(16))
+        .draw()
+        .map_err(plot_err)?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ranges_get_margins_and_flat_ranges_get_width() {
+        assert_eq!(padded(0.0, 10.0, 0.1), (-1.0, 11.0));
+        let (lo, hi) = padded(3.0, 3.0, 0.1);
+        assert!(lo < 3.0 && hi > 3.0);
+        let (lo, hi) = padded(100.0, 100.0, 0.1);
+        assert_eq!((lo, hi), (95.0, 105.0));
+    }
+
+    #[test]
+    fn legend_avoids_the_data() {
+        // A rising line fills the lower-left and upper-right corners.
+        let p = Plot {
+            series: vec![Series {
+                name: "up".into(),
+                points: (0..=100).map(|i| (i as f64, i as f64)).collect(),
+            }],
+            ..Plot::default()
+        };
+        let pos = legend_corner(&p, (0.0, 100.0), (0.0, 100.0));
+        assert!(matches!(
+            pos,
+            SeriesLabelPosition::UpperLeft | SeriesLabelPosition::LowerRight
+        ));
+    }
+
+    #[test]
+    fn bad_plots_are_errors() {
+        let dir = std::env::temp_dir();
+        let empty = Plot::default();
+        assert!(matches!(
+            plot(&empty, &dir.join("marionette-empty.png")),
+            Err(RenderError::Empty(_))
+        ));
+        let nan = Plot {
+            series: vec![Series {
+                name: "s".into(),
+                points: vec![(0.0, 1.0), (1.0, f64::NAN)],
+            }],
+            ..Plot::default()
+        };
+        assert!(matches!(
+            plot(&nan, &dir.join("marionette-nan.png")),
+            Err(RenderError::NonFinitePlot { index: 1, .. })
+        ));
+        assert!(matches!(
+            plot(&nan, &dir.join("marionette.jpg")),
+            Err(RenderError::UnsupportedExtension { .. })
+        ));
+    }
+}

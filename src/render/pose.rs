@@ -1,0 +1,103 @@
+//! One pose: the front and the side view of a frame, side by side, in one PNG.
+
+use std::path::Path;
+
+use super::camera::{Camera, PanelLimits, View, scale_for};
+use super::canvas::{
+    INK, Style, WHITE, blit, draw_figure, draw_key, encode_png, key_width, new_pixmap,
+    panel_background, sheet_size,
+};
+use super::figure::Track;
+use super::text::{Align, Pen, ascent, draw_text, font};
+use super::{RenderError, require_extension, write};
+
+/// Height of each view (pixels).
+const PANEL_HEIGHT: u32 = 360;
+/// Outer margin and gap between panels (pixels).
+const MARGIN: u32 = 16;
+const GAP: u32 = 12;
+
+/// Draws frame `frame` of `track` as a PNG at `path`: the front view (the figure's left on the
+/// viewer's right) and its left side view, side by side at the same scale, framed on the whole
+/// track so pictures of different frames line up; header with the track label, frame index and
+/// time t = frame · frame_time (s); footer with a 1 m scale bar and the left/right colour key.
+pub fn pose_png(track: &Track, frame: usize, path: &Path) -> Result<(), RenderError> {
+    require_extension(path, "png")?;
+    track.validate()?;
+    if frame >= track.frames.len() {
+        return Err(RenderError::FrameOutOfRange {
+            track: track.label.clone(),
+            frame,
+            len: track.frames.len(),
+        });
+    }
+    let font = font()?;
+    let tracks = std::slice::from_ref(track);
+    let (mpp, pad) = scale_for(tracks, PANEL_HEIGHT);
+    let limits = PanelLimits {
+        height: PANEL_HEIGHT,
+        min_width: PANEL_HEIGHT * 11 / 20,
+        max_width: PANEL_HEIGHT * 2,
+    };
+    let cams = [View::Front, View::Side].map(|v| Camera::fit(tracks, v, mpp, pad, limits));
+    let style = Style::for_height(PANEL_HEIGHT);
+
+    let header = (style.text * 2.0) as u32;
+    let footer = (style.small * 2.6) as u32;
+    // Panels are at most MAX_PANEL wide, so these sums stay far below u32::MAX.
+    let panels_w = cams[0].width + GAP + cams[1].width;
+    let key_w = key_width(font, mpp, panels_w as f64 * 0.6, style) as u32;
+    let width = 2 * MARGIN + panels_w.max(key_w);
+    let height = MARGIN + header + PANEL_HEIGHT + footer + MARGIN / 2;
+    sheet_size(width as u64, height as u64)?;
+    let mut sheet = new_pixmap(width, height, WHITE)?;
+
+    let base = MARGIN as f32 + ascent(font, style.text);
+    draw_text(
+        &mut sheet,
+        font,
+        &track.label,
+        (MARGIN as f32, base),
+        Pen {
+            size: style.text,
+            rgb: INK,
+            align: Align::Left,
+        },
+    );
+    let when = format!(
+        "frame {frame}   t = {:.2} s",
+        frame as f64 * track.frame_time
+    );
+    let right = (width - MARGIN) as f32;
+    draw_text(
+        &mut sheet,
+        font,
+        &when,
+        (right, base),
+        Pen {
+            size: style.small,
+            rgb: INK,
+            align: Align::Right,
+        },
+    );
+
+    let mut x = MARGIN + (width - 2 * MARGIN - panels_w) / 2;
+    let y = MARGIN + header;
+    for cam in &cams {
+        let mut panel = panel_background(cam, font, style, true)?;
+        draw_figure(&mut panel, cam, track, frame, style);
+        blit(&mut sheet, &panel, x, y);
+        x += cam.width + GAP;
+    }
+    let key_base = (y + PANEL_HEIGHT) as f32 + style.small * 1.9;
+    draw_key(
+        &mut sheet,
+        font,
+        MARGIN as f32,
+        key_base,
+        mpp,
+        panels_w as f64 * 0.6,
+        style,
+    );
+    write(path, &encode_png(&sheet)?)
+}

@@ -1,0 +1,270 @@
+//! Scene files: a whole experiment described in RON, validated with clear messages, run into one
+//! output folder with a `report.json` of its figures.
+//!
+//! A scene is one variant of [`Scene`], written `Kind(format_version: 1, name: "…", …)`.
+//! Unknown fields are rejected with file, line and column; [`apply_overrides`] sets any field
+//! from the command line (`--set clip.end_s=2.5`) so a parameter can be swept without editing
+//! files.
+
+mod primitives;
+mod show;
+mod source;
+
+pub use primitives::{
+    HighJumpScene, JumpingKneeKickScene, PrimitiveRender, run_high_jump, run_jumping_knee_kick,
+};
+pub use show::{RenderSettings, ShowScene, run_show};
+pub use source::{ClipSource, LoadedMotion, data_dir, load_motion, resolve_path};
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+/// The scene format version this build reads.
+pub const FORMAT_VERSION: u32 = 1;
+
+/// An experiment.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum Scene {
+    /// Load a clip, map it onto a model, play it through the ECS and render it.
+    Show(ShowScene),
+    /// The motor-primitive paper's high jump by extrapolation.
+    HighJump(Box<HighJumpScene>),
+    /// The motor-primitive paper's jumping knee kick.
+    JumpingKneeKick(Box<JumpingKneeKickScene>),
+}
+
+/// Why a scene could not be read or run.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    /// A file could not be read or written.
+    #[error("{path}: {source}")]
+    Io {
+        path: String,
+        source: std::io::Error,
+    },
+    /// RON syntax or schema error (file, line, column, field).
+    #[error(transparent)]
+    Ron(#[from] crate::io::RonError),
+    /// A `--set` override that does not fit the scene.
+    #[error("--set {assignment}: {message}")]
+    Override { assignment: String, message: String },
+    /// A value that is out of range or inconsistent.
+    #[error("{0}")]
+    Invalid(String),
+    /// Reading a BVH file.
+    #[error(transparent)]
+    Bvh(#[from] crate::bvh::BvhError),
+    /// Building a clip.
+    #[error(transparent)]
+    Clip(#[from] crate::skeleton::ClipError),
+    /// A keyframed clip.
+    #[error(transparent)]
+    Keyframes(#[from] crate::clips::KeyframeError),
+    /// Mapping a skeleton.
+    #[error(transparent)]
+    Mapping(#[from] crate::mapping::MappingError),
+    /// A model.
+    #[error(transparent)]
+    Model(#[from] crate::model::ModelError),
+    /// Drawing.
+    #[error(transparent)]
+    Render(#[from] crate::render::RenderError),
+}
+
+impl Scene {
+    /// The scene's name (its default output folder is `out/<name>/`).
+    pub fn name(&self) -> &str {
+        match self {
+            Scene::Show(s) => &s.name,
+            Scene::HighJump(s) => &s.name,
+            Scene::JumpingKneeKick(s) => &s.name,
+        }
+    }
+
+    fn format_version(&self) -> u32 {
+        match self {
+            Scene::Show(s) => s.format_version,
+            Scene::HighJump(s) => s.format_version,
+            Scene::JumpingKneeKick(s) => s.format_version,
+        }
+    }
+
+    /// Parses and checks scene text; `origin` names the file in errors.
+    pub fn parse(text: &str, origin: &str) -> Result<Scene, SceneError> {
+        let scene: Scene = crate::io::parse_ron(text, origin)?;
+        if scene.format_version() > FORMAT_VERSION {
+            return Err(SceneError::Invalid(format!(
+                "{origin}: format_version {} is newer than this build reads ({FORMAT_VERSION})",
+                scene.format_version()
+            )));
+        }
+        Ok(scene)
+    }
+
+    /// Reads a scene file.
+    pub fn load(path: &Path) -> Result<Scene, SceneError> {
+        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
+            path: path.display().to_string(),
+            source,
+        })?;
+        Scene::parse(&text, &path.display().to_string())
+    }
+}
+
+/// Sets fields of `scene` from `path=value` assignments. The path names fields from the scene's
+/// top (`clip.end_s`, `render.gif_fps`); the value is JSON-like (`2.5`, `true`, `null`,
+/// `"text"`, `[1, 2]`) or a bare word taken as text (`humanoid24`).
+pub fn apply_overrides(scene: &Scene, assignments: &[String]) -> Result<Scene, SceneError> {
+    if assignments.is_empty() {
+        return Ok(scene.clone());
+    }
+    let mut value = serde_json::to_value(scene).map_err(|e| SceneError::Invalid(e.to_string()))?;
+    for a in assignments {
+        let err = |message: String| SceneError::Override {
+            assignment: a.clone(),
+            message,
+        };
+        let (path, raw) = a
+            .split_once('=')
+            .ok_or_else(|| err("expected field.path=value".into()))?;
+        let new: serde_json::Value = serde_json::from_str(raw)
+            .unwrap_or_else(|_| serde_json::Value::String(raw.to_string()));
+        // The top level is the scene kind: {"Show": {...}}.
+        let mut cur = value
+            .as_object_mut()
+            .and_then(|o| o.values_mut().next())
+            .ok_or_else(|| err("empty scene".into()))?;
+        let parts: Vec<&str> = path.split('.').collect();
+        for (i, part) in parts.iter().enumerate() {
+            let here = parts[..i].join(".");
+            let next = match cur {
+                serde_json::Value::Object(map) => {
+                    let keys: Vec<String> = map.keys().cloned().collect();
+                    map.get_mut(*part).ok_or_else(|| {
+                        err(format!(
+                            "no field '{part}' at '{here}'; fields there: {}",
+                            keys.join(", ")
+                        ))
+                    })?
+                }
+                serde_json::Value::Array(items) => {
+                    let len = items.len();
+                    let k: usize = part
+                        .parse()
+                        .map_err(|_| err(format!("'{here}' is a list: expected an index")))?;
+                    items.get_mut(k).ok_or_else(|| {
+                        err(format!("index {k} past the end of '{here}' ({len} items)"))
+                    })?
+                }
+                _ => {
+                    return Err(err(format!(
+                        "'{here}' is a value, it has no field '{part}'"
+                    )));
+                }
+            };
+            cur = next;
+        }
+        *cur = new;
+    }
+    serde_json::from_value(value).map_err(|e| SceneError::Override {
+        assignment: assignments.join(" "),
+        message: e.to_string(),
+    })
+}
+
+/// Runs a scene, writing every output into `out_dir` (created), the last one `report.json`;
+/// `base` is the folder relative paths in the scene refer to. Returns the report.
+pub fn run(scene: &Scene, base: &Path, out_dir: &Path) -> Result<serde_json::Value, SceneError> {
+    std::fs::create_dir_all(out_dir).map_err(|source| SceneError::Io {
+        path: out_dir.display().to_string(),
+        source,
+    })?;
+    let started = std::time::Instant::now();
+    let mut report = match scene {
+        Scene::Show(s) => run_show(s, base, out_dir)?,
+        Scene::HighJump(s) => run_high_jump(s, base, out_dir)?,
+        Scene::JumpingKneeKick(s) => run_jumping_knee_kick(s, base, out_dir)?,
+    };
+    if let Some(o) = report.as_object_mut() {
+        o.insert("scene".into(), scene.name().into());
+        o.insert("wall_time_s".into(), started.elapsed().as_secs_f64().into());
+    }
+    write_output(
+        &out_dir.join("report.json"),
+        serde_json::to_string_pretty(&report)
+            .unwrap_or_default()
+            .as_bytes(),
+    )?;
+    Ok(report)
+}
+
+/// The default output folder of a scene: `out/<name>/`.
+pub fn default_out_dir(scene: &Scene) -> PathBuf {
+    PathBuf::from("out").join(scene.name())
+}
+
+/// Writes an output file whole or not at all.
+pub fn write_output(path: &Path, bytes: &[u8]) -> Result<(), SceneError> {
+    crate::io::write_atomic(path, bytes).map_err(|source| SceneError::Io {
+        path: path.display().to_string(),
+        source,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const SCENE: &str = r#"Show(
+    format_version: 1,
+    name: "t",
+    clip: (file: "clips/normal_jump.ron"),
+    model: "humanoid24",
+)"#;
+
+    #[test]
+    fn parses_and_overrides() {
+        let s = Scene::parse(SCENE, "t.ron").unwrap();
+        let s2 = apply_overrides(
+            &s,
+            &[
+                "clip.end_s=1.5".into(),
+                "render.gif=false".into(),
+                "name=other".into(),
+            ],
+        )
+        .unwrap();
+        let Scene::Show(sh) = &s2 else {
+            panic!("not a Show scene")
+        };
+        assert_eq!(sh.clip.end_s, Some(1.5));
+        assert!(!sh.render.gif);
+        assert_eq!(sh.name, "other");
+    }
+
+    #[test]
+    fn errors_name_file_line_column_and_field() {
+        let bad = SCENE.replace("model:", "modle:");
+        let e = Scene::parse(&bad, "t.ron").unwrap_err().to_string();
+        assert!(e.starts_with("t.ron:5:"), "{e}");
+        assert!(e.contains("modle"), "{e}");
+        let s = Scene::parse(SCENE, "t.ron").unwrap();
+        let e = apply_overrides(&s, &["clip.ends=2".into()])
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("no field 'ends' at 'clip'"), "{e}");
+        let e = apply_overrides(&s, &["render.gif_fps=fast".into()])
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("render.gif_fps=fast"), "{e}");
+        let newer = SCENE.replace("format_version: 1", "format_version: 7");
+        assert!(
+            Scene::parse(&newer, "t.ron")
+                .unwrap_err()
+                .to_string()
+                .contains("newer")
+        );
+    }
+}

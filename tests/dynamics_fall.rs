@@ -1,0 +1,178 @@
+//! The pushed fall of the fall21 human (the paper's experiment): it falls the way the push sends
+//! it, comes to rest on the floor without sinking more than a centimetre, and its damage report
+//! is stable when the step is halved.
+
+use marionette::dynamics::Integrator;
+use marionette::dynamics::fall::{FallConfig, FallResult, SimError, simulate_fall};
+use marionette::model::ranges::AgeGroup;
+
+fn check_fell_backward_and_rested(r: &FallResult) {
+    let first = &r.frames[0];
+    let last = r.frames.last().unwrap();
+    // Facing +Z and pushed from the front: the pelvis ends well behind (−Z) where it stood.
+    let dz = last.root_position.z - first.root_position.z;
+    assert!(
+        dz < -0.5,
+        "pelvis moved {dz} m along Z (expected backward, < −0.5)"
+    );
+    assert!(
+        last.root_position.x.abs() < 0.2,
+        "sideways drift {}",
+        last.root_position.x
+    );
+    // Lying on the floor: head and pelvis low.
+    assert!(last.head_height_m < 0.3, "head at {} m", last.head_height_m);
+    assert!(
+        last.root_position.y < 0.3,
+        "pelvis at {} m",
+        last.root_position.y
+    );
+    assert!(
+        r.came_to_rest,
+        "did not come to rest (rest since {:?})",
+        r.rest_time_s
+    );
+    assert!(
+        r.max_penetration_m < 0.01,
+        "sank {} m into the floor",
+        r.max_penetration_m
+    );
+    // The back of the body takes the impact.
+    let idx = |n: &str| r.link_names.iter().position(|l| l == n).unwrap();
+    assert!(r.peak_vertical_force_n[idx("pelvis")] > 1000.0);
+    assert!(r.peak_vertical_force_n[idx("torso")] > 1000.0);
+    assert!(r.damage.is_finite() && r.damage > 0.0);
+    assert_eq!(r.steps, 6000);
+}
+
+#[test]
+fn pushed_from_the_front_the_elderly_figure_falls_backward_and_rests() {
+    let cfg = FallConfig::paper(AgeGroup::Elderly);
+    let r = simulate_fall(&cfg).unwrap();
+    check_fell_backward_and_rested(&r);
+    assert_eq!(r.frames[0].angles.len(), 21);
+    // The record as a fall21 clip: 60 Hz over 3 s, every DOF.
+    let clip = r.to_model_clip();
+    assert_eq!(clip.frame_count(), 181);
+    assert_eq!(clip.dof_count(), 21);
+    assert_eq!(clip.frame_angles(90), &r.frames[90].angles[..]);
+    // Frames are recorded every 1/60 s.
+    assert!((r.frames[60].time_s - 1.0).abs() < 1e-9);
+}
+
+#[test]
+fn pushed_from_the_front_the_adult_figure_falls_backward_and_rests() {
+    let cfg = FallConfig::paper(AgeGroup::Adult);
+    let r = simulate_fall(&cfg).unwrap();
+    check_fell_backward_and_rested(&r);
+}
+
+#[test]
+fn without_a_push_the_figure_keeps_standing() {
+    let mut cfg = FallConfig::paper(AgeGroup::Elderly);
+    cfg.push.force_n = 0.0;
+    cfg.duration_s = 1.0;
+    let r = simulate_fall(&cfg).unwrap();
+    let last = r.frames.last().unwrap();
+    assert!(
+        (last.head_height_m - r.frames[0].head_height_m).abs() < 0.03,
+        "head {}",
+        last.head_height_m
+    );
+    assert!((last.root_position - r.frames[0].root_position).length() < 0.03);
+}
+
+#[test]
+fn damage_is_stable_when_the_step_is_halved() {
+    let mut cfg = FallConfig::paper(AgeGroup::Elderly);
+    let a = simulate_fall(&cfg).unwrap();
+    cfg.dt_s /= 2.0;
+    let b = simulate_fall(&cfg).unwrap();
+    let rel = (a.damage - b.damage).abs() / b.damage;
+    println!(
+        "damage dt={} s: {:.0} N; dt={} s: {:.0} N; relative change {:.2}%",
+        a.dt_s,
+        a.damage,
+        b.dt_s,
+        b.damage,
+        100.0 * rel
+    );
+    assert!(
+        rel < 0.05,
+        "damage changed by {:.2}% when the step was halved",
+        100.0 * rel
+    );
+    // RK4 at the halved step tells the same story.
+    cfg.integrator = Integrator::Rk4;
+    let c = simulate_fall(&cfg).unwrap();
+    let rel_rk = (c.damage - b.damage).abs() / b.damage;
+    assert!(
+        rel_rk < 0.05,
+        "RK4 vs semi-implicit Euler: {:.2}%",
+        100.0 * rel_rk
+    );
+    check_fell_backward_and_rested(&c_with_steps(c, 12000));
+}
+
+fn c_with_steps(mut r: FallResult, expect: u64) -> FallResult {
+    assert_eq!(r.steps, expect);
+    r.steps = 6000;
+    r
+}
+
+#[test]
+fn a_step_above_the_stability_bound_is_refused_up_front() {
+    let mut cfg = FallConfig::paper(AgeGroup::Elderly);
+    cfg.dt_s = 5e-3;
+    match simulate_fall(&cfg) {
+        Err(SimError::Unstable { what, bound_s, .. }) => {
+            assert!(bound_s < 5e-3);
+            assert!(!what.is_empty());
+        }
+        other => panic!("expected an Unstable error, got {other:?}"),
+    }
+}
+
+#[test]
+fn bad_configuration_is_named() {
+    let mut cfg = FallConfig::paper(AgeGroup::Elderly);
+    cfg.kp.pop();
+    let e = simulate_fall(&cfg).unwrap_err().to_string();
+    assert!(e.contains("kp") && e.contains("21"), "{e}");
+    let mut cfg = FallConfig::paper(AgeGroup::Elderly);
+    cfg.push.link = "tail".into();
+    let e = simulate_fall(&cfg).unwrap_err().to_string();
+    assert!(e.contains("push.link") && e.contains("tail"), "{e}");
+    let mut cfg = FallConfig::paper(AgeGroup::Elderly);
+    cfg.damage_weights.insert("wing".into(), 1.0);
+    assert!(
+        simulate_fall(&cfg)
+            .unwrap_err()
+            .to_string()
+            .contains("wing")
+    );
+}
+
+#[test]
+fn config_round_trips_through_ron() {
+    let cfg = FallConfig::paper(AgeGroup::Adult);
+    let text = ron::ser::to_string_pretty(&cfg, ron::ser::PrettyConfig::default()).unwrap();
+    let back: FallConfig = ron::from_str(&text).unwrap();
+    assert_eq!(back, cfg);
+}
+
+#[test]
+fn a_partial_scene_takes_the_paper_defaults() {
+    let text = "(dt_s: 0.00025, integrator: Rk4, ranges: Builtin(adult), push: (link: \"torso\", \
+                point: (0.0, 0.3, 0.0), direction: (0.0, 0.0, -1.0), force_n: 800.0, start_s: 0.1, \
+                duration_s: 0.1))";
+    let cfg: FallConfig = ron::from_str(text).unwrap();
+    assert_eq!(cfg.dt_s, 0.00025);
+    assert_eq!(cfg.integrator, Integrator::Rk4);
+    assert_eq!(cfg.push.force_n, 800.0);
+    assert_eq!(cfg.kp, FallConfig::default().kp);
+    let bad = ron::from_str::<FallConfig>("(dt: 0.001)")
+        .unwrap_err()
+        .to_string();
+    assert!(bad.contains("dt"), "{bad}");
+}
