@@ -11,8 +11,8 @@ use serde::{Deserialize, Serialize};
 use super::canonical::CanonicalSystem;
 use super::error::{PrimitiveError, Result, require_finite};
 
-/// Exponent beyond which a normalised kernel contributes less than e⁻³⁷ ≈ 1e−16 and is skipped.
-const CUTOFF: f64 = 37.0;
+/// Exponent beyond which a normalised kernel contributes less than e⁻²⁵ ≈ 1.4e−11 and is skipped.
+const CUTOFF: f64 = 25.0;
 
 /// A set of Gaussian kernels on the phase coordinate (shared by all DOFs of a primitive).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -110,7 +110,7 @@ impl Basis {
     }
 
     /// Normalised activations ψ_i(x)/Σ_k ψ_k(x) written into `out` (length N); returns the index
-    /// range outside which they are below 1e−16 (and written as 0). For repeated evaluation use
+    /// range outside which they are below 1.4e−11 (and written as 0). For repeated evaluation use
     /// [`Basis::kernels`].
     pub fn normalized(&self, x: f64, out: &mut [f64]) -> std::ops::Range<usize> {
         let k = self.kernels();
@@ -161,7 +161,7 @@ impl Kernels {
 
     /// Normalised activations ψ_i(x)/Σ_k ψ_k(x) for the kernels in the returned index range,
     /// written into `out[range]` (entries outside the range are left untouched: their
-    /// activations are below 1e−16). Computed as exp(e_min − e_i), e_i = (x − c_i)²/(2σ_i²),
+    /// activations are below 1.4e−11). Computed as exp(e_min − e_i), e_i = (x − c_i)²/(2σ_i²),
     /// which leaves the ratio unchanged and never divides 0 by 0, however far x is from every
     /// centre.
     ///
