@@ -18,7 +18,6 @@ use glam::{DQuat, DVec3};
 use serde::{Deserialize, Serialize};
 
 use crate::model::{Model, ModelClip};
-use crate::skeleton::Transform;
 
 /// The RON format version this build reads.
 pub const FORMAT_VERSION: u32 = 1;
@@ -195,56 +194,24 @@ impl KeyframeClip {
             root_rotation: Vec::with_capacity(frames),
             angles: Vec::with_capacity(frames * dofs),
         };
-        let mut ground_y = Vec::with_capacity(frames);
-        let skeleton = model.skeleton();
-        let feet: Vec<usize> = skeleton
-            .joints
-            .iter()
-            .enumerate()
-            .filter(|(_, j)| j.name.ends_with("ankle"))
-            .map(|(i, _)| i)
-            .collect();
-        let mut rot = vec![DQuat::IDENTITY; skeleton.joints.len()];
-        let translations: Vec<DVec3> = skeleton.joints.iter().map(|j| j.offset).collect();
-        let mut g = vec![Transform::IDENTITY; skeleton.joints.len()];
         for f in 0..frames {
             let t = f as f64 * dt;
             let angles: Vec<f64> = dof_keys.iter().map(|s| at(s, t)).collect();
             let root_q =
                 DQuat::from_rotation_y(at(&turn, t)) * DQuat::from_rotation_x(at(&pitch, t));
-            model.local_rotations(&angles, &mut rot);
-            rot[0] = root_q;
-            let mut tr = translations.clone();
-            tr[0] = DVec3::ZERO;
-            crate::skeleton::forward_kinematics(&skeleton, &tr, &rot, &mut g);
-            // Lowest foot point (ankle joints and their End Sites, i.e. heel/ankle and toe).
-            let lowest = feet
-                .iter()
-                .flat_map(|&a| {
-                    let e = skeleton.joints[a].end_site.unwrap_or_default();
-                    [g[a].translation.y, (g[a].translation + g[a].rotation * e).y]
-                })
-                .fold(f64::INFINITY, f64::min);
-            ground_y.push(-lowest);
             clip.root_translation
                 .push(DVec3::new(at(&lat, t), 0.0, at(&fwd, t)));
             clip.root_rotation.push(root_q);
             clip.angles.extend(angles);
         }
-        // Heights: on the ground the lowest foot point touches y = 0; in flight a ballistic arc.
+        // On the ground the lowest foot point touches y = 0; in flight the root follows the
+        // chord between take-off and landing heights plus a ballistic arc g(t − a)(b − t)/2.
+        clip.keep_feet_on_floor(&self.flights, 0.0);
         for f in 0..frames {
             let t = f as f64 * dt;
-            let y = match self.flights.iter().find(|(a, b)| t > *a && t < *b) {
-                Some(&(a, b)) => {
-                    let fa = ((a / dt).round() as usize).min(frames - 1);
-                    let fb = ((b / dt).round() as usize).min(frames - 1);
-                    let u = (t - a) / (b - a);
-                    let chord = ground_y[fa] + u * (ground_y[fb] - ground_y[fa]);
-                    chord + 0.5 * GRAVITY * (t - a) * (b - t)
-                }
-                None => ground_y[f],
-            };
-            clip.root_translation[f].y = y;
+            if let Some(&(a, b)) = self.flights.iter().find(|(a, b)| t > *a && t < *b) {
+                clip.root_translation[f].y += 0.5 * GRAVITY * (t - a) * (b - t);
+            }
         }
         clip
     }

@@ -1,4 +1,5 @@
-//! The two models of the papers, defined once, from a reference body of height H = 1.70 m.
+//! The two models of the papers, defined once as tables, from a reference body of height
+//! H = 1.70 m.
 //!
 //! Segment proportions follow Winter's anthropometric table (Winter, *Biomechanics and Motor
 //! Control of Human Movement*, 4th ed. 2009, Fig. 4.1: segment lengths as fractions of height):
@@ -12,103 +13,6 @@ use super::{Dof, JointKind, Model, ModelJoint};
 /// Reference standing height of the model definitions, metres.
 pub const REFERENCE_HEIGHT: f64 = 1.70;
 
-/// Which side a limb joint is on; decides the axis mirroring.
-#[derive(Clone, Copy, PartialEq)]
-enum Side {
-    Centre,
-    Right,
-    Left,
-}
-
-impl Side {
-    /// Mirrors a right-side axis for the left side: `(a.x, −a.y, −a.z)`.
-    fn axis(self, a: DVec3) -> DVec3 {
-        match self {
-            Side::Left => DVec3::new(a.x, -a.y, -a.z),
-            _ => a,
-        }
-    }
-    /// Mirrors a right-side position for the left side (x is the figure's left).
-    fn lateral(self, x: f64) -> f64 {
-        match self {
-            Side::Left => x,
-            Side::Right => -x,
-            Side::Centre => 0.0,
-        }
-    }
-    fn prefix(self) -> &'static str {
-        match self {
-            Side::Left => "left_",
-            Side::Right => "right_",
-            Side::Centre => "",
-        }
-    }
-}
-
-struct Builder {
-    model: Model,
-}
-
-impl Builder {
-    fn new(name: &str) -> Self {
-        Builder {
-            model: Model {
-                name: name.into(),
-                height: REFERENCE_HEIGHT,
-                joints: vec![],
-                dofs: vec![],
-            },
-        }
-    }
-
-    /// Adds a joint; `dofs` are (name suffix, right-side axis); returns its index.
-    #[allow(clippy::too_many_arguments)]
-    fn joint(
-        &mut self,
-        side: Side,
-        name: &str,
-        link: &str,
-        parent: Option<usize>,
-        kind: JointKind,
-        offset: DVec3,
-        dofs: &[(&str, DVec3)],
-        end_site: Option<DVec3>,
-    ) -> usize {
-        let h = REFERENCE_HEIGHT;
-        let j = self.model.joints.len();
-        let mut dof_ids = vec![];
-        assert_eq!(dofs.len(), kind.dof_count(), "joint {name}");
-        for (suffix, axis) in dofs {
-            let dof_name = if suffix.is_empty() {
-                format!("{}{}", side.prefix(), name)
-            } else {
-                format!("{}{}_{}", side.prefix(), name, suffix)
-            };
-            dof_ids.push(self.model.dofs.len());
-            self.model.dofs.push(Dof {
-                name: dof_name,
-                joint: j,
-                axis: side.axis(*axis),
-            });
-        }
-        let place = |v: DVec3| DVec3::new(side.lateral(v.x), v.y, v.z) * h;
-        self.model.joints.push(ModelJoint {
-            name: format!("{}{}", side.prefix(), name),
-            link: format!("{}{}", side.prefix(), link),
-            parent,
-            kind,
-            offset: place(offset),
-            dofs: dof_ids,
-            end_site: end_site.map(place),
-        });
-        j
-    }
-}
-
-fn v(x: f64, y: f64, z: f64) -> DVec3 {
-    DVec3::new(x, y, z)
-}
-
 const X: DVec3 = DVec3::X;
 const NX: DVec3 = DVec3::NEG_X;
 const Y: DVec3 = DVec3::Y;
@@ -116,223 +20,168 @@ const NY: DVec3 = DVec3::NEG_Y;
 const Z: DVec3 = DVec3::Z;
 const NZ: DVec3 = DVec3::NEG_Z;
 
-/// Adds a leg (hip, knee, ankle) to `b`; the hip is a ball joint for humanoid24 and a universal
-/// joint for fall21; the ankle is fixed for humanoid24 and a pin for fall21.
-fn leg(b: &mut Builder, side: Side, pelvis: usize, fall: bool) {
-    let hip = if fall {
-        b.joint(
-            side,
-            "hip",
-            "thigh",
-            Some(pelvis),
-            JointKind::Universal,
-            v(0.05, 0.0, 0.0),
-            &[("flexion", NX), ("abduction", NZ)],
-            None,
-        )
-    } else {
-        b.joint(
-            side,
-            "hip",
-            "thigh",
-            Some(pelvis),
-            JointKind::Ball,
-            v(0.05, 0.0, 0.0),
-            &[("flexion", NX), ("abduction", NZ), ("rotation", NY)],
-            None,
-        )
-    };
-    let knee = b.joint(
-        side,
-        "knee",
-        "shin",
-        Some(hip),
-        JointKind::Pin,
-        v(0.0, -0.245, 0.0),
-        &[("", X)],
-        None,
-    );
-    let toe = Some(v(0.0, -0.039, 0.117));
-    if fall {
-        b.joint(
-            side,
-            "ankle",
-            "foot",
-            Some(knee),
-            JointKind::Pin,
-            v(0.0, -0.246, 0.0),
-            &[("", NX)],
-            toe,
-        );
-    } else {
-        b.joint(
-            side,
-            "ankle",
-            "foot",
-            Some(knee),
-            JointKind::Fixed,
-            v(0.0, -0.246, 0.0),
-            &[],
-            toe,
-        );
+/// One joint of a model table. Offsets and End Sites are fractions of the height, with x
+/// toward the side the joint is on (a limb's x is mirrored for the right side); DOF axes are
+/// the right side's (mirrored for the left as `(a.x, −a.y, −a.z)`); a DOF named `""` takes the
+/// joint's name (`left_knee`).
+struct Row {
+    name: &'static str,
+    link: &'static str,
+    parent: Option<&'static str>,
+    kind: JointKind,
+    offset: [f64; 3],
+    dofs: &'static [(&'static str, DVec3)],
+    end_site: Option<[f64; 3]>,
+}
+
+/// A part of a model table: a joint on the mid-line, or a limb chain made twice, right then left.
+enum Part<'a> {
+    Centre(Row),
+    Limb(&'a [Row]),
+}
+
+const fn row(
+    name: &'static str,
+    link: &'static str,
+    parent: Option<&'static str>,
+    kind: JointKind,
+    offset: [f64; 3],
+    dofs: &'static [(&'static str, DVec3)],
+    end_site: Option<[f64; 3]>,
+) -> Row {
+    Row {
+        name,
+        link,
+        parent,
+        kind,
+        offset,
+        dofs,
+        end_site,
     }
 }
+
+/// Builds a model from its table: joints in table order (limbs right then left), each
+/// parent before its children.
+fn build(name: &str, parts: &[Part<'_>]) -> Model {
+    let mut model = Model {
+        name: name.into(),
+        height: REFERENCE_HEIGHT,
+        joints: vec![],
+        dofs: vec![],
+    };
+    let mut add = |r: &Row, side: &str| {
+        let mirror = |v: [f64; 3]| {
+            let x = match side {
+                "right_" => -v[0],
+                _ => v[0],
+            };
+            DVec3::new(x, v[1], v[2]) * REFERENCE_HEIGHT
+        };
+        let axis = |a: DVec3| {
+            if side == "left_" {
+                DVec3::new(a.x, -a.y, -a.z)
+            } else {
+                a
+            }
+        };
+        let j = model.joints.len();
+        let joint_name = format!("{side}{}", r.name);
+        let parent = r.parent.map(|p| {
+            let sided = format!("{side}{p}");
+            model
+                .joints
+                .iter()
+                .position(|q| q.name == sided || q.name == p)
+                .expect("model tables list parents first")
+        });
+        assert_eq!(r.dofs.len(), r.kind.dof_count(), "joint {joint_name}");
+        let mut dofs = vec![];
+        for (suffix, a) in r.dofs {
+            let dof_name = if suffix.is_empty() {
+                joint_name.clone()
+            } else {
+                format!("{joint_name}_{suffix}")
+            };
+            dofs.push(model.dofs.len());
+            model.dofs.push(Dof {
+                name: dof_name,
+                joint: j,
+                axis: axis(*a),
+            });
+        }
+        model.joints.push(ModelJoint {
+            name: joint_name,
+            link: format!("{side}{}", r.link),
+            parent,
+            kind: r.kind,
+            offset: mirror(r.offset),
+            dofs,
+            end_site: r.end_site.map(mirror),
+        });
+    };
+    for part in parts {
+        match part {
+            Part::Centre(r) => add(r, ""),
+            Part::Limb(rows) => {
+                for side in ["right_", "left_"] {
+                    for r in *rows {
+                        add(r, side);
+                    }
+                }
+            }
+        }
+    }
+    model
+}
+
+use JointKind::{Ball, Fixed, Free, Pin, Universal};
+
+const TOE: Option<[f64; 3]> = Some([0.0, -0.039, 0.117]);
+const HEAD_TOP: Option<[f64; 3]> = Some([0.0, 0.17, 0.0]);
+const HAND_END: Option<[f64; 3]> = Some([0.0, -0.108, 0.0]);
 
 /// The 24-DOF model of the motor-primitive paper: waist 2, each clavicle 2, each shoulder 3, each
 /// elbow 2, each hip 3, each knee 1. Root motion (pelvis translation and orientation) is carried
 /// apart from the 24 DOFs.
+#[rustfmt::skip]
 pub fn humanoid24() -> Model {
-    let mut b = Builder::new("humanoid24");
-    let c = Side::Centre;
-    let pelvis = b.joint(
-        c,
-        "pelvis",
-        "pelvis",
-        None,
-        JointKind::Free,
-        v(0.0, 0.530, 0.0),
-        &[],
-        None,
-    );
-    let waist = b.joint(
-        c,
-        "waist",
-        "chest",
-        Some(pelvis),
-        JointKind::Universal,
-        v(0.0, 0.07, 0.0),
-        &[("flexion", X), ("lateral", Z)],
-        None,
-    );
-    b.joint(
-        c,
-        "neck",
-        "head",
-        Some(waist),
-        JointKind::Fixed,
-        v(0.0, 0.23, 0.0),
-        &[],
-        Some(v(0.0, 0.17, 0.0)),
-    );
-    for side in [Side::Right, Side::Left] {
-        let clav = b.joint(
-            side,
-            "clavicle",
-            "clavicle",
-            Some(waist),
-            JointKind::Universal,
-            v(0.02, 0.20, 0.0),
-            &[("elevation", NZ), ("protraction", Y)],
-            None,
-        );
-        let sh = b.joint(
-            side,
-            "shoulder",
-            "upper_arm",
-            Some(clav),
-            JointKind::Ball,
-            v(0.11, 0.018, 0.0),
-            &[("flexion", NX), ("abduction", NZ), ("rotation", NY)],
-            None,
-        );
-        let el = b.joint(
-            side,
-            "elbow",
-            "forearm",
-            Some(sh),
-            JointKind::Universal,
-            v(0.0, -0.186, 0.0),
-            &[("flexion", NX), ("pronation", Y)],
-            None,
-        );
-        b.joint(
-            side,
-            "wrist",
-            "hand",
-            Some(el),
-            JointKind::Fixed,
-            v(0.0, -0.146, 0.0),
-            &[],
-            Some(v(0.0, -0.108, 0.0)),
-        );
-    }
-    for side in [Side::Right, Side::Left] {
-        leg(&mut b, side, pelvis, false);
-    }
-    b.model
+    build("humanoid24", &[
+        Part::Centre(row("pelvis", "pelvis", None, Free, [0.0, 0.530, 0.0], &[], None)),
+        Part::Centre(row("waist", "chest", Some("pelvis"), Universal, [0.0, 0.07, 0.0], &[("flexion", X), ("lateral", Z)], None)),
+        Part::Centre(row("neck", "head", Some("waist"), Fixed, [0.0, 0.23, 0.0], &[], HEAD_TOP)),
+        Part::Limb(&[
+            row("clavicle", "clavicle", Some("waist"), Universal, [0.02, 0.20, 0.0], &[("elevation", NZ), ("protraction", Y)], None),
+            row("shoulder", "upper_arm", Some("clavicle"), Ball, [0.11, 0.018, 0.0], &[("flexion", NX), ("abduction", NZ), ("rotation", NY)], None),
+            row("elbow", "forearm", Some("shoulder"), Universal, [0.0, -0.186, 0.0], &[("flexion", NX), ("pronation", Y)], None),
+            row("wrist", "hand", Some("elbow"), Fixed, [0.0, -0.146, 0.0], &[], HAND_END),
+        ]),
+        Part::Limb(&[
+            row("hip", "thigh", Some("pelvis"), Ball, [0.05, 0.0, 0.0], &[("flexion", NX), ("abduction", NZ), ("rotation", NY)], None),
+            row("knee", "shin", Some("hip"), Pin, [0.0, -0.245, 0.0], &[("", X)], None),
+            row("ankle", "foot", Some("knee"), Fixed, [0.0, -0.246, 0.0], &[], TOE),
+        ]),
+    ])
 }
 
 /// The 21-DOF, 15-link model of the falling paper: neck 3, each shoulder 2, each elbow 1, each
 /// wrist 1, waist 2, each hip 2, each knee 1, each ankle 1; the pelvis is the floating base.
+#[rustfmt::skip]
 pub fn fall21() -> Model {
-    let mut b = Builder::new("fall21");
-    let c = Side::Centre;
-    let pelvis = b.joint(
-        c,
-        "pelvis",
-        "pelvis",
-        None,
-        JointKind::Free,
-        v(0.0, 0.530, 0.0),
-        &[],
-        None,
-    );
-    let waist = b.joint(
-        c,
-        "waist",
-        "torso",
-        Some(pelvis),
-        JointKind::Universal,
-        v(0.0, 0.07, 0.0),
-        &[("flexion", X), ("rotation", Y)],
-        None,
-    );
-    b.joint(
-        c,
-        "neck",
-        "head",
-        Some(waist),
-        JointKind::Ball,
-        v(0.0, 0.23, 0.0),
-        &[("flexion", X), ("lateral", Z), ("rotation", Y)],
-        Some(v(0.0, 0.17, 0.0)),
-    );
-    for side in [Side::Right, Side::Left] {
-        let sh = b.joint(
-            side,
-            "shoulder",
-            "upper_arm",
-            Some(waist),
-            JointKind::Universal,
-            v(0.13, 0.218, 0.0),
-            &[("flexion", NX), ("rotation", NY)],
-            None,
-        );
-        let el = b.joint(
-            side,
-            "elbow",
-            "forearm",
-            Some(sh),
-            JointKind::Pin,
-            v(0.0, -0.186, 0.0),
-            &[("", NX)],
-            None,
-        );
-        b.joint(
-            side,
-            "wrist",
-            "hand",
-            Some(el),
-            JointKind::Pin,
-            v(0.0, -0.146, 0.0),
-            &[("", Z)],
-            Some(v(0.0, -0.108, 0.0)),
-        );
-    }
-    for side in [Side::Right, Side::Left] {
-        leg(&mut b, side, pelvis, true);
-    }
-    b.model
+    build("fall21", &[
+        Part::Centre(row("pelvis", "pelvis", None, Free, [0.0, 0.530, 0.0], &[], None)),
+        Part::Centre(row("waist", "torso", Some("pelvis"), Universal, [0.0, 0.07, 0.0], &[("flexion", X), ("rotation", Y)], None)),
+        Part::Centre(row("neck", "head", Some("waist"), Ball, [0.0, 0.23, 0.0], &[("flexion", X), ("lateral", Z), ("rotation", Y)], HEAD_TOP)),
+        Part::Limb(&[
+            row("shoulder", "upper_arm", Some("waist"), Universal, [0.13, 0.218, 0.0], &[("flexion", NX), ("rotation", NY)], None),
+            row("elbow", "forearm", Some("shoulder"), Pin, [0.0, -0.186, 0.0], &[("", NX)], None),
+            row("wrist", "hand", Some("elbow"), Pin, [0.0, -0.146, 0.0], &[("", Z)], HAND_END),
+        ]),
+        Part::Limb(&[
+            row("hip", "thigh", Some("pelvis"), Universal, [0.05, 0.0, 0.0], &[("flexion", NX), ("abduction", NZ)], None),
+            row("knee", "shin", Some("hip"), Pin, [0.0, -0.245, 0.0], &[("", X)], None),
+            row("ankle", "foot", Some("knee"), Pin, [0.0, -0.246, 0.0], &[("", NX)], TOE),
+        ]),
+    ])
 }
 
 #[cfg(test)]

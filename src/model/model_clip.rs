@@ -185,6 +185,32 @@ impl ModelClip {
             .collect()
     }
 
+    /// Height of each foot's lowest point (its ankle joint or the ankle's End Site, the toe) at
+    /// every frame, `[left, right]`, metres.
+    pub fn foot_heights(&self) -> [Vec<f64>; 2] {
+        let clip = self.to_clip();
+        let ankle = |name: &str| clip.skeleton.index(name);
+        let sides = [ankle("left_ankle"), ankle("right_ankle")];
+        let mut g = vec![];
+        let mut out = [
+            Vec::with_capacity(clip.frame_count()),
+            Vec::with_capacity(clip.frame_count()),
+        ];
+        for f in 0..clip.frame_count() {
+            clip.globals(f, &mut g);
+            for (k, a) in sides.iter().enumerate() {
+                let h = a.map_or(f64::NAN, |a| {
+                    let e = clip.skeleton.joints[a].end_site.unwrap_or_default();
+                    g[a].translation
+                        .y
+                        .min((g[a].translation + g[a].rotation * e).y)
+                });
+                out[k].push(h);
+            }
+        }
+        out
+    }
+
     /// Keeps the feet on the floor: outside the `airborne` spans (seconds) the root is raised or
     /// lowered so that the lowest foot point (ankle joints and their End Sites) is at
     /// `floor_y`; inside a span the correction is interpolated linearly between its ends, so a
@@ -192,27 +218,8 @@ impl ModelClip {
     /// does not keep legs and root consistent (an extrapolated crouch lifts the feet); this puts
     /// the contact back. Returns the largest correction applied, metres.
     pub fn keep_feet_on_floor(&mut self, airborne: &[(f64, f64)], floor_y: f64) -> f64 {
-        let clip = self.to_clip();
-        let feet: Vec<usize> = clip
-            .skeleton
-            .joints
-            .iter()
-            .enumerate()
-            .filter(|(_, j)| j.name.ends_with("ankle"))
-            .map(|(i, _)| i)
-            .collect();
-        let mut g = vec![];
-        let lowest: Vec<f64> = (0..clip.frame_count())
-            .map(|f| {
-                clip.globals(f, &mut g);
-                feet.iter()
-                    .flat_map(|&a| {
-                        let e = clip.skeleton.joints[a].end_site.unwrap_or_default();
-                        [g[a].translation.y, (g[a].translation + g[a].rotation * e).y]
-                    })
-                    .fold(f64::INFINITY, f64::min)
-            })
-            .collect();
+        let [left, right] = self.foot_heights();
+        let lowest: Vec<f64> = left.iter().zip(&right).map(|(l, r)| l.min(*r)).collect();
         let n = lowest.len();
         let frame =
             |t: f64| ((t / self.frame_time).round().max(0.0) as usize).min(n.saturating_sub(1));

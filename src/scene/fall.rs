@@ -8,7 +8,7 @@ use serde_json::json;
 
 use super::primitives::PrimitiveRender;
 use super::source::resolve_path;
-use super::{SceneError, write_output};
+use super::{SceneError, draw_tracks, write_output};
 use crate::dynamics::contact::ContactParams;
 use crate::dynamics::ecs::{build_fall_world, run_world};
 use crate::dynamics::fall::{FallConfig, FallResult, Ranges};
@@ -16,7 +16,7 @@ use crate::dynamics::integrator::Integrator;
 use crate::dynamics::push::Push;
 use crate::model::fall21;
 use crate::model::ranges::{AgeGroup, RangeTable};
-use crate::render::{Plot, Series, Track, animation_gif, filmstrip_png, plot};
+use crate::render::{Plot, Series, Track, plot};
 
 /// Time stepping of a simulation.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -235,18 +235,12 @@ pub fn run_fall(
         label,
         frame_time: clip.frame_time,
     };
-    filmstrip_png(
+    draw_tracks(
         std::slice::from_ref(&track),
-        scene.render.filmstrip_frames.max(1),
-        &out.join("filmstrip.png"),
+        scene.render.filmstrip_frames,
+        scene.render.gif.then_some(scene.render.gif_fps),
+        out,
     )?;
-    if scene.render.gif {
-        animation_gif(
-            std::slice::from_ref(&track),
-            scene.render.gif_fps,
-            &out.join("motion.gif"),
-        )?;
-    }
     let push_end = scene.push.start_s + scene.push.duration_s;
     plot(
         &Plot {

@@ -212,6 +212,21 @@ pub fn default_out_dir(scene: &Scene) -> PathBuf {
     PathBuf::from("out").join(scene.name())
 }
 
+/// Draws `tracks` into `out`: `filmstrip.png` with `filmstrip_frames` columns, and
+/// `motion.gif` at `gif_fps` frames per second when that is given.
+pub fn draw_tracks(
+    tracks: &[crate::render::Track],
+    filmstrip_frames: usize,
+    gif_fps: Option<f64>,
+    out: &Path,
+) -> Result<(), SceneError> {
+    crate::render::filmstrip_png(tracks, filmstrip_frames.max(1), &out.join("filmstrip.png"))?;
+    if let Some(fps) = gif_fps {
+        crate::render::animation_gif(tracks, fps, &out.join("motion.gif"))?;
+    }
+    Ok(())
+}
+
 /// Writes an output file whole or not at all.
 pub fn write_output(path: &Path, bytes: &[u8]) -> Result<(), SceneError> {
     crate::io::write_atomic(path, bytes).map_err(|source| SceneError::Io {

@@ -7,13 +7,13 @@ use serde::{Deserialize, Serialize};
 use serde_json::json;
 
 use super::source::{ClipSource, load_motion};
-use super::{SceneError, write_output};
+use super::{SceneError, draw_tracks, write_output};
 use crate::model::{Model, ModelClip};
 use crate::primitive::{
     BlendPlacement, EventConfig, Gamma, JumpEvents, LearnConfig, Learned, Primitive, Relearn,
     Trajectory, blend, connect, find_jump_events,
 };
-use crate::render::{Plot, Series, Track, animation_gif, filmstrip_png, plot};
+use crate::render::{Plot, Series, Track, plot};
 
 /// Pictures of a primitive scene.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -223,14 +223,12 @@ fn draw(
             frame_time: clips[i].frame_time,
         })
         .collect();
-    filmstrip_png(
+    draw_tracks(
         &t,
-        render.filmstrip_frames.max(1),
-        &out.join("filmstrip.png"),
+        render.filmstrip_frames,
+        render.gif.then_some(render.gif_fps),
+        out,
     )?;
-    if render.gif {
-        animation_gif(&t, render.gif_fps, &out.join("motion.gif"))?;
-    }
     Ok(())
 }
 
@@ -316,29 +314,10 @@ pub fn run_high_jump(
     }))
 }
 
-/// Root height and each foot's height over time (`feet[foot][frame]`: the lower of its ankle
-/// and its toe), metres.
+/// Root height and each foot's lowest point over time (`feet[foot][frame]`), metres.
 fn heights(clip: &ModelClip) -> (Vec<f64>, Vec<Vec<f64>>) {
-    let c = clip.to_clip();
-    let names = c.skeleton.point_names();
-    let points = c.point_frames();
     let root: Vec<f64> = clip.root_translation.iter().map(|t| t.y).collect();
-    let foot = ["left_ankle", "right_ankle"]
-        .iter()
-        .map(|side| {
-            let idx: Vec<usize> = names
-                .iter()
-                .enumerate()
-                .filter(|(_, n)| n.starts_with(side))
-                .map(|(i, _)| i)
-                .collect();
-            points
-                .iter()
-                .map(|p| idx.iter().map(|&i| p[i].y).fold(f64::INFINITY, f64::min))
-                .collect()
-        })
-        .collect();
-    (root, foot)
+    (root, clip.foot_heights().into())
 }
 
 fn events_json(e: &JumpEvents) -> serde_json::Value {

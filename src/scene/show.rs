@@ -7,12 +7,12 @@ use serde::{Deserialize, Serialize};
 use serde_json::json;
 
 use super::source::{ClipSource, LoadedMotion, load_motion};
-use super::{SceneError, write_output};
+use super::{SceneError, draw_tracks, write_output};
 use crate::analysis::ground_contacts;
 use crate::ecs::{Recorder, base_schedule, new_world, spawn_clip_character};
 use crate::mapping::effector_errors;
 use crate::model::Model;
-use crate::render::{Plot, Series, Track, animation_gif, filmstrip_png, plot, pose_png};
+use crate::render::{Plot, Series, Track, plot, pose_png};
 use crate::skeleton::Clip;
 
 /// What pictures a scene draws.
@@ -119,18 +119,12 @@ pub fn run_show(
         crate::bvh::to_string(&clip.to_bvh()).as_bytes(),
     )?;
     pose_png(&track, 0, &out.join("pose.png"))?;
-    filmstrip_png(
+    draw_tracks(
         std::slice::from_ref(&track),
-        scene.render.filmstrip_frames.max(1),
-        &out.join("filmstrip.png"),
+        scene.render.filmstrip_frames,
+        scene.render.gif.then_some(scene.render.gif_fps),
+        out,
     )?;
-    if scene.render.gif {
-        animation_gif(
-            std::slice::from_ref(&track),
-            scene.render.gif_fps,
-            &out.join("motion.gif"),
-        )?;
-    }
     report["frames"] = json!(clip.frame_count());
     report["fps"] = json!(1.0 / clip.frame_time);
     report["duration_s"] = json!(clip.duration());
