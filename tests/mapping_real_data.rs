@@ -1,5 +1,5 @@
 //! Mapping the real motion capture in `MARIONETTE_DATA` onto the engine's models: every file
-//! maps onto both models, and the mapped humanoid24 puts head, hands and feet where the source
+//! maps onto both models and renders, and the mapped humanoid24 puts head, hands and feet where the source
 //! does (feet within 5 cm on the CMU jumps).
 
 use std::path::PathBuf;
@@ -48,6 +48,21 @@ fn every_data_file_maps_onto_both_models_and_looks_like_itself() {
                 mapped.angles.iter().all(|a| a.is_finite()),
                 "{file} {model}"
             );
+            // It renders: a filmstrip of the mapped clip.
+            let shown = mapped.to_clip();
+            let figure = shown.skeleton.figure();
+            let frames = shown.point_frames();
+            let track = marionette::render::Track {
+                figure: &figure,
+                frames: &frames,
+                label: file.into(),
+                frame_time: shown.frame_time,
+            };
+            let png = std::env::temp_dir()
+                .join(format!("marionette-map-{}-{model}.png", std::process::id()));
+            marionette::render::filmstrip_png(&[track], 4, &png).unwrap();
+            assert!(std::fs::metadata(&png).unwrap().len() > 1000);
+            std::fs::remove_file(&png).ok();
             let errs = effector_errors(&clip, &mapping, &mapped).unwrap();
             for e in &errs {
                 println!(
