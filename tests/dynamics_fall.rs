@@ -176,3 +176,42 @@ fn a_partial_scene_takes_the_paper_defaults() {
         .to_string();
     assert!(bad.contains("dt"), "{bad}");
 }
+
+#[test]
+fn random_genes_within_the_ranges_all_simulate() {
+    // What the genetic algorithm will do: k_p and θ_d of every DOF drawn at random (θ_d inside
+    // the group's ranges). Every fall must run to the end and come down. Penetration is looser
+    // here than in the paper's fall: with stiffness per kilogram of link mass, a light link that
+    // lands under the body's weight (an upper arm) sinks up to ~3 cm.
+    use marionette::model::ranges::RangeTable;
+    use rand::{RngExt, SeedableRng};
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(5);
+    let fig = marionette::model::fall21();
+    for (n, group) in [AgeGroup::Elderly, AgeGroup::Adult]
+        .into_iter()
+        .cycle()
+        .take(8)
+        .enumerate()
+    {
+        let ranges = RangeTable::builtin(group).for_model(&fig).unwrap();
+        let mut cfg = FallConfig::paper(group);
+        for d in 0..21 {
+            cfg.kp[d] = rng.random_range(0.0..800.0);
+            let (lo, hi) = ranges[d];
+            cfg.key_pose_deg[d] = rng.random_range(lo..=hi).to_degrees();
+        }
+        let r = simulate_fall(&cfg).unwrap_or_else(|e| panic!("fall {n}: {e}"));
+        let last = r.frames.last().unwrap();
+        assert!(
+            last.head_height_m < 1.0,
+            "fall {n}: head at {}",
+            last.head_height_m
+        );
+        assert!(
+            r.max_penetration_m < 0.04,
+            "fall {n}: sank {} m",
+            r.max_penetration_m
+        );
+        assert!(r.damage.is_finite() && r.damage > 0.0);
+    }
+}

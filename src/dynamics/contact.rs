@@ -216,19 +216,22 @@ impl ContactModel {
     }
 
     /// [`update_anchors`](Self::update_anchors) then [`apply`](Self::apply) in one pass over the
-    /// corners (the step-start evaluation): same results, corner positions computed once.
+    /// corners (the step-start evaluation): same results, corner positions computed once; also
+    /// writes each link's deepest corner penetration (m) into `depth`.
     pub fn update_and_apply(
         &self,
         data: &Data,
         state: &mut ContactState,
         f_ext: &mut [ForceVec],
         normal: &mut [f64],
+        depth: &mut [f64],
     ) -> f64 {
         let p = &self.params;
         let n = p.floor_normal;
         let mut deepest: f64 = 0.0;
         for (i, corners) in self.corners.iter().enumerate() {
             normal[i] = 0.0;
+            depth[i] = 0.0;
             let rot = data.rot[i];
             let pos = data.pos[i];
             let (c, r) = self.bounds[i];
@@ -267,6 +270,7 @@ impl ContactModel {
                 }
                 if let Some((fnorm, ft, z)) = self.corner_force(i, x, xd, *slot) {
                     deepest = deepest.max(-z);
+                    depth[i] = depth[i].max(-z);
                     normal[i] += fnorm;
                     let f_world = n * fnorm + ft;
                     f_body += ForceVec::at_point(rot.transpose() * f_world, cl);
