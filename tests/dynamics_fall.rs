@@ -195,9 +195,8 @@ fn random_genes_within_the_ranges_all_simulate() {
     {
         let ranges = RangeTable::builtin(group).for_model(&fig).unwrap();
         let mut cfg = FallConfig::paper(group);
-        for d in 0..21 {
+        for (d, &(lo, hi)) in ranges.iter().enumerate() {
             cfg.kp[d] = rng.random_range(0.0..800.0);
-            let (lo, hi) = ranges[d];
             cfg.key_pose_deg[d] = rng.random_range(lo..=hi).to_degrees();
         }
         let r = simulate_fall(&cfg).unwrap_or_else(|e| panic!("fall {n}: {e}"));
