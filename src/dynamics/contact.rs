@@ -7,8 +7,10 @@
 //! clipped to the friction cone `|f_t| ≤ μ f_n`. The anchor is set where the corner first
 //! touches and is dragged along when the spring would exceed the cone (slip), so a body below the
 //! friction angle sticks (no creep) and one above it slides with `|f_t| = μ f_n`.
-//! Gains are given per kilogram of link mass (`k_p = k̂_p m_link`), so every link has the same
-//! contact frequency and the same static sink `g / (corners · k̂_p)`.
+//! Gains are given per kilogram of link mass (`k_p = k̂_p m_link`), so every link has about the
+//! same contact frequency (hence one stable step for all) and the same static sink
+//! `g / (corners · k̂_p)` under its own weight. The price: a light link that lands under much of
+//! the body's weight (an upper arm under the torso) sinks deeper than a heavy one would.
 
 use super::data::Data;
 use super::human::LinkBox;
