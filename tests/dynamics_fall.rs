@@ -214,3 +214,20 @@ fn random_genes_within_the_ranges_all_simulate() {
         assert!(r.damage.is_finite() && r.damage > 0.0);
     }
 }
+
+#[test]
+fn ranges_can_come_from_an_editable_ron_file() {
+    use marionette::dynamics::fall::Ranges;
+    let path =
+        std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes/models/fall21_adult.ron");
+    let mut cfg = FallConfig::paper(AgeGroup::Adult);
+    cfg.duration_s = 0.2;
+    let builtin = simulate_fall(&cfg).unwrap();
+    cfg.ranges = Ranges::File(path);
+    let from_file = simulate_fall(&cfg).unwrap();
+    assert_eq!(builtin.damage.to_bits(), from_file.damage.to_bits());
+    assert_eq!(builtin.frames.last(), from_file.frames.last());
+    cfg.ranges = Ranges::File("no/such/ranges.ron".into());
+    let e = simulate_fall(&cfg).unwrap_err().to_string();
+    assert!(e.contains("no/such/ranges.ron"), "{e}");
+}

@@ -32,6 +32,9 @@ pub enum Ranges {
     Builtin(AgeGroup),
     /// A user table (degrees), e.g. loaded with [`RangeTable::load`].
     Table(RangeTable),
+    /// A range-table RON file (like `scenes/models/fall21_elderly.ron`), read when the fall is
+    /// built; a relative path is taken from the working directory.
+    File(std::path::PathBuf),
 }
 
 /// Everything that defines one pushed fall. Angles in degrees, per fall21 DOF in model order.
@@ -694,6 +697,7 @@ pub fn build_fall(cfg: &FallConfig) -> Result<FallParts, SimError> {
     let table = match &cfg.ranges {
         Ranges::Builtin(g) => RangeTable::builtin(*g),
         Ranges::Table(t) => t.clone(),
+        Ranges::File(p) => RangeTable::load(p)?,
     };
     let ranges = table.for_model(&body.figure)?;
     let rad = |v: &[f64]| v.iter().map(|x| x.to_radians()).collect::<Vec<_>>();
