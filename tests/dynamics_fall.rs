@@ -51,6 +51,15 @@ fn pushed_from_the_front_the_elderly_figure_falls_backward_and_rests() {
     let r = simulate_fall(&cfg).unwrap();
     check_fell_backward_and_rested(&r);
     assert_eq!(r.frames[0].angles.len(), 21);
+    // The joint limits hold under the fall's loads: no DOF is driven more than 10° past its
+    // elderly range (the arms swing hardest into theirs).
+    for (name, ex) in r.dof_names.iter().zip(&r.max_limit_excursion_rad) {
+        assert!(
+            ex.to_degrees() < 10.0,
+            "{name} went {:.1}° past its range",
+            ex.to_degrees()
+        );
+    }
     // The record as a fall21 clip: 60 Hz over 3 s, every DOF.
     let clip = r.to_model_clip();
     assert_eq!(clip.frame_count(), 181);
