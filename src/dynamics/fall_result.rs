@@ -98,7 +98,7 @@ pub enum SimError {
          (natural frequency {omega:.1} rad/s, damping ratio {zeta:.2}); lower dt_s or the {what} stiffness"
     )]
     Unstable {
-        /// "contact" or "joint <dof>".
+        /// `"contact"` or `"joint <dof name>"`.
         what: String,
         /// Link concerned.
         body: String,
