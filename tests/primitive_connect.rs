@@ -90,3 +90,45 @@ fn connecting_different_models_or_nothing_is_an_error() {
     ));
     assert!(connect(&[], 0.01, None).is_err());
 }
+
+#[test]
+fn a_hand_over_far_from_the_start_keeps_the_primitives_own_scaling() {
+    use marionette::primitive::{DofState, SpatialScaling};
+    // Knee: 5° → 110° crouch → 20° (g − s = 15°, goal-scaled).
+    let n = 121;
+    let knee: Vec<f64> = (0..n)
+        .map(|k| {
+            let x = k as f64 / (n - 1) as f64;
+            (5.0 + 105.0 * (std::f64::consts::PI * x).sin().powi(2) * (1.0 - x) + 15.0 * x) * DEG
+        })
+        .collect();
+    let demo = Trajectory::from_columns(1.0 / 120.0, vec!["knee".into()], &[knee]).unwrap();
+    let p = Primitive::learn("knee", &demo, &LearnConfig::default())
+        .unwrap()
+        .primitive;
+    assert!(matches!(
+        p.dofs[0].scaling,
+        SpatialScaling::GoalMinusStart { .. }
+    ));
+    // Handed over at 19° (almost at the goal): rescaling by (g − θ_c)/(g − s) would flatten the
+    // crouch to 1/15 of its size; keeping the primitive's own s keeps the crouch.
+    let start = DofState {
+        theta: vec![19.0 * DEG],
+        theta_dot: vec![0.0],
+    };
+    let s = p
+        .sample(
+            &(0..=180).map(|k| k as f64 / 120.0).collect::<Vec<_>>(),
+            Some(&start),
+        )
+        .unwrap();
+    let peak = s.values.iter().cloned().fold(f64::MIN, f64::max);
+    let demo_peak = demo.column(0).into_iter().fold(f64::MIN, f64::max);
+    assert!(
+        (peak - demo_peak).abs() < 10.0 * DEG,
+        "peak {} vs demo {}",
+        peak / DEG,
+        demo_peak / DEG
+    );
+    assert!((s.values[180] - p.dofs[0].goal).abs() < 0.5 * DEG);
+}

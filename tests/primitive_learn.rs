@@ -158,3 +158,70 @@ fn too_short_or_malformed_demos_are_clear_errors() {
     let e = Primitive::learn("x", &demo, &bad).unwrap_err();
     assert!(e.to_string().contains("kernels"), "{e}");
 }
+
+#[test]
+fn root_motion_comes_along_and_is_reported_in_millimetres() {
+    use marionette::primitive::DofUnit;
+    use marionette::primitive::synthetic::jump_root_height;
+    let (root, _, truth) = jump_root_height(120.0);
+    let n = root.len();
+    let knee: Vec<f64> = knee_jump(100.0 * DEG, (n - 1) as f64 / 120.0, 120.0);
+    let demo = Trajectory::from_columns(
+        1.0 / 120.0,
+        vec!["left_knee".into(), "root_ty".into()],
+        &[knee, root.clone()],
+    )
+    .unwrap();
+    let l = Primitive::learn("jump", &demo, &LearnConfig::default()).unwrap();
+    let fit = &l.fit.dofs[1];
+    assert_eq!(fit.unit, DofUnit::Metre);
+    eprintln!(
+        "root_ty RMSE {:.3} mm, max {:.3} mm",
+        fit.rmse, fit.max_error
+    );
+    assert!(fit.rmse < 2.0, "root RMSE {} mm", fit.rmse);
+    // The flight survives: the rolled-out root peaks at the demonstrated apex, at Leap.
+    let roll = l.primitive.rollout(demo.dt, None).unwrap();
+    let y = roll.column(1);
+    let (k_max, y_max) =
+        y.iter().enumerate().fold(
+            (0, f64::MIN),
+            |a, (k, v)| if *v > a.1 { (k, *v) } else { a },
+        );
+    let apex = root.iter().cloned().fold(f64::MIN, f64::max);
+    assert!((y_max - apex).abs() < 0.003, "apex {y_max} vs {apex}");
+    assert!((k_max as f64 / 120.0 - truth.leap).abs() < 0.02);
+}
+
+#[test]
+fn learning_a_primitives_own_rollout_reproduces_it() {
+    let demo = smooth_humanoid24(600, 120.0, 5).unwrap();
+    for formulation in [
+        Formulation::default(),
+        Formulation::ijspeert2013(),
+        Formulation::hoffmann2009(),
+    ] {
+        let cfg = LearnConfig {
+            formulation,
+            ..LearnConfig::default()
+        };
+        let p = Primitive::learn("a", &demo, &cfg).unwrap().primitive;
+        let roll = p.rollout(demo.dt, None).unwrap();
+        let again = Primitive::learn("b", &roll, &cfg).unwrap();
+        let max = again.fit.max_angle_rmse_deg().unwrap();
+        assert!(max < 0.01, "{}: RMSE {max} deg", formulation.name());
+        for (a, b) in p.dofs.iter().zip(&again.primitive.dofs) {
+            // The rollout ends where the demonstration did, up to the fit error at the last frame.
+            assert!((a.goal - b.goal).abs() < 1e-3 && (a.start - b.start).abs() < 1e-12);
+            assert_eq!(
+                std::mem::discriminant(&a.scaling),
+                std::mem::discriminant(&b.scaling)
+            );
+        }
+    }
+    let bad = LearnConfig {
+        degenerate_fraction: -1.0,
+        ..LearnConfig::default()
+    };
+    assert!(Primitive::learn("x", &demo, &bad).is_err());
+}

@@ -20,7 +20,7 @@ pub mod ranges;
 
 pub use definition::{fall21, humanoid24};
 pub use joint_angles::{local_rotation, project_rotation, unwrap_near};
-pub use model_clip::ModelClip;
+pub use model_clip::{ModelClip, ROOT_CHANNELS};
 
 use glam::{DQuat, DVec3};
 use serde::{Deserialize, Serialize};

@@ -3,6 +3,13 @@
 use glam::{DQuat, DVec3};
 
 use crate::model::Model;
+use crate::primitive::Trajectory;
+
+/// Names of the root channels in a primitive trajectory: translation (m), then orientation as a
+/// rotation vector (rad).
+pub const ROOT_CHANNELS: [&str; 6] = [
+    "root_tx", "root_ty", "root_tz", "root_rx", "root_ry", "root_rz",
+];
 use crate::skeleton::Clip;
 
 /// A motion expressed on one of the engine's models: per frame, every DOF angle (radians, model
@@ -105,6 +112,126 @@ impl ModelClip {
             translations,
             rotations,
         }
+    }
+
+    /// The motion as a primitive trajectory: the model's DOFs (radians) followed by the root
+    /// channels `root_tx, root_ty, root_tz` (metres) and `root_rx, root_ry, root_rz` (the
+    /// pelvis orientation as a rotation vector, unwrapped over time, radians).
+    pub fn to_trajectory(&self) -> Trajectory {
+        let d = self.dof_count();
+        let mut names = self.model.dof_names();
+        names.extend(ROOT_CHANNELS.iter().map(|s| s.to_string()));
+        let rv = self.root_rotation_vectors();
+        let mut values = Vec::with_capacity(self.frame_count() * (d + 6));
+        for (f, r) in rv.iter().enumerate() {
+            values.extend_from_slice(self.frame_angles(f));
+            let t = self.root_translation[f];
+            values.extend([t.x, t.y, t.z, r.x, r.y, r.z]);
+        }
+        Trajectory {
+            dt: self.frame_time,
+            names,
+            values,
+        }
+    }
+
+    /// A motion on `model` from a trajectory holding every model DOF (by name) and the six root
+    /// channels of [`ModelClip::to_trajectory`].
+    pub fn from_trajectory(model: &Model, traj: &Trajectory) -> Result<ModelClip, String> {
+        let index = |name: &str| {
+            traj.names
+                .iter()
+                .position(|n| n == name)
+                .ok_or_else(|| format!("the trajectory has no channel '{name}'"))
+        };
+        let dof_cols: Vec<usize> = model
+            .dofs
+            .iter()
+            .map(|d| index(&d.name))
+            .collect::<Result<_, _>>()?;
+        let root_cols: Vec<usize> = ROOT_CHANNELS
+            .iter()
+            .map(|n| index(n))
+            .collect::<Result<_, _>>()?;
+        let frames = traj.frames();
+        let mut clip = ModelClip {
+            model: model.clone(),
+            frame_time: traj.dt,
+            root_translation: Vec::with_capacity(frames),
+            root_rotation: Vec::with_capacity(frames),
+            angles: Vec::with_capacity(frames * dof_cols.len()),
+        };
+        for k in 0..frames {
+            let row = traj.frame(k);
+            clip.angles.extend(dof_cols.iter().map(|&c| row[c]));
+            let r = |i: usize| row[root_cols[i]];
+            clip.root_translation.push(DVec3::new(r(0), r(1), r(2)));
+            clip.root_rotation
+                .push(DQuat::from_scaled_axis(DVec3::new(r(3), r(4), r(5))));
+        }
+        Ok(clip)
+    }
+
+    /// Global positions of the model's joints (metres) at every frame, by joint name order of
+    /// the model's skeleton.
+    pub fn joint_positions(&self) -> Vec<Vec<DVec3>> {
+        let clip = self.to_clip();
+        let mut g = vec![];
+        (0..clip.frame_count())
+            .map(|f| {
+                clip.globals(f, &mut g);
+                g.iter().map(|t| t.translation).collect()
+            })
+            .collect()
+    }
+
+    /// Keeps the feet on the floor: outside the `airborne` spans (seconds) the root is raised or
+    /// lowered so that the lowest foot point (ankle joints and their End Sites) is at
+    /// `floor_y`; inside a span the correction is interpolated linearly between its ends, so a
+    /// flight keeps its arc. Blending and extrapolating joint angles and root height separately
+    /// does not keep legs and root consistent (an extrapolated crouch lifts the feet); this puts
+    /// the contact back. Returns the largest correction applied, metres.
+    pub fn keep_feet_on_floor(&mut self, airborne: &[(f64, f64)], floor_y: f64) -> f64 {
+        let clip = self.to_clip();
+        let feet: Vec<usize> = clip
+            .skeleton
+            .joints
+            .iter()
+            .enumerate()
+            .filter(|(_, j)| j.name.ends_with("ankle"))
+            .map(|(i, _)| i)
+            .collect();
+        let mut g = vec![];
+        let lowest: Vec<f64> = (0..clip.frame_count())
+            .map(|f| {
+                clip.globals(f, &mut g);
+                feet.iter()
+                    .flat_map(|&a| {
+                        let e = clip.skeleton.joints[a].end_site.unwrap_or_default();
+                        [g[a].translation.y, (g[a].translation + g[a].rotation * e).y]
+                    })
+                    .fold(f64::INFINITY, f64::min)
+            })
+            .collect();
+        let n = lowest.len();
+        let frame =
+            |t: f64| ((t / self.frame_time).round().max(0.0) as usize).min(n.saturating_sub(1));
+        let mut correction: Vec<f64> = lowest.iter().map(|h| floor_y - h).collect();
+        for &(a, b) in airborne {
+            let (fa, fb) = (frame(a), frame(b));
+            if fb <= fa {
+                continue;
+            }
+            let (ca, cb) = (correction[fa], correction[fb]);
+            for (k, c) in correction.iter_mut().enumerate().take(fb).skip(fa + 1) {
+                let u = (k - fa) as f64 / (fb - fa) as f64;
+                *c = ca + u * (cb - ca);
+            }
+        }
+        for (t, c) in self.root_translation.iter_mut().zip(&correction) {
+            t.y += c;
+        }
+        correction.iter().fold(0.0, |m, c| m.max(c.abs()))
     }
 
     /// The angles as CSV: header `frame,time_s,<dof>,…`, degrees, one row per frame.

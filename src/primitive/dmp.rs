@@ -151,6 +151,7 @@ impl Formulation {
     /// The state derivative (θ′, z′) in normalised time, for goal `g`, start `s`, first-order
     /// phase value `phase_x` (used by Hoffmann's `−K(g − θ₀)s`) and gated, scaled forcing `f`.
     #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
     pub fn derivative(
         &self,
         theta: f64,
@@ -163,12 +164,12 @@ impl Formulation {
         match *self {
             Formulation::Ijspeert2002 {
                 alpha_z, beta_z, ..
-            } => (z + f, alpha_z * (beta_z * (g - theta) - z)),
+            } => deriv_2002(alpha_z, beta_z, theta, z, g, f),
             Formulation::Ijspeert2013 {
                 alpha_z, beta_z, ..
-            } => (z, alpha_z * (beta_z * (g - theta) - z) + f),
+            } => deriv_2013(alpha_z, beta_z, theta, z, g, f),
             Formulation::Hoffmann2009 { k, d, .. } => {
-                (z, k * (g - theta) - d * z - k * (g - s) * phase_x + k * f)
+                deriv_hoffmann(k, d, theta, z, g, s, phase_x, f)
             }
         }
     }
@@ -200,6 +201,34 @@ impl Formulation {
     }
 }
 
+/// Ijspeert 2002: (θ′, z′) = (z + F, α_z(β_z(g − θ) − z)).
+#[inline(always)]
+pub fn deriv_2002(alpha_z: f64, beta_z: f64, theta: f64, z: f64, g: f64, f: f64) -> (f64, f64) {
+    (z + f, alpha_z * (beta_z * (g - theta) - z))
+}
+
+/// Ijspeert 2013: (θ′, z′) = (z, α_z(β_z(g − θ) − z) + F).
+#[inline(always)]
+pub fn deriv_2013(alpha_z: f64, beta_z: f64, theta: f64, z: f64, g: f64, f: f64) -> (f64, f64) {
+    (z, alpha_z * (beta_z * (g - theta) - z) + f)
+}
+
+/// Hoffmann 2009: (θ′, z′) = (z, K(g − θ) − Dz − K(g − θ₀)s + K F), with s the phase.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+pub fn deriv_hoffmann(
+    k: f64,
+    d: f64,
+    theta: f64,
+    z: f64,
+    g: f64,
+    s0: f64,
+    s: f64,
+    f: f64,
+) -> (f64, f64) {
+    (z, k * (g - theta) - d * z - k * (g - s0) * s + k * f)
+}
+
 /// How a DOF's forcing follows a change of goal or start.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub enum SpatialScaling {
@@ -225,30 +254,37 @@ impl SpatialScaling {
     }
 }
 
-/// The paper's learning state z_demo: integrates `z′ = α_z(β_z(g − θ_demo(u)) − z)`, z(0) = `z0`,
-/// along demonstration samples `theta` spaced `du` apart in normalised time. Between samples θ is
-/// taken linear, for which the step is exact:
+/// The paper's learning state z_demo for `goals.len()` DOFs at once: integrates
+/// `z′ = α_z(β_z(g − θ_demo(u)) − z)`, z(0) = `z0`, along demonstration samples `theta`
+/// (frames × dofs, row-major) spaced `du` apart in normalised time; `out` has the same layout.
+/// Between samples θ is taken linear, for which the step is exact:
 /// `z_{k+1} = e^{−a h} z_k + b[(g − θ_k)(1 − e^{−ah})/a − (θ_{k+1} − θ_k)(h/a − (1 − e^{−ah})/a²)/h]`
 /// with a = α_z, b = α_zβ_z, h = du.
 pub fn integrate_z_demo(
     alpha_z: f64,
     beta_z: f64,
-    g: f64,
+    goals: &[f64],
     theta: &[f64],
     du: f64,
-    z0: f64,
+    z0: &[f64],
     out: &mut [f64],
 ) {
+    let dofs = goals.len();
+    let n = theta.len() / dofs;
     let a = alpha_z;
     let b = alpha_z * beta_z;
     let e = (-a * du).exp();
-    let i0 = (1.0 - e) / a;
-    let i1 = (du / a - (1.0 - e) / (a * a)) / du;
-    let mut z = z0;
-    for k in 0..theta.len() {
-        out[k] = z;
-        if k + 1 < theta.len() {
-            z = e * z + b * ((g - theta[k]) * i0 - (theta[k + 1] - theta[k]) * i1);
+    let i0 = b * (1.0 - e) / a;
+    let i1 = b * (du / a - (1.0 - e) / (a * a)) / du;
+    out[..dofs].copy_from_slice(z0);
+    for k in 0..n - 1 {
+        let (done, rest) = out.split_at_mut((k + 1) * dofs);
+        let z = &done[k * dofs..];
+        let next = &mut rest[..dofs];
+        let th = &theta[k * dofs..(k + 1) * dofs];
+        let th1 = &theta[(k + 1) * dofs..(k + 2) * dofs];
+        for j in 0..dofs {
+            next[j] = e * z[j] + (goals[j] - th[j]) * i0 - (th1[j] - th[j]) * i1;
         }
     }
 }
@@ -265,7 +301,7 @@ mod tests {
         let du = 0.1;
         let theta: Vec<f64> = (0..n).map(|k| 0.3 + 0.7 * k as f64 * du).collect();
         let mut z = vec![0.0; n];
-        integrate_z_demo(a, bz, g, &theta, du, 0.4, &mut z);
+        integrate_z_demo(a, bz, &[g], &theta, du, &[0.4], &mut z);
         let f = |u: f64, z: f64| a * (bz * (g - (0.3 + 0.7 * u)) - z);
         let (mut zz, h) = (0.4, 1e-4);
         for step in 0..10_000 {

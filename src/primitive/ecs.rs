@@ -1,10 +1,10 @@
 //! ECS wiring (bevy_ecs): characters carry primitive players; systems step them every frame.
 //!
 //! - [`PrimitivePlayer`] plays a sequence of primitives, connected: each starts from the state the
-//!   previous one ended in (as [`super::connect`]); after the last one the DMP keeps running and
+//!   previous one ended in (as [`super::connect()`]); after the last one the DMP keeps running and
 //!   settles on its goal.
 //! - [`BlendPlayer`] plays two primitives placed on a time line and mixes them live with γ(t′)
-//!   (step 3 of the paper's blending, as [`super::blend`] without re-learning).
+//!   (step 3 of the paper's blending, as [`super::blend()`] without re-learning).
 //! - Both write the character's [`DofPose`] (θ and θ̇ per DOF) for the systems downstream
 //!   (forward kinematics, rendering).
 //! - [`PrimitiveClock`] (a resource) gives the frame step; [`PrimitiveSet`] orders the systems;
@@ -16,7 +16,7 @@ use std::sync::Arc;
 use bevy_ecs::prelude::*;
 
 use super::blend::{BlendPlacement, Gamma};
-use super::error::{PrimitiveError, Result, require_positive};
+use super::error::{PrimitiveError, Result};
 use super::primitive::Primitive;
 use super::rollout::Rollout;
 
@@ -168,7 +168,7 @@ pub struct BlendPlayer {
 }
 
 impl BlendPlayer {
-    /// A live blend (the same checks as [`super::blend`]: same DOFs, a valid arrangement, a valid γ).
+    /// A live blend (the same checks as [`super::blend()`]: same DOFs, a valid arrangement, a valid γ).
     pub fn new(
         a: &Primitive,
         b: &Primitive,
@@ -293,9 +293,4 @@ pub fn add_primitive_systems(schedule: &mut Schedule) {
         step_primitive_players.in_set(PrimitiveSet::Players),
         step_blend_players.in_set(PrimitiveSet::Blends),
     ));
-}
-
-/// Checks a clock step: finite and > 0.
-pub fn validate_clock(clock: &PrimitiveClock) -> Result<()> {
-    require_positive("dt", clock.dt)
 }

@@ -104,20 +104,31 @@ impl Default for LearnConfig {
     }
 }
 
-/// First and second derivatives of samples spaced `h` apart: central differences inside,
-/// second-order one-sided at the ends (needs at least 4 samples).
-pub fn derivatives(x: &[f64], h: f64, d1: &mut [f64], d2: &mut [f64]) {
-    let n = x.len();
+/// First and second derivatives of `dofs` signals sampled `h` apart, stored row-major
+/// (`x[k * dofs + j]`, at least 4 frames): central differences inside, second-order one-sided
+/// at the ends. Results use the same layout. All DOFs of a frame are processed together.
+pub fn derivatives(x: &[f64], dofs: usize, h: f64, d1: &mut [f64], d2: &mut [f64]) {
+    let n = x.len() / dofs;
     debug_assert!(n >= 4);
     let (i1, i2) = (0.5 / h, 1.0 / (h * h));
+    let row = |k: usize| &x[k * dofs..(k + 1) * dofs];
     for k in 1..n - 1 {
-        d1[k] = (x[k + 1] - x[k - 1]) * i1;
-        d2[k] = (x[k + 1] - 2.0 * x[k] + x[k - 1]) * i2;
+        let (a, b, c) = (row(k - 1), row(k), row(k + 1));
+        let o1 = &mut d1[k * dofs..(k + 1) * dofs];
+        let o2 = &mut d2[k * dofs..(k + 1) * dofs];
+        for j in 0..dofs {
+            o1[j] = (c[j] - a[j]) * i1;
+            o2[j] = (c[j] - 2.0 * b[j] + a[j]) * i2;
+        }
     }
-    d1[0] = (-3.0 * x[0] + 4.0 * x[1] - x[2]) * i1;
-    d1[n - 1] = (3.0 * x[n - 1] - 4.0 * x[n - 2] + x[n - 3]) * i1;
-    d2[0] = (2.0 * x[0] - 5.0 * x[1] + 4.0 * x[2] - x[3]) * i2;
-    d2[n - 1] = (2.0 * x[n - 1] - 5.0 * x[n - 2] + 4.0 * x[n - 3] - x[n - 4]) * i2;
+    for j in 0..dofs {
+        let (x0, x1, x2, x3) = (row(0)[j], row(1)[j], row(2)[j], row(3)[j]);
+        d1[j] = (-3.0 * x0 + 4.0 * x1 - x2) * i1;
+        d2[j] = (2.0 * x0 - 5.0 * x1 + 4.0 * x2 - x3) * i2;
+        let (y0, y1, y2, y3) = (row(n - 1)[j], row(n - 2)[j], row(n - 3)[j], row(n - 4)[j]);
+        d1[(n - 1) * dofs + j] = (3.0 * y0 - 4.0 * y1 + y2) * i1;
+        d2[(n - 1) * dofs + j] = (2.0 * y0 - 5.0 * y1 + 4.0 * y2 - y3) * i2;
+    }
 }
 
 /// Learns one [`DofPrimitive`] per DOF of `demo` on `basis`: start s = first frame, goal g = last
@@ -137,56 +148,78 @@ pub fn learn_dofs(
     }
     let f = config.formulation;
     f.validate()?;
+    if !(config.degenerate_fraction >= 0.0 && config.degenerate_fraction.is_finite()) {
+        return Err(PrimitiveError::InvalidParameter {
+            field: "degenerate_fraction".into(),
+            reason: format!("must be ≥ 0 and finite, got {}", config.degenerate_fraction),
+        });
+    }
     let canonical = f.canonical();
     let nk = basis.len();
     let dofs = demo.dofs();
     let du = 1.0 / (n - 1) as f64;
 
-    // Forcing targets, frames × dofs (DOF-major for the regression: dofs × frames).
-    let mut targets = vec![0.0; dofs * n];
-    let mut out = Vec::with_capacity(dofs);
-    let mut col = vec![0.0; n];
-    let (mut d1, mut d2, mut zd) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
-    let phases: Vec<_> = (0..n).map(|k| canonical.phase(k as f64 * du)).collect();
-    for j in 0..dofs {
-        for (k, c) in col.iter_mut().enumerate() {
-            *c = demo.values[k * dofs + j];
+    // Everything below is frames × dofs, row-major: each frame's DOFs are contiguous, so every
+    // per-frame loop runs over all DOFs at once.
+    let x = &demo.values;
+    let mut d1 = vec![0.0; dofs * n];
+    let mut d2 = vec![0.0; dofs * n];
+    derivatives(x, dofs, du, &mut d1, &mut d2);
+    let starts = &x[..dofs];
+    let goals = &x[(n - 1) * dofs..];
+    let mut lo = starts.to_vec();
+    let mut hi = starts.to_vec();
+    for row in x.chunks_exact(dofs) {
+        for j in 0..dofs {
+            lo[j] = if row[j] < lo[j] { row[j] } else { lo[j] };
+            hi[j] = if row[j] > hi[j] { row[j] } else { hi[j] };
         }
-        derivatives(&col, du, &mut d1, &mut d2);
-        let (s, g) = (col[0], col[n - 1]);
-        let (lo, hi) = col
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
-                (a.min(*v), b.max(*v))
-            });
-        let range = hi - lo;
-        let scaling = if f.scales_with_goal()
-            && (g - s).abs() >= (config.degenerate_fraction * range).max(1e-9)
-        {
-            SpatialScaling::GoalMinusStart { reference: g - s }
-        } else {
-            SpatialScaling::Unscaled
-        };
-        if let Formulation::Ijspeert2002 {
-            alpha_z, beta_z, ..
-        } = f
-        {
-            integrate_z_demo(alpha_z, beta_z, g, &col, du, d1[0], &mut zd);
-        }
-        let t = &mut targets[j * n..(j + 1) * n];
-        for k in 0..n {
-            t[k] = f.forcing_target(col[k], d1[k], d2[k], zd[k], g, s, phases[k].x);
-        }
-        out.push(DofPrimitive {
-            name: demo.names[j].clone(),
-            start: s,
-            goal: g,
-            start_rate: d1[0],
-            scaling,
-            weights: vec![0.0; nk],
-        });
     }
+    let mut zd = vec![0.0; dofs * n];
+    if let Formulation::Ijspeert2002 {
+        alpha_z, beta_z, ..
+    } = f
+    {
+        integrate_z_demo(alpha_z, beta_z, goals, x, du, &d1[..dofs], &mut zd);
+    }
+    let phases: Vec<_> = (0..n).map(|k| canonical.phase(k as f64 * du)).collect();
+    let mut targets = vec![0.0; dofs * n];
+    for (k, p) in phases.iter().enumerate() {
+        let r = k * dofs..(k + 1) * dofs;
+        let (th, a, b, z, t) = (
+            &x[r.clone()],
+            &d1[r.clone()],
+            &d2[r.clone()],
+            &zd[r.clone()],
+            &mut targets[r],
+        );
+        for j in 0..dofs {
+            t[j] = f.forcing_target(th[j], a[j], b[j], z[j], goals[j], starts[j], p.x);
+        }
+    }
+    let out: Vec<DofPrimitive> = (0..dofs)
+        .map(|j| {
+            let (s, g) = (starts[j], goals[j]);
+            let range = hi[j] - lo[j];
+            let scaling = if f.scales_with_goal()
+                && (g - s).abs() >= (config.degenerate_fraction * range).max(1e-9)
+            {
+                SpatialScaling::GoalMinusStart { reference: g - s }
+            } else {
+                SpatialScaling::Unscaled
+            };
+            DofPrimitive {
+                name: demo.names[j].clone(),
+                start: s,
+                goal: g,
+                start_rate: d1[j],
+                scaling,
+                weights: vec![0.0; nk],
+            }
+        })
+        .collect();
 
+    let mut out = out;
     let weights = match config.regression {
         Regression::LocallyWeighted => lwr(basis, &phases, &targets, dofs),
         Regression::Ridge { lambda } => {
@@ -200,13 +233,15 @@ pub fn learn_dofs(
         }
     };
     for (j, d) in out.iter_mut().enumerate() {
-        d.weights.copy_from_slice(&weights[j * nk..(j + 1) * nk]);
+        for (i, w) in d.weights.iter_mut().enumerate() {
+            *w = weights[i * dofs + j];
+        }
     }
     Ok(out)
 }
 
 /// The paper's LWR: `w_i = Σ_t ψ_i gate F / Σ_t ψ_i gate²` per kernel and DOF. `targets` is
-/// dofs × frames; returns dofs × kernels.
+/// frames × dofs; returns kernels × dofs.
 fn lwr(
     basis: &Basis,
     phases: &[super::canonical::Phase],
@@ -214,36 +249,36 @@ fn lwr(
     dofs: usize,
 ) -> Vec<f64> {
     let nk = basis.len();
-    let n = phases.len();
-    let mut num = vec![0.0; dofs * nk];
+    let mut num = vec![0.0; nk * dofs];
     let mut den = vec![0.0; nk];
     let mut psi = vec![0.0; nk];
     for (k, p) in phases.iter().enumerate() {
         basis.activations(p.x, &mut psi);
+        let row = &targets[k * dofs..(k + 1) * dofs];
         for i in 0..nk {
             let a = psi[i] * p.gate;
             if a == 0.0 {
                 continue;
             }
             den[i] += a * p.gate;
-            for j in 0..dofs {
-                num[j * nk + i] += a * targets[j * n + k];
+            for (x, t) in num[i * dofs..(i + 1) * dofs].iter_mut().zip(row) {
+                *x += a * t;
             }
         }
     }
-    for j in 0..dofs {
-        for i in 0..nk {
-            num[j * nk + i] = if den[i] > 1e-300 {
-                num[j * nk + i] / den[i]
-            } else {
-                0.0
-            };
+    for i in 0..nk {
+        let inv = if den[i] > 1e-300 { 1.0 / den[i] } else { 0.0 };
+        for x in &mut num[i * dofs..(i + 1) * dofs] {
+            *x *= inv;
         }
     }
     num
 }
 
-/// Ridge least squares over all kernels (see module docs). Returns dofs × kernels.
+/// Ridge least squares over all kernels (see module docs). `targets` is frames × dofs; returns
+/// kernels × dofs. ΦᵀΦ is banded (each frame touches only the kernels near its phase), so it is
+/// accumulated in band storage and factorised by a banded Cholesky: memory and time grow
+/// linearly with the number of kernels.
 fn ridge(
     basis: &Basis,
     phases: &[super::canonical::Phase],
@@ -252,88 +287,114 @@ fn ridge(
     lambda: f64,
 ) -> Result<Vec<f64>> {
     let nk = basis.len();
-    let n = phases.len();
-    let mut ata = vec![0.0; nk * nk];
-    let mut atb = vec![0.0; nk * dofs]; // kernels × dofs
+    let kernels = basis.kernels();
+    // Pass 1: the design rows Φ_t· (gated normalised activations) of every frame, compactly.
     let mut phi = vec![0.0; nk];
+    // (frame, first kernel of its window, its activations in `acts`).
+    let mut rows: Vec<(usize, usize, std::ops::Range<usize>)> = Vec::with_capacity(phases.len());
+    let mut acts: Vec<f64> = Vec::with_capacity(phases.len() * 16);
+    let mut band = 1usize;
     for (k, p) in phases.iter().enumerate() {
-        let r = basis.normalized(p.x, &mut phi);
-        for v in &mut phi[r.clone()] {
-            *v *= p.gate;
+        if p.gate == 0.0 {
+            continue;
         }
-        for a in r.clone() {
-            let pa = phi[a];
-            if pa == 0.0 {
-                continue;
+        let r = kernels.normalized(p.x, &mut phi);
+        band = band.max(r.end - r.start);
+        let at = acts.len();
+        acts.extend(phi[r.clone()].iter().map(|v| v * p.gate));
+        rows.push((k, r.start, at..acts.len()));
+    }
+    // Pass 2: ΦᵀΦ in upper band storage, ab[a·band + (b − a)] for a ≤ b < a + band, and ΦᵀF.
+    let mut ab = vec![0.0; nk * band];
+    let mut atb = vec![0.0; nk * dofs]; // kernels × dofs
+    for (k, a0, r) in &rows {
+        let act = &acts[r.clone()];
+        let row = &targets[k * dofs..(k + 1) * dofs];
+        for (ia, pa) in act.iter().enumerate() {
+            let a = a0 + ia;
+            for (x, y) in ab[a * band..a * band + (act.len() - ia)]
+                .iter_mut()
+                .zip(&act[ia..])
+            {
+                *x += pa * y;
             }
-            for b in a..r.end {
-                ata[a * nk + b] += pa * phi[b];
-            }
-            let row = &mut atb[a * dofs..(a + 1) * dofs];
-            for (j, x) in row.iter_mut().enumerate() {
-                *x += pa * targets[j * n + k];
+            for (x, t) in atb[a * dofs..(a + 1) * dofs].iter_mut().zip(row) {
+                *x += pa * t;
             }
         }
     }
-    let max_diag = (0..nk).map(|i| ata[i * nk + i]).fold(0.0f64, f64::max);
+    let max_diag = (0..nk).map(|i| ab[i * band]).fold(0.0f64, f64::max);
     if max_diag <= 0.0 {
         return Ok(vec![0.0; dofs * nk]);
     }
     for i in 0..nk {
-        ata[i * nk + i] += lambda * ata[i * nk + i] + 1e-12 * max_diag;
-        for b in 0..i {
-            ata[i * nk + b] = ata[b * nk + i];
-        }
+        ab[i * band] += lambda * ab[i * band] + 1e-12 * max_diag;
     }
-    let l = cholesky(&mut ata, nk).ok_or_else(|| PrimitiveError::InvalidParameter {
+    let l = banded_cholesky(&ab, nk, band).ok_or_else(|| PrimitiveError::InvalidParameter {
         field: "regression.lambda".into(),
         reason: "normal equations not positive definite; increase lambda".into(),
     })?;
-    // Solve L Lᵀ W = B for each DOF column.
-    let mut w = vec![0.0; dofs * nk];
-    let mut y = vec![0.0; nk];
-    for j in 0..dofs {
-        for i in 0..nk {
-            let mut s = atb[i * dofs + j];
-            for m in 0..i {
-                s -= l[i * nk + m] * y[m];
+    let bw = band - 1;
+    // L in lower band storage: l[i·band + (i − j)] for i − bw ≤ j ≤ i.
+    let lij = |i: usize, j: usize| l[i * band + (i - j)];
+    // Solve L Lᵀ W = B for all DOF columns at once (rows of B are contiguous).
+    let mut w = atb;
+    for i in 0..nk {
+        let (done, rest) = w.split_at_mut(i * dofs);
+        let wi = &mut rest[..dofs];
+        for m in i.saturating_sub(bw)..i {
+            let c = lij(i, m);
+            for (x, y) in wi.iter_mut().zip(&done[m * dofs..(m + 1) * dofs]) {
+                *x -= c * y;
             }
-            y[i] = s / l[i * nk + i];
         }
-        for i in (0..nk).rev() {
-            let mut s = y[i];
-            for m in i + 1..nk {
-                s -= l[m * nk + i] * w[j * nk + m];
+        let inv = 1.0 / lij(i, i);
+        for x in wi.iter_mut() {
+            *x *= inv;
+        }
+    }
+    for i in (0..nk).rev() {
+        let (head, tail) = w.split_at_mut((i + 1) * dofs);
+        let wi = &mut head[i * dofs..];
+        for m in i + 1..(i + 1 + bw).min(nk) {
+            let c = lij(m, i);
+            let off = (m - i - 1) * dofs;
+            for (x, y) in wi.iter_mut().zip(&tail[off..off + dofs]) {
+                *x -= c * y;
             }
-            w[j * nk + i] = s / l[i * nk + i];
+        }
+        let inv = 1.0 / lij(i, i);
+        for x in wi.iter_mut() {
+            *x *= inv;
         }
     }
     Ok(w)
 }
 
-/// In-place Cholesky A = L Lᵀ of a symmetric n × n matrix (row-major); returns L (lower) or
-/// `None` if A is not positive definite.
-fn cholesky(a: &mut [f64], n: usize) -> Option<&[f64]> {
+/// Cholesky A = L Lᵀ of a symmetric positive-definite n × n matrix given in upper band storage
+/// (`ab[a·band + (b − a)]` = A_ab for a ≤ b < a + band). Returns L in lower band storage
+/// (`l[i·band + (i − j)]` = L_ij for i − band < j ≤ i), or `None` if A is not positive definite.
+fn banded_cholesky(ab: &[f64], n: usize, band: usize) -> Option<Vec<f64>> {
+    let bw = band - 1;
+    let mut l = vec![0.0; n * band];
     for i in 0..n {
-        for j in 0..=i {
-            let mut s = a[i * n + j];
-            for k in 0..j {
-                s -= a[i * n + k] * a[j * n + k];
+        let lo_i = i.saturating_sub(bw);
+        for j in lo_i..=i {
+            let mut s = ab[j * band + (i - j)];
+            for k in lo_i.max(j.saturating_sub(bw))..j {
+                s -= l[i * band + (i - k)] * l[j * band + (j - k)];
             }
             if i == j {
                 if s <= 0.0 || !s.is_finite() {
                     return None;
                 }
-                a[i * n + i] = s.sqrt();
+                l[i * band] = s.sqrt();
             } else {
-                a[i * n + j] = s / a[j * n + j];
+                l[i * band + (i - j)] = s / l[j * band];
             }
         }
-        for j in i + 1..n {
-            a[i * n + j] = 0.0;
-        }
     }
-    Some(a)
+    Some(l)
 }
 
 #[cfg(test)]
@@ -347,7 +408,7 @@ mod tests {
             .map(|k| (k as f64 * h).powi(2) * 3.0 + k as f64 * h)
             .collect();
         let (mut d1, mut d2) = (vec![0.0; 50], vec![0.0; 50]);
-        derivatives(&x, h, &mut d1, &mut d2);
+        derivatives(&x, 1, h, &mut d1, &mut d2);
         for k in 0..50 {
             let u = k as f64 * h;
             assert!((d1[k] - (6.0 * u + 1.0)).abs() < 1e-9, "k={k}");
@@ -356,13 +417,19 @@ mod tests {
     }
 
     #[test]
-    fn cholesky_solves_a_known_system() {
-        let mut a = vec![4.0, 2.0, 2.0, 3.0];
-        let l = cholesky(&mut a, 2).unwrap().to_vec();
-        assert!((l[0] - 2.0).abs() < 1e-15 && (l[2] - 1.0).abs() < 1e-15);
-        assert!((l[3] - 2f64.sqrt()).abs() < 1e-15);
-        let mut b = vec![1.0, 2.0, 2.0, 1.0];
-        assert!(cholesky(&mut b, 2).is_none());
+    fn banded_cholesky_factors_a_tridiagonal_matrix() {
+        // A = L Lᵀ with L = [[2,0,0],[1,√2,0],[0,1,1]] → A = [[4,2,0],[2,3,√2],[0,√2,2]].
+        let r2 = 2f64.sqrt();
+        // Upper band storage, band 2: rows (A_aa, A_a,a+1).
+        let ab = vec![4.0, 2.0, 3.0, r2, 2.0, 0.0];
+        let l = banded_cholesky(&ab, 3, 2).unwrap();
+        // Lower band storage: rows (L_ii, L_i,i−1).
+        let expect = [2.0, 0.0, r2, 1.0, 1.0, 1.0];
+        for (x, y) in l.iter().zip(&expect) {
+            assert!((x - y).abs() < 1e-14, "{l:?}");
+        }
+        // [[1, 2], [2, 1]] is not positive definite.
+        assert!(banded_cholesky(&[1.0, 2.0, 1.0, 0.0], 2, 2).is_none());
     }
 
     #[test]

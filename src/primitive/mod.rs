@@ -25,9 +25,33 @@
 //! u = t/τ ∈ [0, 1] over the movement, so playing a primitive at τ′ = 2τ traces the same path in
 //! twice the time (velocities halve). See [`rollout`] for the integrator.
 //!
+//! **Wiring** (plain data in and out):
+//!
+//! ```
+//! use marionette::primitive::synthetic::knee_jump;
+//! use marionette::primitive::{blend, BlendPlacement, Gamma, LearnConfig, Primitive, Relearn, Trajectory};
+//!
+//! let fps = 120.0;
+//! let demo = |peak_deg: f64, secs: f64| {
+//!     let knee = knee_jump(peak_deg.to_radians(), secs, fps);
+//!     Trajectory::from_columns(1.0 / fps, vec!["left_knee".into()], &[knee]).unwrap()
+//! };
+//! let cfg = LearnConfig::default(); // the paper's Ijspeert 2002, ridge fit
+//! let low = Primitive::learn("low jump", &demo(70.0, 0.9), &cfg).unwrap();
+//! let normal = Primitive::learn("normal jump", &demo(110.0, 1.2), &cfg).unwrap();
+//! assert!(normal.fit.median_angle_rmse_deg().unwrap() < 0.5);
+//! // The paper's high jump: A = low, B = normal, same span, γ = −0.5, learned again as one.
+//! let span = BlendPlacement { a_start: 0.0, a_end: 1.2, b_start: 0.0, b_end: 1.2 };
+//! let high = blend(&low.primitive, &normal.primitive, &span, &Gamma::Constant(-0.5),
+//!                  1.0 / fps, Relearn::Whole, &cfg).unwrap();
+//! let played: Trajectory = high.primitives[0].primitive.rollout(1.0 / fps, None).unwrap();
+//! let peak = played.column(0).into_iter().fold(f64::MIN, f64::max).to_degrees();
+//! assert!(peak > 80.0); // deeper than the normal jump's crouch
+//! ```
+//!
 //! Files: [`canonical`] (shared phase), [`basis`] (kernels), [`dmp`] (one-DOF transformation system,
 //! formulations), [`learn`] (LWR and ridge), [`rollout`] (fixed-step integrator), [`primitive`]
-//! (multi-DOF primitive, adjust, RON io), [`connect`], [`blend`], [`events`], [`ecs`].
+//! (multi-DOF primitive, adjust, RON io), [`mod@connect`], [`mod@blend`], [`events`], [`ecs`].
 
 pub mod basis;
 pub mod blend;

@@ -147,7 +147,15 @@ impl Primitive {
     /// Checks every invariant: version, duration > 0, formulation, basis, unique non-empty DOF
     /// names, one weight per kernel, finite numbers, non-zero scaling references.
     pub fn validate(&self) -> Result<()> {
-        if self.format_version > PRIMITIVE_FORMAT_VERSION || self.format_version == 0 {
+        if self.format_version == 0 {
+            return Err(PrimitiveError::InvalidParameter {
+                field: "format_version".into(),
+                reason: format!(
+                    "versions start at 1 (this build writes {PRIMITIVE_FORMAT_VERSION})"
+                ),
+            });
+        }
+        if self.format_version > PRIMITIVE_FORMAT_VERSION {
             return Err(PrimitiveError::UnsupportedVersion {
                 source_name: self.name.clone(),
                 found: self.format_version,

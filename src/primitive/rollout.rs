@@ -1,15 +1,23 @@
 //! Playing a primitive: a fixed-step integrator of all DOFs' transformation systems driven by the
 //! one shared canonical phase.
 //!
-//! **Integrator.** Classical RK4 in normalised time u = t/τ. To reach a requested time the interval
-//! Δu is cut into `ceil(Δu / h_max)` equal sub-steps with `h_max = min(1/500, 1/(4(N − 1)))`
-//! (N kernels: at least four sub-steps per kernel spacing). The phase is evaluated exactly
-//! ([`CanonicalSystem::phase`]) at each sub-step's start, middle and end, once for all DOFs; the
-//! forcing of every DOF is then a dot product of its weights with the shared normalised
-//! activations. Because steps are fixed in u, playing at τ′ = kτ and sampling at k·t performs
-//! exactly the same arithmetic: the same path, k times slower.
+//! **Integrator.** In normalised time u = t/τ every formulation's transformation system is linear
+//! with constant coefficients in e = θ − g and z:
+//! `(e, z)′ = A (e, z) + B F̃(u)`, `A = [[0, 1], [−K, −D]]`
+//! (K = α_zβ_z, D = α_z for Ijspeert 2002/2013; K, D for Hoffmann 2009), with the input
+//! B F̃ = (F, 0) for 2002 (forcing in the velocity equation), (0, F) for 2013 and
+//! (0, K(F − (g − θ₀)s)) for Hoffmann. To reach a requested time, the interval Δu is cut into
+//! `ceil(Δu / h_max)` equal sub-steps, `h_max = min(1/500, 1/(4(N − 1)))` (N kernels: at least
+//! four sub-steps per kernel spacing), and each sub-step is integrated **exactly** for an input
+//! that is linear across the sub-step (first-order hold):
+//! `x₁ = Φx₀ + (Ψ₁ − Ψ₂/h)B F̃₀ + (Ψ₂/h)B F̃₁`, with `Φ = e^{Ah}`, `Ψ₁ = ∫₀ʰe^{Aσ}dσ`,
+//! `Ψ₂ = ∫₀ʰe^{A(h−σ)}σ dσ` read off one 6 × 6 matrix exponential (Van Loan) and cached per step
+//! size. The only approximation is the linear hold of F̃ over a sub-step (its error telescopes to
+//! O(h²) overall); the forcing is evaluated once per sub-step end, for all DOFs at once from the
+//! shared phase. Because steps are fixed in u, playing at τ′ = kτ and sampling at k·t performs
+//! the same arithmetic: the same path, k times slower.
 
-use super::basis::Basis;
+use super::basis::Kernels;
 use super::canonical::CanonicalSystem;
 use super::dmp::Formulation;
 use super::error::{PrimitiveError, Result, require_finite};
@@ -43,11 +51,10 @@ pub struct Samples {
 pub struct Rollout {
     formulation: Formulation,
     canonical: CanonicalSystem,
-    basis: Basis,
+    kernels: Kernels,
     tau: f64,
     h_max: f64,
-    nk: usize,
-    /// dofs × kernels.
+    /// kernels × dofs (kernel-major: one kernel's weights for all DOFs are contiguous).
     weights: Vec<f64>,
     goal: Vec<f64>,
     start: Vec<f64>,
@@ -58,37 +65,135 @@ pub struct Rollout {
     theta: Vec<f64>,
     z: Vec<f64>,
     f_now: Vec<f64>,
-    f_mid: Vec<f64>,
     f_end: Vec<f64>,
     psi: Vec<f64>,
+    /// Cached discretisation for the last sub-step size.
+    disc: Option<Discrete>,
+}
+
+/// The exact first-order-hold discretisation of (e, z)′ = A(e, z) + B F̃ over one step h.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Discrete {
+    h: f64,
+    phi: [[f64; 2]; 2],
+    /// Weight vector of F̃ at the step's start: (Ψ₁ − Ψ₂/h)B.
+    g0: [f64; 2],
+    /// Weight vector of F̃ at the step's end: (Ψ₂/h)B.
+    g1: [f64; 2],
+}
+
+impl Discrete {
+    /// Builds the discretisation from the 6 × 6 Van Loan exponential
+    /// exp([[A, I, 0], [0, 0, I], [0, 0, 0]]·h) = [[Φ, Ψ₁, Ψ₂], …].
+    fn new(k: f64, d: f64, b: [f64; 2], h: f64) -> Discrete {
+        let mut m = [[0.0; 6]; 6];
+        m[0][1] = h;
+        m[1][0] = -k * h;
+        m[1][1] = -d * h;
+        for i in 0..2 {
+            m[i][i + 2] = h;
+            m[i + 2][i + 4] = h;
+        }
+        let e = expm6(&m);
+        let phi = [[e[0][0], e[0][1]], [e[1][0], e[1][1]]];
+        let mut g0 = [0.0; 2];
+        let mut g1 = [0.0; 2];
+        for i in 0..2 {
+            for j in 0..2 {
+                let psi1 = e[i][j + 2];
+                let psi2 = e[i][j + 4] / h;
+                g0[i] += (psi1 - psi2) * b[j];
+                g1[i] += psi2 * b[j];
+            }
+        }
+        Discrete { h, phi, g0, g1 }
+    }
+}
+
+/// Matrix exponential of a 6 × 6 matrix: scaling and squaring with an 18-term Taylor series
+/// (the norms met here, ‖Ah‖ ≲ 1, need at most a few squarings; accuracy ~1e−16 relative).
+fn expm6(m: &[[f64; 6]; 6]) -> [[f64; 6]; 6] {
+    let norm = m
+        .iter()
+        .map(|r| r.iter().map(|v| v.abs()).sum::<f64>())
+        .fold(0.0, f64::max);
+    let mut s = 0;
+    let mut scale = 1.0;
+    while norm * scale > 0.5 {
+        scale *= 0.5;
+        s += 1;
+    }
+    let mul = |a: &[[f64; 6]; 6], b: &[[f64; 6]; 6]| {
+        let mut c = [[0.0; 6]; 6];
+        for i in 0..6 {
+            for k in 0..6 {
+                if a[i][k] != 0.0 {
+                    for j in 0..6 {
+                        c[i][j] += a[i][k] * b[k][j];
+                    }
+                }
+            }
+        }
+        c
+    };
+    let mut a = *m;
+    for r in a.iter_mut() {
+        for v in r.iter_mut() {
+            *v *= scale;
+        }
+    }
+    let mut result = [[0.0; 6]; 6];
+    let mut term = [[0.0; 6]; 6];
+    for i in 0..6 {
+        result[i][i] = 1.0;
+        term[i][i] = 1.0;
+    }
+    for n in 1..=18 {
+        term = mul(&term, &a);
+        for r in term.iter_mut() {
+            for v in r.iter_mut() {
+                *v /= n as f64;
+            }
+        }
+        for i in 0..6 {
+            for j in 0..6 {
+                result[i][j] += term[i][j];
+            }
+        }
+    }
+    for _ in 0..s {
+        result = mul(&result, &result);
+    }
+    result
 }
 
 /// Gated, scaled forcing of every DOF at normalised time u into `out`; returns the phase x.
+/// F_j = gate · k_j · Σ_i ψ̂_i w_ij with ψ̂ the normalised activations (one evaluation for all DOFs).
 #[allow(clippy::too_many_arguments)]
 fn forcing(
     canonical: &CanonicalSystem,
-    basis: &Basis,
+    kernels: &Kernels,
     weights: &[f64],
     scale: &[f64],
-    nk: usize,
     psi: &mut [f64],
     u: f64,
     out: &mut [f64],
 ) -> f64 {
     let p = canonical.phase(u);
+    out.fill(0.0);
     if p.gate == 0.0 {
-        out.fill(0.0);
         return p.x;
     }
-    let r = basis.normalized(p.x, psi);
-    let act = &psi[r.clone()];
-    for (j, o) in out.iter_mut().enumerate() {
-        let w = &weights[j * nk + r.start..j * nk + r.end];
-        let mut h = 0.0;
-        for (a, b) in act.iter().zip(w) {
-            h += a * b;
+    let d = out.len();
+    let r = kernels.normalized(p.x, psi);
+    for i in r {
+        let a = psi[i];
+        for (o, w) in out.iter_mut().zip(&weights[i * d..(i + 1) * d]) {
+            *o += a * w;
         }
-        *o = p.gate * scale[j] * h;
+    }
+    for (o, k) in out.iter_mut().zip(scale) {
+        *o *= p.gate * k;
     }
     p.x
 }
@@ -96,8 +201,11 @@ fn forcing(
 impl Rollout {
     /// Starts playing `p` at t = 0 from the demonstrated start (θ = s, θ̇ = k·start_rate/τ with k
     /// the goal-scaling factor, so a new goal scales the whole demonstrated path), or from
-    /// `start` (connect: θ and θ̇ of the previous motion). The start enters the spatial scaling
-    /// k = (g − s)/A with s = the actual start angle.
+    /// `start` (connect: θ and θ̇ of the previous motion). The spatial scaling k = (g − s)/A
+    /// keeps the primitive's own s: a connected primitive starting elsewhere follows its own
+    /// course, and the transformation system's spring–damper pulls the state onto it (the
+    /// paper's connection), instead of rescaling the whole motion by how far the hand-over
+    /// state is from s (which, for a DOF whose g − s is small, would blow the motion up).
     pub fn new(p: &Primitive, start: Option<&DofState>) -> Result<Rollout> {
         p.validate()?;
         let dofs = p.dofs.len();
@@ -134,21 +242,21 @@ impl Rollout {
         let scale: Vec<f64> = p
             .dofs
             .iter()
-            .zip(&theta0)
-            .map(|(d, s)| d.scaling.factor(d.goal, *s))
+            .map(|d| d.scaling.factor(d.goal, d.start))
             .collect();
-        let mut weights = Vec::with_capacity(dofs * nk);
-        for d in &p.dofs {
-            weights.extend_from_slice(&d.weights);
+        let mut weights = vec![0.0; nk * dofs];
+        for (j, d) in p.dofs.iter().enumerate() {
+            for (i, w) in d.weights.iter().enumerate() {
+                weights[i * dofs + j] = *w;
+            }
         }
         let canonical = p.formulation.canonical();
         let mut r = Rollout {
             formulation: p.formulation,
             canonical,
-            basis: p.basis.clone(),
+            kernels: p.basis.kernels(),
             tau: p.duration,
             h_max: (1.0f64 / 500.0).min(0.25 / (nk.max(2) - 1) as f64),
-            nk,
             weights,
             goal: p.dofs.iter().map(|d| d.goal).collect(),
             start: theta0.clone(),
@@ -158,16 +266,15 @@ impl Rollout {
             theta: theta0,
             z: vec![0.0; dofs],
             f_now: vec![0.0; dofs],
-            f_mid: vec![0.0; dofs],
             f_end: vec![0.0; dofs],
             psi: vec![0.0; nk],
+            disc: None,
         };
         r.x_now = forcing(
             &r.canonical,
-            &r.basis,
+            &r.kernels,
             &r.weights,
             &r.scale,
-            nk,
             &mut r.psi,
             0.0,
             &mut r.f_now,
@@ -246,41 +353,51 @@ impl Rollout {
         }
     }
 
-    /// One RK4 step from u = a to u = b.
+    /// One exact first-order-hold step from u = a to u = b (see the module docs).
     fn step(&mut self, a: f64, b: f64) {
         let h = b - a;
-        let nk = self.nk;
-        let xm = forcing(
-            &self.canonical,
-            &self.basis,
-            &self.weights,
-            &self.scale,
-            nk,
-            &mut self.psi,
-            a + 0.5 * h,
-            &mut self.f_mid,
-        );
+        let (k, d, bvec) = match self.formulation {
+            Formulation::Ijspeert2002 {
+                alpha_z, beta_z, ..
+            } => (alpha_z * beta_z, alpha_z, [1.0, 0.0]),
+            Formulation::Ijspeert2013 {
+                alpha_z, beta_z, ..
+            } => (alpha_z * beta_z, alpha_z, [0.0, 1.0]),
+            Formulation::Hoffmann2009 { k, d, .. } => (k, d, [0.0, k]),
+        };
+        let disc = match self.disc {
+            // Step sizes that differ only by rounding (relative 1e−9) share one discretisation.
+            Some(c) if (c.h - h).abs() <= 1e-9 * h => c,
+            _ => {
+                let c = Discrete::new(k, d, bvec, h);
+                self.disc = Some(c);
+                c
+            }
+        };
         let x1 = forcing(
             &self.canonical,
-            &self.basis,
+            &self.kernels,
             &self.weights,
             &self.scale,
-            nk,
             &mut self.psi,
             b,
             &mut self.f_end,
         );
-        let x0 = self.x_now;
-        let f = self.formulation;
-        let hh = 0.5 * h;
+        let hoffmann = matches!(self.formulation, Formulation::Hoffmann2009 { .. });
+        let (x0, [[p00, p01], [p10, p11]], g0, g1) = (self.x_now, disc.phi, disc.g0, disc.g1);
         for j in 0..self.theta.len() {
-            let (th, z, g, s) = (self.theta[j], self.z[j], self.goal[j], self.start[j]);
-            let k1 = f.derivative(th, z, g, s, x0, self.f_now[j]);
-            let k2 = f.derivative(th + hh * k1.0, z + hh * k1.1, g, s, xm, self.f_mid[j]);
-            let k3 = f.derivative(th + hh * k2.0, z + hh * k2.1, g, s, xm, self.f_mid[j]);
-            let k4 = f.derivative(th + h * k3.0, z + h * k3.1, g, s, x1, self.f_end[j]);
-            self.theta[j] = th + h / 6.0 * (k1.0 + 2.0 * (k2.0 + k3.0) + k4.0);
-            self.z[j] = z + h / 6.0 * (k1.1 + 2.0 * (k2.1 + k3.1) + k4.1);
+            let g = self.goal[j];
+            // Hoffmann's input is F − (g − θ₀)s (times K, which B carries).
+            let (u0, u1) = if hoffmann {
+                let c = g - self.start[j];
+                (self.f_now[j] - c * x0, self.f_end[j] - c * x1)
+            } else {
+                (self.f_now[j], self.f_end[j])
+            };
+            let e = self.theta[j] - g;
+            let z = self.z[j];
+            self.theta[j] = g + p00 * e + p01 * z + g0[0] * u0 + g1[0] * u1;
+            self.z[j] = p10 * e + p11 * z + g0[1] * u0 + g1[1] * u1;
         }
         std::mem::swap(&mut self.f_now, &mut self.f_end);
         self.x_now = x1;
@@ -302,5 +419,46 @@ impl Samples {
     /// Rate of DOF `j` at sample `k`.
     pub fn velocity(&self, k: usize, j: usize) -> f64 {
         self.velocities[k * self.names.len() + j]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn exact_discretisation_matches_fine_rk4_for_a_linear_input() {
+        // 2002 gains; input F(u) = 1 + 3u over one step h = 0.01, from e = 0.2, z = −0.5.
+        let (k, d, h) = (156.25, 25.0, 0.01);
+        for b in [[1.0, 0.0], [0.0, 1.0]] {
+            let disc = Discrete::new(k, d, b, h);
+            let (e0, z0) = (0.2, -0.5);
+            let e1 = disc.phi[0][0] * e0
+                + disc.phi[0][1] * z0
+                + disc.g0[0] * 1.0
+                + disc.g1[0] * (1.0 + 3.0 * h);
+            let z1 = disc.phi[1][0] * e0
+                + disc.phi[1][1] * z0
+                + disc.g0[1] * 1.0
+                + disc.g1[1] * (1.0 + 3.0 * h);
+            let f = |u: f64, e: f64, z: f64| {
+                let inp = 1.0 + 3.0 * u;
+                (z + b[0] * inp, -k * e - d * z + b[1] * inp)
+            };
+            let (mut e, mut z) = (e0, z0);
+            let n = 10_000;
+            let s = h / n as f64;
+            for i in 0..n {
+                let u = i as f64 * s;
+                let k1 = f(u, e, z);
+                let k2 = f(u + 0.5 * s, e + 0.5 * s * k1.0, z + 0.5 * s * k1.1);
+                let k3 = f(u + 0.5 * s, e + 0.5 * s * k2.0, z + 0.5 * s * k2.1);
+                let k4 = f(u + s, e + s * k3.0, z + s * k3.1);
+                e += s / 6.0 * (k1.0 + 2.0 * k2.0 + 2.0 * k3.0 + k4.0);
+                z += s / 6.0 * (k1.1 + 2.0 * k2.1 + 2.0 * k3.1 + k4.1);
+            }
+            assert!((e1 - e).abs() < 1e-13, "{b:?}: e {e1} vs {e}");
+            assert!((z1 - z).abs() < 1e-12, "{b:?}: z {z1} vs {z}");
+        }
     }
 }

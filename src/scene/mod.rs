@@ -6,9 +6,15 @@
 //! from the command line (`--set clip.end_s=2.5`) so a parameter can be swept without editing
 //! files.
 
+mod fall;
+mod primitives;
 mod show;
 mod source;
 
+pub use fall::{Body, Controller, FallScene, Simulation, fall_report, run_fall, simulate_in_world};
+pub use primitives::{
+    HighJumpScene, JumpingKneeKickScene, PrimitiveRender, run_high_jump, run_jumping_knee_kick,
+};
 pub use show::{RenderSettings, ShowScene, run_show};
 pub use source::{ClipSource, LoadedMotion, data_dir, load_motion, resolve_path};
 
@@ -25,6 +31,12 @@ pub const FORMAT_VERSION: u32 = 1;
 pub enum Scene {
     /// Load a clip, map it onto a model, play it through the ECS and render it.
     Show(ShowScene),
+    /// The motor-primitive paper's high jump by extrapolation.
+    HighJump(Box<HighJumpScene>),
+    /// The motor-primitive paper's jumping knee kick.
+    JumpingKneeKick(Box<JumpingKneeKickScene>),
+    /// The falling paper's pushed figure.
+    Fall(Box<FallScene>),
 }
 
 /// Why a scene could not be read or run.
@@ -70,12 +82,18 @@ impl Scene {
     pub fn name(&self) -> &str {
         match self {
             Scene::Show(s) => &s.name,
+            Scene::HighJump(s) => &s.name,
+            Scene::JumpingKneeKick(s) => &s.name,
+            Scene::Fall(s) => &s.name,
         }
     }
 
     fn format_version(&self) -> u32 {
         match self {
             Scene::Show(s) => s.format_version,
+            Scene::HighJump(s) => s.format_version,
+            Scene::JumpingKneeKick(s) => s.format_version,
+            Scene::Fall(s) => s.format_version,
         }
     }
 
@@ -172,6 +190,9 @@ pub fn run(scene: &Scene, base: &Path, out_dir: &Path) -> Result<serde_json::Val
     let started = std::time::Instant::now();
     let mut report = match scene {
         Scene::Show(s) => run_show(s, base, out_dir)?,
+        Scene::HighJump(s) => run_high_jump(s, base, out_dir)?,
+        Scene::JumpingKneeKick(s) => run_jumping_knee_kick(s, base, out_dir)?,
+        Scene::Fall(s) => run_fall(s, base, out_dir)?,
     };
     if let Some(o) = report.as_object_mut() {
         o.insert("scene".into(), scene.name().into());
@@ -222,7 +243,9 @@ mod tests {
             ],
         )
         .unwrap();
-        let Scene::Show(sh) = &s2;
+        let Scene::Show(sh) = &s2 else {
+            panic!("not a Show scene")
+        };
         assert_eq!(sh.clip.end_s, Some(1.5));
         assert!(!sh.render.gif);
         assert_eq!(sh.name, "other");

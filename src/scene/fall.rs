@@ -1,0 +1,275 @@
+//! The `Fall` scene: the falling paper's pushed figure (SPEC §3), simulated in an ECS world.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+use serde_json::json;
+
+use super::primitives::PrimitiveRender;
+use super::source::resolve_path;
+use super::{SceneError, write_output};
+use crate::dynamics::contact::ContactParams;
+use crate::dynamics::ecs::{build_fall_world, run_world};
+use crate::dynamics::fall::{FallConfig, FallResult, Ranges};
+use crate::dynamics::integrator::Integrator;
+use crate::dynamics::push::Push;
+use crate::model::fall21;
+use crate::model::ranges::{AgeGroup, RangeTable};
+use crate::render::{Plot, Series, Track, animation_gif, filmstrip_png, plot};
+
+/// Time stepping of a simulation.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Simulation {
+    /// Step, seconds.
+    pub dt: f64,
+    /// Integration scheme.
+    pub integrator: Integrator,
+    /// Simulated time, seconds.
+    pub duration: f64,
+}
+
+/// The subject.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Body {
+    /// Standing height, metres.
+    pub height_m: f64,
+    /// Mass, kilograms.
+    pub mass_kg: f64,
+}
+
+/// PD settings per DOF, by full DOF name (`left_knee`) or side-less name (`knee`, both sides);
+/// DOFs not named keep the paper defaults.
+#[derive(Clone, Debug, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Controller {
+    /// Key pose θ_d, degrees.
+    pub key_pose_deg: BTreeMap<String, f64>,
+    /// Proportional gains k_p, N·m/rad.
+    pub kp: BTreeMap<String, f64>,
+    /// Derivative gains k_v, N·m·s/rad.
+    pub kv: BTreeMap<String, f64>,
+    /// Time the reaction toward the key pose starts, seconds.
+    pub start_s: Option<f64>,
+}
+
+/// A pushed fall: an elderly or adult figure with given PD settings, pushed.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FallScene {
+    /// Scene format version.
+    pub format_version: u32,
+    /// Scene name.
+    pub name: String,
+    /// Age group whose joint ranges are used (`Elderly` or `Adult`).
+    pub age_group: AgeGroup,
+    /// A range table (RON) to use instead of the age group's built-in one.
+    #[serde(default)]
+    pub ranges_file: Option<String>,
+    /// Time stepping.
+    pub simulation: Simulation,
+    /// The push.
+    pub push: Push,
+    /// The subject (default 1.70 m, 65 kg).
+    #[serde(default)]
+    pub body: Option<Body>,
+    /// PD control toward a key pose.
+    #[serde(default)]
+    pub controller: Controller,
+    /// Damage weight w_i per link (links not named keep the default; the head is protected most).
+    #[serde(default)]
+    pub damage_weights: BTreeMap<String, f64>,
+    /// Floor contact parameters.
+    #[serde(default)]
+    pub contact: Option<ContactParams>,
+    /// Pictures.
+    #[serde(default)]
+    pub render: PrimitiveRender,
+}
+
+fn strip_side(name: &str) -> &str {
+    name.strip_prefix("left_")
+        .or_else(|| name.strip_prefix("right_"))
+        .unwrap_or(name)
+}
+
+/// Applies per-DOF overrides by full or side-less name; an unknown name is an error.
+fn override_per_dof(
+    field: &str,
+    values: &mut [f64],
+    names: &[String],
+    by_name: &BTreeMap<String, f64>,
+) -> Result<(), SceneError> {
+    for (key, v) in by_name {
+        let mut hit = false;
+        for (i, n) in names.iter().enumerate() {
+            if n == key || strip_side(n) == key {
+                values[i] = *v;
+                hit = true;
+            }
+        }
+        if !hit {
+            return Err(SceneError::Invalid(format!(
+                "controller.{field}: '{key}' is not a fall21 DOF (e.g. knee, left_knee, neck_flexion)"
+            )));
+        }
+    }
+    Ok(())
+}
+
+impl FallScene {
+    /// The simulation configuration: the paper's experiment for the age group, with this
+    /// scene's settings.
+    pub fn config(&self, base: &Path) -> Result<FallConfig, SceneError> {
+        let mut c = FallConfig::paper(self.age_group);
+        if let Some(f) = &self.ranges_file {
+            c.ranges = Ranges::Table(
+                RangeTable::load(&resolve_path(f, base))
+                    .map_err(|e| SceneError::Invalid(e.to_string()))?,
+            );
+        }
+        c.dt_s = self.simulation.dt;
+        c.integrator = self.simulation.integrator;
+        c.duration_s = self.simulation.duration;
+        c.push = self.push.clone();
+        if let Some(b) = &self.body {
+            c.height_m = b.height_m;
+            c.mass_kg = b.mass_kg;
+        }
+        if let Some(p) = &self.contact {
+            c.contact = *p;
+        }
+        let names = fall21().dof_names();
+        override_per_dof(
+            "key_pose_deg",
+            &mut c.key_pose_deg,
+            &names,
+            &self.controller.key_pose_deg,
+        )?;
+        override_per_dof("kp", &mut c.kp, &names, &self.controller.kp)?;
+        override_per_dof("kv", &mut c.kv, &names, &self.controller.kv)?;
+        if let Some(s) = self.controller.start_s {
+            c.control_start_s = s;
+        }
+        for (link, w) in &self.damage_weights {
+            if !c.damage_weights.contains_key(link) {
+                return Err(SceneError::Invalid(format!(
+                    "damage_weights: '{link}' is not a fall21 link ({})",
+                    c.damage_weights
+                        .keys()
+                        .cloned()
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                )));
+            }
+            c.damage_weights.insert(link.clone(), *w);
+        }
+        Ok(c)
+    }
+}
+
+/// Simulates one fall in its own ECS world.
+pub fn simulate_in_world(config: &FallConfig) -> Result<FallResult, SceneError> {
+    let mut world = build_fall_world(config).map_err(|e| SceneError::Invalid(e.to_string()))?;
+    run_world(&mut world)
+        .into_iter()
+        .next()
+        .ok_or_else(|| SceneError::Invalid("the world held no figure".into()))?
+        .map_err(|e| SceneError::Invalid(e.to_string()))
+}
+
+/// Per-link values as a JSON object keyed by link name.
+fn per_link(names: &[String], values: &[f64]) -> serde_json::Value {
+    serde_json::Value::Object(
+        names
+            .iter()
+            .zip(values)
+            .map(|(n, v)| (n.clone(), json!(v)))
+            .collect(),
+    )
+}
+
+/// The report of one fall.
+pub fn fall_report(r: &FallResult, sim_wall_s: f64) -> serde_json::Value {
+    let head: Vec<f64> = r.frames.iter().map(|f| f.head_height_m).collect();
+    json!({
+        "damage": r.damage,
+        "peak_vertical_force_n": per_link(&r.link_names, &r.peak_vertical_force_n),
+        "impulse_n_s": per_link(&r.link_names, &r.impulse_n_s),
+        "max_penetration_m": r.max_penetration_m,
+        "came_to_rest": r.came_to_rest,
+        "rest_time_s": r.rest_time_s,
+        "steps": r.steps,
+        "dt_s": r.dt_s,
+        "simulation_wall_time_s": sim_wall_s,
+        "final_head_height_m": head.last(),
+        "final_pelvis_position_m": r.frames.last().map(|f| f.root_position.to_array()),
+    })
+}
+
+/// Runs a [`FallScene`]: writes `fall.bvh` (fall21 skeleton), `filmstrip.png`, `motion.gif`,
+/// `head_height.png` (the paper's Fig. 3) and returns the report.
+pub fn run_fall(
+    scene: &FallScene,
+    base: &Path,
+    out: &Path,
+) -> Result<serde_json::Value, SceneError> {
+    let config = scene.config(base)?;
+    let started = std::time::Instant::now();
+    let result = simulate_in_world(&config)?;
+    let sim_wall = started.elapsed().as_secs_f64();
+    let motion = result.to_model_clip();
+    let clip = motion.to_clip();
+    write_output(
+        &out.join("fall.bvh"),
+        crate::bvh::to_string(&clip.to_bvh()).as_bytes(),
+    )?;
+    let figure = clip.skeleton.figure();
+    let frames = clip.point_frames();
+    let label = format!("{} ({:?})", scene.name, scene.age_group);
+    let track = Track {
+        figure: &figure,
+        frames: &frames,
+        label,
+        frame_time: clip.frame_time,
+    };
+    filmstrip_png(
+        std::slice::from_ref(&track),
+        scene.render.filmstrip_frames.max(1),
+        &out.join("filmstrip.png"),
+    )?;
+    if scene.render.gif {
+        animation_gif(
+            std::slice::from_ref(&track),
+            scene.render.gif_fps,
+            &out.join("motion.gif"),
+        )?;
+    }
+    let push_end = scene.push.start_s + scene.push.duration_s;
+    plot(
+        &Plot {
+            title: format!("Head height: {} ({:?})", scene.name, scene.age_group),
+            x_label: "time (s)".into(),
+            y_label: "head height (m)".into(),
+            series: vec![Series {
+                name: format!("{:?}", scene.age_group),
+                points: result
+                    .frames
+                    .iter()
+                    .map(|f| (f.time_s, f.head_height_m))
+                    .collect(),
+            }],
+            markers: vec![
+                (scene.push.start_s, "push".into()),
+                (push_end, "push ends".into()),
+            ],
+        },
+        &out.join("head_height.png"),
+    )?;
+    let mut report = fall_report(&result, sim_wall);
+    report["age_group"] = json!(scene.age_group);
+    report["damage_weights"] = json!(config.damage_weights);
+    Ok(report)
+}
