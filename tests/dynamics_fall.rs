@@ -240,3 +240,33 @@ fn ranges_can_come_from_an_editable_ron_file() {
     let e = simulate_fall(&cfg).unwrap_err().to_string();
     assert!(e.contains("no/such/ranges.ron"), "{e}");
 }
+
+#[test]
+fn stopping_at_rest_keeps_the_damage_and_saves_the_steps() {
+    let mut cfg = FallConfig::paper(AgeGroup::Elderly);
+    let full = simulate_fall(&cfg).unwrap();
+    cfg.stop_at_rest = true;
+    let short = simulate_fall(&cfg).unwrap();
+    assert!(short.came_to_rest);
+    assert!(
+        short.steps < full.steps / 2,
+        "{} of {} steps",
+        short.steps,
+        full.steps
+    );
+    assert_eq!(short.damage.to_bits(), full.damage.to_bits());
+    assert_eq!(short.peak_vertical_force_n, full.peak_vertical_force_n);
+    let n = short.frames.len();
+    assert_eq!(short.frames[..n], full.frames[..n]);
+    // Standing still before a late push is not rest: the run goes on to the push and the fall.
+    cfg.push.start_s = 0.6;
+    cfg.control_start_s = 0.75;
+    let late = simulate_fall(&cfg).unwrap();
+    let last = late.frames.last().unwrap();
+    assert!(
+        last.head_height_m < 0.3,
+        "stopped before falling: head at {}",
+        last.head_height_m
+    );
+    assert!(late.rest_time_s.unwrap() > 0.7);
+}

@@ -111,6 +111,8 @@ pub struct Recorder {
     pub rest_energy: f64,
     /// Start of the current rest interval (s).
     pub rest_since: Option<f64>,
+    /// Rest is only detected from this time on (the end of the push, s).
+    pub rest_after: f64,
     /// Hold time (s).
     pub rest_hold: f64,
     /// Steps to run in total.
@@ -121,6 +123,20 @@ pub struct Recorder {
     pub hz: f64,
     /// Integration scheme.
     pub integrator: Integrator,
+    /// End the run once the body has rested for the hold time.
+    pub stop_at_rest: bool,
+}
+
+impl Recorder {
+    /// True once the run is over for `state`: all steps taken, or (with `stop_at_rest`) the
+    /// body has stayed at rest for the hold time.
+    pub fn finished(&self, state: &JointState) -> bool {
+        state.steps >= self.total_steps
+            || (self.stop_at_rest
+                && self
+                    .rest_since
+                    .is_some_and(|t0| state.time_s - t0 >= self.rest_hold))
+    }
 }
 
 /// The scratch workspace component (dynamics and integrator buffers; no allocation per step).

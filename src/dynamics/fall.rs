@@ -315,8 +315,10 @@ pub fn build_fall(cfg: &FallConfig) -> Result<FallParts, SimError> {
             frames: Vec::with_capacity(frames),
             rest_energy: cfg.rest_kinetic_energy_j,
             rest_since: None,
+            rest_after: cfg.push.start_s + cfg.push.duration_s,
             rest_hold: cfg.rest_hold_s,
             total_steps,
+            stop_at_rest: cfg.stop_at_rest,
             dt: cfg.dt_s,
             hz: cfg.record_hz,
             integrator: cfg.integrator,
@@ -589,7 +591,9 @@ pub fn record_phase(
         }
         ke += model.bodies[i].inertia.kinetic_energy(vel);
     }
-    if ke < recorder.rest_energy {
+    // Rest counts only once the push is over (a figure standing still before it is not
+    // "at rest" on the floor).
+    if ke < recorder.rest_energy && t >= recorder.rest_after {
         recorder.rest_since.get_or_insert(t);
     } else {
         recorder.rest_since = None;
@@ -695,7 +699,7 @@ pub fn finish(
 pub fn simulate_fall(config: &FallConfig) -> Result<FallResult, SimError> {
     let mut parts = build_fall(config)?;
     record_initial(&mut parts);
-    for _ in 0..parts.recorder.total_steps {
+    while !parts.recorder.finished(&parts.state) {
         step_fall(&mut parts)?;
     }
     Ok(finish(

@@ -69,6 +69,9 @@ pub struct FallConfig {
     pub rest_kinetic_energy_j: f64,
     /// …for at least this long (s), up to the end of the run.
     pub rest_hold_s: f64,
+    /// End the run as soon as the body has rested for `rest_hold_s` (saves most of the time
+    /// of a GA evaluation; peaks and damage are unchanged, impulses stop accumulating).
+    pub stop_at_rest: bool,
 }
 
 /// A per-DOF table in fall21 order from a function of the DOF name.
@@ -155,6 +158,7 @@ impl FallConfig {
             record_hz: 60.0,
             rest_kinetic_energy_j: 1.0,
             rest_hold_s: 0.3,
+            stop_at_rest: false,
         }
     }
 }
