@@ -133,13 +133,18 @@ fn c_with_steps(mut r: FallResult, expect: u64) -> FallResult {
 fn a_step_above_the_stability_bound_is_refused_up_front() {
     let mut cfg = FallConfig::paper(AgeGroup::Elderly);
     cfg.dt_s = 5e-3;
-    match simulate_fall(&cfg) {
+    let bound = match simulate_fall(&cfg) {
         Err(SimError::Unstable { what, bound_s, .. }) => {
             assert!(bound_s < 5e-3);
             assert!(!what.is_empty());
+            bound_s
         }
         other => panic!("expected an Unstable error, got {other:?}"),
-    }
+    };
+    // The bound named is the most restrictive one: just below it the fall is accepted.
+    cfg.dt_s = 0.99 * bound;
+    cfg.duration_s = 0.05;
+    simulate_fall(&cfg).unwrap();
 }
 
 #[test]

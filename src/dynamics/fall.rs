@@ -82,7 +82,8 @@ fn scheme_name(i: Integrator) -> &'static str {
     }
 }
 
-/// Checks the step against the contact and joint stiffnesses before running: per link the
+/// Checks the step against the contact and joint stiffnesses before running and, if it is too
+/// large, names the most restrictive mode (its bound is the largest usable step): per link the
 /// contact bound of [`ContactModel::link_frequency`]; per DOF `ω² = (k_p + k_lim)(H⁻¹)_jj`,
 /// `2ζω = d (H⁻¹)_jj` (`d` the joint damping, zero when it is taken implicitly) with `H` the
 /// joint-space inertia at the stance.
@@ -90,20 +91,18 @@ pub fn check_stability(cfg: &FallConfig, parts: &FallParts) -> Result<(), SimErr
     let body = &parts.body.body;
     let cm = &parts.body.contact;
     let dt = cfg.dt_s;
+    // The most restrictive mode: (bound, what, link, ω, ζ).
+    let mut worst: Option<(f64, String, usize, f64, f64)> = None;
+    let mut consider =
+        |bound: f64, what: &dyn Fn() -> String, link: usize, omega: f64, zeta: f64| {
+            if worst.as_ref().is_none_or(|w| bound < w.0) {
+                worst = Some((bound, what(), link, omega, zeta));
+            }
+        };
     for i in 0..body.model.nbodies() {
         let (omega, zeta) = cm.link_frequency(i, &body.model.bodies[i].inertia);
         let bound = stable_step(cfg.integrator, omega, zeta);
-        if dt > bound {
-            return Err(SimError::Unstable {
-                what: "contact".into(),
-                body: body.link_names[i].clone(),
-                omega,
-                zeta,
-                dt_s: dt,
-                bound_s: bound,
-                integrator: scheme_name(cfg.integrator),
-            });
-        }
+        consider(bound, &|| "contact".to_string(), i, omega, zeta);
     }
     let model = &body.model;
     let nv = model.nv;
@@ -135,20 +134,27 @@ pub fn check_stability(cfg: &FallConfig, parts: &FallParts) -> Result<(), SimErr
             0.0
         };
         let bound = stable_step(cfg.integrator, omega, zeta);
-        if dt > bound {
-            let j = body.figure.dofs[d].joint;
-            return Err(SimError::Unstable {
-                what: format!("joint {}", body.figure.dofs[d].name),
-                body: body.link_names[j].clone(),
-                omega,
-                zeta,
-                dt_s: dt,
-                bound_s: bound,
-                integrator: scheme_name(cfg.integrator),
-            });
-        }
+        let dof = &body.figure.dofs[d];
+        consider(
+            bound,
+            &|| format!("joint {}", dof.name),
+            dof.joint,
+            omega,
+            zeta,
+        );
     }
-    Ok(())
+    match worst {
+        Some((bound, what, link, omega, zeta)) if dt > bound => Err(SimError::Unstable {
+            what,
+            body: body.link_names[link].clone(),
+            omega,
+            zeta,
+            dt_s: dt,
+            bound_s: bound,
+            integrator: scheme_name(cfg.integrator),
+        }),
+        _ => Ok(()),
+    }
 }
 
 /// Validates `cfg`, builds the body and its initial state (standing on the floor), and checks
