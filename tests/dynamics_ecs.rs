@@ -108,3 +108,22 @@ fn a_runaway_push_stops_with_time_body_and_quantity() {
     let mut world = build_fall_world(&cfg).unwrap();
     assert!(run_world(&mut world).pop().unwrap().is_err());
 }
+
+#[test]
+fn two_characters_in_one_world_fall_independently() {
+    use bevy_ecs::world::World;
+    use marionette::dynamics::ecs::spawn_fall;
+    use marionette::dynamics::fall::build_fall;
+    let a = short(AgeGroup::Elderly);
+    let mut b = short(AgeGroup::Adult);
+    b.push.force_n = 700.0;
+    let mut world = World::new();
+    spawn_fall(&mut world, build_fall(&a).unwrap());
+    spawn_fall(&mut world, build_fall(&b).unwrap());
+    let results = run_world(&mut world);
+    assert_eq!(results.len(), 2);
+    let ra = results[0].as_ref().unwrap();
+    let rb = results[1].as_ref().unwrap();
+    assert_eq!(bits(ra), bits(&simulate_fall(&a).unwrap()));
+    assert_eq!(bits(rb), bits(&simulate_fall(&b).unwrap()));
+}

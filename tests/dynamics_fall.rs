@@ -51,6 +51,15 @@ fn pushed_from_the_front_the_elderly_figure_falls_backward_and_rests() {
     let r = simulate_fall(&cfg).unwrap();
     check_fell_backward_and_rested(&r);
     assert_eq!(r.frames[0].angles.len(), 21);
+    // The joint limits hold under the fall's loads: no DOF is driven more than 10° past its
+    // elderly range (the arms swing hardest into theirs).
+    for (name, ex) in r.dof_names.iter().zip(&r.max_limit_excursion_rad) {
+        assert!(
+            ex.to_degrees() < 10.0,
+            "{name} went {:.1}° past its range",
+            ex.to_degrees()
+        );
+    }
     // The record as a fall21 clip: 60 Hz over 3 s, every DOF.
     let clip = r.to_model_clip();
     assert_eq!(clip.frame_count(), 181);
@@ -124,13 +133,18 @@ fn c_with_steps(mut r: FallResult, expect: u64) -> FallResult {
 fn a_step_above_the_stability_bound_is_refused_up_front() {
     let mut cfg = FallConfig::paper(AgeGroup::Elderly);
     cfg.dt_s = 5e-3;
-    match simulate_fall(&cfg) {
+    let bound = match simulate_fall(&cfg) {
         Err(SimError::Unstable { what, bound_s, .. }) => {
             assert!(bound_s < 5e-3);
             assert!(!what.is_empty());
+            bound_s
         }
         other => panic!("expected an Unstable error, got {other:?}"),
-    }
+    };
+    // The bound named is the most restrictive one: just below it the fall is accepted.
+    cfg.dt_s = 0.99 * bound;
+    cfg.duration_s = 0.05;
+    simulate_fall(&cfg).unwrap();
 }
 
 #[test]
@@ -175,4 +189,89 @@ fn a_partial_scene_takes_the_paper_defaults() {
         .unwrap_err()
         .to_string();
     assert!(bad.contains("dt"), "{bad}");
+}
+
+#[test]
+fn random_genes_within_the_ranges_all_simulate() {
+    // What the genetic algorithm will do: k_p and θ_d of every DOF drawn at random (θ_d inside
+    // the group's ranges). Every fall must run to the end and come down. Penetration is looser
+    // here than in the paper's fall: with stiffness per kilogram of link mass, a light link that
+    // lands under the body's weight (an upper arm) sinks up to ~3 cm.
+    use marionette::model::ranges::RangeTable;
+    use rand::{RngExt, SeedableRng};
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(5);
+    let fig = marionette::model::fall21();
+    for (n, group) in [AgeGroup::Elderly, AgeGroup::Adult]
+        .into_iter()
+        .cycle()
+        .take(8)
+        .enumerate()
+    {
+        let ranges = RangeTable::builtin(group).for_model(&fig).unwrap();
+        let mut cfg = FallConfig::paper(group);
+        for (d, &(lo, hi)) in ranges.iter().enumerate() {
+            cfg.kp[d] = rng.random_range(0.0..800.0);
+            cfg.key_pose_deg[d] = rng.random_range(lo..=hi).to_degrees();
+        }
+        let r = simulate_fall(&cfg).unwrap_or_else(|e| panic!("fall {n}: {e}"));
+        let last = r.frames.last().unwrap();
+        assert!(
+            last.head_height_m < 1.0,
+            "fall {n}: head at {}",
+            last.head_height_m
+        );
+        assert!(
+            r.max_penetration_m < 0.04,
+            "fall {n}: sank {} m",
+            r.max_penetration_m
+        );
+        assert!(r.damage.is_finite() && r.damage > 0.0);
+    }
+}
+
+#[test]
+fn ranges_can_come_from_an_editable_ron_file() {
+    use marionette::dynamics::fall::Ranges;
+    let path =
+        std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes/models/fall21_adult.ron");
+    let mut cfg = FallConfig::paper(AgeGroup::Adult);
+    cfg.duration_s = 0.2;
+    let builtin = simulate_fall(&cfg).unwrap();
+    cfg.ranges = Ranges::File(path);
+    let from_file = simulate_fall(&cfg).unwrap();
+    assert_eq!(builtin.damage.to_bits(), from_file.damage.to_bits());
+    assert_eq!(builtin.frames.last(), from_file.frames.last());
+    cfg.ranges = Ranges::File("no/such/ranges.ron".into());
+    let e = simulate_fall(&cfg).unwrap_err().to_string();
+    assert!(e.contains("no/such/ranges.ron"), "{e}");
+}
+
+#[test]
+fn stopping_at_rest_keeps_the_damage_and_saves_the_steps() {
+    let mut cfg = FallConfig::paper(AgeGroup::Elderly);
+    let full = simulate_fall(&cfg).unwrap();
+    cfg.stop_at_rest = true;
+    let short = simulate_fall(&cfg).unwrap();
+    assert!(short.came_to_rest);
+    assert!(
+        short.steps < full.steps / 2,
+        "{} of {} steps",
+        short.steps,
+        full.steps
+    );
+    assert_eq!(short.damage.to_bits(), full.damage.to_bits());
+    assert_eq!(short.peak_vertical_force_n, full.peak_vertical_force_n);
+    let n = short.frames.len();
+    assert_eq!(short.frames[..n], full.frames[..n]);
+    // Standing still before a late push is not rest: the run goes on to the push and the fall.
+    cfg.push.start_s = 0.6;
+    cfg.control_start_s = 0.75;
+    let late = simulate_fall(&cfg).unwrap();
+    let last = late.frames.last().unwrap();
+    assert!(
+        last.head_height_m < 0.3,
+        "stopped before falling: head at {}",
+        last.head_height_m
+    );
+    assert!(late.rest_time_s.unwrap() > 0.7);
 }

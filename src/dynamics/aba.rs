@@ -57,10 +57,11 @@ pub fn aba_passes(
         let arm = |k: usize| armature.map_or(0.0, |a| a[iv + k]);
         match body.joint {
             JointType::Pin { .. } => {
-                let s = data.s[i][0];
-                let u = ia.apply(s);
-                let d = s.dot(u) + arm(0);
-                let uu = tau[iv] - s.dot(pa);
+                // Revolute columns are pure rotations: S = [a; 0].
+                let a = data.s[i][0].ang;
+                let u = ia.apply_angular(a);
+                let d = a.dot(u.ang) + arm(0);
+                let uu = tau[iv] - a.dot(pa.ang);
                 let dinv = 1.0 / d;
                 data.u[i][0] = u;
                 data.dinv[i].x_axis.x = dinv;
@@ -80,12 +81,13 @@ pub fn aba_passes(
                 let mut d = DMat3::IDENTITY;
                 let mut uu = DVec3::ZERO;
                 for k in 0..nv {
-                    u[k] = ia.apply(data.s[i][k]);
-                    uu[k] = tau[iv + k] - data.s[i][k].dot(pa);
+                    let a = data.s[i][k].ang;
+                    u[k] = ia.apply_angular(a);
+                    uu[k] = tau[iv + k] - a.dot(pa.ang);
                 }
                 for r in 0..nv {
                     for k in 0..nv {
-                        let mut e = data.s[i][r].dot(u[k]);
+                        let mut e = data.s[i][r].ang.dot(u[k].ang);
                         if r == k {
                             e += arm(k);
                         }
@@ -125,7 +127,9 @@ pub fn aba_passes(
             JointType::Pin { .. } => {
                 let qdd = data.dinv[i].x_axis.x * (data.uu[i].x - data.u[i][0].dot_motion(a_prime));
                 data.qdd[iv] = qdd;
-                data.a[i] = a_prime + data.s[i][0] * qdd;
+                let mut a = a_prime;
+                a.ang += data.s[i][0].ang * qdd;
+                data.a[i] = a;
             }
             JointType::Universal { .. } | JointType::Ball { .. } => {
                 let nv = body.joint.nv();
@@ -137,7 +141,7 @@ pub fn aba_passes(
                 let mut a = a_prime;
                 for k in 0..nv {
                     data.qdd[iv + k] = qdd[k];
-                    a += data.s[i][k] * qdd[k];
+                    a.ang += data.s[i][k].ang * qdd[k];
                 }
                 data.a[i] = a;
             }

@@ -7,8 +7,10 @@
 //! clipped to the friction cone `|f_t| ≤ μ f_n`. The anchor is set where the corner first
 //! touches and is dragged along when the spring would exceed the cone (slip), so a body below the
 //! friction angle sticks (no creep) and one above it slides with `|f_t| = μ f_n`.
-//! Gains are given per kilogram of link mass (`k_p = k̂_p m_link`), so every link has the same
-//! contact frequency and the same static sink `g / (corners · k̂_p)`.
+//! Gains are given per kilogram of link mass (`k_p = k̂_p m_link`), so every link has about the
+//! same contact frequency (hence one stable step for all) and the same static sink
+//! `g / (corners · k̂_p)` under its own weight. The price: a light link that lands under much of
+//! the body's weight (an upper arm under the torso) sinks deeper than a heavy one would.
 
 use super::data::Data;
 use super::human::LinkBox;
@@ -216,19 +218,22 @@ impl ContactModel {
     }
 
     /// [`update_anchors`](Self::update_anchors) then [`apply`](Self::apply) in one pass over the
-    /// corners (the step-start evaluation): same results, corner positions computed once.
+    /// corners (the step-start evaluation): same results, corner positions computed once; also
+    /// writes each link's deepest corner penetration (m) into `depth`.
     pub fn update_and_apply(
         &self,
         data: &Data,
         state: &mut ContactState,
         f_ext: &mut [ForceVec],
         normal: &mut [f64],
+        depth: &mut [f64],
     ) -> f64 {
         let p = &self.params;
         let n = p.floor_normal;
         let mut deepest: f64 = 0.0;
         for (i, corners) in self.corners.iter().enumerate() {
             normal[i] = 0.0;
+            depth[i] = 0.0;
             let rot = data.rot[i];
             let pos = data.pos[i];
             let (c, r) = self.bounds[i];
@@ -267,6 +272,7 @@ impl ContactModel {
                 }
                 if let Some((fnorm, ft, z)) = self.corner_force(i, x, xd, *slot) {
                     deepest = deepest.max(-z);
+                    depth[i] = depth[i].max(-z);
                     normal[i] += fnorm;
                     let f_world = n * fnorm + ft;
                     f_body += ForceVec::at_point(rot.transpose() * f_world, cl);

@@ -32,7 +32,7 @@ pub enum FallSet {
 
 /// True while a character still has steps to take and no error.
 fn running(state: &JointState, rec: &Recorder, ws: &Workspace) -> bool {
-    ws.error.is_none() && state.steps < rec.total_steps
+    ws.error.is_none() && !rec.finished(state)
 }
 
 /// Control system: the key pose becomes the target at the reaction time.

@@ -7,6 +7,8 @@
 //! projected on the joint's orthonormal DOF axes (`ω = A v`); a free joint's six velocities are the
 //! body's spatial velocity `[ω; v]` in body coordinates. Quaternions are stored `x, y, z, w`; a
 //! free joint's configuration is `[p; Q]` (world position of the body origin, then orientation).
+//! The motion-subspace columns of pin, universal and ball joints are pure rotations `[a; 0]`
+//! (the joint frame's origin is the rotation centre); the articulated-body algorithm relies on it.
 
 use super::spatial::{MotionVec, SpatialTransform};
 use glam::{DMat3, DQuat, DVec3};

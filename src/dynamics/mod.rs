@@ -22,11 +22,14 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod aba;
+pub mod components;
 pub mod contact;
 pub mod crba;
 pub mod data;
 pub mod ecs;
 pub mod fall;
+pub mod fall_config;
+pub mod fall_result;
 pub mod human;
 pub mod integrator;
 pub mod joint;

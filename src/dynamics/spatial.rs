@@ -20,6 +20,12 @@ pub fn skew(r: DVec3) -> DMat3 {
     )
 }
 
+/// `Aᵀ x` without forming the transpose.
+#[inline]
+pub fn transpose_mul(a: &DMat3, x: DVec3) -> DVec3 {
+    DVec3::new(a.x_axis.dot(x), a.y_axis.dot(x), a.z_axis.dot(x))
+}
+
 /// The outer product `a bᵀ` as a 3×3 matrix.
 #[inline]
 pub fn outer(a: DVec3, b: DVec3) -> DMat3 {
@@ -368,7 +374,16 @@ impl ArticulatedInertia {
     pub fn apply(&self, v: MotionVec) -> ForceVec {
         ForceVec {
             ang: self.m * v.ang + self.h * v.lin,
-            lin: self.h.transpose() * v.ang + self.l * v.lin,
+            lin: transpose_mul(&self.h, v.ang) + self.l * v.lin,
+        }
+    }
+
+    /// `I [ω; 0] = [Mω; Hᵀω]`: the product with a pure rotation (a revolute joint's column).
+    #[inline]
+    pub fn apply_angular(&self, w: DVec3) -> ForceVec {
+        ForceVec {
+            ang: self.m * w,
+            lin: transpose_mul(&self.h, w),
         }
     }
 

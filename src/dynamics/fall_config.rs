@@ -1,0 +1,171 @@
+//! The configuration of a pushed fall: subject, joint ranges, PD gains and key pose, push,
+//! step, integrator, contact and damage weights — everything a scene file (RON) gives.
+
+use super::contact::ContactParams;
+use super::integrator::Integrator;
+use super::limits::JointLimitParams;
+use super::push::Push;
+use crate::model::ranges::{AgeGroup, RangeTable};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+
+/// Where the joint ranges come from.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub enum Ranges {
+    /// A built-in age group (`scenes/models/fall21_{elderly,adult}.ron`).
+    Builtin(AgeGroup),
+    /// A user table (degrees), e.g. loaded with [`RangeTable::load`].
+    Table(RangeTable),
+    /// A range-table RON file (like `scenes/models/fall21_elderly.ron`), read when the fall is
+    /// built; a relative path is taken from the working directory.
+    File(std::path::PathBuf),
+}
+
+/// Everything that defines one pushed fall. Angles in degrees, per fall21 DOF in model order.
+/// In a scene file every field may be left out: it then takes its value from
+/// [`FallConfig::paper`] for the elderly group (`FallConfig::default()`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct FallConfig {
+    /// Standing height (m).
+    pub height_m: f64,
+    /// Body mass (kg).
+    pub mass_kg: f64,
+    /// Gravitational acceleration magnitude (m/s²), acting along −Y.
+    pub gravity: f64,
+    /// Joint ranges (age group).
+    pub ranges: Ranges,
+    /// Joint-model gains (friction inside the range, spring and damper past it).
+    pub limits: JointLimitParams,
+    /// Initial standing pose (deg, 21 DOFs), held by the stance gains until `control_start_s`.
+    pub stance_pose_deg: Vec<f64>,
+    /// Stance PD stiffness per DOF (N·m/rad).
+    pub stance_kp: Vec<f64>,
+    /// Stance PD damping per DOF (N·m·s/rad).
+    pub stance_kv: Vec<f64>,
+    /// Key pose θ_d (deg, 21 DOFs) the reaction drives toward (θ̇_d = 0).
+    pub key_pose_deg: Vec<f64>,
+    /// PD stiffness k_p per DOF toward the key pose (N·m/rad) — a GA gene.
+    pub kp: Vec<f64>,
+    /// PD damping k_v per DOF (N·m·s/rad).
+    pub kv: Vec<f64>,
+    /// Time at which control switches from the stance to the key pose (s).
+    pub control_start_s: f64,
+    /// The push.
+    pub push: Push,
+    /// Time step (s).
+    pub dt_s: f64,
+    /// Integration scheme.
+    pub integrator: Integrator,
+    /// Simulated time (s).
+    pub duration_s: f64,
+    /// Floor contact parameters.
+    pub contact: ContactParams,
+    /// Damage weight w_i per link name (links not listed weigh 1).
+    pub damage_weights: BTreeMap<String, f64>,
+    /// Frames recorded per second.
+    pub record_hz: f64,
+    /// The body is at rest while its kinetic energy stays below this (J)…
+    pub rest_kinetic_energy_j: f64,
+    /// …for at least this long (s), up to the end of the run.
+    pub rest_hold_s: f64,
+    /// End the run as soon as the body has rested for `rest_hold_s` (saves most of the time
+    /// of a GA evaluation; peaks and damage are unchanged, impulses stop accumulating).
+    pub stop_at_rest: bool,
+}
+
+/// A per-DOF table in fall21 order from a function of the DOF name.
+fn per_dof(names: &[String], f: impl Fn(&str) -> f64) -> Vec<f64> {
+    names.iter().map(|n| f(n)).collect()
+}
+
+fn strip_side(n: &str) -> &str {
+    n.trim_start_matches("left_").trim_start_matches("right_")
+}
+
+impl FallConfig {
+    /// The paper's experiment for `group`: a 1.70 m, 65 kg subject standing with bent knees
+    /// (34°: the elderly knee range of the paper's Table 1 starts at 32°, so both groups stand
+    /// alike inside their ranges), pushed with 1000 N on the chest from the front for 0.1 s from
+    /// t = 0.1 s; the reaction toward the key pose (here the stance itself) starts at 0.25 s;
+    /// semi-implicit Euler with implicit damping at 0.5 ms (the contact stability bound is
+    /// 0.63 ms) for 3 s; damage weights protect the head most (w = 10).
+    pub fn paper(group: AgeGroup) -> Self {
+        let names = crate::model::fall21().dof_names();
+        let stance = per_dof(&names, |n| match strip_side(n) {
+            "waist_flexion" => 5.0,
+            "elbow" => 30.0,
+            "hip_flexion" => 16.0,
+            "knee" => 34.0,
+            "ankle" => 17.0,
+            _ => 0.0,
+        });
+        let gain = |n: &str| match strip_side(n) {
+            "neck_flexion" | "neck_lateral" | "neck_rotation" => 40.0,
+            "waist_flexion" | "waist_rotation" => 600.0,
+            "shoulder_flexion" | "shoulder_rotation" => 60.0,
+            "elbow" => 40.0,
+            "wrist" => 8.0,
+            "hip_flexion" | "hip_abduction" => 600.0,
+            "knee" => 600.0,
+            "ankle" => 400.0,
+            _ => 50.0,
+        };
+        let kp = per_dof(&names, gain);
+        let kv = per_dof(&names, |n| 0.1 * gain(n));
+        let mut w = BTreeMap::new();
+        for (link, wi) in [
+            ("head", 10.0),
+            ("torso", 2.0),
+            ("pelvis", 2.0),
+            ("right_upper_arm", 1.0),
+            ("left_upper_arm", 1.0),
+            ("right_forearm", 1.0),
+            ("left_forearm", 1.0),
+            ("right_hand", 0.5),
+            ("left_hand", 0.5),
+            ("right_thigh", 1.0),
+            ("left_thigh", 1.0),
+            ("right_shin", 1.0),
+            ("left_shin", 1.0),
+            ("right_foot", 0.2),
+            ("left_foot", 0.2),
+        ] {
+            w.insert(link.to_string(), wi);
+        }
+        let h = 1.70;
+        Self {
+            height_m: h,
+            mass_kg: 65.0,
+            gravity: 9.81,
+            ranges: Ranges::Builtin(group),
+            limits: JointLimitParams::default(),
+            stance_pose_deg: stance.clone(),
+            stance_kp: kp.clone(),
+            stance_kv: kv.clone(),
+            key_pose_deg: stance,
+            kp,
+            kv,
+            control_start_s: 0.25,
+            push: super::push::paper_push(0.1, 0.16 * h),
+            dt_s: 5e-4,
+            integrator: Integrator::SemiImplicitEuler {
+                implicit_damping: true,
+            },
+            duration_s: 3.0,
+            contact: ContactParams::default(),
+            damage_weights: w,
+            record_hz: 60.0,
+            rest_kinetic_energy_j: 1.0,
+            rest_hold_s: 0.3,
+            stop_at_rest: false,
+        }
+    }
+}
+
+impl Default for FallConfig {
+    /// The paper's experiment for the elderly group.
+    fn default() -> Self {
+        Self::paper(AgeGroup::Elderly)
+    }
+}

@@ -1,0 +1,142 @@
+//! What a pushed fall reports ([`FallResult`], frame by frame and per link) and why one can
+//! fail ([`SimError`]: bad configuration, an unstable step, or a runaway state with its time,
+//! body and quantity).
+
+use super::human::HumanError;
+use crate::model::ranges::RangeError;
+use glam::{DQuat, DVec3};
+use serde::{Deserialize, Serialize};
+
+/// One recorded frame.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FallFrame {
+    /// Time (s).
+    pub time_s: f64,
+    /// Pelvis (root) position, world (m).
+    pub root_position: DVec3,
+    /// Pelvis orientation (body → world).
+    pub root_orientation: DQuat,
+    /// Every fall21 DOF angle in model order (rad).
+    pub angles: Vec<f64>,
+    /// Height of the head's centre of mass above the floor (m).
+    pub head_height_m: f64,
+}
+
+/// The outcome of a fall.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FallResult {
+    /// DOF names (fall21 model order), matching `FallFrame::angles`.
+    pub dof_names: Vec<String>,
+    /// Link names, matching the per-link vectors.
+    pub link_names: Vec<String>,
+    /// Frames at `record_hz`: frame `k` is the state at the step nearest to `k / record_hz`.
+    pub frames: Vec<FallFrame>,
+    /// Frame rate of `frames` (Hz).
+    pub record_hz: f64,
+    /// Damage `D = Σ w_i f_i` (N): the paper's eq. 5.1.
+    pub damage: f64,
+    /// Peak vertical (normal) floor force per link, f_i (N).
+    pub peak_vertical_force_n: Vec<f64>,
+    /// Normal impulse per link (N·s).
+    pub impulse_n_s: Vec<f64>,
+    /// Deepest corner penetration into the floor over the run (m).
+    pub max_penetration_m: f64,
+    /// Deepest corner penetration per link over the run (m).
+    pub max_penetration_by_link_m: Vec<f64>,
+    /// Largest excursion of any DOF past its range over the run (rad), per DOF.
+    pub max_limit_excursion_rad: Vec<f64>,
+    /// True if the kinetic energy stayed below the rest threshold for the hold time at the end.
+    pub came_to_rest: bool,
+    /// Time from which the body stayed at rest (s).
+    pub rest_time_s: Option<f64>,
+    /// Integration steps taken.
+    pub steps: u64,
+    /// Time step (s).
+    pub dt_s: f64,
+    /// Standing height of the simulated subject (m).
+    pub height_m: f64,
+}
+
+impl FallResult {
+    /// The recorded motion as a clip on the fall21 model (scaled to the subject's height), ready
+    /// for BVH output and pictures.
+    pub fn to_model_clip(&self) -> crate::model::ModelClip {
+        crate::model::ModelClip {
+            model: crate::model::fall21().scaled_to_height(self.height_m),
+            frame_time: 1.0 / self.record_hz,
+            root_translation: self.frames.iter().map(|f| f.root_position).collect(),
+            root_rotation: self.frames.iter().map(|f| f.root_orientation).collect(),
+            angles: self
+                .frames
+                .iter()
+                .flat_map(|f| f.angles.iter().copied())
+                .collect(),
+        }
+    }
+}
+
+/// Why a fall could not be simulated.
+#[derive(Debug, thiserror::Error)]
+pub enum SimError {
+    /// A configuration field is invalid.
+    #[error("fall configuration: {field}: {message}")]
+    Config {
+        /// Field name.
+        field: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// The body could not be built.
+    #[error(transparent)]
+    Body(#[from] HumanError),
+    /// The joint ranges could not be resolved.
+    #[error(transparent)]
+    Ranges(#[from] RangeError),
+    /// The step is too large for a stiffness (checked before running).
+    #[error(
+        "dt = {dt_s} s exceeds the {integrator} stability bound {bound_s:.3e} s for the {what} of '{body}' \
+         (natural frequency {omega:.1} rad/s, damping ratio {zeta:.2}); lower dt_s or the {what} stiffness"
+    )]
+    Unstable {
+        /// `"contact"` or `"joint <dof name>"`.
+        what: String,
+        /// Link concerned.
+        body: String,
+        /// Natural frequency bound (rad/s).
+        omega: f64,
+        /// Damping ratio.
+        zeta: f64,
+        /// Step given (s).
+        dt_s: f64,
+        /// Largest stable step (s).
+        bound_s: f64,
+        /// Scheme name.
+        integrator: &'static str,
+    },
+    /// A non-finite value appeared.
+    #[error("non-finite {quantity} of '{body}' at t = {time_s:.4} s")]
+    NonFinite {
+        /// Simulated time (s).
+        time_s: f64,
+        /// Body (link) name.
+        body: String,
+        /// Which quantity.
+        quantity: String,
+    },
+    /// The state ran away.
+    #[error(
+        "exploding {quantity} of '{body}' at t = {time_s:.4} s: {value:.3e} (limit {limit:.1e})"
+    )]
+    Exploding {
+        /// Simulated time (s).
+        time_s: f64,
+        /// Body (link) name.
+        body: String,
+        /// Which quantity.
+        quantity: String,
+        /// Value found.
+        value: f64,
+        /// Allowed magnitude.
+        limit: f64,
+    },
+}
