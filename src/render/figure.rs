@@ -257,6 +257,10 @@ mod tests {
             "hip_L",
             "knee.l",
             "Arm-L",
+            "Shoulder_L",
+            "leftEye",
+            "lPinky2",
+            "lButtock",
         ] {
             assert_eq!(side_from_name(name), Side::Left, "{name}");
         }
@@ -268,6 +272,9 @@ mod tests {
             "r_hip",
             "hip_R",
             "foot.r",
+            "Hand_R",
+            "rCollar",
+            "rightEye",
         ] {
             assert_eq!(side_from_name(name), Side::Right, "{name}");
         }
@@ -281,6 +288,9 @@ mod tests {
             "Neck",
             "Head",
             "Ribs",
+            "joint_Root",
+            "abdomen",
+            "hip",
             "End Site",
             "",
             "l",
