@@ -277,6 +277,11 @@ fn non_finite_and_miscounted_input_is_an_error_and_writes_nothing() {
         Err(RenderError::InvalidArgument(_))
     ));
     assert!(!path.exists() && !gif_path.exists());
+    let nowhere = std::path::Path::new("/nonexistent-marionette-dir/x.png");
+    assert!(matches!(
+        pose_png(&t, 0, nowhere),
+        Err(RenderError::Io { .. })
+    ));
     std::fs::remove_dir_all(dir).unwrap();
 }
 
