@@ -53,6 +53,14 @@ fn pendulum(seconds: f64) -> (Figure, Vec<Vec<DVec3>>) {
     (fig, frames)
 }
 
+/// Logical screen size of a GIF.
+fn dec_size(path: &std::path::Path) -> (u16, u16) {
+    let d = gif::DecodeOptions::new()
+        .read_info(std::fs::File::open(path).unwrap())
+        .unwrap();
+    (d.width(), d.height())
+}
+
 fn png_size(path: &std::path::Path) -> (u32, u32) {
     let p = tiny_skia::Pixmap::load_png(path).expect("a decodable PNG");
     (p.width(), p.height())
@@ -174,12 +182,27 @@ fn pose_filmstrip_and_gif_are_written_and_decode() {
     let mut dec = opts
         .read_info(std::fs::File::open(&gif_path).unwrap())
         .unwrap();
+    let palette = dec.global_palette().unwrap().to_vec();
     let mut count = 0;
     let mut delays = 0u32;
+    let mut first_frame_colours = Vec::new();
     while let Some(f) = dec.read_next_frame().unwrap() {
+        if count == 0 {
+            // The first frame is the whole page.
+            assert_eq!((f.width, f.height), (dec_size(&gif_path)));
+            first_frame_colours = f
+                .buffer
+                .iter()
+                .map(|&i| &palette[3 * i as usize..3 * i as usize + 3])
+                .map(|c| [c[0], c[1], c[2]])
+                .collect();
+        }
         count += 1;
         delays += f.delay as u32;
     }
+    // The palette keeps the drawing's colours: the pendulum's grey rod and black dots, white.
+    let has = |rgb: [u8; 3]| first_frame_colours.contains(&rgb);
+    assert!(has([255, 255, 255]) && has([85, 85, 85]) && has([30, 30, 30]));
     // 2 s at 25 frames per second: t = 0, 0.04, …, 2.0.
     assert_eq!(count, 51);
     assert_eq!(delays, 204, "51 frames of 4 hundredths of a second");
@@ -254,6 +277,11 @@ fn non_finite_and_miscounted_input_is_an_error_and_writes_nothing() {
         Err(RenderError::InvalidArgument(_))
     ));
     assert!(!path.exists() && !gif_path.exists());
+    let nowhere = std::path::Path::new("/nonexistent-marionette-dir/x.png");
+    assert!(matches!(
+        pose_png(&t, 0, nowhere),
+        Err(RenderError::Io { .. })
+    ));
     std::fs::remove_dir_all(dir).unwrap();
 }
 

@@ -196,6 +196,7 @@ pub fn animation_gif(tracks: &[Track], fps: f64, path: &Path) -> Result<(), Rend
         )));
     }
     let frames = steps as usize + 1;
+    let sides: Vec<_> = tracks.iter().map(|t| t.figure.sides()).collect();
     let lut = lookup();
     let time_base = MARGIN as f32 + ascent(font, style.text);
     let mut still = vec![0u8; (width * height) as usize];
@@ -218,11 +219,11 @@ pub fn animation_gif(tracks: &[Track], fps: f64, path: &Path) -> Result<(), Rend
         };
         draw_text(&mut strip, font, &label, (MARGIN as f32, time_base), pen);
         quantise_into(&mut img, width as usize, &strip, 0, 0, lut);
-        for (track, origin) in tracks.iter().zip(&origins) {
+        for ((track, origin), sides) in tracks.iter().zip(&origins).zip(&sides) {
             let f = track.frame_at(t);
             for (v, cam) in cams.iter().enumerate() {
                 let mut panel = backgrounds[v].clone();
-                draw_figure(&mut panel, cam, track, f, style);
+                draw_figure(&mut panel, cam, track, sides, f, style);
                 quantise_into(&mut img, width as usize, &panel, origin[v], panel_y, lut);
             }
         }

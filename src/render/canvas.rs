@@ -220,8 +220,15 @@ fn frame(p: &mut Pixmap, w: f32, h: f32) {
 /// Draws frame `k` of `track` into a panel that already holds its background: floor ticks every
 /// 0.5 m (they move when the camera follows the root), then the bones from the farthest to the
 /// nearest (painter's order by the depth of their midpoints, so near limbs cover far ones),
-/// then the joints as dots.
-pub(crate) fn draw_figure(p: &mut Pixmap, cam: &Camera, track: &Track, k: usize, style: Style) {
+/// then the joints as dots. `sides` is `track.figure.sides()`, computed once per track.
+pub(crate) fn draw_figure(
+    p: &mut Pixmap,
+    cam: &Camera,
+    track: &Track,
+    sides: &[Side],
+    k: usize,
+    style: Style,
+) {
     let pts = &track.frames[k];
     let fig = track.figure;
     let centre = cam.centre_for(pts[fig.root()]);
@@ -231,7 +238,6 @@ pub(crate) fn draw_figure(p: &mut Pixmap, cam: &Camera, track: &Track, k: usize,
     } else {
         floor_grid(p, cam, centre);
     }
-    let sides = fig.sides();
     let mut bones: Vec<(f64, usize, usize)> = fig
         .parents
         .iter()

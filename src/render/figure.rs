@@ -92,8 +92,8 @@ fn names_side(name: &str, word: &str, letter: char) -> bool {
 impl Figure {
     /// The side of every point: [`side_from_name`] of its name, or, when that is
     /// [`Side::Centre`], the side of its parent (so an unnamed end site below `LeftHand` is left).
-    /// Requires a valid figure (see [`Figure::validate`]): parents come before children in the
-    /// walk below only through the memo, so any acyclic order works.
+    /// Points may be listed in any order; on a cyclic figure (which [`Figure::validate`]
+    /// rejects) the walk stops after as many steps as there are points.
     pub fn sides(&self) -> Vec<Side> {
         let n = self.names.len();
         let mut memo: Vec<Option<Side>> = vec![None; n];
@@ -257,6 +257,10 @@ mod tests {
             "hip_L",
             "knee.l",
             "Arm-L",
+            "Shoulder_L",
+            "leftEye",
+            "lPinky2",
+            "lButtock",
         ] {
             assert_eq!(side_from_name(name), Side::Left, "{name}");
         }
@@ -268,6 +272,9 @@ mod tests {
             "r_hip",
             "hip_R",
             "foot.r",
+            "Hand_R",
+            "rCollar",
+            "rightEye",
         ] {
             assert_eq!(side_from_name(name), Side::Right, "{name}");
         }
@@ -281,6 +288,9 @@ mod tests {
             "Neck",
             "Head",
             "Ribs",
+            "joint_Root",
+            "abdomen",
+            "hip",
             "End Site",
             "",
             "l",

@@ -117,9 +117,10 @@ pub fn filmstrip_view_png(
             },
         );
         y += label_row;
+        let sides = track.figure.sides();
         for (j, &t) in times.iter().enumerate() {
             let mut cell = if j == 0 { first.clone() } else { rest.clone() };
-            draw_figure(&mut cell, &cam, track, track.frame_at(t), style);
+            draw_figure(&mut cell, &cam, track, &sides, track.frame_at(t), style);
             blit(&mut sheet, &cell, x0 + j as u32 * (cam.width + GAP), y);
         }
         y += cam.height + ROW_GAP;

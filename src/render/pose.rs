@@ -81,11 +81,12 @@ pub fn pose_png(track: &Track, frame: usize, path: &Path) -> Result<(), RenderEr
         },
     );
 
+    let sides = track.figure.sides();
     let mut x = MARGIN + (width - 2 * MARGIN - panels_w) / 2;
     let y = MARGIN + header;
     for cam in &cams {
         let mut panel = panel_background(cam, font, style, true)?;
-        draw_figure(&mut panel, cam, track, frame, style);
+        draw_figure(&mut panel, cam, track, &sides, frame, style);
         blit(&mut sheet, &panel, x, y);
         x += cam.width + GAP;
     }
