@@ -733,8 +733,8 @@ fn unknown_channel_names_and_wrong_channel_counts() {
         with_line(9, "\t\tCHANNELS 3 Zrotation Xrotation"),
         9,
         &[
-            "3 channel names on the CHANNELS line, found only 2",
-            "end of the line",
+            "column 33: expected 3 channel names for joint `Chest` (2 given on the CHANNELS line)",
+            "found the end of the line",
         ],
     );
     fails(
@@ -788,7 +788,12 @@ fn frame_time_must_be_positive_and_finite() {
     fails(
         with_line(18, "Frame Tim: 0.03"),
         18,
-        &["`Time:` after `Frame`"],
+        &["column 7: expected `Time:` after `Frame`, found `Tim:`"],
+    );
+    fails(
+        with_line(18, "Frame"),
+        18,
+        &["expected `Time:` after `Frame`, found the end of the line"],
     );
     fails(
         with_line(18, "Frame: 0.03"),

@@ -488,7 +488,9 @@ impl<'a> Reader<'a> {
         let mut channels = Vec::new();
         for i in 0..n {
             let Some(tok) = self.lex.next_on_line() else {
-                let what = format!("{n} channel names on the CHANNELS line, found only {i} and");
+                let what = format!(
+                    "{n} channel names for joint `{name}` ({i} given on the CHANNELS line)"
+                );
                 return Err(self.end_of_line(at, what));
             };
             let Some(c) = channel_from_name(tok.text) else {
@@ -555,8 +557,10 @@ impl<'a> Reader<'a> {
         let time = self
             .lex
             .next_on_line()
-            .filter(|t| t.text.get(..5).is_some_and(|p| kw(p, "Time:")))
             .ok_or_else(|| self.end_of_line(tok, "`Time:` after `Frame`".into()))?;
+        if !time.text.get(..5).is_some_and(|p| kw(p, "Time:")) {
+            return Err(expected(time, "`Time:` after `Frame`"));
+        }
         let num = if time.text.len() > 5 {
             Token {
                 text: &time.text[5..],
