@@ -2,12 +2,14 @@
 //! knee kick (§4.2), on keyframed or captured clips.
 
 use std::path::Path;
+use std::sync::Arc;
 
 use serde::{Deserialize, Serialize};
 use serde_json::json;
 
 use super::source::{ClipSource, load_motion};
 use super::{SceneError, draw_tracks, write_output};
+use crate::ecs::{Recorder, new_primitive_world, run_primitive_world, spawn_primitive_character};
 use crate::model::{Model, ModelClip};
 use crate::primitive::{
     BlendPlacement, EventConfig, Gamma, JumpEvents, LearnConfig, Learned, Primitive, Relearn,
@@ -320,6 +322,39 @@ fn heights(clip: &ModelClip) -> (Vec<f64>, Vec<Vec<f64>>) {
     (root, clip.foot_heights().into())
 }
 
+/// Plays the connected sequence by a character in an ECS world (players → pose → forward
+/// kinematics → recorder) and returns the largest distance between its recorded points and
+/// the kernel's `expected` motion, metres. The recorder holds the state after each step, so
+/// recorded frame i is expected frame i + 1.
+fn play_in_world(
+    model: &Model,
+    sequence: &[Primitive],
+    expected: &ModelClip,
+) -> Result<f64, SceneError> {
+    let dt = expected.frame_time;
+    let mut world = new_primitive_world(dt);
+    let seq = sequence.iter().cloned().map(Arc::new).collect();
+    let e = spawn_primitive_character(
+        &mut world,
+        "jumping knee kick",
+        Arc::new(model.clone()),
+        seq,
+    )
+    .map_err(primitive_error)?;
+    let frames = expected.frame_count();
+    run_primitive_world(&mut world, frames - 1);
+    let recorded = &world
+        .get::<Recorder>(e)
+        .ok_or_else(|| SceneError::Invalid("no recorder".into()))?
+        .frames;
+    let kernel = expected.to_clip().point_frames();
+    Ok(recorded
+        .iter()
+        .zip(&kernel[1..])
+        .flat_map(|(a, b)| a.iter().zip(b).map(|(p, q)| (*p - *q).length()))
+        .fold(0.0, f64::max))
+}
+
 fn events_json(e: &JumpEvents) -> serde_json::Value {
     json!({ "start": e.start, "bend": e.bend, "take_off": e.take_off, "leap": e.leap, "land": e.land })
 }
@@ -373,6 +408,7 @@ pub fn run_jumping_knee_kick(
     let angle_jump = junction.map_or(0.0, |j| j.max_angle_jump.to_degrees());
     let velocity_jump = junction.map_or(0.0, |j| j.max_velocity_jump.to_degrees());
     let result_clip = on_model(&model, &connected.trajectory)?;
+    let ecs_gap = play_in_world(&model, &sequence, &result_clip)?;
 
     // Checks of the paper's figure: the jump's posture at Bend, the kick's at Leap, both feet
     // down after landing.
@@ -472,6 +508,7 @@ pub fn run_jumping_knee_kick(
         "posture_gap_deg": { "jump_at_bend": at_bend, "kick_at_leap": at_leap },
         "feet_above_floor_after_landing_m": feet_after_landing,
         "lands_with_both_feet": both_feet_down,
+        "ecs_vs_kernel_max_m": ecs_gap,
         "fit_rmse_deg": {
             "jumping_knee_kick": fit_json(&parts[0]),
             "land": fit_json(&parts[1]),

@@ -1,0 +1,126 @@
+//! Wiring of the motor primitives into the base ECS: a character whose DOF pose comes from
+//! primitive players gets its joint state from its model, then goes through forward kinematics
+//! and recording like any other character.
+
+use std::sync::Arc;
+
+use bevy_ecs::prelude::*;
+use glam::{DQuat, DVec3};
+
+use super::components::{Character, JointState, Recorder, SkeletonRef};
+use super::systems::BaseSet;
+use crate::model::{Model, ROOT_CHANNELS};
+use crate::primitive::ecs::{
+    DofPose, PrimitiveClock, PrimitivePlayer, PrimitiveSet, add_primitive_systems,
+};
+use crate::primitive::{Primitive, PrimitiveError};
+
+/// Which entries of a character's [`DofPose`] are its model's DOFs and its six root channels
+/// (`root_tx, root_ty, root_tz` in metres, `root_rx, root_ry, root_rz` a rotation vector).
+#[derive(Component, Clone, Debug)]
+pub struct ModelBinding {
+    /// The model the pose drives.
+    pub model: Arc<Model>,
+    dof_cols: Vec<usize>,
+    root_cols: [usize; 6],
+}
+
+impl ModelBinding {
+    /// Binds pose entries named `names` to `model`; every model DOF and root channel must be
+    /// among them.
+    pub fn new(model: Arc<Model>, names: &[String]) -> Result<ModelBinding, String> {
+        let col = |n: &str| {
+            names
+                .iter()
+                .position(|x| x == n)
+                .ok_or_else(|| format!("the pose has no channel '{n}'"))
+        };
+        let dof_cols = model
+            .dofs
+            .iter()
+            .map(|d| col(&d.name))
+            .collect::<Result<_, _>>()?;
+        let mut root_cols = [0; 6];
+        for (k, n) in ROOT_CHANNELS.iter().enumerate() {
+            root_cols[k] = col(n)?;
+        }
+        Ok(ModelBinding {
+            model,
+            dof_cols,
+            root_cols,
+        })
+    }
+}
+
+/// Sets every bound character's joint state from its DOF pose: the root from the root
+/// channels, every other joint's rotation from its DOF angles (see [`Model::local_rotations`]).
+pub fn pose_from_dofs(mut q: Query<(&ModelBinding, &DofPose, &mut JointState)>) {
+    for (b, pose, mut state) in &mut q {
+        let angles: Vec<f64> = b.dof_cols.iter().map(|&c| pose.theta[c]).collect();
+        let st = &mut *state;
+        b.model.local_rotations(&angles, &mut st.rotations);
+        for (t, j) in st.translations.iter_mut().zip(&b.model.joints) {
+            *t = j.offset;
+        }
+        let r = |k: usize| pose.theta[b.root_cols[k]];
+        st.translations[0] = DVec3::new(r(0), r(1), r(2));
+        st.rotations[0] = DQuat::from_scaled_axis(DVec3::new(r(3), r(4), r(5)));
+    }
+}
+
+/// Adds the primitive systems to a base schedule: players step inside [`BaseSet::Pose`], then
+/// [`pose_from_dofs`] turns their poses into joint states before forward kinematics. The world
+/// needs a [`PrimitiveClock`] with the same step as its [`super::SimulationClock`].
+pub fn add_primitive_wiring(schedule: &mut Schedule) {
+    add_primitive_systems(schedule);
+    schedule.configure_sets((PrimitiveSet::Players, PrimitiveSet::Blends).in_set(BaseSet::Pose));
+    schedule.add_systems(
+        pose_from_dofs
+            .in_set(BaseSet::Pose)
+            .after(PrimitiveSet::Blends),
+    );
+}
+
+/// Spawns a character on `model` that plays `sequence` (connected) and records its points.
+pub fn spawn_primitive_character(
+    world: &mut World,
+    name: &str,
+    model: Arc<Model>,
+    sequence: Vec<Arc<Primitive>>,
+) -> Result<Entity, PrimitiveError> {
+    let player = PrimitivePlayer::new(sequence)?;
+    let pose = player.pose();
+    let binding = ModelBinding::new(model.clone(), &pose.names)
+        .map_err(|what| PrimitiveError::DofMismatch { what })?;
+    let skeleton = Arc::new(model.skeleton());
+    let n = skeleton.joints.len();
+    Ok(world
+        .spawn((
+            Character { name: name.into() },
+            SkeletonRef(skeleton),
+            JointState::new(n),
+            Recorder::default(),
+            pose,
+            player,
+            binding,
+        ))
+        .id())
+}
+
+/// Runs `steps` frames of a world holding primitive characters (base schedule plus primitive
+/// wiring); the world must have been made by [`super::new_world`] and given a
+/// [`PrimitiveClock`].
+pub fn run_primitive_world(world: &mut World, steps: usize) {
+    let mut schedule = super::base_schedule();
+    add_primitive_wiring(&mut schedule);
+    for _ in 0..steps {
+        schedule.run(world);
+    }
+}
+
+/// A world with both clocks set to `dt`, ready for primitive characters.
+pub fn new_primitive_world(dt: f64) -> World {
+    let mut world = super::new_world(dt);
+    world.insert_resource(PrimitiveClock { dt });
+    world
+}
