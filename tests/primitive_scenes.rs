@@ -101,7 +101,7 @@ fn check_kick(r: &serde_json::Value) {
     assert!(f(r, &["fit_rmse_deg", "jumping_knee_kick", "median"]) < 0.5);
     // The same sequence played by a character in an ECS world lands on the kernel's motion.
     assert!(
-        f(r, &["ecs_vs_kernel_max_m"]) < 1e-3,
+        f(r, &["ecs_vs_kernel_max_m"]) < 1e-9,
         "ECS playback differs by {} m",
         r["ecs_vs_kernel_max_m"]
     );
