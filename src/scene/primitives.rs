@@ -509,7 +509,8 @@ pub fn run_jumping_knee_kick(
         "feet_above_floor_after_landing_m": feet_after_landing,
         "lands_with_both_feet": both_feet_down,
         "ecs_vs_kernel_max_m": ecs_gap,
-        "fit_rmse_deg": {
+        "fit_rmse_deg": fit_json(&parts[0]),
+        "fit_rmse_deg_by_primitive": {
             "jumping_knee_kick": fit_json(&parts[0]),
             "land": fit_json(&parts[1]),
             "knee_kick": fit_json(&kick),
