@@ -45,6 +45,14 @@ fn pushed_from_the_front_the_figure_falls_backward_and_rests() {
     );
     let d = r["damage"].as_f64().unwrap();
     assert!(d.is_finite() && d > 0.0);
+    // The adult figure took the same push in its own World beside it; before any evolution the
+    // two groups' damage is about the same (the paper's starting point).
+    assert_eq!(r["compared"]["age_group"], "adult");
+    let d_adult = r["compared"]["damage"].as_f64().unwrap();
+    assert!(
+        (d_adult - d).abs() / d < 0.1,
+        "elderly {d} vs adult {d_adult}"
+    );
     for k in ["peak_vertical_force_n", "impulse_n_s"] {
         assert_eq!(r[k].as_object().unwrap().len(), 15, "{k} per link");
     }

@@ -10,7 +10,7 @@ use super::primitives::PrimitiveRender;
 use super::source::resolve_path;
 use super::{SceneError, draw_tracks, write_output};
 use crate::dynamics::contact::ContactParams;
-use crate::dynamics::ecs::{build_fall_world, run_world};
+use crate::dynamics::ecs::{build_fall_world, run_parallel, run_world};
 use crate::dynamics::fall::{FallConfig, FallResult, Ranges};
 use crate::dynamics::integrator::Integrator;
 use crate::dynamics::push::Push;
@@ -84,6 +84,9 @@ pub struct FallScene {
     /// Floor contact parameters.
     #[serde(default)]
     pub contact: Option<ContactParams>,
+    /// Also simulate this age group (same push and controller), beside the first.
+    #[serde(default)]
+    pub compare_with: Option<AgeGroup>,
     /// Pictures.
     #[serde(default)]
     pub render: PrimitiveRender,
@@ -210,33 +213,58 @@ pub fn fall_report(r: &FallResult, sim_wall_s: f64) -> serde_json::Value {
 }
 
 /// Runs a [`FallScene`]: writes `fall.bvh` (fall21 skeleton), `filmstrip.png`, `motion.gif`,
-/// `head_height.png` (the paper's Fig. 3) and returns the report.
+/// `head_height.png` (the paper's Fig. 3) and returns the report. With `compare_with`, the same
+/// fall is also simulated for the other age group in a second World, in parallel, and drawn and
+/// plotted beside the first (`fall_<group>.bvh` for it; its report under `compared`).
 pub fn run_fall(
     scene: &FallScene,
     base: &Path,
     out: &Path,
 ) -> Result<serde_json::Value, SceneError> {
     let config = scene.config(base)?;
+    let mut groups = vec![(scene.age_group, config.clone())];
+    if let Some(other) = scene.compare_with {
+        let mut c = scene.config(base)?;
+        if scene.ranges_file.is_none() {
+            c.ranges = Ranges::Builtin(other);
+        }
+        groups.push((other, c));
+    }
+    let configs: Vec<FallConfig> = groups.iter().map(|(_, c)| c.clone()).collect();
     let started = std::time::Instant::now();
-    let result = simulate_in_world(&config)?;
+    let results: Vec<FallResult> = run_parallel(&configs)
+        .into_iter()
+        .map(|r| r.map_err(|e| SceneError::Invalid(e.to_string())))
+        .collect::<Result<_, _>>()?;
     let sim_wall = started.elapsed().as_secs_f64();
-    let motion = result.to_model_clip();
-    let clip = motion.to_clip();
-    write_output(
-        &out.join("fall.bvh"),
-        crate::bvh::to_string(&clip.to_bvh()).as_bytes(),
-    )?;
-    let figure = clip.skeleton.figure();
-    let frames = clip.point_frames();
-    let label = format!("{} ({:?})", scene.name, scene.age_group);
-    let track = Track {
-        figure: &figure,
-        frames: &frames,
-        label,
-        frame_time: clip.frame_time,
-    };
+
+    let clips: Vec<_> = results
+        .iter()
+        .map(|r| r.to_model_clip().to_clip())
+        .collect();
+    for (k, clip) in clips.iter().enumerate() {
+        let name = if k == 0 {
+            "fall.bvh".to_string()
+        } else {
+            format!("fall_{}.bvh", group_name(groups[k].0))
+        };
+        write_output(
+            &out.join(name),
+            crate::bvh::to_string(&clip.to_bvh()).as_bytes(),
+        )?;
+    }
+    let figures: Vec<_> = clips.iter().map(|c| c.skeleton.figure()).collect();
+    let frames: Vec<_> = clips.iter().map(|c| c.point_frames()).collect();
+    let tracks: Vec<Track> = (0..clips.len())
+        .map(|k| Track {
+            figure: &figures[k],
+            frames: &frames[k],
+            label: format!("{} ({})", scene.name, group_name(groups[k].0)),
+            frame_time: clips[k].frame_time,
+        })
+        .collect();
     draw_tracks(
-        std::slice::from_ref(&track),
+        &tracks,
         scene.render.filmstrip_frames,
         scene.render.gif.then_some(scene.render.gif_fps),
         out,
@@ -244,17 +272,21 @@ pub fn run_fall(
     let push_end = scene.push.start_s + scene.push.duration_s;
     plot(
         &Plot {
-            title: format!("Head height: {} ({:?})", scene.name, scene.age_group),
+            title: format!("Head height: {}", scene.name),
             x_label: "time (s)".into(),
             y_label: "head height (m)".into(),
-            series: vec![Series {
-                name: format!("{:?}", scene.age_group),
-                points: result
-                    .frames
-                    .iter()
-                    .map(|f| (f.time_s, f.head_height_m))
-                    .collect(),
-            }],
+            series: results
+                .iter()
+                .zip(&groups)
+                .map(|(r, (g, _))| Series {
+                    name: group_name(*g).into(),
+                    points: r
+                        .frames
+                        .iter()
+                        .map(|f| (f.time_s, f.head_height_m))
+                        .collect(),
+                })
+                .collect(),
             markers: vec![
                 (scene.push.start_s, "push".into()),
                 (push_end, "push ends".into()),
@@ -262,8 +294,20 @@ pub fn run_fall(
         },
         &out.join("head_height.png"),
     )?;
-    let mut report = fall_report(&result, sim_wall);
+    let mut report = fall_report(&results[0], sim_wall);
     report["age_group"] = json!(scene.age_group);
     report["damage_weights"] = json!(config.damage_weights);
+    if let (Some(r), Some((g, _))) = (results.get(1), groups.get(1)) {
+        let mut other = fall_report(r, sim_wall);
+        other["age_group"] = json!(g);
+        report["compared"] = other;
+    }
     Ok(report)
+}
+
+fn group_name(g: AgeGroup) -> &'static str {
+    match g {
+        AgeGroup::Elderly => "elderly",
+        AgeGroup::Adult => "adult",
+    }
 }
