@@ -59,6 +59,52 @@ mod tests {
     }
 }
 
+/// Why a data file (RON) could not be read: the file itself, its syntax, or its version.
+#[derive(Debug, thiserror::Error)]
+pub enum FileError {
+    /// The file could not be read.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: String,
+        /// The operating system's reason.
+        source: std::io::Error,
+    },
+    /// RON syntax or schema error, with line and column.
+    #[error(transparent)]
+    Ron(#[from] RonError),
+    /// A format version newer than this build reads.
+    #[error("{path}: format_version {found} is newer than this build reads ({supported})")]
+    Version {
+        /// The file.
+        path: String,
+        /// The version in the file.
+        found: u32,
+        /// The newest version this build reads.
+        supported: u32,
+    },
+}
+
+/// Reads a whole text file, naming it in the error.
+pub fn read_text(path: &Path) -> Result<String, FileError> {
+    std::fs::read_to_string(path).map_err(|source| FileError::Io {
+        path: path.display().to_string(),
+        source,
+    })
+}
+
+/// Refuses a `format_version` newer than `supported`.
+pub fn check_version(origin: &str, found: u32, supported: u32) -> Result<(), FileError> {
+    if found > supported {
+        return Err(FileError::Version {
+            path: origin.to_string(),
+            found,
+            supported,
+        });
+    }
+    Ok(())
+}
+
 /// A RON syntax or schema error, located: `path:line:column: message`.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error("{path}:{line}:{column}: {message}")]

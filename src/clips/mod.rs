@@ -75,15 +75,9 @@ pub struct KeyframeClip {
 /// Errors of keyframed clips.
 #[derive(Debug, thiserror::Error)]
 pub enum KeyframeError {
-    /// The file could not be read.
-    #[error("{path}: {source}")]
-    Io {
-        path: String,
-        source: std::io::Error,
-    },
-    /// RON syntax or schema error, with line and column.
+    /// The file could not be read, parsed, or is of a newer version.
     #[error(transparent)]
-    Parse(#[from] crate::io::RonError),
+    File(#[from] crate::io::FileError),
     /// Inconsistent content.
     #[error("{path}: {message}")]
     Content { path: String, message: String },
@@ -92,19 +86,15 @@ pub enum KeyframeError {
 impl KeyframeClip {
     /// Parses RON text and checks it; `origin` names the source in errors.
     pub fn parse(text: &str, origin: &str) -> Result<KeyframeClip, KeyframeError> {
-        let c: KeyframeClip = crate::io::parse_ron(text, origin)?;
+        let c: KeyframeClip =
+            crate::io::parse_ron(text, origin).map_err(crate::io::FileError::from)?;
         let bad = |message: String| {
             Err(KeyframeError::Content {
                 path: origin.into(),
                 message,
             })
         };
-        if c.format_version > FORMAT_VERSION {
-            return bad(format!(
-                "format_version {} is newer than this build reads ({FORMAT_VERSION})",
-                c.format_version
-            ));
-        }
+        crate::io::check_version(origin, c.format_version, FORMAT_VERSION)?;
         if !(c.fps.is_finite() && c.fps > 0.0 && c.duration.is_finite() && c.duration > 0.0) {
             return bad(format!(
                 "fps and duration must be positive, found fps {} and duration {}",
@@ -151,12 +141,8 @@ impl KeyframeClip {
 
     /// Reads and checks a keyframed clip file.
     pub fn load(path: &Path) -> Result<KeyframeClip, KeyframeError> {
-        let p = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|source| KeyframeError::Io {
-            path: p.clone(),
-            source,
-        })?;
-        KeyframeClip::parse(&text, &p)
+        let text = crate::io::read_text(path)?;
+        KeyframeClip::parse(&text, &path.display().to_string())
     }
 
     /// Samples the clip at its frame rate into a motion on its model.

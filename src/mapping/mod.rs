@@ -64,18 +64,9 @@ pub struct Mapping {
 /// Errors of mappings.
 #[derive(Debug, thiserror::Error)]
 pub enum MappingError {
-    /// The file could not be read.
-    #[error("{path}: {source}")]
-    Io {
-        path: String,
-        source: std::io::Error,
-    },
-    /// RON syntax or schema error, with line and column.
+    /// The file could not be read, parsed, or is of a newer version.
     #[error(transparent)]
-    Parse(#[from] crate::io::RonError),
-    /// A newer format.
-    #[error("{path}: format_version {found} is newer than this build reads ({FORMAT_VERSION})")]
-    Version { path: String, found: u32 },
+    File(#[from] crate::io::FileError),
     /// A landmark missing from the file, or an unknown one.
     #[error("mapping '{mapping}': {message}")]
     Landmarks { mapping: String, message: String },
@@ -131,13 +122,8 @@ const BUILTIN: [(&str, &str); 5] = [
 impl Mapping {
     /// Parses RON text; `origin` names the source in errors.
     pub fn parse(text: &str, origin: &str) -> Result<Mapping, MappingError> {
-        let m: Mapping = crate::io::parse_ron(text, origin)?;
-        if m.format_version > FORMAT_VERSION {
-            return Err(MappingError::Version {
-                path: origin.into(),
-                found: m.format_version,
-            });
-        }
+        let m: Mapping = crate::io::parse_ron(text, origin).map_err(crate::io::FileError::from)?;
+        crate::io::check_version(origin, m.format_version, FORMAT_VERSION)?;
         for l in LANDMARKS {
             if !m.landmarks.contains_key(l) {
                 return Err(MappingError::Landmarks {
@@ -164,12 +150,8 @@ impl Mapping {
 
     /// Reads a mapping from a RON file.
     pub fn load(path: &Path) -> Result<Mapping, MappingError> {
-        let p = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|source| MappingError::Io {
-            path: p.clone(),
-            source,
-        })?;
-        Mapping::parse(&text, &p)
+        let text = crate::io::read_text(path)?;
+        Mapping::parse(&text, &path.display().to_string())
     }
 
     /// The built-in mappings (`scenes/mappings/*.ron`, embedded in the program).

@@ -38,18 +38,9 @@ pub enum AgeGroup {
 /// Errors reading a range table.
 #[derive(Debug, thiserror::Error)]
 pub enum RangeError {
-    /// The file could not be read.
-    #[error("{path}: {source}")]
-    Io {
-        path: String,
-        source: std::io::Error,
-    },
-    /// RON syntax or schema error, with line and column.
+    /// The file could not be read, parsed, or is of a newer version.
     #[error(transparent)]
-    Parse(#[from] crate::io::RonError),
-    /// A version this build does not know.
-    #[error("{path}: format_version {found} is newer than this build reads ({FORMAT_VERSION})")]
-    Version { path: String, found: u32 },
+    File(#[from] crate::io::FileError),
     /// A DOF without a range, an unknown DOF name or an empty range.
     #[error("{path}: {message}")]
     Content { path: String, message: String },
@@ -73,23 +64,15 @@ impl RangeTable {
 
     /// Reads a table from a RON file.
     pub fn load(path: &Path) -> Result<RangeTable, RangeError> {
-        let p = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|source| RangeError::Io {
-            path: p.clone(),
-            source,
-        })?;
-        RangeTable::parse(&text, &p)
+        let text = crate::io::read_text(path)?;
+        RangeTable::parse(&text, &path.display().to_string())
     }
 
     /// Parses RON text; `origin` names the source in errors.
     pub fn parse(text: &str, origin: &str) -> Result<RangeTable, RangeError> {
-        let t: RangeTable = crate::io::parse_ron(text, origin)?;
-        if t.format_version > FORMAT_VERSION {
-            return Err(RangeError::Version {
-                path: origin.into(),
-                found: t.format_version,
-            });
-        }
+        let t: RangeTable =
+            crate::io::parse_ron(text, origin).map_err(crate::io::FileError::from)?;
+        crate::io::check_version(origin, t.format_version, FORMAT_VERSION)?;
         for (k, (lo, hi)) in &t.ranges {
             if !(lo.is_finite() && hi.is_finite() && lo <= hi) {
                 return Err(RangeError::Content {
