@@ -6,11 +6,11 @@ use std::process::ExitCode;
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
 
-use marionette::analysis::ground_contacts;
+use marionette::analysis::clip_contacts;
 use marionette::bvh;
 use marionette::mapping::{Mapping, effector_errors, retarget};
 use marionette::model::Model;
-use marionette::render::{Side, Track, animation_gif, filmstrip_png, side_from_name};
+use marionette::render::{Track, animation_gif, filmstrip_png};
 use marionette::scene::{self, ClipSource, Scene, load_motion};
 use marionette::skeleton::Clip;
 
@@ -186,52 +186,10 @@ fn inspect(file: &Path, unit_scale: Option<f64>) -> Result<()> {
         );
     }
     // Ground contact and flight from the feet: the mapping's ankles and toes, else by name.
-    let feet = |side: Side| -> Vec<(usize, bool)> {
-        if let Ok(m) = Mapping::detect(&clip.skeleton) {
-            let s = if side == Side::Left { "left" } else { "right" };
-            return ["ankle", "toe"]
-                .iter()
-                .filter_map(|p| m.resolve(&clip.skeleton, &format!("{s}_{p}")).ok())
-                .map(|l| (l.joint, l.end_site))
-                .collect();
-        }
-        clip.skeleton
-            .joints
-            .iter()
-            .enumerate()
-            .filter(|(_, j)| {
-                let n = j.name.to_lowercase();
-                (n.contains("foot") || n.contains("toe") || n.contains("ankle"))
-                    && side_from_name(&j.name) == side
-            })
-            .map(|(i, _)| (i, false))
-            .collect()
-    };
-    let (lf, rf) = (feet(Side::Left), feet(Side::Right));
-    if lf.is_empty() || rf.is_empty() {
+    let Some(c) = clip_contacts(&clip, 0.03, 0.1) else {
         println!("contact     (no feet found: no joint named foot/toe/ankle on each side)");
         return Ok(());
-    }
-    let mut g = vec![];
-    let (mut l, mut r) = (vec![], vec![]);
-    for f in 0..clip.frame_count() {
-        clip.globals(f, &mut g);
-        let pts = |idx: &[(usize, bool)]| -> Vec<glam::DVec3> {
-            idx.iter()
-                .map(|&(j, end)| {
-                    let e = if end {
-                        clip.skeleton.joints[j].end_site.unwrap_or_default()
-                    } else {
-                        glam::DVec3::ZERO
-                    };
-                    g[j].translation + g[j].rotation * e
-                })
-                .collect()
-        };
-        l.push(pts(&lf));
-        r.push(pts(&rf));
-    }
-    let c = ground_contacts(&l, &r, clip.frame_time, 0.03, 0.1);
+    };
     let spans = |s: &[marionette::analysis::Span]| -> String {
         s.iter()
             .map(|x| format!("{:.2}-{:.2}", x.start_s, x.end_s))

@@ -283,6 +283,7 @@ pub fn retarget(clip: &Clip, mapping: &Mapping, model: &Model) -> Result<ModelCl
     let mut root_rotation = Vec::with_capacity(frames);
     let mut root_translation = Vec::with_capacity(frames);
     let mut achieved = vec![DQuat::IDENTITY; n];
+    let joint_axes: Vec<Vec<DVec3>> = (0..n).map(|j| model.joint_axes(j)).collect();
     for f in 0..frames {
         for j in 0..n {
             let joint = &model.joints[j];
@@ -292,25 +293,28 @@ pub fn retarget(clip: &Clip, mapping: &Mapping, model: &Model) -> Result<ModelCl
                 achieved[j] = target;
                 continue;
             }
-            let axes = model.joint_axes(j);
+            let axes = &joint_axes[j];
             let local = parent.inverse() * target;
             let m = joint.dofs.len();
             let mut out = [0.0; 3];
             if m > 0 {
                 let first = joint.dofs[0];
-                let prev = (f > 0)
-                    .then(|| angles[(f - 1) * dofs + first..(f - 1) * dofs + first + m].to_vec());
+                let mut prev = [0.0; 3];
+                if f > 0 {
+                    let row = (f - 1) * dofs + first;
+                    prev[..m].copy_from_slice(&angles[row..row + m]);
+                }
                 project_rotation(
                     joint.kind,
-                    &axes,
+                    axes,
                     rest_dirs[j],
                     local,
-                    prev.as_deref(),
+                    (f > 0).then_some(&prev[..m]),
                     &mut out[..m],
                 );
                 angles[f * dofs + first..f * dofs + first + m].copy_from_slice(&out[..m]);
             }
-            achieved[j] = parent * local_rotation(joint.kind, &axes, &out[..m]);
+            achieved[j] = parent * local_rotation(joint.kind, axes, &out[..m]);
         }
         root_rotation.push(achieved[0]);
         root_translation.push(positions[f * k + pelvis_lm]);

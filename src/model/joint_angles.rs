@@ -28,6 +28,30 @@ pub fn unwrap_near(a: f64, reference: f64) -> f64 {
     a - TAU * ((a - reference) / TAU).round()
 }
 
+/// The rotation vector of `q` (axis × angle, radians) nearest `previous`: of the
+/// representatives `v + 2πk·v̂` of the same rotation, the one closest to the previous frame's,
+/// so a rotation growing through π does not flip to the opposite side.
+pub fn rotation_vector_near(q: DQuat, previous: Option<DVec3>) -> DVec3 {
+    let q = if q.w < 0.0 { -q } else { q };
+    let v = q.to_scaled_axis();
+    let Some(prev) = previous else { return v };
+    let angle = v.length();
+    if angle > 1e-9 {
+        let dir = v / angle;
+        let k = ((prev.dot(dir) - angle) / TAU).round();
+        let alt = dir * (angle + TAU * k);
+        if (alt - prev).length() < (v - prev).length() {
+            alt
+        } else {
+            v
+        }
+    } else if prev.length() > PI {
+        prev.normalize() * TAU * (prev.length() / TAU).round()
+    } else {
+        v
+    }
+}
+
 /// Best DOF angles (radians) for a joint of `kind` with DOF `axes` to reproduce the local
 /// rotation `q`, written to `out`; `previous` (the same joint's angles one frame earlier) keeps
 /// the result continuous over time (no ±2π jumps, no rotation-vector flips).
@@ -98,25 +122,8 @@ pub fn project_rotation(
             out[1] = best.1;
         }
         JointKind::Ball => {
-            let q = if q.w < 0.0 { -q } else { q };
-            let mut v = q.to_scaled_axis();
-            if let Some(p) = previous {
-                let prev = axes[0] * p[0] + axes[1] * p[1] + axes[2] * p[2];
-                let angle = v.length();
-                if angle > 1e-9 {
-                    // The same rotation, other representatives: v − 2π v̂ and v + 2π v̂ … pick nearest.
-                    let dir = v / angle;
-                    let k = ((prev.dot(dir) - angle) / TAU).round();
-                    let alt = dir * (angle + TAU * k);
-                    if (alt - prev).length() < (v - prev).length() {
-                        v = alt;
-                    }
-                } else if prev.length() > PI {
-                    let dir = prev.normalize();
-                    let k = (prev.length() / TAU).round();
-                    v = dir * TAU * k;
-                }
-            }
+            let prev = previous.map(|p| axes[0] * p[0] + axes[1] * p[1] + axes[2] * p[2]);
+            let v = rotation_vector_near(q, prev);
             for k in 0..3 {
                 out[k] = v.dot(axes[k]);
             }

@@ -19,7 +19,7 @@ mod model_clip;
 pub mod ranges;
 
 pub use definition::{fall21, humanoid24};
-pub use joint_angles::{local_rotation, project_rotation, unwrap_near};
+pub use joint_angles::{local_rotation, project_rotation, rotation_vector_near, unwrap_near};
 pub use model_clip::{ModelClip, ROOT_CHANNELS};
 
 use glam::{DQuat, DVec3};

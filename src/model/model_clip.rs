@@ -2,7 +2,7 @@
 
 use glam::{DQuat, DVec3};
 
-use crate::model::Model;
+use crate::model::{Model, rotation_vector_near};
 use crate::primitive::Trajectory;
 
 /// Names of the root channels in a primitive trajectory: translation (m), then orientation as a
@@ -57,19 +57,7 @@ impl ModelClip {
     pub fn root_rotation_vectors(&self) -> Vec<DVec3> {
         let mut out: Vec<DVec3> = Vec::with_capacity(self.root_rotation.len());
         for q in &self.root_rotation {
-            let q = if q.w < 0.0 { -*q } else { *q };
-            let mut v = q.to_scaled_axis();
-            if let Some(prev) = out.last() {
-                let angle = v.length();
-                if angle > 1e-9 {
-                    let dir = v / angle;
-                    let k = ((prev.dot(dir) - angle) / std::f64::consts::TAU).round();
-                    let alt = dir * (angle + std::f64::consts::TAU * k);
-                    if (alt - *prev).length() < (v - *prev).length() {
-                        v = alt;
-                    }
-                }
-            }
+            let v = rotation_vector_near(*q, out.last().copied());
             out.push(v);
         }
         out
@@ -170,19 +158,6 @@ impl ModelClip {
                 .push(DQuat::from_scaled_axis(DVec3::new(r(3), r(4), r(5))));
         }
         Ok(clip)
-    }
-
-    /// Global positions of the model's joints (metres) at every frame, by joint name order of
-    /// the model's skeleton.
-    pub fn joint_positions(&self) -> Vec<Vec<DVec3>> {
-        let clip = self.to_clip();
-        let mut g = vec![];
-        (0..clip.frame_count())
-            .map(|f| {
-                clip.globals(f, &mut g);
-                g.iter().map(|t| t.translation).collect()
-            })
-            .collect()
     }
 
     /// Height of each foot's lowest point (its ankle joint or the ankle's End Site, the toe) at

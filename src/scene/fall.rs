@@ -224,7 +224,7 @@ pub fn run_fall(
     let config = scene.config(base)?;
     let mut groups = vec![(scene.age_group, config.clone())];
     if let Some(other) = scene.compare_with {
-        let mut c = scene.config(base)?;
+        let mut c = config.clone();
         if scene.ranges_file.is_none() {
             c.ranges = Ranges::Builtin(other);
         }

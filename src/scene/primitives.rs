@@ -234,17 +234,23 @@ fn draw(
     Ok(())
 }
 
-fn knee_series(label: &str, traj: &Trajectory) -> Result<Series, SceneError> {
+/// One DOF of a trajectory as a plot series in degrees, its time shifted by `offset` seconds.
+fn dof_series(
+    label: &str,
+    traj: &Trajectory,
+    dof: &str,
+    offset: f64,
+) -> Result<Series, SceneError> {
     let j = traj
-        .index_of("left_knee")
-        .ok_or_else(|| SceneError::Invalid("no DOF 'left_knee'".into()))?;
+        .index_of(dof)
+        .ok_or_else(|| SceneError::Invalid(format!("no DOF '{dof}'")))?;
     Ok(Series {
         name: label.into(),
         points: traj
             .column(j)
             .iter()
             .enumerate()
-            .map(|(k, a)| (k as f64 * traj.dt, a.to_degrees()))
+            .map(|(k, v)| (offset + k as f64 * traj.dt, v.to_degrees()))
             .collect(),
     })
 }
@@ -316,9 +322,9 @@ pub fn run_high_jump(
             x_label: "time (s)".into(),
             y_label: "left knee flexion (deg)".into(),
             series: vec![
-                knee_series("low", &r_low)?,
-                knee_series("normal", &r_normal)?,
-                knee_series("high", &r_high)?,
+                dof_series("low", &r_low, "left_knee", 0.0)?,
+                dof_series("normal", &r_normal, "left_knee", 0.0)?,
+                dof_series("high", &r_high, "left_knee", 0.0)?,
             ],
             markers: vec![],
         },
@@ -480,20 +486,8 @@ pub fn run_jumping_knee_kick(
         (ev.land, "Land".into()),
     ];
     for dof in ["left_knee", "right_knee"] {
-        let series = |label: &str, traj: &Trajectory, offset: f64| -> Result<Series, SceneError> {
-            let j = traj
-                .index_of(dof)
-                .ok_or_else(|| SceneError::Invalid(format!("no DOF '{dof}'")))?;
-            Ok(Series {
-                name: label.into(),
-                points: traj
-                    .column(j)
-                    .iter()
-                    .enumerate()
-                    .map(|(k, v)| (offset + k as f64 * traj.dt, v.to_degrees()))
-                    .collect(),
-            })
-        };
+        let series =
+            |label: &str, traj: &Trajectory, offset: f64| dof_series(label, traj, dof, offset);
         plot(
             &Plot {
                 title: format!(

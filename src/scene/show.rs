@@ -8,7 +8,7 @@ use serde_json::json;
 
 use super::source::{ClipSource, LoadedMotion, load_motion};
 use super::{SceneError, draw_tracks, write_output};
-use crate::analysis::ground_contacts;
+use crate::analysis::clip_contacts;
 use crate::ecs::{Recorder, base_schedule, new_world, spawn_clip_character};
 use crate::mapping::effector_errors;
 use crate::model::Model;
@@ -129,34 +129,7 @@ pub fn run_show(
     report["fps"] = json!(1.0 / clip.frame_time);
     report["duration_s"] = json!(clip.duration());
 
-    // Ground contact from the feet (ankles and their End Sites on a model, else by name).
-    let foot_points = |side: &str| -> Vec<usize> {
-        let names = clip.skeleton.point_names();
-        names
-            .iter()
-            .enumerate()
-            .filter(|(_, n)| {
-                let l = n.to_lowercase();
-                (l.contains("ankle") || l.contains("foot") || l.contains("toe"))
-                    && crate::render::side_from_name(n)
-                        == if side == "left" {
-                            crate::render::Side::Left
-                        } else {
-                            crate::render::Side::Right
-                        }
-            })
-            .map(|(i, _)| i)
-            .collect()
-    };
-    let (lf, rf) = (foot_points("left"), foot_points("right"));
-    if !lf.is_empty() && !rf.is_empty() {
-        let pick = |idx: &[usize]| -> Vec<Vec<glam::DVec3>> {
-            frames
-                .iter()
-                .map(|f| idx.iter().map(|&i| f[i]).collect())
-                .collect()
-        };
-        let c = ground_contacts(&pick(&lf), &pick(&rf), clip.frame_time, 0.03, 0.1);
+    if let Some(c) = clip_contacts(&clip, 0.03, 0.1) {
         report["flights"] = json!(c.flights);
     }
 
