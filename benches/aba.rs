@@ -4,7 +4,7 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::{DQuat, DVec3};
-use marionette::dynamics::human::fall21_body;
+use marionette::humanoid::body::fall21_body;
 use marionette::dynamics::{Data, ForceVec, aba};
 use std::hint::black_box;
 

@@ -6,8 +6,8 @@
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use marionette::dynamics::Integrator;
-use marionette::dynamics::fall::{FallConfig, simulate_fall};
-use marionette::model::ranges::AgeGroup;
+use marionette::experiments::fall::{FallConfig, simulate_fall};
+use marionette::humanoid::ranges::AgeGroup;
 use std::hint::black_box;
 use std::time::Duration;
 

@@ -3,9 +3,9 @@
 //! Run: `cargo bench --bench falls_parallel`.
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use marionette::dynamics::ecs::run_parallel;
-use marionette::dynamics::fall::FallConfig;
-use marionette::model::ranges::AgeGroup;
+use marionette::experiments::fall::ecs::run_parallel;
+use marionette::experiments::fall::FallConfig;
+use marionette::humanoid::ranges::AgeGroup;
 use std::hint::black_box;
 use std::time::Duration;
 

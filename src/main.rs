@@ -9,7 +9,7 @@ use clap::{Parser, Subcommand};
 use marionette::analysis::clip_contacts;
 use marionette::bvh;
 use marionette::mapping::{Mapping, effector_errors, retarget};
-use marionette::model::Model;
+use marionette::humanoid::Model;
 use marionette::render::{Track, animation_gif, filmstrip_png};
 use marionette::scene::{self, ClipSource, Scene, load_motion};
 use marionette::skeleton::Clip;
@@ -50,7 +50,7 @@ enum Command {
         /// With --bvh: the model to map onto (humanoid24 or fall21).
         #[arg(long, requires = "bvh")]
         model: Option<String>,
-        /// A mapping file for the skeleton (default: detected among scenes/mappings/*.ron).
+        /// A mapping file for the skeleton (default: detected among src/mapping/builtin/*.ron).
         #[arg(long)]
         mapping: Option<PathBuf>,
         /// Metres per file unit (estimated from the standing height when absent).

@@ -3,9 +3,9 @@
 //! body and quantity.
 
 use glam::DVec3;
-use marionette::dynamics::ecs::{build_fall_world, run_parallel, run_world};
-use marionette::dynamics::fall::{FallConfig, FallResult, SimError, simulate_fall};
-use marionette::model::ranges::AgeGroup;
+use marionette::experiments::fall::ecs::{build_fall_world, run_parallel, run_world};
+use marionette::experiments::fall::{FallConfig, FallResult, SimError, simulate_fall};
+use marionette::humanoid::ranges::AgeGroup;
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64;
 
@@ -112,8 +112,8 @@ fn a_runaway_push_stops_with_time_body_and_quantity() {
 #[test]
 fn two_characters_in_one_world_fall_independently() {
     use bevy_ecs::world::World;
-    use marionette::dynamics::ecs::spawn_fall;
-    use marionette::dynamics::fall::build_fall;
+    use marionette::experiments::fall::ecs::spawn_fall;
+    use marionette::experiments::fall::build_fall;
     let a = short(AgeGroup::Elderly);
     let mut b = short(AgeGroup::Adult);
     b.push.force_n = 700.0;

@@ -3,8 +3,8 @@
 //! is stable when the step is halved.
 
 use marionette::dynamics::Integrator;
-use marionette::dynamics::fall::{FallConfig, FallResult, SimError, simulate_fall};
-use marionette::model::ranges::AgeGroup;
+use marionette::experiments::fall::{FallConfig, FallResult, SimError, simulate_fall};
+use marionette::humanoid::ranges::AgeGroup;
 
 fn check_fell_backward_and_rested(r: &FallResult) {
     let first = &r.frames[0];
@@ -197,10 +197,10 @@ fn random_genes_within_the_ranges_all_simulate() {
     // the group's ranges). Every fall must run to the end and come down. Penetration is looser
     // here than in the paper's fall: with stiffness per kilogram of link mass, a light link that
     // lands under the body's weight (an upper arm) sinks up to ~3 cm.
-    use marionette::model::ranges::RangeTable;
+    use marionette::humanoid::ranges::RangeTable;
     use rand::{RngExt, SeedableRng};
     let mut rng = rand_pcg::Pcg64::seed_from_u64(5);
-    let fig = marionette::model::fall21();
+    let fig = marionette::humanoid::fall21();
     for (n, group) in [AgeGroup::Elderly, AgeGroup::Adult]
         .into_iter()
         .cycle()
@@ -231,9 +231,9 @@ fn random_genes_within_the_ranges_all_simulate() {
 
 #[test]
 fn ranges_can_come_from_an_editable_ron_file() {
-    use marionette::dynamics::fall::Ranges;
+    use marionette::experiments::fall::Ranges;
     let path =
-        std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes/models/fall21_adult.ron");
+        std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("src/humanoid/data/fall21_adult.ron");
     let mut cfg = FallConfig::paper(AgeGroup::Adult);
     cfg.duration_s = 0.2;
     let builtin = simulate_fall(&cfg).unwrap();

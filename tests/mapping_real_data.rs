@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 use marionette::bvh;
 use marionette::mapping::{Mapping, effector_errors, retarget};
-use marionette::model::Model;
+use marionette::humanoid::Model;
 use marionette::skeleton::Clip;
 
 fn data_dir() -> Option<PathBuf> {

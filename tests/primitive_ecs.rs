@@ -4,7 +4,7 @@
 use std::sync::Arc;
 
 use bevy_ecs::prelude::*;
-use marionette::primitive::ecs::{
+use marionette::ecs::primitive::{
     BlendPlayer, DofPose, PrimitiveClock, PrimitivePlayer, add_primitive_systems,
 };
 use marionette::primitive::synthetic::smooth_humanoid24;

@@ -17,7 +17,7 @@ use std::path::Path;
 use glam::{DQuat, DVec3};
 use serde::{Deserialize, Serialize};
 
-use crate::model::{Model, ModelClip};
+use crate::humanoid::{Model, ModelClip};
 
 /// The RON format version this build reads.
 pub const FORMAT_VERSION: u32 = 1;

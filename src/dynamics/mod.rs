@@ -10,7 +10,7 @@
 //!
 //! ```no_run
 //! use marionette::dynamics::{FallConfig, simulate_fall};
-//! use marionette::model::ranges::AgeGroup;
+//! use marionette::humanoid::ranges::AgeGroup;
 //! let result = simulate_fall(&FallConfig::paper(AgeGroup::Elderly)).unwrap();
 //! println!("damage {:.0} N, at rest: {}", result.damage, result.came_to_rest);
 //! ```
@@ -22,30 +22,19 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod aba;
-pub mod components;
-pub mod contact;
 pub mod crba;
 pub mod data;
-pub mod ecs;
-pub mod fall;
-pub mod fall_config;
-pub mod fall_result;
-pub mod human;
+pub mod forces;
 pub mod integrator;
 pub mod joint;
 pub mod kinematics;
-pub mod limits;
 pub mod model;
-pub mod pd;
-pub mod push;
 pub mod rnea;
 pub mod spatial;
 
 pub use aba::{aba, aba_passes};
 pub use crba::{crba, forward_dynamics_crba};
 pub use data::Data;
-pub use ecs::{FallSet, build_fall_world, run_parallel, run_world};
-pub use fall::{FallConfig, FallFrame, FallResult, SimError, simulate_fall};
 pub use integrator::{Dynamics, Integrator, IntegratorWorkspace};
 pub use joint::JointType;
 pub use kinematics::kinematics;

@@ -2,7 +2,7 @@
 //! state, a clip playback and a recorder; a schedule advances time, samples clips, runs forward
 //! kinematics and records, in explicit, user-orderable system sets.
 //!
-//! Characters driven by motor primitives carry a [`crate::primitive::ecs::PrimitivePlayer`] and
+//! Characters driven by motor primitives carry a [`crate::ecs::primitive::PrimitivePlayer`] and
 //! a [`ModelBinding`]: the players step in [`BaseSet::Pose`] and [`pose_from_dofs`] hands their
 //! poses to forward kinematics ([`add_primitive_wiring`]).
 //!
@@ -10,12 +10,13 @@
 //! parallel ([`run_worlds_parallel`]). Build one schedule per world with [`base_schedule`]
 //! (schedules are not `Clone`).
 
-mod components;
-mod model_pose;
+mod dof_pose;
+mod motion;
+pub mod primitive;
 mod systems;
 
-pub use components::{Character, ClipPlayback, JointState, Recorder, SimulationClock, SkeletonRef};
-pub use model_pose::{
+pub use motion::{Character, ClipPlayback, JointState, Recorder, SimulationClock, SkeletonRef};
+pub use dof_pose::{
     ModelBinding, add_primitive_wiring, new_primitive_world, pose_from_dofs, run_primitive_world,
     spawn_primitive_character,
 };

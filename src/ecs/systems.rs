@@ -2,7 +2,7 @@
 
 use bevy_ecs::prelude::*;
 
-use super::components::{ClipPlayback, JointState, Recorder, SimulationClock, SkeletonRef};
+use super::motion::{ClipPlayback, JointState, Recorder, SimulationClock, SkeletonRef};
 use crate::skeleton::forward_kinematics;
 
 /// The stages of a base step, run in this order: sample poses from clips, forward kinematics,

@@ -3,7 +3,7 @@
 use serde::Serialize;
 
 use super::{Mapping, MappingError};
-use crate::model::ModelClip;
+use crate::humanoid::ModelClip;
 use crate::skeleton::Clip;
 
 /// Distance between where the source and the mapped model put one end effector, metres.

@@ -1,6 +1,6 @@
 //! Mapping real skeletons onto the engine's models.
 //!
-//! A [`Mapping`] (a RON file a user can copy and edit, see `scenes/mappings/`) names, for each
+//! A [`Mapping`] (a RON file a user can copy and edit, see `src/mapping/builtin/`) names, for each
 //! anatomical landmark (pelvis, waist, neck, head, and per side clavicle, shoulder, elbow, wrist,
 //! hand, hip, knee, ankle, toe), the source joint or End Site that marks it. [`retarget`] turns a
 //! clip into the model's DOF angle trajectories plus root motion ([`ModelClip`]).
@@ -82,7 +82,7 @@ pub enum MappingError {
     },
     /// No built-in mapping fits the skeleton.
     #[error(
-        "no built-in mapping fits this skeleton (root '{root}'); built-in: {builtins}. Copy one of scenes/mappings/*.ron, name your joints in it and pass it with --mapping"
+        "no built-in mapping fits this skeleton (root '{root}'); built-in: {builtins}. Copy one of src/mapping/builtin/*.ron, name your joints in it and pass it with --mapping"
     )]
     NoMatch { root: String, builtins: String },
 }
@@ -99,23 +99,23 @@ pub struct Landmark {
 const BUILTIN: [(&str, &str); 5] = [
     (
         "marionette_humanoid24.ron",
-        include_str!("../../scenes/mappings/marionette_humanoid24.ron"),
+        include_str!("builtin/marionette_humanoid24.ron"),
     ),
     (
         "marionette_fall21.ron",
-        include_str!("../../scenes/mappings/marionette_fall21.ron"),
+        include_str!("builtin/marionette_fall21.ron"),
     ),
     (
         "cmu_cgspeed.ron",
-        include_str!("../../scenes/mappings/cmu_cgspeed.ron"),
+        include_str!("builtin/cmu_cgspeed.ron"),
     ),
     (
         "cmu_acrnn.ron",
-        include_str!("../../scenes/mappings/cmu_acrnn.ron"),
+        include_str!("builtin/cmu_acrnn.ron"),
     ),
     (
         "bandai.ron",
-        include_str!("../../scenes/mappings/bandai.ron"),
+        include_str!("builtin/bandai.ron"),
     ),
 ];
 
@@ -154,7 +154,7 @@ impl Mapping {
         Mapping::parse(&text, &path.display().to_string())
     }
 
-    /// The built-in mappings (`scenes/mappings/*.ron`, embedded in the program).
+    /// The built-in mappings (`src/mapping/builtin/*.ron`, embedded in the program).
     pub fn builtins() -> Vec<Mapping> {
         BUILTIN
             .iter()

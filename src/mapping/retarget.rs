@@ -15,8 +15,8 @@
 use glam::{DMat3, DQuat, DVec3};
 
 use super::{Landmark, Mapping, MappingError};
-use crate::model::ModelClip;
-use crate::model::{JointKind, Model, local_rotation, project_rotation};
+use crate::humanoid::ModelClip;
+use crate::humanoid::{JointKind, Model, local_rotation, project_rotation};
 use crate::skeleton::Clip;
 
 /// Which landmark an End Site of a model joint stands for.

@@ -58,7 +58,6 @@ pub mod blend;
 pub mod canonical;
 pub mod connect;
 pub mod dmp;
-pub mod ecs;
 pub mod error;
 pub mod events;
 pub mod learn;

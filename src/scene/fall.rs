@@ -9,13 +9,13 @@ use serde_json::json;
 use super::primitives::PrimitiveRender;
 use super::source::resolve_path;
 use super::{SceneError, draw_tracks, write_output};
-use crate::dynamics::contact::ContactParams;
-use crate::dynamics::ecs::{build_fall_world, run_parallel, run_world};
-use crate::dynamics::fall::{FallConfig, FallResult, Ranges};
+use crate::dynamics::forces::contact::ContactParams;
+use crate::experiments::fall::ecs::{build_fall_world, run_parallel, run_world};
+use crate::experiments::fall::{FallConfig, FallResult, Ranges};
 use crate::dynamics::integrator::Integrator;
-use crate::dynamics::push::Push;
-use crate::model::fall21;
-use crate::model::ranges::{AgeGroup, RangeTable};
+use crate::dynamics::forces::external::Push;
+use crate::humanoid::fall21;
+use crate::humanoid::ranges::{AgeGroup, RangeTable};
 use crate::render::{Plot, Series, Track, plot};
 
 /// Time stepping of a simulation.

@@ -71,7 +71,7 @@ pub enum SceneError {
     Mapping(#[from] crate::mapping::MappingError),
     /// A model.
     #[error(transparent)]
-    Model(#[from] crate::model::ModelError),
+    Model(#[from] crate::humanoid::ModelError),
     /// Drawing.
     #[error(transparent)]
     Render(#[from] crate::render::RenderError),

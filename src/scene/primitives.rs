@@ -10,7 +10,7 @@ use serde_json::json;
 use super::source::{ClipSource, load_motion};
 use super::{SceneError, draw_tracks, write_output};
 use crate::ecs::{Recorder, new_primitive_world, run_primitive_world, spawn_primitive_character};
-use crate::model::{Model, ModelClip};
+use crate::humanoid::{Model, ModelClip};
 use crate::primitive::{
     BlendPlacement, EventConfig, Gamma, JumpEvents, LearnConfig, Learned, Primitive, Relearn,
     Trajectory, blend, connect, find_jump_events,

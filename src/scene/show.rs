@@ -11,7 +11,7 @@ use super::{SceneError, draw_tracks, write_output};
 use crate::analysis::clip_contacts;
 use crate::ecs::{Recorder, base_schedule, new_world, spawn_clip_character};
 use crate::mapping::effector_errors;
-use crate::model::Model;
+use crate::humanoid::Model;
 use crate::render::{Plot, Series, Track, plot, pose_png};
 use crate::skeleton::Clip;
 

@@ -9,7 +9,7 @@ use super::SceneError;
 use crate::bvh::{self, Bvh};
 use crate::clips::KeyframeClip;
 use crate::mapping::{Mapping, retarget};
-use crate::model::{Model, ModelClip};
+use crate::humanoid::{Model, ModelClip};
 use crate::skeleton::Clip;
 
 /// A clip in a scene: a file (`.bvh`, or `.ron` for a keyframed clip), optionally a window of

@@ -2,8 +2,8 @@
 //! fail ([`SimError`]: bad configuration, an unstable step, or a runaway state with its time,
 //! body and quantity).
 
-use super::human::HumanError;
-use crate::model::ranges::RangeError;
+use crate::humanoid::body::HumanError;
+use crate::humanoid::ranges::RangeError;
 use glam::{DQuat, DVec3};
 use serde::{Deserialize, Serialize};
 
@@ -60,9 +60,9 @@ pub struct FallResult {
 impl FallResult {
     /// The recorded motion as a clip on the fall21 model (scaled to the subject's height), ready
     /// for BVH output and pictures.
-    pub fn to_model_clip(&self) -> crate::model::ModelClip {
-        crate::model::ModelClip {
-            model: crate::model::fall21().scaled_to_height(self.height_m),
+    pub fn to_model_clip(&self) -> crate::humanoid::ModelClip {
+        crate::humanoid::ModelClip {
+            model: crate::humanoid::fall21().scaled_to_height(self.height_m),
             frame_time: 1.0 / self.record_hz,
             root_translation: self.frames.iter().map(|f| f.root_position).collect(),
             root_rotation: self.frames.iter().map(|f| f.root_orientation).collect(),

@@ -6,7 +6,7 @@
 //! rayon and give bit-identical results on any number of threads, because each World is a
 //! deterministic, single-threaded computation that shares nothing mutable.
 
-use super::fall::{
+use super::{
     BodyModel, ContactComponent, DamageRecord, FallConfig, FallParts, FallResult, JointLimits,
     JointState, PdController, Recorder, SimError, Workspace, build_fall, contact_phase,
     control_phase, dynamics_phase, finish, limits_phase, record_initial, record_phase,

@@ -2,14 +2,14 @@
 //! contact, damage, recorder, workspace), plain data that the phases of
 //! [`fall`](super::fall) update and the systems of [`ecs`](super::ecs) query.
 
-use super::contact::{ContactModel, ContactState};
-use super::data::Data;
-use super::fall_result::{FallFrame, SimError};
-use super::human::HumanBody;
-use super::integrator::{Integrator, IntegratorWorkspace};
-use super::limits::JointLimitParams;
-use super::push::Push;
-use super::spatial::ForceVec;
+use crate::dynamics::forces::contact::{ContactModel, ContactState};
+use crate::dynamics::data::Data;
+use super::result::{FallFrame, SimError};
+use crate::humanoid::body::HumanBody;
+use crate::dynamics::integrator::{Integrator, IntegratorWorkspace};
+use crate::dynamics::forces::limits::JointLimitParams;
+use crate::dynamics::forces::external::Push;
+use crate::dynamics::spatial::ForceVec;
 use bevy_ecs::component::Component;
 use std::sync::Arc;
 

@@ -8,23 +8,28 @@
 //! integrator; every stage evaluates PD + joint model + contact + push and the ABA), record
 //! (frames, rest detection, divergence checks).
 
-pub use super::components::{
+pub mod components;
+pub mod config;
+pub mod ecs;
+pub mod result;
+
+pub use self::components::{
     BodyModel, ContactComponent, DamageRecord, FallParts, JointLimits, JointState, PdController,
     Recorder, Scratch, Workspace,
 };
-pub use super::fall_config::{FallConfig, Ranges};
-pub use super::fall_result::{FallFrame, FallResult, SimError};
+pub use self::config::{FallConfig, Ranges};
+pub use self::result::{FallFrame, FallResult, SimError};
 
-use super::contact::{ContactModel, ContactState};
-use super::crba::{cholesky_factor, cholesky_solve, crba};
-use super::data::Data;
-use super::human::{HumanBody, fall21_body};
-use super::integrator::{Dynamics, Integrator, IntegratorWorkspace, step};
-use super::kinematics::kinematics;
-use super::limits::joint_torque;
-use super::pd::pd_torque;
-use super::spatial::ForceVec;
-use crate::model::ranges::RangeTable;
+use crate::dynamics::forces::contact::{ContactModel, ContactState};
+use crate::dynamics::crba::{cholesky_factor, cholesky_solve, crba};
+use crate::dynamics::data::Data;
+use crate::humanoid::body::{HumanBody, fall21_body};
+use crate::dynamics::integrator::{Dynamics, Integrator, IntegratorWorkspace, step};
+use crate::dynamics::kinematics::kinematics;
+use crate::dynamics::forces::limits::joint_torque;
+use crate::dynamics::forces::pd::pd_torque;
+use crate::dynamics::spatial::ForceVec;
+use crate::humanoid::ranges::RangeTable;
 use glam::{DQuat, DVec3};
 use std::sync::Arc;
 
@@ -422,7 +427,7 @@ impl Dynamics for FallDynamics<'_> {
             }
             None => None,
         };
-        super::aba::aba_passes(model, &mut ws.data, &ws.tau, &ws.f_ext, arm);
+        crate::dynamics::aba::aba_passes(model, &mut ws.data, &ws.tau, &ws.f_ext, arm);
         qdd.copy_from_slice(&ws.data.qdd);
         if let Some(k) = qdd.iter().position(|x| !x.is_finite()) {
             let b = (0..model.nbodies())

@@ -1,22 +1,22 @@
 //! The configuration of a pushed fall: subject, joint ranges, PD gains and key pose, push,
 //! step, integrator, contact and damage weights — everything a scene file (RON) gives.
 
-use super::contact::ContactParams;
-use super::integrator::Integrator;
-use super::limits::JointLimitParams;
-use super::push::Push;
-use crate::model::ranges::{AgeGroup, RangeTable};
+use crate::dynamics::forces::contact::ContactParams;
+use crate::dynamics::integrator::Integrator;
+use crate::dynamics::forces::limits::JointLimitParams;
+use crate::dynamics::forces::external::Push;
+use crate::humanoid::ranges::{AgeGroup, RangeTable};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
 /// Where the joint ranges come from.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub enum Ranges {
-    /// A built-in age group (`scenes/models/fall21_{elderly,adult}.ron`).
+    /// A built-in age group (`src/humanoid/data/fall21_{elderly,adult}.ron`).
     Builtin(AgeGroup),
     /// A user table (degrees), e.g. loaded with [`RangeTable::load`].
     Table(RangeTable),
-    /// A range-table RON file (like `scenes/models/fall21_elderly.ron`), read when the fall is
+    /// A range-table RON file (like `src/humanoid/data/fall21_elderly.ron`), read when the fall is
     /// built; a relative path is taken from the working directory.
     File(std::path::PathBuf),
 }
@@ -91,7 +91,7 @@ impl FallConfig {
     /// semi-implicit Euler with implicit damping at 0.5 ms (the contact stability bound is
     /// 0.63 ms) for 3 s; damage weights protect the head most (w = 10).
     pub fn paper(group: AgeGroup) -> Self {
-        let names = crate::model::fall21().dof_names();
+        let names = crate::humanoid::fall21().dof_names();
         let stance = per_dof(&names, |n| match strip_side(n) {
             "waist_flexion" => 5.0,
             "elbow" => 30.0,
@@ -147,7 +147,7 @@ impl FallConfig {
             kp,
             kv,
             control_start_s: 0.25,
-            push: super::push::paper_push(0.1, 0.16 * h),
+            push: crate::dynamics::forces::external::paper_push(0.1, 0.16 * h),
             dt_s: 5e-4,
             integrator: Integrator::SemiImplicitEuler {
                 implicit_damping: true,

@@ -13,6 +13,8 @@
 //! - [`fall21`]: the 21-DOF, 15-link model of the falling paper (SPEC §3), with age-dependent
 //!   joint ranges in [`ranges`].
 
+pub mod anthropometry;
+pub mod body;
 mod definition;
 mod joint_angles;
 mod model_clip;

@@ -12,11 +12,40 @@
 //! `g / (corners · k̂_p)` under its own weight. The price: a light link that lands under much of
 //! the body's weight (an upper arm under the torso) sinks deeper than a heavy one would.
 
-use super::data::Data;
-use super::human::LinkBox;
-use super::spatial::ForceVec;
+use crate::dynamics::data::Data;
+use crate::dynamics::spatial::ForceVec;
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
+
+/// A contact box on a link: centre and half-extents in the link frame (m).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LinkBox {
+    /// Centre in the link frame (m).
+    pub center: DVec3,
+    /// Half edge lengths along the link axes (m).
+    pub half: DVec3,
+}
+
+impl LinkBox {
+    /// The 8 corners in the link frame.
+    pub fn corners(&self) -> [DVec3; 8] {
+        let mut out = [DVec3::ZERO; 8];
+        for (k, o) in out.iter_mut().enumerate() {
+            let s = DVec3::new(
+                if k & 1 == 0 { -1.0 } else { 1.0 },
+                if k & 2 == 0 { -1.0 } else { 1.0 },
+                if k & 4 == 0 { -1.0 } else { 1.0 },
+            );
+            *o = self.center + s * self.half;
+        }
+        out
+    }
+
+    /// Radius of the sphere about the centre that holds the box (m).
+    pub fn radius(&self) -> f64 {
+        self.half.length()
+    }
+}
 
 /// Floor and contact parameters.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -130,7 +159,7 @@ impl ContactModel {
     }
 
     /// Adds the contact force of every link to `f_ext` (body coordinates) after
-    /// [`kinematics`](super::kinematics::kinematics); writes each link's total normal force (N)
+    /// [`kinematics`](crate::dynamics::kinematics::kinematics); writes each link's total normal force (N)
     /// into `normal` and returns the deepest penetration (m, ≥ 0).
     pub fn apply(
         &self,
@@ -287,13 +316,13 @@ impl ContactModel {
     /// with `w = 1/m + max_c λ_max([r_c]×ᵀ I_c⁻¹ [r_c]×)` the largest inverse effective mass at a
     /// corner of the free link (the tree only adds mass), four corners down give
     /// `ω² ≤ 4 k w`, `2ζω ≤ 4 c w`.
-    pub fn link_frequency(&self, i: usize, inertia: &super::spatial::Inertia) -> (f64, f64) {
+    pub fn link_frequency(&self, i: usize, inertia: &crate::dynamics::spatial::Inertia) -> (f64, f64) {
         let p = &self.params;
         let iinv = inertia.inertia_com.inverse();
         let mut w: f64 = 0.0;
         for &cl in &self.corners[i] {
             let r = cl - inertia.com;
-            let rx = super::spatial::skew(r);
+            let rx = crate::dynamics::spatial::skew(r);
             let a = rx.transpose() * iinv * rx;
             // λ_max of a symmetric PSD 3×3 by power iteration.
             let mut x = DVec3::new(1.0, 0.7, 0.3).normalize();

@@ -7,10 +7,10 @@ use std::sync::Arc;
 use bevy_ecs::prelude::*;
 use glam::{DQuat, DVec3};
 
-use super::components::{Character, JointState, Recorder, SkeletonRef};
+use super::motion::{Character, JointState, Recorder, SkeletonRef};
 use super::systems::BaseSet;
-use crate::model::{Model, ROOT_CHANNELS};
-use crate::primitive::ecs::{
+use crate::humanoid::{Model, ROOT_CHANNELS};
+use super::primitive::{
     DofPose, PrimitiveClock, PrimitivePlayer, PrimitiveSet, add_primitive_systems,
 };
 use crate::primitive::{Primitive, PrimitiveError};

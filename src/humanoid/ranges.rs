@@ -1,5 +1,5 @@
 //! Age-dependent joint ranges of the fall21 model, as data a user can edit
-//! (`scenes/models/fall21_elderly.ron`, `scenes/models/fall21_adult.ron`).
+//! (`src/humanoid/data/fall21_elderly.ron`, `src/humanoid/data/fall21_adult.ron`).
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -52,11 +52,11 @@ impl RangeTable {
         let (name, text) = match group {
             AgeGroup::Elderly => (
                 "fall21_elderly.ron",
-                include_str!("../../scenes/models/fall21_elderly.ron"),
+                include_str!("data/fall21_elderly.ron"),
             ),
             AgeGroup::Adult => (
                 "fall21_adult.ron",
-                include_str!("../../scenes/models/fall21_adult.ron"),
+                include_str!("data/fall21_adult.ron"),
             ),
         };
         RangeTable::parse(text, name).expect("built-in range tables are valid")
@@ -124,7 +124,7 @@ fn strip_side(name: &str) -> &str {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::fall21;
+    use crate::humanoid::fall21;
 
     #[test]
     fn builtin_tables_cover_every_fall21_dof() {

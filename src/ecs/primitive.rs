@@ -15,10 +15,10 @@ use std::sync::Arc;
 
 use bevy_ecs::prelude::*;
 
-use super::blend::{BlendPlacement, Gamma};
-use super::error::{PrimitiveError, Result};
-use super::primitive::Primitive;
-use super::rollout::Rollout;
+use crate::primitive::blend::{BlendPlacement, Gamma};
+use crate::primitive::error::{PrimitiveError, Result};
+use crate::primitive::primitive::Primitive;
+use crate::primitive::rollout::Rollout;
 
 /// The frame step of the primitive systems, seconds.
 #[derive(Resource, Clone, Copy, Debug, PartialEq)]

@@ -2,7 +2,7 @@
 
 use glam::{DQuat, DVec3};
 
-use crate::model::{Model, rotation_vector_near};
+use crate::humanoid::{Model, rotation_vector_near};
 use crate::primitive::Trajectory;
 
 /// Names of the root channels in a primitive trajectory: translation (m), then orientation as a

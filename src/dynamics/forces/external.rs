@@ -1,8 +1,8 @@
 //! External pushes: a force of given magnitude and world direction applied at a point of a link
 //! during `[start, start + duration)` (the paper: 1000 N on the torso from the front for 0.1 s).
 
-use super::data::Data;
-use super::spatial::ForceVec;
+use crate::dynamics::data::Data;
+use crate::dynamics::spatial::ForceVec;
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 

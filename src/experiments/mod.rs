@@ -1,0 +1,7 @@
+//! The papers' experiments as library functions above the kernels: a typed configuration in, a
+//! typed outcome out, no files and no pictures (a scene file is only the front door that reads a
+//! configuration, calls one of these and writes its outputs).
+//!
+//! - [`fall`]: the falling paper's pushed figure (SPEC §3), one fall or many in parallel Worlds.
+
+pub mod fall;
