@@ -4,7 +4,7 @@
 //! stay unit and no Euler angles are involved:
 //! - classical 4th-order Runge–Kutta (as the paper), run in the chart `z` around `q_n` with the
 //!   exact chart rate `ż = dexp⁻¹(z, ω)`, which keeps 4th order on SO(3) (Munthe-Kaas RKMK);
-//! - semi-implicit (symplectic) Euler `v' = v + h q̈(q, v)`, `q' = q ⊞ h ż(q, v')`, optionally
+//! - semi-implicit Euler `v' = v + h q̈(q, v)`, `q' = q ⊞ h ż(q, v')`, optionally
 //!   with joint damping taken implicitly: `(H + h·diag(d)) q̈ = τ(q, v) − C`, the linearly
 //!   implicit step of `τ = −d v'`, so stiff friction and PD damping gains do not force tiny steps.
 //!
@@ -69,7 +69,6 @@ impl IntegratorWorkspace {
 }
 
 /// Advances `(q, v)` from time `t` by `h` seconds with `scheme`.
-#[allow(clippy::too_many_arguments)]
 pub fn step<D: Dynamics>(
     scheme: Integrator,
     model: &Model,
@@ -77,13 +76,13 @@ pub fn step<D: Dynamics>(
     dynamics: &mut D,
     t: f64,
     h: f64,
-    q: &mut [f64],
-    v: &mut [f64],
+    (q, v): (&mut [f64], &mut [f64]),
 ) -> Result<(), D::Error> {
     match scheme {
-        Integrator::Rk4 => rk4_step(model, ws, dynamics, t, h, q, v),
+        Integrator::Rk4 => rk4_step(model, ws, dynamics, t, h, (q, v)),
         Integrator::SemiImplicitEuler { implicit_damping } => {
-            semi_implicit_euler_step(model, ws, dynamics, t, h, q, v, implicit_damping)
+            let implicit = implicit_damping.then_some(h);
+            semi_implicit_euler_step(model, ws, dynamics, t, implicit, h, (q, v))
         }
     }
 }
@@ -96,8 +95,7 @@ pub fn rk4_step<D: Dynamics>(
     dynamics: &mut D,
     t: f64,
     h: f64,
-    q: &mut [f64],
-    v: &mut [f64],
+    (q, v): (&mut [f64], &mut [f64]),
 ) -> Result<(), D::Error> {
     let nv = model.nv;
     const C: [f64; 4] = [0.0, 0.5, 0.5, 1.0];
@@ -127,20 +125,18 @@ pub fn rk4_step<D: Dynamics>(
     Ok(())
 }
 
-/// One semi-implicit Euler step: `v ← v + h q̈(q, v)`, then `q ← q ⊞ h ż(q, v)`.
-#[allow(clippy::too_many_arguments)]
+/// One semi-implicit Euler step: `v ← v + h q̈(q, v)`, then `q ← q ⊞ h ż(q, v)`; with
+/// `implicit = Some(h)` the joint damping is taken implicitly in `q̈`.
 pub fn semi_implicit_euler_step<D: Dynamics>(
     model: &Model,
     ws: &mut IntegratorWorkspace,
     dynamics: &mut D,
     t: f64,
+    implicit: Option<f64>,
     h: f64,
-    q: &mut [f64],
-    v: &mut [f64],
-    implicit_damping: bool,
+    (q, v): (&mut [f64], &mut [f64]),
 ) -> Result<(), D::Error> {
     let nv = model.nv;
-    let implicit = implicit_damping.then_some(h);
     dynamics.acceleration(t, q, v, implicit, &mut ws.kv[0])?;
     for k in 0..nv {
         v[k] += h * ws.kv[0][k];

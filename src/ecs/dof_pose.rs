@@ -8,11 +8,8 @@ use bevy_ecs::prelude::*;
 use glam::{DQuat, DVec3};
 
 use super::motion::{Character, JointState, Recorder, SkeletonRef};
-use super::systems::BaseSet;
 use crate::humanoid::{Model, ROOT_CHANNELS};
-use super::primitive::{
-    DofPose, PrimitiveClock, PrimitivePlayer, PrimitiveSet, add_primitive_systems,
-};
+use super::primitive::{DofPose, PrimitivePlayer};
 use crate::primitive::{Primitive, PrimitiveError};
 
 /// Which entries of a character's [`DofPose`] are its model's DOFs and its six root channels
@@ -28,12 +25,14 @@ pub struct ModelBinding {
 impl ModelBinding {
     /// Binds pose entries named `names` to `model`; every model DOF and root channel must be
     /// among them.
-    pub fn new(model: Arc<Model>, names: &[String]) -> Result<ModelBinding, String> {
+    pub fn new(model: Arc<Model>, names: &[String]) -> Result<ModelBinding, PrimitiveError> {
         let col = |n: &str| {
             names
                 .iter()
                 .position(|x| x == n)
-                .ok_or_else(|| format!("the pose has no channel '{n}'"))
+                .ok_or_else(|| PrimitiveError::DofMismatch {
+                    what: format!("the pose has no channel '{n}'"),
+                })
         };
         let dof_cols = model
             .dofs
@@ -68,19 +67,6 @@ pub fn pose_from_dofs(mut q: Query<(&ModelBinding, &DofPose, &mut JointState)>) 
     }
 }
 
-/// Adds the primitive systems to a base schedule: players step inside [`BaseSet::Pose`], then
-/// [`pose_from_dofs`] turns their poses into joint states before forward kinematics. The world
-/// needs a [`PrimitiveClock`] with the same step as its [`super::SimulationClock`].
-pub fn add_primitive_wiring(schedule: &mut Schedule) {
-    add_primitive_systems(schedule);
-    schedule.configure_sets((PrimitiveSet::Players, PrimitiveSet::Blends).in_set(BaseSet::Pose));
-    schedule.add_systems(
-        pose_from_dofs
-            .in_set(BaseSet::Pose)
-            .after(PrimitiveSet::Blends),
-    );
-}
-
 /// Spawns a character on `model` that plays `sequence` (connected) and records its points.
 pub fn spawn_primitive_character(
     world: &mut World,
@@ -90,8 +76,7 @@ pub fn spawn_primitive_character(
 ) -> Result<Entity, PrimitiveError> {
     let player = PrimitivePlayer::new(sequence)?;
     let pose = player.pose();
-    let binding = ModelBinding::new(model.clone(), &pose.names)
-        .map_err(|what| PrimitiveError::DofMismatch { what })?;
+    let binding = ModelBinding::new(model.clone(), &pose.names)?;
     let skeleton = Arc::new(model.skeleton());
     let n = skeleton.joints.len();
     Ok(world
@@ -105,22 +90,4 @@ pub fn spawn_primitive_character(
             binding,
         ))
         .id())
-}
-
-/// Runs `steps` frames of a world holding primitive characters (base schedule plus primitive
-/// wiring); the world must have been made by [`super::new_world`] and given a
-/// [`PrimitiveClock`].
-pub fn run_primitive_world(world: &mut World, steps: usize) {
-    let mut schedule = super::base_schedule();
-    add_primitive_wiring(&mut schedule);
-    for _ in 0..steps {
-        schedule.run(world);
-    }
-}
-
-/// A world with both clocks set to `dt`, ready for primitive characters.
-pub fn new_primitive_world(dt: f64) -> World {
-    let mut world = super::new_world(dt);
-    world.insert_resource(PrimitiveClock { dt });
-    world
 }

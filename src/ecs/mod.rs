@@ -1,38 +1,46 @@
-//! The ECS wiring of the engine's base: characters are entities carrying a skeleton, a joint
-//! state, a clip playback and a recorder; a schedule advances time, samples clips, runs forward
-//! kinematics and records, in explicit, user-orderable system sets.
+//! The ECS wiring, the only module that knows `bevy_ecs`. Characters are entities; what they
+//! carry decides what happens to them:
 //!
-//! Characters driven by motor primitives carry a [`crate::ecs::primitive::PrimitivePlayer`] and
-//! a [`ModelBinding`]: the players step in [`BaseSet::Pose`] and [`pose_from_dofs`] hands their
-//! poses to forward kinematics ([`add_primitive_wiring`]).
+//! - every character: [`Character`], [`SkeletonRef`], [`JointState`] and a [`Recorder`] of its
+//!   drawable points; forward kinematics and recording treat all alike;
+//! - kinematic motion: a [`ClipPlayback`], or primitive players
+//!   ([`primitive::PrimitivePlayer`], [`primitive::BlendPlayer`]) writing a
+//!   [`primitive::DofPose`] that a [`ModelBinding`] turns into the joint state;
+//! - physics: a [`physics::PhysicsBundle`] and the force components the step reads
+//!   ([`physics::PdController`], [`physics::JointLimits`], [`physics::FloorContact`],
+//!   [`physics::ExternalForces`]); its pose reaches the same joint state.
 //!
-//! A [`bevy_ecs::world::World`] holds one whole experiment and is `Send`, so many run in
-//! parallel ([`run_worlds_parallel`]). Build one schedule per world with [`base_schedule`]
-//! (schedules are not `Clone`).
+//! One [`Clock`] per World (a tick per schedule run, physics substeps inside it) and one
+//! hierarchy of sets, [`MotionSet`], that a user orders their own systems against. Each domain
+//! adds its systems to the user's schedule: [`add_core_systems`] (sets and clock, once),
+//! [`add_motion_systems`], [`primitive::add_primitive_systems`],
+//! [`physics::add_physics_systems`]. A World holds one experiment and is `Send`; a
+//! [`WorldPool`] runs many in parallel, each with its own seeded generator.
 
+mod clock;
 mod dof_pose;
 mod motion;
+pub mod physics;
 pub mod primitive;
+mod sets;
 mod systems;
+pub mod worlds;
 
-pub use motion::{Character, ClipPlayback, JointState, Recorder, SimulationClock, SkeletonRef};
-pub use dof_pose::{
-    ModelBinding, add_primitive_wiring, new_primitive_world, pose_from_dofs, run_primitive_world,
-    spawn_primitive_character,
-};
-pub use systems::{
-    BaseSet, advance_clock, base_schedule, forward_kinematics_system, record_frames, sample_clips,
-};
+pub use clock::{Clock, advance_clock};
+pub use dof_pose::{ModelBinding, pose_from_dofs, spawn_primitive_character};
+pub use motion::{Character, ClipPlayback, JointState, Recorder, SkeletonRef};
+pub use sets::{MotionSet, add_core_systems, configure_motion_sets};
+pub use systems::{add_motion_systems, forward_kinematics_system, record_frames, sample_clips};
+pub use worlds::{WorldPool, WorldRng, WorldSeed, world_seed};
 
 use std::sync::Arc;
 
 use bevy_ecs::prelude::*;
-use rayon::prelude::*;
 
 use crate::skeleton::Clip;
 
 /// Spawns a character that plays `clip` (looping or not) and records the drawable points of
-/// every step; returns its entity.
+/// every tick; returns its entity.
 pub fn spawn_clip_character(
     world: &mut World,
     name: &str,
@@ -59,26 +67,28 @@ pub fn spawn_clip_character(
         .id()
 }
 
-/// A world with a clock of step `dt` seconds, ready for characters.
-pub fn new_world(dt: f64) -> World {
+/// A World with `clock`, ready for characters.
+pub fn new_world(clock: Clock) -> World {
     let mut world = World::new();
-    world.insert_resource(SimulationClock {
-        time: 0.0,
-        dt,
-        step: 0,
-    });
+    world.insert_resource(clock);
     world
 }
 
-/// Runs `steps` steps of the base schedule on every world, in parallel with rayon (one schedule
-/// per world). Worlds share nothing, so the result does not depend on the thread count.
-pub fn run_worlds_parallel(worlds: &mut [World], steps: usize) {
-    worlds.par_iter_mut().for_each(|w| {
-        let mut schedule = base_schedule();
-        for _ in 0..steps {
-            schedule.run(w);
-        }
-    });
+/// The schedule of kinematic characters: core sets and clock, clip playback, primitive players,
+/// forward kinematics and recording.
+pub fn kinematic_schedule() -> Schedule {
+    let mut s = Schedule::default();
+    add_core_systems(&mut s);
+    add_motion_systems(&mut s);
+    primitive::add_primitive_systems(&mut s);
+    s
+}
+
+/// Runs `ticks` runs of `schedule` on `world`.
+pub fn run_ticks(world: &mut World, schedule: &mut Schedule, ticks: usize) {
+    for _ in 0..ticks {
+        schedule.run(world);
+    }
 }
 
 #[cfg(test)]
@@ -107,9 +117,9 @@ mod tests {
     #[test]
     fn playback_records_the_clip_frames() {
         let clip = test_clip();
-        let mut world = new_world(clip.frame_time);
+        let mut world = new_world(Clock::new(clip.frame_time, 1));
         let e = spawn_clip_character(&mut world, "a", clip.clone(), false);
-        let mut schedule = base_schedule();
+        let mut schedule = kinematic_schedule();
         for _ in 0..clip.frame_count() {
             schedule.run(&mut world);
         }
@@ -126,26 +136,27 @@ mod tests {
     #[test]
     fn parallel_worlds_give_the_same_bits_on_one_and_two_threads() {
         let clip = test_clip();
-        let make = || -> Vec<World> {
-            (0..8)
-                .map(|i| {
-                    let mut w = new_world(clip.frame_time * 0.37);
-                    let e = spawn_clip_character(&mut w, "c", clip.clone(), true);
-                    w.get_mut::<ClipPlayback>(e).unwrap().speed = 0.5 + 0.1 * i as f64;
-                    w
-                })
-                .collect()
+        let make = || -> WorldPool {
+            WorldPool::new(8, 1, |i, w| {
+                w.insert_resource(Clock::new(clip.frame_time * 0.37, 1));
+                let e = spawn_clip_character(w, "c", clip.clone(), true);
+                w.get_mut::<ClipPlayback>(e).unwrap().speed = 0.5 + 0.1 * i as f64;
+                Ok::<(), ()>(())
+            })
+            .unwrap()
         };
         let run = |threads: usize| -> Vec<Vec<Vec<glam::DVec3>>> {
             let pool = rayon::ThreadPoolBuilder::new()
                 .num_threads(threads)
                 .build()
                 .unwrap();
-            let mut worlds = make();
-            pool.install(|| run_worlds_parallel(&mut worlds, 200));
-            worlds
-                .iter_mut()
-                .map(|w| {
+            pool.install(|| {
+                let mut worlds = make();
+                worlds.run(|w| {
+                    let mut schedule = kinematic_schedule();
+                    run_ticks(w, &mut schedule, 200);
+                });
+                worlds.run(|w| {
                     w.query::<&Recorder>()
                         .iter(w)
                         .next()
@@ -153,7 +164,7 @@ mod tests {
                         .frames
                         .clone()
                 })
-                .collect()
+            })
         };
         let one = run(1);
         let two = run(2);

@@ -1,4 +1,5 @@
-//! Components and resources of the base ECS.
+//! The components of every character, kinematic or simulated: name, skeleton, joint state
+//! (local and global transforms), clip playback and the recorder of drawable points.
 
 use std::sync::Arc;
 
@@ -60,15 +61,4 @@ pub struct ClipPlayback {
 pub struct Recorder {
     /// One entry per recorded step.
     pub frames: Vec<Vec<DVec3>>,
-}
-
-/// The world's clock: simulated time and a fixed step.
-#[derive(Resource, Clone, Copy, Debug)]
-pub struct SimulationClock {
-    /// Simulated time at the start of the current step, seconds.
-    pub time: f64,
-    /// Step, seconds.
-    pub dt: f64,
-    /// Steps completed.
-    pub step: u64,
 }

@@ -7,25 +7,23 @@
 //!   (step 3 of the paper's blending, as [`super::blend()`] without re-learning).
 //! - Both write the character's [`DofPose`] (θ and θ̇ per DOF) for the systems downstream
 //!   (forward kinematics, rendering).
-//! - [`PrimitiveClock`] (a resource) gives the frame step; [`PrimitiveSet`] orders the systems;
-//!   [`add_primitive_systems`] adds them to a [`Schedule`]. Many characters live in one World.
+//! - The World's [`Clock`] gives the step (one tick); [`PrimitiveSet`] orders the systems inside
+//!   [`MotionSet::Animate`]; [`add_primitive_systems`] adds them to a [`Schedule`]. Many
+//!   characters live in one World.
 
 use std::collections::VecDeque;
 use std::sync::Arc;
 
 use bevy_ecs::prelude::*;
 
+use super::clock::Clock;
+use super::dof_pose::pose_from_dofs;
+use super::sets::{MotionSet, configure_motion_sets};
+
 use crate::primitive::blend::{BlendPlacement, Gamma};
 use crate::primitive::error::{PrimitiveError, Result};
 use crate::primitive::primitive::Primitive;
 use crate::primitive::rollout::Rollout;
-
-/// The frame step of the primitive systems, seconds.
-#[derive(Resource, Clone, Copy, Debug, PartialEq)]
-pub struct PrimitiveClock {
-    /// Seconds advanced per schedule run (> 0).
-    pub dt: f64,
-}
 
 /// A character's current DOF state, written by the primitive systems.
 #[derive(Component, Clone, Debug, PartialEq, Default)]
@@ -264,33 +262,41 @@ pub enum PrimitiveSet {
     Blends,
 }
 
-/// Steps every [`PrimitivePlayer`] by the clock's dt and writes its [`DofPose`].
+/// Steps every [`PrimitivePlayer`] by one tick and writes its [`DofPose`].
 pub fn step_primitive_players(
-    clock: Res<PrimitiveClock>,
+    clock: Res<Clock>,
     mut q: Query<(&mut PrimitivePlayer, &mut DofPose)>,
 ) {
     for (mut player, mut pose) in &mut q {
-        player.advance(clock.dt);
+        player.advance(clock.tick_s);
         player.write_pose(&mut pose);
     }
 }
 
-/// Steps every [`BlendPlayer`] by the clock's dt and writes its [`DofPose`].
+/// Steps every [`BlendPlayer`] by one tick and writes its [`DofPose`].
 pub fn step_blend_players(
-    clock: Res<PrimitiveClock>,
+    clock: Res<Clock>,
     mut q: Query<(&mut BlendPlayer, &mut DofPose)>,
 ) {
     for (mut player, mut pose) in &mut q {
-        player.advance(clock.dt, &mut pose);
+        player.advance(clock.tick_s, &mut pose);
     }
 }
 
-/// Adds the primitive systems to `schedule`, in [`PrimitiveSet::Players`] then
-/// [`PrimitiveSet::Blends`]. The World needs a [`PrimitiveClock`] resource.
+/// Adds the primitive systems to `schedule`: [`PrimitiveSet::Players`] then
+/// [`PrimitiveSet::Blends`] inside [`MotionSet::Animate`], and [`pose_from_dofs`] in
+/// [`MotionSet::Pose`] (characters with a [`ModelBinding`](super::ModelBinding) get their joint
+/// state from their DOF pose).
 pub fn add_primitive_systems(schedule: &mut Schedule) {
-    schedule.configure_sets((PrimitiveSet::Players, PrimitiveSet::Blends).chain());
+    configure_motion_sets(schedule);
+    schedule.configure_sets(
+        (PrimitiveSet::Players, PrimitiveSet::Blends)
+            .chain()
+            .in_set(MotionSet::Animate),
+    );
     schedule.add_systems((
         step_primitive_players.in_set(PrimitiveSet::Players),
         step_blend_players.in_set(PrimitiveSet::Blends),
+        pose_from_dofs.in_set(MotionSet::Pose),
     ));
 }

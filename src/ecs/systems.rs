@@ -1,28 +1,16 @@
-//! Systems of the base ECS and their ordering sets.
+//! The motion systems: clip playback, forward kinematics and recording of every character.
 
 use bevy_ecs::prelude::*;
 
-use super::motion::{ClipPlayback, JointState, Recorder, SimulationClock, SkeletonRef};
+use super::clock::Clock;
+use super::motion::{ClipPlayback, JointState, Recorder, SkeletonRef};
+use super::sets::{MotionSet, configure_motion_sets};
 use crate::skeleton::forward_kinematics;
 
-/// The stages of a base step, run in this order: sample poses from clips, forward kinematics,
-/// record, advance the clock. Other domains put their systems in or between these sets.
-#[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum BaseSet {
-    /// Poses are set (clip sampling, primitives, dynamics).
-    Pose,
-    /// Global transforms from local ones.
-    Kinematics,
-    /// Outputs are recorded.
-    Record,
-    /// Time advances.
-    Clock,
-}
-
 /// Samples every playing clip at its current time into the joint state, then advances the clip
-/// time by `speed × dt`.
+/// time by `speed × tick`.
 pub fn sample_clips(
-    clock: Res<SimulationClock>,
+    clock: Res<Clock>,
     mut q: Query<(&mut ClipPlayback, &mut JointState)>,
 ) {
     for (mut play, mut state) in &mut q {
@@ -48,7 +36,7 @@ pub fn sample_clips(
                 r0[j].slerp(r1[j], w)
             };
         }
-        play.time += play.speed * clock.dt;
+        play.time += play.speed * clock.tick_s;
     }
 }
 
@@ -69,29 +57,13 @@ pub fn record_frames(mut q: Query<(&SkeletonRef, &JointState, &mut Recorder)>) {
     }
 }
 
-/// Advances the world clock by one step.
-pub fn advance_clock(mut clock: ResMut<SimulationClock>) {
-    clock.time += clock.dt;
-    clock.step += 1;
-}
-
-/// The base schedule: [`BaseSet`]s chained in order, with the base systems in them.
-pub fn base_schedule() -> Schedule {
-    let mut s = Schedule::default();
-    s.configure_sets(
-        (
-            BaseSet::Pose,
-            BaseSet::Kinematics,
-            BaseSet::Record,
-            BaseSet::Clock,
-        )
-            .chain(),
-    );
-    s.add_systems((
-        sample_clips.in_set(BaseSet::Pose),
-        forward_kinematics_system.in_set(BaseSet::Kinematics),
-        record_frames.in_set(BaseSet::Record),
-        advance_clock.in_set(BaseSet::Clock),
+/// Adds the motion systems to `schedule`: clip playback in [`MotionSet::Animate`], forward
+/// kinematics in [`MotionSet::Kinematics`], recording in [`MotionSet::Record`].
+pub fn add_motion_systems(schedule: &mut Schedule) {
+    configure_motion_sets(schedule);
+    schedule.add_systems((
+        sample_clips.in_set(MotionSet::Animate),
+        forward_kinematics_system.in_set(MotionSet::Kinematics),
+        record_frames.in_set(MotionSet::Record),
     ));
-    s
 }

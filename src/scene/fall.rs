@@ -10,7 +10,7 @@ use super::primitives::PrimitiveRender;
 use super::source::resolve_path;
 use super::{SceneError, draw_tracks, write_output};
 use crate::dynamics::forces::contact::ContactParams;
-use crate::experiments::fall::ecs::{build_fall_world, run_parallel, run_world};
+use crate::experiments::fall::ecs::run_parallel;
 use crate::experiments::fall::{FallConfig, FallResult, Ranges};
 use crate::dynamics::integrator::Integrator;
 use crate::dynamics::forces::external::Push;
@@ -171,16 +171,6 @@ impl FallScene {
         }
         Ok(c)
     }
-}
-
-/// Simulates one fall in its own ECS world.
-pub fn simulate_in_world(config: &FallConfig) -> Result<FallResult, SceneError> {
-    let mut world = build_fall_world(config).map_err(|e| SceneError::Invalid(e.to_string()))?;
-    run_world(&mut world)
-        .into_iter()
-        .next()
-        .ok_or_else(|| SceneError::Invalid("the world held no figure".into()))?
-        .map_err(|e| SceneError::Invalid(e.to_string()))
 }
 
 /// Per-link values as a JSON object keyed by link name.

@@ -11,7 +11,7 @@ mod primitives;
 mod show;
 mod source;
 
-pub use fall::{Body, Controller, FallScene, Simulation, fall_report, run_fall, simulate_in_world};
+pub use fall::{Body, Controller, FallScene, Simulation, fall_report, run_fall};
 pub use primitives::{
     HighJumpScene, JumpingKneeKickScene, PrimitiveRender, run_high_jump, run_jumping_knee_kick,
 };

@@ -9,7 +9,9 @@ use serde_json::json;
 
 use super::source::{ClipSource, load_motion};
 use super::{SceneError, draw_tracks, write_output};
-use crate::ecs::{Recorder, new_primitive_world, run_primitive_world, spawn_primitive_character};
+use crate::ecs::{
+    Clock, Recorder, kinematic_schedule, new_world, run_ticks, spawn_primitive_character,
+};
 use crate::humanoid::{Model, ModelClip};
 use crate::primitive::{
     BlendPlacement, EventConfig, Gamma, JumpEvents, LearnConfig, Learned, Primitive, Relearn,
@@ -358,7 +360,7 @@ fn play_in_world(
     expected: &ModelClip,
 ) -> Result<f64, SceneError> {
     let dt = expected.frame_time;
-    let mut world = new_primitive_world(dt);
+    let mut world = new_world(Clock::new(dt, 1));
     let seq = sequence.iter().cloned().map(Arc::new).collect();
     let e = spawn_primitive_character(
         &mut world,
@@ -368,7 +370,7 @@ fn play_in_world(
     )
     .map_err(primitive_error)?;
     let frames = expected.frame_count();
-    run_primitive_world(&mut world, frames - 1);
+    run_ticks(&mut world, &mut kinematic_schedule(), frames - 1);
     let recorded = &world
         .get::<Recorder>(e)
         .ok_or_else(|| SceneError::Invalid("no recorder".into()))?

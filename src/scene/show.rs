@@ -9,7 +9,7 @@ use serde_json::json;
 use super::source::{ClipSource, LoadedMotion, load_motion};
 use super::{SceneError, draw_tracks, write_output};
 use crate::analysis::clip_contacts;
-use crate::ecs::{Recorder, base_schedule, new_world, spawn_clip_character};
+use crate::ecs::{Clock, Recorder, kinematic_schedule, new_world, spawn_clip_character};
 use crate::mapping::effector_errors;
 use crate::humanoid::Model;
 use crate::render::{Plot, Series, Track, plot, pose_png};
@@ -61,9 +61,9 @@ pub struct ShowScene {
 /// Plays `clip` through a world of the base ECS and returns the recorded points of every frame.
 pub fn play_through_ecs(clip: &Clip) -> Vec<Vec<glam::DVec3>> {
     let clip = Arc::new(clip.clone());
-    let mut world = new_world(clip.frame_time);
+    let mut world = new_world(Clock::new(clip.frame_time, 1));
     let e = spawn_clip_character(&mut world, "character", clip.clone(), false);
-    let mut schedule = base_schedule();
+    let mut schedule = kinematic_schedule();
     for _ in 0..clip.frame_count() {
         schedule.run(&mut world);
     }

@@ -158,77 +158,48 @@ impl ContactModel {
         Some((fnorm, ft, z))
     }
 
-    /// Adds the contact force of every link to `f_ext` (body coordinates) after
-    /// [`kinematics`](crate::dynamics::kinematics::kinematics); writes each link's total normal force (N)
-    /// into `normal` and returns the deepest penetration (m, ≥ 0).
-    pub fn apply(
+    /// The contact force of link `i` (body coordinates), its total normal force (N) and its
+    /// deepest corner penetration (m, ≥ 0) for the state in `data`, with the friction anchors
+    /// `anchors` (its 8 corners). With `UPDATE` the anchors are first brought to this state: a
+    /// corner that left the floor loses its anchor, a new contact anchors where it touches, and a
+    /// corner whose spring would leave the friction cone drags its anchor to the cone's edge
+    /// (slip).
+    #[inline]
+    fn link_contact<const UPDATE: bool>(
         &self,
         data: &Data,
-        state: &ContactState,
-        f_ext: &mut [ForceVec],
-        normal: &mut [f64],
-    ) -> f64 {
+        i: usize,
+        anchors: &mut [Option<DVec3>],
+    ) -> (ForceVec, f64, f64) {
         let p = &self.params;
         let n = p.floor_normal;
-        let mut deepest: f64 = 0.0;
-        for (i, corners) in self.corners.iter().enumerate() {
-            normal[i] = 0.0;
-            let rot = data.rot[i];
-            let pos = data.pos[i];
-            let (c, r) = self.bounds[i];
-            if n.dot(pos + rot * c) - p.floor_height > r {
-                continue;
+        let rot = data.rot[i];
+        let pos = data.pos[i];
+        let (c, r) = self.bounds[i];
+        if n.dot(pos + rot * c) - p.floor_height > r {
+            if UPDATE {
+                anchors.fill(None);
             }
-            let v = data.v[i];
-            let mut f_body = ForceVec::ZERO;
-            for (k, &cl) in corners.iter().enumerate() {
-                let x = pos + rot * cl;
-                if n.dot(x) - p.floor_height >= 0.0 {
-                    continue;
-                }
-                let xd = rot * (v.lin + v.ang.cross(cl));
-                if let Some((fnorm, ft, z)) = self.corner_force(i, x, xd, state.anchors[i * 8 + k])
-                {
-                    deepest = deepest.max(-z);
-                    normal[i] += fnorm;
-                    let f_world = n * fnorm + ft;
-                    f_body += ForceVec::at_point(rot.transpose() * f_world, cl);
-                }
-            }
-            f_ext[i] += f_body;
+            return (ForceVec::ZERO, 0.0, 0.0);
         }
-        deepest
-    }
-
-    /// Updates the friction anchors for the state in `data` (call once per step): a corner that
-    /// left the floor loses its anchor, a new contact anchors where it touches, and a corner
-    /// whose spring would leave the friction cone drags its anchor to the cone's edge (slip).
-    pub fn update_anchors(&self, data: &Data, state: &mut ContactState) {
-        let p = &self.params;
-        let n = p.floor_normal;
-        for (i, corners) in self.corners.iter().enumerate() {
-            let rot = data.rot[i];
-            let pos = data.pos[i];
-            let (c, r) = self.bounds[i];
-            if n.dot(pos + rot * c) - p.floor_height > r {
-                state.anchors[i * 8..i * 8 + 8].fill(None);
+        let v = data.v[i];
+        let m = self.masses[i];
+        let (mut f_body, mut normal, mut depth) = (ForceVec::ZERO, 0.0, 0.0f64);
+        for (k, &cl) in self.corners[i].iter().enumerate() {
+            let x = pos + rot * cl;
+            let z = n.dot(x) - p.floor_height;
+            if z >= 0.0 {
+                if UPDATE {
+                    anchors[k] = None;
+                }
                 continue;
             }
-            let v = data.v[i];
-            let m = self.masses[i];
-            for (k, &cl) in corners.iter().enumerate() {
-                let x = pos + rot * cl;
-                let z = n.dot(x) - p.floor_height;
-                let slot = &mut state.anchors[i * 8 + k];
-                if z >= 0.0 {
-                    *slot = None;
-                    continue;
-                }
+            let xd = rot * (v.lin + v.ang.cross(cl));
+            if UPDATE {
                 let on_floor = x - n * z;
-                match *slot {
-                    None => *slot = Some(on_floor),
+                match anchors[k] {
+                    None => anchors[k] = Some(on_floor),
                     Some(a) => {
-                        let xd = rot * (v.lin + v.ang.cross(cl));
                         let zd = n.dot(xd);
                         let fnorm =
                             (-p.stiffness_per_kg * m * z - p.damping_per_kg * m * zd).max(0.0);
@@ -238,17 +209,47 @@ impl ContactModel {
                         let s = stretch.length();
                         if s > max_stretch {
                             let keep = if s > 0.0 { max_stretch / s } else { 0.0 };
-                            *slot = Some(on_floor - stretch * keep);
+                            anchors[k] = Some(on_floor - stretch * keep);
                         }
                     }
                 }
             }
+            if let Some((fnorm, ft, z)) = self.corner_force(i, x, xd, anchors[k]) {
+                depth = depth.max(-z);
+                normal += fnorm;
+                let f_world = n * fnorm + ft;
+                f_body += ForceVec::at_point(rot.transpose() * f_world, cl);
+            }
         }
+        (f_body, normal, depth)
     }
 
-    /// [`update_anchors`](Self::update_anchors) then [`apply`](Self::apply) in one pass over the
-    /// corners (the step-start evaluation): same results, corner positions computed once; also
-    /// writes each link's deepest corner penetration (m) into `depth`.
+    /// Adds the contact force of every link to `f_ext` (body coordinates) after
+    /// [`kinematics`](crate::dynamics::kinematics::kinematics), with the anchors of `state` as
+    /// they are; writes each link's total normal force (N) into `normal` and returns the
+    /// deepest penetration (m, ≥ 0). Used at every evaluation inside a step.
+    pub fn apply(
+        &self,
+        data: &Data,
+        state: &ContactState,
+        f_ext: &mut [ForceVec],
+        normal: &mut [f64],
+    ) -> f64 {
+        let mut deepest: f64 = 0.0;
+        for i in 0..self.corners.len() {
+            let mut anchors = [None; 8];
+            anchors.copy_from_slice(&state.anchors[i * 8..i * 8 + 8]);
+            let (f, fn_i, d) = self.link_contact::<false>(data, i, &mut anchors);
+            normal[i] = fn_i;
+            deepest = deepest.max(d);
+            f_ext[i] += f;
+        }
+        deepest
+    }
+
+    /// The step-start evaluation: updates the friction anchors for the state in `data` (once
+    /// per step), then does what [`apply`](Self::apply) does, also writing each link's deepest
+    /// corner penetration (m) into `depth`.
     pub fn update_and_apply(
         &self,
         data: &Data,
@@ -257,57 +258,14 @@ impl ContactModel {
         normal: &mut [f64],
         depth: &mut [f64],
     ) -> f64 {
-        let p = &self.params;
-        let n = p.floor_normal;
         let mut deepest: f64 = 0.0;
-        for (i, corners) in self.corners.iter().enumerate() {
-            normal[i] = 0.0;
-            depth[i] = 0.0;
-            let rot = data.rot[i];
-            let pos = data.pos[i];
-            let (c, r) = self.bounds[i];
-            if n.dot(pos + rot * c) - p.floor_height > r {
-                state.anchors[i * 8..i * 8 + 8].fill(None);
-                continue;
-            }
-            let v = data.v[i];
-            let m = self.masses[i];
-            let mut f_body = ForceVec::ZERO;
-            for (k, &cl) in corners.iter().enumerate() {
-                let x = pos + rot * cl;
-                let z = n.dot(x) - p.floor_height;
-                let slot = &mut state.anchors[i * 8 + k];
-                if z >= 0.0 {
-                    *slot = None;
-                    continue;
-                }
-                let xd = rot * (v.lin + v.ang.cross(cl));
-                let on_floor = x - n * z;
-                match *slot {
-                    None => *slot = Some(on_floor),
-                    Some(a) => {
-                        let zd = n.dot(xd);
-                        let fnorm =
-                            (-p.stiffness_per_kg * m * z - p.damping_per_kg * m * zd).max(0.0);
-                        let d = x - a;
-                        let stretch = d - n * n.dot(d);
-                        let max_stretch = p.friction * fnorm / (p.tangential_stiffness_per_kg * m);
-                        let s = stretch.length();
-                        if s > max_stretch {
-                            let keep = if s > 0.0 { max_stretch / s } else { 0.0 };
-                            *slot = Some(on_floor - stretch * keep);
-                        }
-                    }
-                }
-                if let Some((fnorm, ft, z)) = self.corner_force(i, x, xd, *slot) {
-                    deepest = deepest.max(-z);
-                    depth[i] = depth[i].max(-z);
-                    normal[i] += fnorm;
-                    let f_world = n * fnorm + ft;
-                    f_body += ForceVec::at_point(rot.transpose() * f_world, cl);
-                }
-            }
-            f_ext[i] += f_body;
+        for i in 0..self.corners.len() {
+            let anchors = &mut state.anchors[i * 8..i * 8 + 8];
+            let (f, fn_i, d) = self.link_contact::<true>(data, i, anchors);
+            normal[i] = fn_i;
+            depth[i] = d;
+            deepest = deepest.max(d);
+            f_ext[i] += f;
         }
         deepest
     }
@@ -347,5 +305,44 @@ impl ContactModel {
             0.0
         };
         (omega, zeta)
+    }
+}
+
+/// What the floor did to each link over a run: peak normal force (N), normal impulse (N·s),
+/// deepest corner penetration (m), and the deepest penetration of any link (m). The paper's
+/// damage (eq. 5.1) weighs the peaks.
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct ContactStats {
+    /// Peak normal force per link (N).
+    pub peak: Vec<f64>,
+    /// Normal impulse per link (N·s).
+    pub impulse: Vec<f64>,
+    /// Deepest penetration per link (m).
+    pub max_depth: Vec<f64>,
+    /// Deepest penetration of any link (m).
+    pub max_penetration: f64,
+}
+
+impl ContactStats {
+    /// Zeros for `nlinks` links.
+    pub fn new(nlinks: usize) -> Self {
+        Self {
+            peak: vec![0.0; nlinks],
+            impulse: vec![0.0; nlinks],
+            max_depth: vec![0.0; nlinks],
+            max_penetration: 0.0,
+        }
+    }
+
+    /// Accounts for one step of `dt` seconds whose start saw per-link normal forces `normal`
+    /// (N), depths `depth` (m) and deepest penetration `penetration` (m).
+    pub fn accumulate(&mut self, normal: &[f64], depth: &[f64], penetration: f64, dt: f64) {
+        for i in 0..normal.len() {
+            let f = normal[i];
+            self.peak[i] = self.peak[i].max(f);
+            self.impulse[i] += f * dt;
+            self.max_depth[i] = self.max_depth[i].max(depth[i]);
+        }
+        self.max_penetration = self.max_penetration.max(penetration);
     }
 }

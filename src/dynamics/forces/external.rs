@@ -1,5 +1,7 @@
-//! External pushes: a force of given magnitude and world direction applied at a point of a link
-//! during `[start, start + duration)` (the paper: 1000 N on the torso from the front for 0.1 s).
+//! External forces: a world-frame force applied at a point of a body during
+//! `[start, start + duration)` ([`ExternalForce`], what the step reads), and the scene-level
+//! description of a push by link name ([`Push`]; the paper: 1000 N on the torso from the front
+//! for 0.1 s).
 
 use crate::dynamics::data::Data;
 use crate::dynamics::spatial::ForceVec;
@@ -32,12 +34,55 @@ impl Push {
         t >= self.start_s && t < self.start_s + self.duration_s
     }
 
-    /// The spatial force in the body coordinates of `link` (index `i`) after kinematics:
-    /// `f = Rᵀ F`, `n = p × f`.
+    /// This push as a force on body `body` (the index of [`Push::link`] in the model).
+    pub fn to_force(&self, body: usize) -> ExternalForce {
+        ExternalForce {
+            body,
+            point: self.point,
+            force: self.direction.normalize_or_zero() * self.force_n,
+            start_s: self.start_s,
+            duration_s: self.duration_s,
+        }
+    }
+}
+
+/// A force `F` (world frame, N) applied at `point` (body frame, m) of body `body` while
+/// `start_s ≤ t < start_s + duration_s`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ExternalForce {
+    /// Body index in the model.
+    pub body: usize,
+    /// Point of application in the body frame (m).
+    pub point: DVec3,
+    /// Force in world coordinates (N).
+    pub force: DVec3,
+    /// Start time (s).
+    pub start_s: f64,
+    /// Duration (s); `f64::INFINITY` for a force that stays.
+    pub duration_s: f64,
+}
+
+impl ExternalForce {
+    /// True while the force acts at time `t` (s).
     #[inline]
-    pub fn body_force(&self, data: &Data, i: usize) -> ForceVec {
-        let f_world = self.direction.normalize_or_zero() * self.force_n;
-        ForceVec::at_point(data.rot[i].transpose() * f_world, self.point)
+    pub fn active(&self, t: f64) -> bool {
+        t >= self.start_s && t < self.start_s + self.duration_s
+    }
+
+    /// The spatial force in body coordinates after kinematics: `f = Rᵀ F`, `n = p × f`.
+    #[inline]
+    pub fn body_force(&self, data: &Data) -> ForceVec {
+        ForceVec::at_point(data.rot[self.body].transpose() * self.force, self.point)
+    }
+}
+
+/// Adds every force of `forces` active at time `t` (s) to `f_ext` (body coordinates).
+#[inline]
+pub fn apply_external(data: &Data, forces: &[ExternalForce], t: f64, f_ext: &mut [ForceVec]) {
+    for f in forces {
+        if f.active(t) {
+            f_ext[f.body] += f.body_force(data);
+        }
     }
 }
 

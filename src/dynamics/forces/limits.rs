@@ -25,6 +25,31 @@ impl Default for JointLimitParams {
     }
 }
 
+/// The joint model of a body: one range `(θ_lo, θ_hi)` per actuated DOF (rad) and the shared
+/// gains.
+#[derive(Clone, Debug, PartialEq)]
+pub struct JointRanges {
+    /// `(lo, hi)` per DOF (rad).
+    pub ranges: Vec<(f64, f64)>,
+    /// Gains.
+    pub params: JointLimitParams,
+}
+
+impl JointRanges {
+    /// How far angle `theta` (rad) of DOF `d` lies outside its range (rad, ≥ 0).
+    #[inline]
+    pub fn excursion(&self, d: usize, theta: f64) -> f64 {
+        let (lo, hi) = self.ranges[d];
+        (lo - theta).max(theta - hi).max(0.0)
+    }
+
+    /// The joint-model torque (N·m) and velocity coefficient on DOF `d`.
+    #[inline]
+    pub fn torque(&self, d: usize, theta: f64, theta_dot: f64) -> (f64, f64) {
+        joint_torque(&self.params, self.ranges[d], theta, theta_dot)
+    }
+}
+
 /// The joint torque `τ` (N·m) and its velocity coefficient `d = −∂τ/∂θ̇` (N·m·s/rad) for angle
 /// `theta` and rate `theta_dot` with range `(lo, hi)` (rad).
 #[inline]

@@ -1,193 +1,150 @@
-//! The ECS wiring of the pushed fall: a character is an entity carrying the body, joint-state,
-//! PD-controller, joint-limit, contact, damage, recorder and workspace components of
-//! [`fall`](super::fall); systems run the phases in explicit, user-orderable sets
-//! [`FallSet::Control`] → [`FallSet::Limits`] → [`FallSet::Contact`] → [`FallSet::Step`] →
-//! [`FallSet::Record`]. One `World` per simulation (it is `Send`); N Worlds run in parallel with
-//! rayon and give bit-identical results on any number of threads, because each World is a
-//! deterministic, single-threaded computation that shares nothing mutable.
+//! The pushed fall in a World: a falling character is the physics components of
+//! [`crate::ecs::physics`] (stepped by the engine's physics systems) plus the paper's
+//! [`FallController`] (in [`MotionSet::Control`]) and a [`FallRecorder`] (in
+//! [`MotionSet::Record`]), which stops the body once its run is over. One World per fall runs
+//! with the World's [`Clock`] ticking one physics step; many run in parallel in a
+//! [`WorldPool`], to the same bits on any number of threads.
 
-use super::{
-    BodyModel, ContactComponent, DamageRecord, FallConfig, FallParts, FallResult, JointLimits,
-    JointState, PdController, Recorder, SimError, Workspace, build_fall, contact_phase,
-    control_phase, dynamics_phase, finish, limits_phase, record_initial, record_phase,
-};
-use bevy_ecs::prelude::*;
-use rayon::prelude::*;
 use std::sync::Arc;
 
-/// The ordered phases of one fall step.
-#[derive(SystemSet, Debug, Clone, PartialEq, Eq, Hash)]
-pub enum FallSet {
-    /// Choose the PD target (stance or key pose).
-    Control,
-    /// Monitor joint-range excursions.
-    Limits,
-    /// Friction anchors and per-link contact statistics.
-    Contact,
-    /// One integrator step of the full force model.
-    Step,
-    /// Frames, rest detection, divergence checks.
-    Record,
-}
+use bevy_ecs::prelude::*;
 
-/// True while a character still has steps to take and no error.
-fn running(state: &JointState, rec: &Recorder, ws: &Workspace) -> bool {
-    ws.error.is_none() && !rec.finished(state)
-}
+use super::{FallCharacter, FallConfig, FallController, FallRecorder, FallResult, SimError};
+use crate::ecs::physics::{
+    BodyState, PdController, PhysicsBody, PhysicsMonitor, PhysicsStatus, PhysicsWorkspace,
+    add_physics_systems,
+};
+use crate::ecs::{Clock, MotionSet, WorldPool, add_core_systems, configure_motion_sets};
 
-/// Control system: the key pose becomes the target at the reaction time.
-pub fn control_system(mut q: Query<(&JointState, &Recorder, &Workspace, &mut PdController)>) {
-    for (state, rec, ws, mut pd) in &mut q {
-        if running(state, rec, ws) {
-            control_phase(state, &mut pd);
-        }
-    }
-}
-
-/// Limits system: records range excursions at the step start.
-pub fn limits_system(
+/// The paper's controller: the key pose becomes the PD target at the reaction time.
+pub fn fall_control_system(
     mut q: Query<(
-        &BodyModel,
-        &JointState,
-        &Recorder,
-        &mut JointLimits,
-        &mut Workspace,
+        &BodyState,
+        &PhysicsStatus,
+        &mut FallController,
+        &mut PdController,
     )>,
 ) {
-    for (body, state, rec, mut limits, mut ws) in &mut q {
-        if running(state, rec, &ws) {
-            limits_phase(body, state, &mut limits, &mut ws);
+    for (state, status, mut controller, mut pd) in &mut q {
+        if status.running() {
+            controller.apply(state.time_s, &mut pd.0);
         }
     }
 }
 
-/// Contact system: anchors and per-link peak force, impulse, penetration.
-pub fn contact_system(
+/// Records every falling body that stepped (frames, rest) and stops it once its run is over.
+pub fn fall_record_system(
     mut q: Query<(
-        &BodyModel,
-        &JointState,
-        &Recorder,
-        &mut ContactComponent,
-        &mut DamageRecord,
-        &mut Workspace,
+        &PhysicsBody,
+        &BodyState,
+        &mut PhysicsWorkspace,
+        &mut FallRecorder,
+        &mut PhysicsStatus,
     )>,
 ) {
-    for (body, state, rec, mut contact, mut damage, mut ws) in &mut q {
-        if running(state, rec, &ws) {
-            contact_phase(body, state, &mut contact, &mut damage, rec.dt, &mut ws);
+    for (body, state, mut ws, mut recorder, mut status) in &mut q {
+        if status.error.is_some() {
+            continue;
+        }
+        let b = &*body.body;
+        recorder.record(b, state, ws.kinematics_of(&b.model, state));
+        if recorder.finished(state) {
+            status.stopped = true;
         }
     }
 }
 
-/// Dynamics-step system: integrates one step; an error stops the character.
-pub fn step_system(
-    mut q: Query<(
-        &BodyModel,
-        &mut JointState,
-        &PdController,
-        &JointLimits,
-        &ContactComponent,
-        &Recorder,
-        &mut Workspace,
-    )>,
-) {
-    for (body, mut state, pd, limits, contact, rec, mut ws) in &mut q {
-        if running(&state, rec, &ws)
-            && let Err(e) = dynamics_phase(body, &mut state, pd, limits, contact, rec, &mut ws)
-        {
-            ws.error = Some(Arc::new(e));
-        }
-    }
+/// Adds the fall systems to `schedule`: [`fall_control_system`] in [`MotionSet::Control`],
+/// [`fall_record_system`] in [`MotionSet::Record`].
+pub fn add_fall_systems(schedule: &mut Schedule) {
+    configure_motion_sets(schedule);
+    schedule.add_systems((
+        fall_control_system.in_set(MotionSet::Control),
+        fall_record_system.in_set(MotionSet::Record),
+    ));
 }
 
-/// Record system: frames, rest detection and divergence checks after the step.
-pub fn record_system(mut q: Query<(&BodyModel, &JointState, &mut Recorder, &mut Workspace)>) {
-    for (body, state, mut rec, mut ws) in &mut q {
-        // The step has been taken: `steps` counts it, so record while no error is set.
-        if ws.error.is_none()
-            && state.steps > 0
-            && let Err(e) = record_phase(body, state, &mut rec, &mut ws)
-        {
-            ws.error = Some(Arc::new(e));
-        }
-    }
-}
-
-/// The schedule of one fall step with its sets chained in order.
+/// The schedule of a World of falls: core sets and clock, physics, the fall systems.
 pub fn fall_schedule() -> Schedule {
     let mut s = Schedule::default();
-    s.configure_sets(
-        (
-            FallSet::Control,
-            FallSet::Limits,
-            FallSet::Contact,
-            FallSet::Step,
-            FallSet::Record,
-        )
-            .chain(),
-    );
-    s.add_systems((
-        control_system.in_set(FallSet::Control),
-        limits_system.in_set(FallSet::Limits),
-        contact_system.in_set(FallSet::Contact),
-        step_system.in_set(FallSet::Step),
-        record_system.in_set(FallSet::Record),
-    ));
+    add_core_systems(&mut s);
+    add_physics_systems(&mut s);
+    add_fall_systems(&mut s);
     s
 }
 
-/// Spawns one falling character's components into `world`.
-pub fn spawn_fall(world: &mut World, mut parts: FallParts) -> Entity {
-    record_initial(&mut parts);
-    let FallParts {
-        body,
-        state,
+/// Spawns one falling character into `world` and records its first frame. The World's
+/// [`Clock`] must step physics by the fall's `dt_s`.
+pub fn spawn_fall(world: &mut World, mut ch: FallCharacter) -> Result<Entity, SimError> {
+    let dt = world.get_resource::<Clock>().map(|c| c.physics_dt());
+    if dt != Some(ch.recorder.dt) {
+        return Err(SimError::Config {
+            field: "dt_s".into(),
+            message: format!(
+                "the fall steps by {} s but the World's clock steps physics by {}",
+                ch.recorder.dt,
+                dt.map_or("nothing (no Clock)".to_string(), |d| format!("{d} s"))
+            ),
+        });
+    }
+    let p = &mut ch.physics;
+    let b = &*p.body.body;
+    let data = p.workspace.kinematics_of(&b.model, &p.state);
+    ch.recorder.record(b, &p.state, data);
+    if ch.recorder.finished(&p.state) {
+        p.status.stopped = true;
+    }
+    let FallCharacter {
+        physics,
         pd,
         limits,
         contact,
-        damage,
+        external,
+        controller,
         recorder,
-        ws,
-    } = parts;
-    world
-        .spawn((body, state, pd, limits, contact, damage, recorder, ws))
-        .id()
+    } = ch;
+    Ok(world
+        .spawn((physics, pd, limits, contact, external, controller, recorder))
+        .id())
 }
 
-/// A World holding the character of `config` (validated and stability-checked).
+/// A World holding the fall of `config` (validated and stability-checked), its clock ticking
+/// one step of `config.dt_s`.
 pub fn build_fall_world(config: &FallConfig) -> Result<World, SimError> {
-    let parts = build_fall(config)?;
+    let ch = super::build_fall(config)?;
     let mut world = World::new();
-    spawn_fall(&mut world, parts);
+    world.insert_resource(Clock::physics(config.dt_s));
+    spawn_fall(&mut world, ch)?;
     Ok(world)
 }
 
-/// Runs the fall schedule until every character in `world` has finished or failed; returns the
-/// result of each character in spawn order.
-pub fn run_world(world: &mut World) -> Vec<Result<FallResult, Arc<SimError>>> {
+/// Runs the fall schedule until every falling body in `world` has finished or failed; returns
+/// the result of each in spawn order.
+pub fn run_fall_world(world: &mut World) -> Vec<Result<FallResult, Arc<SimError>>> {
     let mut schedule = fall_schedule();
-    loop {
-        let mut q = world.query::<(&JointState, &Recorder, &Workspace)>();
-        if !q.iter(world).any(|(s, r, w)| running(s, r, w)) {
-            break;
-        }
+    let mut running = world.query_filtered::<&PhysicsStatus, With<FallRecorder>>();
+    while running.iter(world).any(PhysicsStatus::running) {
         schedule.run(world);
     }
+    fall_results(world)
+}
+
+/// The result of every falling body in `world`, in spawn order.
+pub fn fall_results(world: &mut World) -> Vec<Result<FallResult, Arc<SimError>>> {
     let mut q = world.query::<(
         Entity,
-        &BodyModel,
-        &JointState,
-        &JointLimits,
-        &DamageRecord,
-        &Recorder,
-        &Workspace,
+        &PhysicsBody,
+        &BodyState,
+        &PhysicsMonitor,
+        &FallRecorder,
+        &PhysicsStatus,
     )>();
     let mut out: Vec<(Entity, Result<FallResult, Arc<SimError>>)> = q
         .iter(world)
-        .map(|(e, body, state, limits, damage, recorder, ws)| {
-            let r = match &ws.error {
-                Some(err) => Err(err.clone()),
-                None => Ok(finish(body, state, limits, damage, recorder)),
+        .map(|(e, body, state, monitor, recorder, status)| {
+            let r = match &status.error {
+                Some(err) => Err(Arc::new(SimError::Step((**err).clone()))),
+                None => Ok(recorder.result(&body.body, state, monitor)),
             };
             (e, r)
         })
@@ -196,19 +153,35 @@ pub fn run_world(world: &mut World) -> Vec<Result<FallResult, Arc<SimError>>> {
     out.into_iter().map(|(_, r)| r).collect()
 }
 
-/// Simulates each configuration in its own World, in parallel on the current rayon pool; the
-/// results are in input order and do not depend on the number of threads.
+/// Why a World of a pool holds no fall.
+#[derive(Resource)]
+struct NotBuilt(Arc<SimError>);
+
+/// Simulates each configuration in its own World of a [`WorldPool`], in parallel on the
+/// current rayon pool; the results are in input order and do not depend on the number of
+/// threads.
 pub fn run_parallel(configs: &[FallConfig]) -> Vec<Result<FallResult, Arc<SimError>>> {
-    configs
-        .par_iter()
-        .map(|c| {
-            let mut world = build_fall_world(c).map_err(Arc::new)?;
-            run_world(&mut world).pop().unwrap_or_else(|| {
-                Err(Arc::new(SimError::Config {
-                    field: "world".into(),
-                    message: "no character".into(),
-                }))
-            })
+    let pool = WorldPool::new(configs.len(), 0, |k, world| {
+        world.insert_resource(Clock::physics(configs[k].dt_s));
+        let built = super::build_fall(&configs[k]).and_then(|ch| spawn_fall(world, ch));
+        if let Err(e) = built {
+            world.insert_resource(NotBuilt(Arc::new(e)));
+        }
+        Ok::<(), std::convert::Infallible>(())
+    });
+    let mut pool = match pool {
+        Ok(p) => p,
+        Err(never) => match never {},
+    };
+    pool.run(|w| {
+        if let Some(e) = w.get_resource::<NotBuilt>() {
+            return Err(e.0.clone());
+        }
+        run_fall_world(w).pop().unwrap_or_else(|| {
+            Err(Arc::new(SimError::Config {
+                field: "world".into(),
+                message: "no character".into(),
+            }))
         })
-        .collect()
+    })
 }

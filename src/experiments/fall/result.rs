@@ -2,6 +2,7 @@
 //! fail ([`SimError`]: bad configuration, an unstable step, or a runaway state with its time,
 //! body and quantity).
 
+use crate::dynamics::pipeline::StepError;
 use crate::humanoid::body::HumanError;
 use crate::humanoid::ranges::RangeError;
 use glam::{DQuat, DVec3};
@@ -113,30 +114,7 @@ pub enum SimError {
         /// Scheme name.
         integrator: &'static str,
     },
-    /// A non-finite value appeared.
-    #[error("non-finite {quantity} of '{body}' at t = {time_s:.4} s")]
-    NonFinite {
-        /// Simulated time (s).
-        time_s: f64,
-        /// Body (link) name.
-        body: String,
-        /// Which quantity.
-        quantity: String,
-    },
-    /// The state ran away.
-    #[error(
-        "exploding {quantity} of '{body}' at t = {time_s:.4} s: {value:.3e} (limit {limit:.1e})"
-    )]
-    Exploding {
-        /// Simulated time (s).
-        time_s: f64,
-        /// Body (link) name.
-        body: String,
-        /// Which quantity.
-        quantity: String,
-        /// Value found.
-        value: f64,
-        /// Allowed magnitude.
-        limit: f64,
-    },
+    /// A step went wrong: a non-finite or runaway state, with time, body and value.
+    #[error(transparent)]
+    Step(#[from] StepError),
 }

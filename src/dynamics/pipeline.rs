@@ -1,0 +1,436 @@
+//! One simulation step as a pipeline of named stages, after MuJoCo's `mj_step`: every stage
+//! takes the immutable [`Model`], the forces the body feels ([`Forces`], plain parameters) and
+//! the mutable [`State`] and [`StepWorkspace`].
+//!
+//! 1. **position**: forward kinematics at the step start (reused when the previous step's check
+//!    left it in the workspace);
+//! 2. **limits**: each DOF's excursion past its range, for the [`StepMonitor`];
+//! 3. **contact**: friction anchors brought to the step start, contact forces there, per-link
+//!    statistics ([`ContactStats`]);
+//! 4. **integrate**: the scheme's evaluations of `q̈ = ABA(q, v, τ, f_ext)`, each summing PD
+//!    torques `τ = k_p(θ_d − θ) + k_v(θ̇_d − θ̇)`, the joint model, contact and external forces;
+//! 5. **check**: kinematics of the new state; a non-finite or runaway body stops the run with
+//!    its time, body and value.
+//!
+//! A force whose parameters are absent (`None`, or no external forces) is simply not felt.
+
+use super::aba::aba_passes;
+use super::data::Data;
+use super::forces::contact::{ContactModel, ContactState, ContactStats};
+use super::forces::external::{ExternalForce, apply_external};
+use super::forces::limits::JointRanges;
+use super::forces::pd::PdTargets;
+use super::integrator::{self, Dynamics, Integrator, IntegratorWorkspace};
+use super::kinematics::kinematics;
+use super::model::Model;
+use super::spatial::ForceVec;
+
+/// The state of a simulated body: configuration `q` (nq), velocity `v` (nv), the friction
+/// anchors of its contact corners, time (s) and steps taken.
+#[derive(Clone, Debug, PartialEq)]
+pub struct State {
+    /// Configuration (size nq).
+    pub q: Vec<f64>,
+    /// Velocity (size nv).
+    pub v: Vec<f64>,
+    /// Friction anchors of the contact corners.
+    pub anchors: ContactState,
+    /// Simulated time (s): `steps · dt`.
+    pub time_s: f64,
+    /// Steps taken.
+    pub steps: u64,
+}
+
+impl State {
+    /// A state at `q` with velocity `v` for a body of `nlinks` links, no corner touching, at
+    /// time 0.
+    pub fn new(q: Vec<f64>, v: Vec<f64>, nlinks: usize) -> Self {
+        Self {
+            q,
+            v,
+            anchors: ContactState::new(nlinks),
+            time_s: 0.0,
+            steps: 0,
+        }
+    }
+}
+
+/// The forces a body feels, all optional: PD control and the joint model act on the DOFs
+/// `dofs` (their indices in `v`, the order of the per-DOF entries), contact on every link.
+#[derive(Clone, Copy, Debug)]
+pub struct Forces<'a> {
+    /// Velocity index of each actuated DOF.
+    pub dofs: &'a [usize],
+    /// PD targets and gains per DOF.
+    pub pd: Option<&'a PdTargets>,
+    /// Joint ranges and the joint model's gains per DOF.
+    pub limits: Option<&'a JointRanges>,
+    /// Floor contact of the links.
+    pub contact: Option<&'a ContactModel>,
+    /// Applied forces.
+    pub external: &'a [ExternalForce],
+}
+
+/// The time step and its scheme.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StepSettings {
+    /// Integration scheme.
+    pub integrator: Integrator,
+    /// Time step (s).
+    pub dt: f64,
+}
+
+/// What the steps saw: at the start of the latest step the normal force (N) and deepest corner
+/// penetration (m) per link and of the body; over all steps the contact statistics and the
+/// largest range excursion per DOF (rad).
+#[derive(Clone, Debug, PartialEq)]
+pub struct StepMonitor {
+    /// Normal force per link at the latest step start (N).
+    pub normal: Vec<f64>,
+    /// Deepest penetration per link at the latest step start (m).
+    pub depth: Vec<f64>,
+    /// Deepest penetration at the latest step start (m).
+    pub penetration: f64,
+    /// Peaks, impulses and depths over all steps.
+    pub contact: ContactStats,
+    /// Largest excursion past the range per DOF so far (rad).
+    pub max_excursion: Vec<f64>,
+}
+
+impl StepMonitor {
+    /// Zeros for `nlinks` links and `ndofs` actuated DOFs.
+    pub fn new(nlinks: usize, ndofs: usize) -> Self {
+        Self {
+            normal: vec![0.0; nlinks],
+            depth: vec![0.0; nlinks],
+            penetration: 0.0,
+            contact: ContactStats::new(nlinks),
+            max_excursion: vec![0.0; ndofs],
+        }
+    }
+}
+
+/// Buffers of the pipeline (no allocation per step).
+#[derive(Clone, Debug)]
+pub struct StepWorkspace {
+    /// Buffers of the force evaluation.
+    pub eval: EvalScratch,
+    /// Integrator buffers.
+    pub iws: IntegratorWorkspace,
+}
+
+/// Buffers of one force evaluation.
+#[derive(Clone, Debug)]
+pub struct EvalScratch {
+    /// Dynamics buffers; after a step, the kinematics of the new state.
+    pub data: Data,
+    /// External forces per body (body coordinates).
+    pub f_ext: Vec<ForceVec>,
+    /// Joint forces (nv).
+    pub tau: Vec<f64>,
+    /// Joint damping coefficients (nv).
+    pub damping: Vec<f64>,
+    /// Armature `h·d` (nv).
+    pub armature: Vec<f64>,
+    /// Angles (nv).
+    pub angles: Vec<f64>,
+    /// Per-link normal forces (scratch).
+    pub normal: Vec<f64>,
+    /// `data` holds the kinematics of the state after this many steps.
+    pub kinematics_at_step: Option<u64>,
+    /// `data` and `f_ext` hold the step-start kinematics and contact forces, so the
+    /// integrator's first evaluation (always at the step-start state) reuses them.
+    pub step_start_ready: bool,
+}
+
+impl StepWorkspace {
+    /// Buffers for `model`.
+    pub fn new(model: &Model) -> Self {
+        let (nb, nv) = (model.nbodies(), model.nv);
+        Self {
+            eval: EvalScratch {
+                data: Data::new(model),
+                f_ext: vec![ForceVec::ZERO; nb],
+                tau: vec![0.0; nv],
+                damping: vec![0.0; nv],
+                armature: vec![0.0; nv],
+                angles: vec![0.0; nv],
+                normal: vec![0.0; nb],
+                kinematics_at_step: None,
+                step_start_ready: false,
+            },
+            iws: IntegratorWorkspace::new(model),
+        }
+    }
+
+    /// Forward kinematics of `state` into the workspace, unless it already holds them; returns
+    /// the data.
+    pub fn kinematics_of(&mut self, model: &Model, state: &State) -> &Data {
+        let e = &mut self.eval;
+        if e.kinematics_at_step != Some(state.steps) {
+            kinematics(model, &mut e.data, &state.q, &state.v);
+            e.kinematics_at_step = Some(state.steps);
+        }
+        &e.data
+    }
+}
+
+/// Why a step failed: a non-finite or runaway quantity, with the time and the body.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum StepError {
+    /// A non-finite value appeared.
+    #[error("non-finite {quantity} of '{body}' at t = {time_s:.4} s")]
+    NonFinite {
+        /// Simulated time (s).
+        time_s: f64,
+        /// Body (link) name.
+        body: String,
+        /// Which quantity.
+        quantity: String,
+    },
+    /// The state ran away.
+    #[error(
+        "exploding {quantity} of '{body}' at t = {time_s:.4} s: {value:.3e} (limit {limit:.1e})"
+    )]
+    Exploding {
+        /// Simulated time (s).
+        time_s: f64,
+        /// Body (link) name.
+        body: String,
+        /// Which quantity.
+        quantity: String,
+        /// Value found.
+        value: f64,
+        /// Allowed magnitude.
+        limit: f64,
+    },
+}
+
+/// Largest speed (m/s or rad/s) and position excursion (m) before a run counts as exploding:
+/// far beyond any human motion (even a stiff PD snapping a hand reaches ~500 rad/s), so only a
+/// numerical blow-up trips them.
+pub const MAX_SPEED: f64 = 2000.0;
+/// Largest distance of a body from the origin (m) before a run counts as exploding.
+pub const MAX_EXTENT: f64 = 100.0;
+
+/// One step of `settings.dt` seconds through the five stages; advances `state` (time
+/// `steps · dt`) and accounts for the step in `monitor`.
+pub fn step(
+    model: &Model,
+    settings: StepSettings,
+    forces: &Forces,
+    state: &mut State,
+    ws: &mut StepWorkspace,
+    monitor: &mut StepMonitor,
+) -> Result<(), StepError> {
+    position_stage(model, state, ws);
+    limits_stage(model, forces, state, ws, monitor);
+    contact_stage(forces, state, ws, monitor, settings.dt);
+    integrate_stage(model, settings, forces, state, ws)?;
+    check_stage(model, state, ws)
+}
+
+/// Stage 1: kinematics at the step start.
+fn position_stage(model: &Model, state: &State, ws: &mut StepWorkspace) {
+    ws.kinematics_of(model, state);
+}
+
+/// Stage 2: the largest excursion past each DOF's range at the step start.
+fn limits_stage(
+    model: &Model,
+    forces: &Forces,
+    state: &State,
+    ws: &mut StepWorkspace,
+    monitor: &mut StepMonitor,
+) {
+    if let Some(l) = forces.limits {
+        let e = &mut ws.eval;
+        model.angles(&state.q, &mut e.angles);
+        for (d, &k) in forces.dofs.iter().enumerate() {
+            let ex = l.excursion(d, e.angles[k]);
+            monitor.max_excursion[d] = monitor.max_excursion[d].max(ex);
+        }
+    }
+}
+
+/// Stage 3: anchors and contact forces at the step start, per-link statistics.
+fn contact_stage(
+    forces: &Forces,
+    state: &mut State,
+    ws: &mut StepWorkspace,
+    monitor: &mut StepMonitor,
+    dt: f64,
+) {
+    let e = &mut ws.eval;
+    e.f_ext.fill(ForceVec::ZERO);
+    if let Some(cm) = forces.contact {
+        monitor.penetration = cm.update_and_apply(
+            &e.data,
+            &mut state.anchors,
+            &mut e.f_ext,
+            &mut monitor.normal,
+            &mut monitor.depth,
+        );
+        monitor.contact.accumulate(
+            &monitor.normal,
+            &monitor.depth,
+            monitor.penetration,
+            dt,
+        );
+    }
+    e.step_start_ready = true;
+}
+
+/// Stage 4: the integrator step; time becomes `steps · dt`.
+fn integrate_stage(
+    model: &Model,
+    settings: StepSettings,
+    forces: &Forces,
+    state: &mut State,
+    ws: &mut StepWorkspace,
+) -> Result<(), StepError> {
+    let StepWorkspace { eval, iws } = ws;
+    // The stages overwrite `data`: the cached kinematics no longer match any state.
+    eval.kinematics_at_step = None;
+    let mut f = Evaluation {
+        model,
+        forces,
+        anchors: &state.anchors,
+        ws: eval,
+    };
+    let t = state.time_s;
+    integrator::step(
+        settings.integrator,
+        model,
+        iws,
+        &mut f,
+        t,
+        settings.dt,
+        (&mut state.q, &mut state.v),
+    )?;
+    state.steps += 1;
+    state.time_s = state.steps as f64 * settings.dt;
+    Ok(())
+}
+
+/// Stage 5: kinematics of the new state (kept for the next step) and the divergence checks.
+fn check_stage(model: &Model, state: &State, ws: &mut StepWorkspace) -> Result<(), StepError> {
+    let t = state.time_s;
+    let data = ws.kinematics_of(model, state);
+    for i in 0..model.nbodies() {
+        let (p, vel) = (data.pos[i], data.v[i]);
+        let name = || model.bodies[i].name.clone();
+        if !p.is_finite() || !data.rot[i].is_finite() {
+            return Err(StepError::NonFinite {
+                time_s: t,
+                body: name(),
+                quantity: "position".into(),
+            });
+        }
+        if !vel.is_finite() {
+            return Err(StepError::NonFinite {
+                time_s: t,
+                body: name(),
+                quantity: "velocity".into(),
+            });
+        }
+        let speed = vel.ang.length().max(vel.lin.length());
+        if speed > MAX_SPEED {
+            return Err(StepError::Exploding {
+                time_s: t,
+                body: name(),
+                quantity: "speed".into(),
+                value: speed,
+                limit: MAX_SPEED,
+            });
+        }
+        if p.abs().max_element() > MAX_EXTENT {
+            return Err(StepError::Exploding {
+                time_s: t,
+                body: name(),
+                quantity: "position".into(),
+                value: p.abs().max_element(),
+                limit: MAX_EXTENT,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// The force model evaluated at every integrator stage: joint torques (PD + joint model),
+/// contact and external forces, then the ABA.
+struct Evaluation<'a> {
+    model: &'a Model,
+    forces: &'a Forces<'a>,
+    anchors: &'a ContactState,
+    ws: &'a mut EvalScratch,
+}
+
+impl Dynamics for Evaluation<'_> {
+    type Error = StepError;
+
+    fn acceleration(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+        implicit_dt: Option<f64>,
+        qdd: &mut [f64],
+    ) -> Result<(), StepError> {
+        let model = self.model;
+        let forces = self.forces;
+        let ws = &mut *self.ws;
+        if ws.step_start_ready {
+            // First evaluation of the step: the contact stage computed kinematics and contact
+            // forces at exactly this state.
+            ws.step_start_ready = false;
+        } else {
+            kinematics(model, &mut ws.data, q, v);
+            ws.f_ext.fill(ForceVec::ZERO);
+            if let Some(cm) = forces.contact {
+                cm.apply(&ws.data, self.anchors, &mut ws.f_ext, &mut ws.normal);
+            }
+        }
+        apply_external(&ws.data, forces.external, t, &mut ws.f_ext);
+        if forces.pd.is_some() || forces.limits.is_some() {
+            model.angles(q, &mut ws.angles);
+        }
+        for (d, &k) in forces.dofs.iter().enumerate() {
+            let (th, thd) = (ws.angles[k], v[k]);
+            let (mut tau, mut damp) = (0.0, 0.0);
+            if let Some(pd) = forces.pd {
+                (tau, damp) = pd.torque(d, th, thd);
+            }
+            if let Some(l) = forces.limits {
+                let (t2, d2) = l.torque(d, th, thd);
+                tau += t2;
+                damp += d2;
+            }
+            ws.tau[k] = tau;
+            ws.damping[k] = damp;
+        }
+        let arm = match implicit_dt {
+            Some(h) => {
+                for k in 0..ws.armature.len() {
+                    ws.armature[k] = h * ws.damping[k];
+                }
+                Some(&ws.armature[..])
+            }
+            None => None,
+        };
+        aba_passes(model, &mut ws.data, &ws.tau, &ws.f_ext, arm);
+        qdd.copy_from_slice(&ws.data.qdd);
+        if let Some(k) = qdd.iter().position(|x| !x.is_finite()) {
+            let b = (0..model.nbodies())
+                .rev()
+                .find(|&b| model.v_idx[b] <= k)
+                .unwrap_or(0);
+            return Err(StepError::NonFinite {
+                time_s: t,
+                body: model.bodies[b].name.clone(),
+                quantity: "joint acceleration".into(),
+            });
+        }
+        Ok(())
+    }
+}

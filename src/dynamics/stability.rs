@@ -1,0 +1,171 @@
+//! The largest stable time step of a body before it runs: every contact and joint stiffness is
+//! a damped oscillator `ẍ = −ω²x − 2ζωẋ`, and the step must stay inside the scheme's stability
+//! region for the stiffest of them.
+
+use super::crba::{cholesky_factor, cholesky_solve, crba};
+use super::data::Data;
+use super::forces::contact::ContactModel;
+use super::integrator::Integrator;
+use super::model::Model;
+
+/// The stable step bound for a damped oscillator `ẍ = −ω²x − 2ζωẋ`: semi-implicit Euler
+/// `h ≤ 2(√(1+ζ²) − ζ)/ω`; RK4 `h ≤ 2.5 / (ω(ζ + √(1+ζ²)))` (the real-axis limit is 2.78 and
+/// the imaginary-axis limit 2.83 in units of `1/|λ|`).
+pub fn stable_step(integrator: Integrator, omega: f64, zeta: f64) -> f64 {
+    if omega <= 0.0 {
+        return f64::INFINITY;
+    }
+    let s = (1.0 + zeta * zeta).sqrt();
+    match integrator {
+        Integrator::Rk4 => 2.5 / (omega * (zeta + s)),
+        Integrator::SemiImplicitEuler { .. } => 2.0 * (s - zeta) / omega,
+    }
+}
+
+/// The readable name of a scheme.
+pub fn scheme_name(i: Integrator) -> &'static str {
+    match i {
+        Integrator::Rk4 => "RK4",
+        Integrator::SemiImplicitEuler {
+            implicit_damping: true,
+        } => "semi-implicit Euler (implicit damping)",
+        Integrator::SemiImplicitEuler { .. } => "semi-implicit Euler",
+    }
+}
+
+/// The mode that bounds the step most: its bound (s), what it is, the body index, `ω` (rad/s)
+/// and `ζ`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StiffestMode {
+    /// Largest stable step for this mode (s).
+    pub bound_s: f64,
+    /// `"contact"` or `"joint <dof>"`.
+    pub what: String,
+    /// Body index.
+    pub body: usize,
+    /// Natural frequency (rad/s).
+    pub omega: f64,
+    /// Damping ratio.
+    pub zeta: f64,
+}
+
+/// One actuated DOF's stiffness for the bound: velocity index, body index, name, stiffness
+/// (N·m/rad) and explicit damping (N·m·s/rad; zero when the scheme takes it implicitly).
+#[derive(Clone, Debug, PartialEq)]
+pub struct DofStiffness {
+    /// Index in `v`.
+    pub v: usize,
+    /// Body the DOF moves.
+    pub body: usize,
+    /// DOF name.
+    pub name: String,
+    /// Stiffness (N·m/rad).
+    pub stiffness: f64,
+    /// Damping taken explicitly (N·m·s/rad).
+    pub damping: f64,
+}
+
+/// The stiffest mode of a body at configuration `q`: per link the contact bound of
+/// [`ContactModel::link_frequency`]; per DOF `ω² = k (H⁻¹)_jj`, `2ζω = d (H⁻¹)_jj` with `H` the
+/// joint-space inertia at `q`. `None` when there is nothing stiff.
+pub fn stiffest_mode(
+    model: &Model,
+    q: &[f64],
+    integrator: Integrator,
+    contact: Option<&ContactModel>,
+    dofs: &[DofStiffness],
+) -> Result<Option<StiffestMode>, super::crba::NotPositiveDefinite> {
+    let mut worst: Option<StiffestMode> = None;
+    let mut consider = |bound: f64, what: &dyn Fn() -> String, body: usize, omega, zeta| {
+        if worst.as_ref().is_none_or(|w| bound < w.bound_s) {
+            worst = Some(StiffestMode {
+                bound_s: bound,
+                what: what(),
+                body,
+                omega,
+                zeta,
+            });
+        }
+    };
+    if let Some(cm) = contact {
+        for i in 0..model.nbodies() {
+            let (omega, zeta) = cm.link_frequency(i, &model.bodies[i].inertia);
+            let bound = stable_step(integrator, omega, zeta);
+            consider(bound, &|| "contact".to_string(), i, omega, zeta);
+        }
+    }
+    let nv = model.nv;
+    let mut data = Data::new(model);
+    crba(model, &mut data, q);
+    let mut h = data.h.clone();
+    cholesky_factor(&mut h, nv)?;
+    for d in dofs {
+        let mut e = vec![0.0; nv];
+        e[d.v] = 1.0;
+        cholesky_solve(&h, nv, &mut e);
+        let w = e[d.v];
+        let omega = (d.stiffness * w).sqrt();
+        let zeta = if omega > 0.0 {
+            d.damping * w / (2.0 * omega)
+        } else {
+            0.0
+        };
+        let bound = stable_step(integrator, omega, zeta);
+        consider(bound, &|| format!("joint {}", d.name), d.body, omega, zeta);
+    }
+    Ok(worst)
+}
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::dynamics::integrator::Integrator;
+
+    /// Largest |x| after `n` steps of `ẍ = −ω²x − 2ζωẋ` from x = 1 with the given scheme.
+    fn oscillate(integrator: Integrator, omega: f64, zeta: f64, h: f64, n: usize) -> f64 {
+        let f = |x: f64, v: f64| -omega * omega * x - 2.0 * zeta * omega * v;
+        let (mut x, mut v) = (1.0f64, 0.0f64);
+        let mut peak: f64 = 0.0;
+        for _ in 0..n {
+            match integrator {
+                Integrator::SemiImplicitEuler { .. } => {
+                    v += h * f(x, v);
+                    x += h * v;
+                }
+                Integrator::Rk4 => {
+                    let (k1x, k1v) = (v, f(x, v));
+                    let (k2x, k2v) = (v + 0.5 * h * k1v, f(x + 0.5 * h * k1x, v + 0.5 * h * k1v));
+                    let (k3x, k3v) = (v + 0.5 * h * k2v, f(x + 0.5 * h * k2x, v + 0.5 * h * k2v));
+                    let (k4x, k4v) = (v + h * k3v, f(x + h * k3x, v + h * k3v));
+                    x += h / 6.0 * (k1x + 2.0 * k2x + 2.0 * k3x + k4x);
+                    v += h / 6.0 * (k1v + 2.0 * k2v + 2.0 * k3v + k4v);
+                }
+            }
+            peak = peak.max(x.abs());
+        }
+        peak
+    }
+
+    #[test]
+    fn the_step_bound_separates_stable_from_unstable() {
+        let euler = Integrator::SemiImplicitEuler {
+            implicit_damping: false,
+        };
+        for zeta in [0.0, 0.3, 1.0, 3.0] {
+            let b = stable_step(euler, 100.0, zeta);
+            assert!(
+                oscillate(euler, 100.0, zeta, 0.99 * b, 20_000) < 10.0,
+                "ζ={zeta}"
+            );
+            assert!(
+                oscillate(euler, 100.0, zeta, 1.02 * b, 20_000) > 1e3,
+                "ζ={zeta}"
+            );
+            // RK4's bound is conservative: stable at it.
+            let r = stable_step(Integrator::Rk4, 100.0, zeta);
+            assert!(
+                oscillate(Integrator::Rk4, 100.0, zeta, r, 20_000) <= 1.0 + 1e-9,
+                "ζ={zeta}"
+            );
+        }
+    }
+}

@@ -1,0 +1,228 @@
+//! Simulated characters: every force a body feels comes from a component the step reads.
+//!
+//! A physical character carries a [`PhysicsBundle`] (the body, its state, workspace, monitor
+//! and status) and any of [`PdController`] (targets θ_d, θ̇_d and gains per DOF),
+//! [`JointLimits`] (ranges and the joint model), [`FloorContact`] and [`ExternalForces`].
+//! Removing one removes that force; a controller of the user's (a primitive player, a GA
+//! genome, a game's input) writes [`PdController`] in [`MotionSet::Control`].
+//! [`step_bodies`] takes the clock's substeps in [`MotionSet::Physics`] through
+//! [`pipeline::step`]; [`publish_body_pose`] hands the body's pose to the same joint state,
+//! forward kinematics and recorder as a kinematic character in [`MotionSet::Pose`].
+
+use std::ops::{Deref, DerefMut};
+use std::sync::Arc;
+
+use bevy_ecs::prelude::*;
+use glam::{DQuat, DVec3};
+
+use super::clock::Clock;
+use super::motion::{Character, JointState, Recorder, SkeletonRef};
+use super::sets::{MotionSet, configure_motion_sets};
+use crate::dynamics::forces::contact::ContactModel;
+use crate::dynamics::forces::external::ExternalForce;
+use crate::dynamics::forces::limits::JointRanges;
+use crate::dynamics::forces::pd::PdTargets;
+use crate::dynamics::integrator::Integrator;
+use crate::dynamics::pipeline::{
+    self, Forces, State, StepError, StepMonitor, StepSettings, StepWorkspace,
+};
+use crate::humanoid::body::HumanBody;
+
+macro_rules! wrapper {
+    ($name:ident, $inner:ty) => {
+        impl Deref for $name {
+            type Target = $inner;
+            fn deref(&self) -> &$inner {
+                &self.0
+            }
+        }
+        impl DerefMut for $name {
+            fn deref_mut(&mut self) -> &mut $inner {
+                &mut self.0
+            }
+        }
+    };
+}
+
+/// The simulated body: the articulated human (immutable, shared) and its integration scheme.
+#[derive(Component, Clone, Debug)]
+pub struct PhysicsBody {
+    /// The body (model, figure, DOF map, link names, contact boxes).
+    pub body: Arc<HumanBody>,
+    /// Integration scheme.
+    pub integrator: Integrator,
+}
+
+/// The body's state `(q, v)`, friction anchors, time (s) and steps.
+#[derive(Component, Clone, Debug, PartialEq)]
+pub struct BodyState(pub State);
+wrapper!(BodyState, State);
+
+/// PD control toward θ_d, θ̇_d per DOF (body DOF order), read at every evaluation.
+#[derive(Component, Clone, Debug, PartialEq)]
+pub struct PdController(pub PdTargets);
+wrapper!(PdController, PdTargets);
+
+/// Joint ranges and the joint model (friction inside, spring–damper past a limit).
+#[derive(Component, Clone, Debug, PartialEq)]
+pub struct JointLimits(pub JointRanges);
+wrapper!(JointLimits, JointRanges);
+
+/// Floor contact of the body's link boxes.
+#[derive(Component, Clone, Debug)]
+pub struct FloorContact(pub Arc<ContactModel>);
+
+/// Forces applied to the body (pushes), each with its time window.
+#[derive(Component, Clone, Debug, PartialEq, Default)]
+pub struct ExternalForces(pub Vec<ExternalForce>);
+wrapper!(ExternalForces, Vec<ExternalForce>);
+
+/// The pipeline's buffers.
+#[derive(Component, Clone, Debug)]
+pub struct PhysicsWorkspace(pub StepWorkspace);
+wrapper!(PhysicsWorkspace, StepWorkspace);
+
+/// What the steps saw: contact forces and depths, their peaks and impulses, range excursions.
+#[derive(Component, Clone, Debug, PartialEq)]
+pub struct PhysicsMonitor(pub StepMonitor);
+wrapper!(PhysicsMonitor, StepMonitor);
+
+/// Whether the body steps: `stopped` by its owner (e.g. a finished experiment) or by an error
+/// (a runaway state, with time, body and value).
+#[derive(Component, Clone, Debug, Default)]
+pub struct PhysicsStatus {
+    /// The body no longer steps.
+    pub stopped: bool,
+    /// The error that stopped it.
+    pub error: Option<Arc<StepError>>,
+}
+
+impl PhysicsStatus {
+    /// True while the body steps.
+    pub fn running(&self) -> bool {
+        !self.stopped && self.error.is_none()
+    }
+}
+
+/// The components every simulated body needs.
+#[derive(Bundle, Clone, Debug)]
+pub struct PhysicsBundle {
+    /// Body.
+    pub body: PhysicsBody,
+    /// State.
+    pub state: BodyState,
+    /// Buffers.
+    pub workspace: PhysicsWorkspace,
+    /// Monitor.
+    pub monitor: PhysicsMonitor,
+    /// Status.
+    pub status: PhysicsStatus,
+}
+
+impl PhysicsBundle {
+    /// `body` at configuration `q`, at rest, integrated with `integrator`.
+    pub fn new(body: Arc<HumanBody>, integrator: Integrator, q: Vec<f64>) -> Self {
+        let m = &body.model;
+        let state = State::new(q, vec![0.0; m.nv], m.nbodies());
+        let workspace = StepWorkspace::new(m);
+        let monitor = StepMonitor::new(m.nbodies(), body.dof_v.len());
+        Self {
+            body: PhysicsBody { body, integrator },
+            state: BodyState(state),
+            workspace: PhysicsWorkspace(workspace),
+            monitor: PhysicsMonitor(monitor),
+            status: PhysicsStatus::default(),
+        }
+    }
+}
+
+/// The drawable side of a simulated body: a character with the body's figure skeleton, so the
+/// motion systems draw and record it as any other character.
+pub fn drawn_body(name: &str, body: &HumanBody) -> impl Bundle {
+    let skeleton = Arc::new(body.figure.skeleton());
+    let n = skeleton.joints.len();
+    (
+        Character { name: name.into() },
+        SkeletonRef(skeleton),
+        JointState::new(n),
+        Recorder::default(),
+    )
+}
+
+/// The components of one body as the step reads them.
+type StepQuery<'a> = (
+    &'a PhysicsBody,
+    &'a mut BodyState,
+    Option<&'a PdController>,
+    Option<&'a JointLimits>,
+    Option<&'a FloorContact>,
+    Option<&'a ExternalForces>,
+    &'a mut PhysicsWorkspace,
+    &'a mut PhysicsMonitor,
+    &'a mut PhysicsStatus,
+);
+
+/// Steps every running body by the clock's substeps of `tick / substeps` seconds; an error
+/// stops that body (recorded in its [`PhysicsStatus`]) and no other.
+pub fn step_bodies(clock: Res<Clock>, mut q: Query<StepQuery>) {
+    let dt = clock.physics_dt();
+    for (body, mut state, pd, limits, contact, external, mut ws, mut monitor, mut status) in &mut q
+    {
+        if !status.running() {
+            continue;
+        }
+        let forces = Forces {
+            dofs: &body.body.dof_v,
+            pd: pd.map(|p| &p.0),
+            limits: limits.map(|l| &l.0),
+            contact: contact.map(|c| &*c.0),
+            external: external.map_or(&[], |e| &e.0[..]),
+        };
+        let settings = StepSettings {
+            integrator: body.integrator,
+            dt,
+        };
+        for _ in 0..clock.substeps {
+            if let Err(e) = pipeline::step(
+                &body.body.model,
+                settings,
+                &forces,
+                &mut state.0,
+                &mut ws.0,
+                &mut monitor.0,
+            ) {
+                status.error = Some(Arc::new(e));
+                break;
+            }
+        }
+    }
+}
+
+/// Sets the joint state of every drawn body from its configuration: the pelvis from the
+/// floating base, every other joint from its DOF angles (as a model clip does).
+pub fn publish_body_pose(mut q: Query<(&PhysicsBody, &BodyState, &mut JointState)>) {
+    for (body, state, mut joints) in &mut q {
+        let b = &*body.body;
+        let mut all = vec![0.0; b.model.nv];
+        b.model.angles(&state.q, &mut all);
+        let angles: Vec<f64> = b.dof_v.iter().map(|&k| all[k]).collect();
+        let js = &mut *joints;
+        b.figure.local_rotations(&angles, &mut js.rotations);
+        for (t, j) in js.translations.iter_mut().zip(&b.figure.joints) {
+            *t = j.offset;
+        }
+        let qs = &state.q;
+        js.translations[0] = DVec3::new(qs[0], qs[1], qs[2]);
+        js.rotations[0] = DQuat::from_xyzw(qs[3], qs[4], qs[5], qs[6]);
+    }
+}
+
+/// Adds the physics systems to `schedule`: [`step_bodies`] in [`MotionSet::Physics`],
+/// [`publish_body_pose`] in [`MotionSet::Pose`].
+pub fn add_physics_systems(schedule: &mut Schedule) {
+    configure_motion_sets(schedule);
+    schedule.add_systems((
+        step_bodies.in_set(MotionSet::Physics),
+        publish_body_pose.in_set(MotionSet::Pose),
+    ));
+}

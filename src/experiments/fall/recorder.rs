@@ -1,0 +1,154 @@
+//! What a fall keeps while it runs: frames at the record rate, rest detection from the kinetic
+//! energy, when the run is over, and the damage weights; and the [`FallResult`] it yields.
+
+use bevy_ecs::prelude::*;
+use glam::{DQuat, DVec3};
+
+use super::config::FallConfig;
+use super::result::{FallFrame, FallResult};
+use crate::dynamics::data::Data;
+use crate::dynamics::pipeline::{State, StepMonitor};
+use crate::humanoid::body::HumanBody;
+
+/// Frames, rest detection and the end of the run.
+#[derive(Component, Clone, Debug, PartialEq)]
+pub struct FallRecorder {
+    /// Frames so far; frame `k` is the state at the step nearest to `k / hz`.
+    pub frames: Vec<FallFrame>,
+    /// Index of the next frame to record.
+    pub next_frame: u64,
+    /// Frame rate (Hz).
+    pub hz: f64,
+    /// Physics step (s).
+    pub dt: f64,
+    /// Steps to run in total.
+    pub total_steps: u64,
+    /// Rest threshold on the kinetic energy (J).
+    pub rest_energy: f64,
+    /// Start of the current rest interval (s).
+    pub rest_since: Option<f64>,
+    /// Rest is only detected from this time on (the end of the push, s).
+    pub rest_after: f64,
+    /// Hold time (s).
+    pub rest_hold: f64,
+    /// End the run once the body has rested for the hold time.
+    pub stop_at_rest: bool,
+    /// Damage weight w_i per link.
+    pub weights: Vec<f64>,
+    /// The step the last record was taken at.
+    pub recorded_step: Option<u64>,
+    angles: Vec<f64>,
+}
+
+impl FallRecorder {
+    /// The recorder of the fall `cfg` (damage weights `weights` per link, a body of `nv`
+    /// velocity DOFs).
+    pub fn new(cfg: &FallConfig, weights: Vec<f64>, nv: usize) -> Self {
+        let frames = (cfg.duration_s * cfg.record_hz).floor() as usize + 1;
+        Self {
+            frames: Vec::with_capacity(frames),
+            next_frame: 0,
+            hz: cfg.record_hz,
+            dt: cfg.dt_s,
+            total_steps: (cfg.duration_s / cfg.dt_s).round() as u64,
+            rest_energy: cfg.rest_kinetic_energy_j,
+            rest_since: None,
+            rest_after: cfg.push.start_s + cfg.push.duration_s,
+            rest_hold: cfg.rest_hold_s,
+            stop_at_rest: cfg.stop_at_rest,
+            weights,
+            recorded_step: None,
+            angles: vec![0.0; nv],
+        }
+    }
+
+    /// True once the run is over for `state`: all steps taken, or (with `stop_at_rest`) the
+    /// body has stayed at rest for the hold time.
+    pub fn finished(&self, state: &State) -> bool {
+        state.steps >= self.total_steps
+            || (self.stop_at_rest
+                && self
+                    .rest_since
+                    .is_some_and(|t0| state.time_s - t0 >= self.rest_hold))
+    }
+
+    /// Records `state` (whose kinematics are in `data`): at step 0 the first frame; after a
+    /// step the rest detection (kinetic energy below the threshold once the push is over) and
+    /// a frame when one is due.
+    pub fn record(&mut self, body: &HumanBody, state: &State, data: &Data) {
+        if self.recorded_step == Some(state.steps) {
+            return;
+        }
+        self.recorded_step = Some(state.steps);
+        if state.steps == 0 {
+            let f = self.frame(body, state, data);
+            self.frames.push(f);
+            self.next_frame = 1;
+            return;
+        }
+        let model = &body.model;
+        let t = state.time_s;
+        let mut ke = 0.0;
+        for i in 0..model.nbodies() {
+            ke += model.bodies[i].inertia.kinetic_energy(data.v[i]);
+        }
+        // Rest counts only once the push is over (a figure standing still before it is not
+        // "at rest" on the floor).
+        if ke < self.rest_energy && t >= self.rest_after {
+            self.rest_since.get_or_insert(t);
+        } else {
+            self.rest_since = None;
+        }
+        if state.steps >= self.frame_step(self.next_frame) {
+            let f = self.frame(body, state, data);
+            self.frames.push(f);
+            self.next_frame += 1;
+        }
+    }
+
+    /// The step at which frame `k` is taken: the one nearest to `k / hz`.
+    fn frame_step(&self, k: u64) -> u64 {
+        (k as f64 / (self.hz * self.dt)).round() as u64
+    }
+
+    fn frame(&mut self, b: &HumanBody, state: &State, data: &Data) -> FallFrame {
+        let q = &state.q;
+        b.model.angles(q, &mut self.angles);
+        let angles = b.dof_v.iter().map(|&k| self.angles[k]).collect();
+        let head = b.link_index("head").unwrap_or(0);
+        let head_com = data.pos[head] + data.rot[head] * b.model.bodies[head].inertia.com;
+        FallFrame {
+            time_s: state.time_s,
+            root_position: DVec3::new(q[0], q[1], q[2]),
+            root_orientation: DQuat::from_xyzw(q[3], q[4], q[5], q[6]),
+            angles,
+            head_height_m: head_com.y,
+        }
+    }
+
+    /// The result of the run so far; the damage is `D = Σ w_i f_i` (eq. 5.1) over the peak
+    /// normal forces `f_i` of `monitor`.
+    pub fn result(&self, body: &HumanBody, state: &State, monitor: &StepMonitor) -> FallResult {
+        let c = &monitor.contact;
+        let damage = self.weights.iter().zip(&c.peak).map(|(w, f)| w * f).sum();
+        let end = state.time_s;
+        let rest_time_s = self.rest_since.filter(|&t0| end - t0 >= self.rest_hold);
+        FallResult {
+            dof_names: body.figure.dof_names(),
+            link_names: body.link_names.clone(),
+            frames: self.frames.clone(),
+            record_hz: self.hz,
+            damage,
+            peak_vertical_force_n: c.peak.clone(),
+            impulse_n_s: c.impulse.clone(),
+            max_penetration_m: c.max_penetration,
+            max_penetration_by_link_m: c.max_depth.clone(),
+            max_limit_excursion_rad: monitor.max_excursion.clone(),
+            came_to_rest: rest_time_s.is_some(),
+            rest_time_s,
+            steps: state.steps,
+            dt_s: self.dt,
+            height_m: body.figure.height,
+        }
+    }
+}
