@@ -3,10 +3,10 @@
 //! `g(sin α − μ cos α)` above it; a joint limit holds a lever under load.
 
 use glam::{DQuat, DVec3};
-use marionette::dynamics::forces::contact::{ContactModel, ContactParams, ContactState};
 use marionette::dynamics::forces::contact::LinkBox;
-use marionette::dynamics::integrator::step;
+use marionette::dynamics::forces::contact::{ContactModel, ContactParams, ContactState};
 use marionette::dynamics::forces::limits::{JointLimitParams, joint_torque};
+use marionette::dynamics::integrator::step;
 use marionette::dynamics::{
     Body, Data, Dynamics, ForceVec, Inertia, Integrator, IntegratorWorkspace, JointType, Model,
     SpatialTransform, aba, kinematics,
@@ -83,11 +83,22 @@ fn run(w: &mut BoxOnFloor, q: &mut [f64], v: &mut [f64], seconds: f64) {
     let n = (seconds / h).round() as usize;
     for k in 0..n {
         kinematics(&w.model, &mut w.data, q, v);
-        w.contact.update_anchors(&w.data, &mut w.state);
+        let (mut f, mut n, mut d) = ([ForceVec::ZERO], [0.0], [0.0]);
+        w.contact
+            .update_and_apply(&w.data, &mut w.state, &mut f, &mut n, &mut d);
         let scheme = Integrator::SemiImplicitEuler {
             implicit_damping: false,
         };
-        step(scheme, &w.model.clone(), &mut ws, w, k as f64 * h, h, q, v).unwrap();
+        step(
+            scheme,
+            &w.model.clone(),
+            &mut ws,
+            w,
+            k as f64 * h,
+            h,
+            (q, v),
+        )
+        .unwrap();
     }
 }
 
@@ -221,8 +232,7 @@ fn a_joint_limit_holds_a_lever_under_load() {
             &mut lever,
             k as f64 * h,
             h,
-            &mut q,
-            &mut v,
+            (&mut q, &mut v),
         )
         .unwrap();
         highest = highest.max(q[0]);

@@ -3,7 +3,8 @@
 //! body and quantity.
 
 use glam::DVec3;
-use marionette::experiments::fall::ecs::{build_fall_world, run_parallel, run_world};
+use marionette::dynamics::StepError;
+use marionette::experiments::fall::ecs::{build_fall_world, run_fall_world, run_parallel};
 use marionette::experiments::fall::{FallConfig, FallResult, SimError, simulate_fall};
 use marionette::humanoid::ranges::AgeGroup;
 use rand::{RngExt, SeedableRng};
@@ -40,7 +41,7 @@ fn a_world_reproduces_simulate_fall_bit_for_bit() {
     let cfg = short(AgeGroup::Elderly);
     let direct = simulate_fall(&cfg).unwrap();
     let mut world = build_fall_world(&cfg).unwrap();
-    let ecs = run_world(&mut world).pop().unwrap().unwrap();
+    let ecs = run_fall_world(&mut world).pop().unwrap().unwrap();
     assert_eq!(bits(&direct), bits(&ecs));
     assert!(direct.frames.len() > 30);
 }
@@ -89,16 +90,18 @@ fn a_runaway_push_stops_with_time_body_and_quantity() {
     let mut cfg = short(AgeGroup::Elderly);
     cfg.push.force_n = 5.0e5;
     match simulate_fall(&cfg) {
-        Err(SimError::Exploding {
+        Err(SimError::Step(StepError::Exploding {
             time_s,
             body,
             quantity,
             ..
-        }) => {
+        })) => {
             assert!(time_s >= cfg.push.start_s && time_s < 0.6, "t = {time_s}");
             assert!(!body.is_empty() && !quantity.is_empty());
         }
-        Err(SimError::NonFinite { time_s, body, .. }) => assert!(time_s > 0.0 && !body.is_empty()),
+        Err(SimError::Step(StepError::NonFinite { time_s, body, .. })) => {
+            assert!(time_s > 0.0 && !body.is_empty())
+        }
         other => panic!(
             "expected the run to stop, got {:?}",
             other.map(|r| r.damage)
@@ -106,21 +109,22 @@ fn a_runaway_push_stops_with_time_body_and_quantity() {
     }
     // The World path reports the same failure.
     let mut world = build_fall_world(&cfg).unwrap();
-    assert!(run_world(&mut world).pop().unwrap().is_err());
+    assert!(run_fall_world(&mut world).pop().unwrap().is_err());
 }
 
 #[test]
 fn two_characters_in_one_world_fall_independently() {
     use bevy_ecs::world::World;
-    use marionette::experiments::fall::ecs::spawn_fall;
     use marionette::experiments::fall::build_fall;
+    use marionette::experiments::fall::ecs::spawn_fall;
     let a = short(AgeGroup::Elderly);
     let mut b = short(AgeGroup::Adult);
     b.push.force_n = 700.0;
     let mut world = World::new();
-    spawn_fall(&mut world, build_fall(&a).unwrap());
-    spawn_fall(&mut world, build_fall(&b).unwrap());
-    let results = run_world(&mut world);
+    world.insert_resource(marionette::ecs::Clock::physics(a.dt_s));
+    spawn_fall(&mut world, build_fall(&a).unwrap()).unwrap();
+    spawn_fall(&mut world, build_fall(&b).unwrap()).unwrap();
+    let results = run_fall_world(&mut world);
     assert_eq!(results.len(), 2);
     let ra = results[0].as_ref().unwrap();
     let rb = results[1].as_ref().unwrap();

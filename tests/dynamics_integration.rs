@@ -125,8 +125,7 @@ fn pendulum_period_matches_the_elliptic_integral() {
             &mut dynm,
             t,
             h,
-            &mut q,
-            &mut v,
+            (&mut q, &mut v),
         )
         .unwrap();
         t += h;
@@ -218,8 +217,7 @@ fn passive_chain_conserves_energy_under_rk4() {
             &mut dynm,
             n as f64 * h,
             h,
-            &mut q,
-            &mut v,
+            (&mut q, &mut v),
         )
         .unwrap();
         if n % 100 == 99 {
@@ -272,8 +270,7 @@ fn free_fall_of_a_spinning_body_follows_the_parabola() {
             &mut dynm,
             k as f64 * h,
             h,
-            &mut q,
-            &mut v,
+            (&mut q, &mut v),
         )
         .unwrap();
     }
@@ -311,8 +308,7 @@ fn implicit_damping_is_stable_where_explicit_euler_blows_up() {
                 &mut dynm,
                 k as f64 * 2e-3,
                 2e-3,
-                &mut q,
-                &mut v,
+                (&mut q, &mut v),
             )
             .unwrap();
         }
@@ -364,8 +360,7 @@ fn rk4_keeps_fourth_order_on_the_rotation_manifold() {
                 &mut dynm,
                 k as f64 * h,
                 h,
-                &mut q,
-                &mut v,
+                (&mut q, &mut v),
             )
             .unwrap();
         }

@@ -4,9 +4,7 @@
 use std::sync::Arc;
 
 use bevy_ecs::prelude::*;
-use marionette::ecs::primitive::{
-    BlendPlayer, DofPose, PrimitiveClock, PrimitivePlayer, add_primitive_systems,
-};
+use marionette::ecs::primitive::{BlendPlayer, DofPose, PrimitivePlayer, add_primitive_systems};
 use marionette::primitive::synthetic::smooth_humanoid24;
 use marionette::primitive::{
     BlendPlacement, Gamma, LearnConfig, Primitive, Relearn, Trajectory, blend, connect,
@@ -39,7 +37,7 @@ fn hundred_characters_in_one_world_match_the_kernel() {
     let a = three_dof(1, 0, 150);
     let b = three_dof(2, 300, 420);
     let mut world = World::new();
-    world.insert_resource(PrimitiveClock { dt });
+    world.insert_resource(marionette::ecs::Clock::new(dt, 1));
     let mut schedule = Schedule::default();
     add_primitive_systems(&mut schedule);
 

@@ -271,12 +271,9 @@ fn contact_stage(
             &mut monitor.normal,
             &mut monitor.depth,
         );
-        monitor.contact.accumulate(
-            &monitor.normal,
-            &monitor.depth,
-            monitor.penetration,
-            dt,
-        );
+        monitor
+            .contact
+            .accumulate(&monitor.normal, &monitor.depth, monitor.penetration, dt);
     }
     e.step_start_ready = true;
 }

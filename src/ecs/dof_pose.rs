@@ -8,8 +8,8 @@ use bevy_ecs::prelude::*;
 use glam::{DQuat, DVec3};
 
 use super::motion::{Character, JointState, Recorder, SkeletonRef};
-use crate::humanoid::{Model, ROOT_CHANNELS};
 use super::primitive::{DofPose, PrimitivePlayer};
+use crate::humanoid::{Model, ROOT_CHANNELS};
 use crate::primitive::{Primitive, PrimitiveError};
 
 /// Which entries of a character's [`DofPose`] are its model's DOFs and its six root channels

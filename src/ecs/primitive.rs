@@ -274,10 +274,7 @@ pub fn step_primitive_players(
 }
 
 /// Steps every [`BlendPlayer`] by one tick and writes its [`DofPose`].
-pub fn step_blend_players(
-    clock: Res<Clock>,
-    mut q: Query<(&mut BlendPlayer, &mut DofPose)>,
-) {
+pub fn step_blend_players(clock: Res<Clock>, mut q: Query<(&mut BlendPlayer, &mut DofPose)>) {
     for (mut player, mut pose) in &mut q {
         player.advance(clock.tick_s, &mut pose);
     }

@@ -9,10 +9,7 @@ use crate::skeleton::forward_kinematics;
 
 /// Samples every playing clip at its current time into the joint state, then advances the clip
 /// time by `speed × tick`.
-pub fn sample_clips(
-    clock: Res<Clock>,
-    mut q: Query<(&mut ClipPlayback, &mut JointState)>,
-) {
+pub fn sample_clips(clock: Res<Clock>, mut q: Query<(&mut ClipPlayback, &mut JointState)>) {
     for (mut play, mut state) in &mut q {
         let clip = play.clip.clone();
         let frames = clip.frame_count();

@@ -60,7 +60,7 @@ impl WorldPool {
 
     /// Runs `f` on every World in parallel; the results are in World order.
     pub fn run<T: Send>(&mut self, f: impl Fn(&mut World) -> T + Sync + Send) -> Vec<T> {
-        self.worlds.par_iter_mut().map(|w| f(w)).collect()
+        self.worlds.par_iter_mut().map(f).collect()
     }
 
     /// The Worlds.

@@ -31,9 +31,7 @@ use crate::dynamics::forces::pd::PdTargets;
 use crate::dynamics::kinematics::kinematics;
 use crate::dynamics::pipeline::{self, Forces, StepSettings};
 use crate::dynamics::stability::{DofStiffness, scheme_name, stiffest_mode};
-use crate::ecs::physics::{
-    ExternalForces, FloorContact, JointLimits, PdController, PhysicsBundle,
-};
+use crate::ecs::physics::{ExternalForces, FloorContact, JointLimits, PdController, PhysicsBundle};
 use crate::humanoid::body::{HumanBody, fall21_body};
 use crate::humanoid::ranges::RangeTable;
 
