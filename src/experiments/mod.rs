@@ -5,3 +5,5 @@
 //! - [`fall`]: the falling paper's pushed figure (SPEC §3), one fall or many in parallel Worlds.
 
 pub mod fall;
+pub mod high_jump;
+pub mod knee_kick;
