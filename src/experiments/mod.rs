@@ -2,6 +2,10 @@
 //! typed outcome out, no files and no pictures (a scene file is only the front door that reads a
 //! configuration, calls one of these and writes its outputs).
 //!
-//! - [`fall`]: the falling paper's pushed figure (SPEC §3), one fall or many in parallel Worlds.
+//! - [`fall`]: the falling paper's pushed figure (SPEC §3), one fall or many in parallel Worlds;
+//! - [`high_jump`]: the motor-primitive paper's high jump by extrapolation (§4.1);
+//! - [`knee_kick`]: its jumping knee kick, blended and connected (§4.2).
 
 pub mod fall;
+pub mod high_jump;
+pub mod knee_kick;

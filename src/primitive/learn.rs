@@ -21,9 +21,9 @@
 use serde::{Deserialize, Serialize};
 
 use super::basis::Basis;
+use super::definition::DofPrimitive;
 use super::dmp::{Formulation, SpatialScaling, integrate_z_demo};
 use super::error::{PrimitiveError, Result, require_positive};
-use super::primitive::DofPrimitive;
 use super::trajectory::Trajectory;
 
 /// How many kernels a primitive gets.

@@ -49,14 +49,17 @@
 //! assert!(peak > 80.0); // deeper than the normal jump's crouch
 //! ```
 //!
-//! Files: [`canonical`] (shared phase), [`basis`] (kernels), [`dmp`] (one-DOF transformation system,
-//! formulations), [`learn`] (LWR and ridge), [`rollout`] (fixed-step integrator), [`primitive`]
-//! (multi-DOF primitive, adjust, RON io), [`mod@connect`], [`mod@blend`], [`events`], [`ecs`].
+//! Files: [`canonical`] (shared phase), [`basis`] (kernels), [`dmp`] (one-DOF transformation
+//! system, formulations), [`definition`] (the multi-DOF primitive as data and its invariants),
+//! [`learn`] (LWR and ridge), [`rollout`] (fixed-step integrator), [`primitive`] (learn, adjust,
+//! sample, fit, RON io), [`mod@connect`], [`mod@blend`], [`events`]; the ECS players are in
+//! [`crate::ecs`].
 
 pub mod basis;
 pub mod blend;
 pub mod canonical;
 pub mod connect;
+pub mod definition;
 pub mod dmp;
 pub mod error;
 pub mod events;

@@ -19,9 +19,9 @@
 
 use super::basis::Kernels;
 use super::canonical::CanonicalSystem;
+use super::definition::Primitive;
 use super::dmp::Formulation;
 use super::error::{PrimitiveError, Result, require_finite};
-use super::primitive::Primitive;
 
 /// The state of every DOF at one instant: angle (rad, or m) and rate (rad/s, or m/s).
 #[derive(Clone, Debug, PartialEq, Default)]

@@ -1,5 +1,9 @@
 //! Scenes of the motor-primitive paper: the high jump by extrapolation (§4.1) and the jumping
-//! knee kick (§4.2), on keyframed or captured clips.
+//! knee kick (§4.2), on keyframed or captured clips. The experiments themselves are
+//! [`experiments::high_jump`](crate::experiments::high_jump) and
+//! [`experiments::knee_kick`](crate::experiments::knee_kick); a scene loads the clips onto
+//! humanoid24, builds their configuration, runs them and writes the outputs (BVH, primitive RON
+//! files, pictures, the report's figures).
 
 use std::path::Path;
 use std::sync::Arc;
@@ -12,10 +16,11 @@ use super::{SceneError, draw_tracks, write_output};
 use crate::ecs::{
     Clock, Recorder, kinematic_schedule, new_world, run_ticks, spawn_primitive_character,
 };
+use crate::experiments::high_jump::{self, HighJumpConfig, PrimitiveExperimentError};
+use crate::experiments::knee_kick::{self, KneeKickConfig};
 use crate::humanoid::{Model, ModelClip};
 use crate::primitive::{
-    BlendPlacement, EventConfig, Gamma, JumpEvents, LearnConfig, Learned, Primitive, Relearn,
-    Trajectory, blend, connect, find_jump_events,
+    EventConfig, Gamma, JumpEvents, LearnConfig, Learned, Primitive, PrimitiveError, Trajectory,
 };
 use crate::render::{Plot, Series, Track, plot};
 
@@ -42,12 +47,12 @@ impl Default for PrimitiveRender {
 }
 
 fn extrapolate_half() -> Gamma {
-    Gamma::Constant(-0.5)
+    high_jump::PAPER_GAMMA
 }
 
-/// The paper's §4.1: a high jump extrapolated from a low and a normal jump. The low jump (A) is
-/// time-scaled to the normal jump's (B) duration, both span the same time, and
-/// `θ = γ·θ_A + (1 − γ)·θ_B` with constant γ = −0.5 gives `1.5·normal − 0.5·low`.
+/// The paper's §4.1 as a scene ([`high_jump::run`]): a high jump extrapolated from a low and a
+/// normal jump. The low jump (A) is time-scaled to the normal jump's (B) duration, both span the
+/// same time, and `θ = γ·θ_A + (1 − γ)·θ_B` with constant γ = −0.5 gives `1.5·normal − 0.5·low`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct HighJumpScene {
@@ -71,10 +76,11 @@ pub struct HighJumpScene {
 }
 
 fn kick_gamma() -> Gamma {
-    Gamma::Ramp { from: 1.0, to: 0.0 }
+    knee_kick::PAPER_GAMMA
 }
 
-/// The paper's §4.2: a jumping knee kick. A is the high jump of [`HighJumpScene`] (Start … Land);
+/// The paper's §4.2 as a scene ([`knee_kick::run`]): a jumping knee kick. A is the high jump of
+/// [`HighJumpScene`] (Start … Land);
 /// B, a knee kick, is placed from A's Bend (deepest crouch) to its Leap (hips highest) and
 /// blended with γ(t′) = 1 − t′; the result is re-learned as two primitives split at Leap
 /// ("jumping knee kick" and "land"), which are then connected.
@@ -100,7 +106,11 @@ pub struct JumpingKneeKickScene {
     pub render: PrimitiveRender,
 }
 
-fn primitive_error(e: crate::primitive::PrimitiveError) -> SceneError {
+fn primitive_error(e: PrimitiveError) -> SceneError {
+    SceneError::Invalid(e.to_string())
+}
+
+fn experiment_error(e: PrimitiveExperimentError) -> SceneError {
     SceneError::Invalid(e.to_string())
 }
 
@@ -109,103 +119,23 @@ fn demo(src: &ClipSource, base: &Path, model: &Model) -> Result<ModelClip, Scene
     load_motion(src, base)?.on_model(model)
 }
 
-fn learn(name: &str, traj: &Trajectory, config: &LearnConfig) -> Result<Learned, SceneError> {
-    Primitive::learn(name, traj, config).map_err(primitive_error)
-}
-
-fn rollout(p: &Primitive, dt: f64) -> Result<Trajectory, SceneError> {
-    p.rollout(dt, None).map_err(primitive_error)
-}
-
-fn on_model(model: &Model, traj: &Trajectory) -> Result<ModelClip, SceneError> {
-    ModelClip::from_trajectory(model, traj).map_err(SceneError::Invalid)
-}
-
-/// Peak of a DOF over a trajectory, degrees.
-fn peak_deg(traj: &Trajectory, dof: &str) -> Result<f64, SceneError> {
-    let j = traj
-        .index_of(dof)
-        .ok_or_else(|| SceneError::Invalid(format!("no DOF '{dof}'")))?;
-    Ok(traj
-        .column(j)
-        .into_iter()
-        .fold(f64::MIN, f64::max)
-        .to_degrees())
+/// The high jump's configuration: the scene's clips loaded onto `model`.
+fn high_jump_config(
+    scene: &HighJumpScene,
+    base: &Path,
+    model: &Model,
+) -> Result<HighJumpConfig, SceneError> {
+    Ok(HighJumpConfig {
+        model: model.clone(),
+        low: demo(&scene.low, base, model)?,
+        normal: demo(&scene.normal, base, model)?,
+        gamma: scene.gamma.clone(),
+        learn: scene.learn,
+    })
 }
 
 fn fit_json(l: &Learned) -> serde_json::Value {
     json!({ "median": l.fit.median_angle_rmse_deg(), "max": l.fit.max_angle_rmse_deg() })
-}
-
-/// Learned A (low), B (normal), and the high jump; their rollouts on the model.
-struct HighJump {
-    low: Learned,
-    normal: Learned,
-    high: Learned,
-    dt: f64,
-    /// Largest root-height correction that put the feet back on the floor, metres.
-    ground_correction_m: f64,
-}
-
-/// The lowest foot point (ankles and toes) of a clip over all frames: its floor, metres.
-fn lowest_foot(clip: &ModelClip) -> f64 {
-    heights(clip)
-        .1
-        .iter()
-        .flatten()
-        .copied()
-        .fold(f64::INFINITY, f64::min)
-}
-
-fn make_high_jump(
-    scene: &HighJumpScene,
-    base: &Path,
-    model: &Model,
-) -> Result<HighJump, SceneError> {
-    let low_clip = demo(&scene.low, base, model)?;
-    let normal_clip = demo(&scene.normal, base, model)?;
-    let dt = normal_clip.frame_time;
-    let low = learn("low_jump", &low_clip.to_trajectory(), &scene.learn)?;
-    let normal = learn("normal_jump", &normal_clip.to_trajectory(), &scene.learn)?;
-    let t = normal.primitive.duration;
-    // A time-scaled to B's duration; both on [0, T].
-    let placement = BlendPlacement {
-        a_start: 0.0,
-        a_end: t,
-        b_start: 0.0,
-        b_end: t,
-    };
-    let result = blend(
-        &low.primitive,
-        &normal.primitive,
-        &placement,
-        &scene.gamma,
-        dt,
-        Relearn::Whole,
-        &scene.learn,
-    )
-    .map_err(primitive_error)?;
-    let blended = result
-        .primitives
-        .into_iter()
-        .next()
-        .ok_or_else(|| SceneError::Invalid("the blend re-learned no primitive".into()))?;
-    // Put the feet back on the floor outside the normal jump's flight, then learn the high jump.
-    let normal_roll = on_model(model, &rollout(&normal.primitive, dt)?)?;
-    let (root_y, feet) = heights(&normal_roll);
-    let ev = find_jump_events(&root_y, dt, Some(&feet), &EventConfig::default())
-        .map_err(primitive_error)?;
-    let mut high_clip = on_model(model, &rollout(&blended.primitive, dt)?)?;
-    let floor = lowest_foot(&normal_roll);
-    let ground_correction_m = high_clip.keep_feet_on_floor(&[(ev.take_off, ev.land)], floor);
-    let high = learn("high_jump", &high_clip.to_trajectory(), &scene.learn)?;
-    Ok(HighJump {
-        low,
-        normal,
-        high,
-        dt,
-        ground_correction_m,
-    })
 }
 
 /// Draws tracks of model clips: filmstrip, GIF.
@@ -257,63 +187,44 @@ fn dof_series(
     })
 }
 
-/// Runs the high-jump scene. A jump's knee flexion is that of its crouch (the peak before
-/// take-off, found by [`find_jump_events`] on each rollout), as in the paper's Fig. 8; the whole
-/// clip's peak, which for a low jump can be the landing, is reported apart. Writes
-/// `high_jump.bvh`, the primitives (`*.primitive.ron`),
-/// `filmstrip.png`, `motion.gif`, `left_knee.png` (the paper's Fig. 8) and returns the report.
+/// Writes primitives as `<name>.primitive.ron` into `out`.
+fn save_primitives<'a>(
+    learned: impl IntoIterator<Item = &'a Learned>,
+    out: &Path,
+) -> Result<(), SceneError> {
+    for l in learned {
+        l.primitive
+            .save(&out.join(format!("{}.primitive.ron", l.primitive.name)))
+            .map_err(primitive_error)?;
+    }
+    Ok(())
+}
+
+/// Runs the high-jump scene ([`high_jump::run`] on the scene's clips). A jump's knee flexion is
+/// that of its crouch (the peak before take-off), as in the paper's Fig. 8; the whole clip's
+/// peak, which for a low jump can be the landing, is reported apart. Writes `high_jump.bvh`, the
+/// primitives (`*.primitive.ron`), `filmstrip.png`, `motion.gif`, `left_knee.png` (the paper's
+/// Fig. 8) and returns the report.
 pub fn run_high_jump(
     scene: &HighJumpScene,
     base: &Path,
     out: &Path,
 ) -> Result<serde_json::Value, SceneError> {
     let model = Model::by_name("humanoid24")?;
-    let hj = make_high_jump(scene, base, &model)?;
-    let t = hj.normal.primitive.duration;
-    // Rollouts on the common span: the low jump time-scaled to the normal jump's duration.
-    let low_scaled = hj.low.primitive.with_duration(t).map_err(primitive_error)?;
-    let r_low = rollout(&low_scaled, hj.dt)?;
-    let r_normal = rollout(&hj.normal.primitive, hj.dt)?;
-    let r_high = rollout(&hj.high.primitive, hj.dt)?;
-    let high_clip = on_model(&model, &r_high)?;
-    let low_clip = on_model(&model, &r_low)?;
-    let normal_clip = on_model(&model, &r_normal)?;
-    // The paper's knee flexion of a jump is that of its crouch: the peak before take-off.
-    let crouch_peak = |traj: &Trajectory, clip: &ModelClip| -> Result<f64, SceneError> {
-        let (root_y, feet) = heights(clip);
-        let ev = find_jump_events(&root_y, hj.dt, Some(&feet), &EventConfig::default())
-            .map_err(primitive_error)?;
-        let frames = ((ev.take_off / traj.dt).round() as usize).clamp(1, traj.frames() - 1);
-        peak_deg(
-            &traj.slice_frames(0, frames).map_err(primitive_error)?,
-            "left_knee",
-        )
-    };
-    let (p_low, p_normal, p_high) = (
-        crouch_peak(&r_low, &low_clip)?,
-        crouch_peak(&r_normal, &normal_clip)?,
-        crouch_peak(&r_high, &high_clip)?,
-    );
-    let whole = (
-        peak_deg(&r_low, "left_knee")?,
-        peak_deg(&r_normal, "left_knee")?,
-        peak_deg(&r_high, "left_knee")?,
-    );
-    let expected = 1.5 * p_normal - 0.5 * p_low;
+    let config = high_jump_config(scene, base, &model)?;
+    let hj = high_jump::run(&config).map_err(experiment_error)?;
+    let learned = &hj.primitives.learned;
+    let (clips, rollouts) = (&hj.clips, &hj.rollouts);
     write_output(
         &out.join("high_jump.bvh"),
-        crate::bvh::to_string(&high_clip.to_clip().to_bvh()).as_bytes(),
+        crate::bvh::to_string(&clips.high.to_clip().to_bvh()).as_bytes(),
     )?;
-    for l in [&hj.low, &hj.normal, &hj.high] {
-        l.primitive
-            .save(&out.join(format!("{}.primitive.ron", l.primitive.name)))
-            .map_err(primitive_error)?;
-    }
+    save_primitives([&learned.low, &learned.normal, &learned.high], out)?;
     draw(
         &[
-            ("low (time-scaled)", &low_clip),
-            ("normal", &normal_clip),
-            ("high (γ = −0.5)", &high_clip),
+            ("low (time-scaled)", &clips.low),
+            ("normal", &clips.normal),
+            ("high (γ = −0.5)", &clips.high),
         ],
         &scene.render,
         out,
@@ -324,30 +235,25 @@ pub fn run_high_jump(
             x_label: "time (s)".into(),
             y_label: "left knee flexion (deg)".into(),
             series: vec![
-                dof_series("low", &r_low, "left_knee", 0.0)?,
-                dof_series("normal", &r_normal, "left_knee", 0.0)?,
-                dof_series("high", &r_high, "left_knee", 0.0)?,
+                dof_series("low", &rollouts.low, "left_knee", 0.0)?,
+                dof_series("normal", &rollouts.normal, "left_knee", 0.0)?,
+                dof_series("high", &rollouts.high, "left_knee", 0.0)?,
             ],
             markers: vec![],
         },
         &out.join("left_knee.png"),
     )?;
+    let (p, whole) = (&hj.crouch_knee_flexion_deg, &hj.whole_clip_knee_flexion_deg);
     Ok(json!({
-        "peak_knee_flexion_deg": { "low": p_low, "normal": p_normal, "high": p_high },
-        "peak_knee_flexion_whole_clip_deg": { "low": whole.0, "normal": whole.1, "high": whole.2 },
-        "expected_high_deg": expected,
-        "high_minus_expected_deg": p_high - expected,
-        "fit_rmse_deg": fit_json(&hj.high),
-        "fit_rmse_deg_by_primitive": { "low": fit_json(&hj.low), "normal": fit_json(&hj.normal), "high": fit_json(&hj.high) },
-        "duration_s": t,
-        "ground_correction_m": hj.ground_correction_m,
+        "peak_knee_flexion_deg": { "low": p.low, "normal": p.normal, "high": p.high },
+        "peak_knee_flexion_whole_clip_deg": { "low": whole.low, "normal": whole.normal, "high": whole.high },
+        "expected_high_deg": hj.expected_high_deg,
+        "high_minus_expected_deg": hj.high_minus_expected_deg,
+        "fit_rmse_deg": fit_json(&learned.high),
+        "fit_rmse_deg_by_primitive": { "low": fit_json(&learned.low), "normal": fit_json(&learned.normal), "high": fit_json(&learned.high) },
+        "duration_s": hj.duration_s,
+        "ground_correction_m": hj.primitives.ground_correction_m,
     }))
-}
-
-/// Root height and each foot's lowest point over time (`feet[foot][frame]`), metres.
-fn heights(clip: &ModelClip) -> (Vec<f64>, Vec<Vec<f64>>) {
-    let root: Vec<f64> = clip.root_translation.iter().map(|t| t.y).collect();
-    (root, clip.foot_heights().into())
 }
 
 /// Plays the connected sequence by a character in an ECS world (players → pose → forward
@@ -387,96 +293,36 @@ fn events_json(e: &JumpEvents) -> serde_json::Value {
     json!({ "start": e.start, "bend": e.bend, "take_off": e.take_off, "leap": e.leap, "land": e.land })
 }
 
-/// Runs the jumping-knee-kick scene: writes `jumping_knee_kick.bvh`, the two primitives,
-/// `filmstrip.png`, `motion.gif`, `left_knee.png`, `right_knee.png` and returns the report.
+/// Runs the jumping-knee-kick scene ([`knee_kick::run`] on the scene's clips, then the connected
+/// sequence played in an ECS world and compared with the kernel): writes
+/// `jumping_knee_kick.bvh`, the two primitives, `filmstrip.png`, `motion.gif`, `left_knee.png`,
+/// `right_knee.png` and returns the report.
 pub fn run_jumping_knee_kick(
     scene: &JumpingKneeKickScene,
     base: &Path,
     out: &Path,
 ) -> Result<serde_json::Value, SceneError> {
     let model = Model::by_name("humanoid24")?;
-    let hj = make_high_jump(&scene.jump, base, &model)?;
-    let dt = hj.dt;
-    let a = &hj.high.primitive;
-    let r_jump = rollout(a, dt)?;
-    let jump_clip = on_model(&model, &r_jump)?;
-    let (root_y, feet) = heights(&jump_clip);
-    let ev = find_jump_events(&root_y, dt, Some(&feet), &scene.events).map_err(primitive_error)?;
-
-    let kick_clip = demo(&scene.kick, base, &model)?;
-    let kick = learn("knee_kick", &kick_clip.to_trajectory(), &scene.jump.learn)?;
-    let placement = BlendPlacement {
-        a_start: 0.0,
-        a_end: a.duration,
-        b_start: ev.bend,
-        b_end: ev.leap,
+    let config = KneeKickConfig {
+        jump: high_jump_config(&scene.jump, base, &model)?,
+        kick: demo(&scene.kick, base, &model)?,
+        gamma: scene.gamma.clone(),
+        events: scene.events,
     };
-    let result = blend(
-        a,
-        &kick.primitive,
-        &placement,
-        &scene.gamma,
-        dt,
-        Relearn::SplitAtBEnd,
-        &scene.jump.learn,
-    )
-    .map_err(primitive_error)?;
-    if result.primitives.len() != 2 {
-        return Err(SceneError::Invalid(format!(
-            "expected two primitives split at Leap, got {}",
-            result.primitives.len()
-        )));
-    }
-    let mut parts: Vec<Learned> = result.primitives;
-    parts[0].primitive.name = "jumping_knee_kick".into();
-    parts[1].primitive.name = "land".into();
-    let sequence: Vec<Primitive> = parts.iter().map(|l| l.primitive.clone()).collect();
-    let connected = connect(&sequence, dt, None).map_err(primitive_error)?;
-    let junction = connected.junctions.first();
-    let angle_jump = junction.map_or(0.0, |j| j.max_angle_jump.to_degrees());
-    let velocity_jump = junction.map_or(0.0, |j| j.max_velocity_jump.to_degrees());
-    let result_clip = on_model(&model, &connected.trajectory)?;
-    let ecs_gap = play_in_world(&model, &sequence, &result_clip)?;
-
-    // Checks of the paper's figure: the jump's posture at Bend, the kick's at Leap, both feet
-    // down after landing.
-    let frame_at = |t: f64| ((t / dt).round() as usize).min(result_clip.frame_count() - 1);
-    let posture_gap = |a_clip: &ModelClip, fa: usize, fb: usize| -> f64 {
-        a_clip
-            .frame_angles(fa)
-            .iter()
-            .zip(result_clip.frame_angles(fb))
-            .map(|(x, y)| (x - y).abs().to_degrees())
-            .fold(0.0, f64::max)
-    };
-    let kick_end = kick_clip.frame_count() - 1;
-    let at_bend = posture_gap(&jump_clip, frame_at(ev.bend), frame_at(ev.bend));
-    let at_leap = posture_gap(&kick_clip, kick_end, frame_at(ev.leap));
-    let (_, result_feet) = heights(&result_clip);
-    let settle = frame_at(ev.land + 0.25);
-    let floor = lowest_foot(&jump_clip);
-    let feet_after_landing: Vec<f64> = result_feet
-        .iter()
-        .map(|foot| foot[settle.min(foot.len() - 1)] - floor)
-        .collect();
-    let both_feet_down = feet_after_landing.iter().all(|h| *h < 0.05);
+    let kk = knee_kick::run(&config).map_err(experiment_error)?;
+    let ecs_gap = play_in_world(&model, &kk.sequence(), &kk.result_clip)?;
+    let ev = &kk.events;
 
     write_output(
         &out.join("jumping_knee_kick.bvh"),
-        crate::bvh::to_string(&result_clip.to_clip().to_bvh()).as_bytes(),
+        crate::bvh::to_string(&kk.result_clip.to_clip().to_bvh()).as_bytes(),
     )?;
-    for l in &parts {
-        l.primitive
-            .save(&out.join(format!("{}.primitive.ron", l.primitive.name)))
-            .map_err(primitive_error)?;
-    }
-    let r_kick = rollout(&kick.primitive, dt)?;
-    let kick_model = on_model(&model, &r_kick)?;
+    save_primitives(&kk.parts, out)?;
     draw(
         &[
-            ("high jump (A)", &jump_clip),
-            ("knee kick (B)", &kick_model),
-            ("jumping knee kick", &result_clip),
+            ("high jump (A)", &kk.jump_clip),
+            ("knee kick (B)", &kk.kick_clip),
+            ("jumping knee kick", &kk.result_clip),
         ],
         &scene.render,
         out,
@@ -498,43 +344,34 @@ pub fn run_jumping_knee_kick(
                 x_label: "time (s)".into(),
                 y_label: format!("{dof} flexion (deg)"),
                 series: vec![
-                    series("high jump", &r_jump, 0.0)?,
-                    series(
-                        "knee kick (time-scaled)",
-                        &rollout(
-                            &kick
-                                .primitive
-                                .with_duration(ev.leap - ev.bend)
-                                .map_err(primitive_error)?,
-                            dt,
-                        )?,
-                        ev.bend,
-                    )?,
-                    series("jumping knee kick", &connected.trajectory, 0.0)?,
+                    series("high jump", &kk.jump_rollout, 0.0)?,
+                    series("knee kick (time-scaled)", &kk.kick_placed_rollout, ev.bend)?,
+                    series("jumping knee kick", &kk.connected.trajectory, 0.0)?,
                 ],
                 markers: markers.clone(),
             },
             &out.join(format!("{dof}.png")),
         )?;
     }
+    let (j, gap, parts) = (&kk.junction, &kk.posture_gap_deg, &kk.parts);
     Ok(json!({
-        "events_s": events_json(&ev),
-        "arrangement": format!("{:?}", result.arrangement),
-        "junction": { "time_s": junction.map(|j| j.time), "max_angle_jump_deg": angle_jump, "max_velocity_jump_deg_s": velocity_jump },
-        "posture_gap_deg": { "jump_at_bend": at_bend, "kick_at_leap": at_leap },
-        "feet_above_floor_after_landing_m": feet_after_landing,
-        "lands_with_both_feet": both_feet_down,
+        "events_s": events_json(ev),
+        "arrangement": format!("{:?}", kk.arrangement),
+        "junction": { "time_s": j.time_s, "max_angle_jump_deg": j.max_angle_jump_deg, "max_velocity_jump_deg_s": j.max_velocity_jump_deg_s },
+        "posture_gap_deg": { "jump_at_bend": gap.jump_at_bend_deg, "kick_at_leap": gap.kick_at_leap_deg },
+        "feet_above_floor_after_landing_m": kk.feet_above_floor_after_landing_m,
+        "lands_with_both_feet": kk.lands_with_both_feet,
         "ecs_vs_kernel_max_m": ecs_gap,
         "fit_rmse_deg": fit_json(&parts[0]),
         "fit_rmse_deg_by_primitive": {
             "jumping_knee_kick": fit_json(&parts[0]),
             "land": fit_json(&parts[1]),
-            "knee_kick": fit_json(&kick),
-            "high_jump": fit_json(&hj.high),
+            "knee_kick": fit_json(&kk.kick),
+            "high_jump": fit_json(&kk.jump.learned.high),
         },
         "peak_knee_flexion_deg": {
-            "right_knee": peak_deg(&connected.trajectory, "right_knee")?,
-            "left_knee": peak_deg(&connected.trajectory, "left_knee")?,
+            "right_knee": kk.peak_knee_flexion_deg.right_knee,
+            "left_knee": kk.peak_knee_flexion_deg.left_knee,
         },
     }))
 }
