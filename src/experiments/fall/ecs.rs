@@ -94,17 +94,16 @@ pub fn spawn_fall(world: &mut World, mut ch: FallCharacter) -> Result<Entity, Si
     if ch.recorder.finished(&p.state) {
         p.status.stopped = true;
     }
-    let FallCharacter {
-        physics,
-        pd,
-        limits,
-        contact,
-        external,
-        controller,
-        recorder,
-    } = ch;
     Ok(world
-        .spawn((physics, pd, limits, contact, external, controller, recorder))
+        .spawn((
+            ch.physics,
+            ch.pd,
+            ch.limits,
+            ch.contact,
+            ch.external,
+            ch.controller,
+            ch.recorder,
+        ))
         .id())
 }
 
