@@ -4,8 +4,8 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::{DQuat, DVec3};
-use marionette::humanoid::body::fall21_body;
 use marionette::dynamics::{Data, ForceVec, aba};
+use marionette::humanoid::body::fall21_body;
 use std::hint::black_box;
 
 fn bench_aba(c: &mut Criterion) {

@@ -3,8 +3,8 @@
 //! Run: `cargo bench --bench falls_parallel`.
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use marionette::experiments::fall::ecs::run_parallel;
 use marionette::experiments::fall::FallConfig;
+use marionette::experiments::fall::ecs::run_parallel;
 use marionette::humanoid::ranges::AgeGroup;
 use std::hint::black_box;
 use std::time::Duration;

@@ -13,11 +13,13 @@ pub mod bvh;
 pub mod clips;
 pub mod dynamics;
 pub mod ecs;
-pub mod io;
-pub mod mapping;
 pub mod experiments;
 pub mod humanoid;
+pub mod io;
+pub mod mapping;
 pub mod primitive;
+#[cfg(feature = "render")]
 pub mod render;
+#[cfg(feature = "render")]
 pub mod scene;
 pub mod skeleton;

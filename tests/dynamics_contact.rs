@@ -3,10 +3,10 @@
 //! `g(sin α − μ cos α)` above it; a joint limit holds a lever under load.
 
 use glam::{DQuat, DVec3};
-use marionette::dynamics::forces::contact::{ContactModel, ContactParams, ContactState};
 use marionette::dynamics::forces::contact::LinkBox;
-use marionette::dynamics::integrator::step;
+use marionette::dynamics::forces::contact::{ContactModel, ContactParams, ContactState};
 use marionette::dynamics::forces::limits::{JointLimitParams, joint_torque};
+use marionette::dynamics::integrator::step;
 use marionette::dynamics::{
     Body, Data, Dynamics, ForceVec, Inertia, Integrator, IntegratorWorkspace, JointType, Model,
     SpatialTransform, aba, kinematics,

@@ -112,8 +112,8 @@ fn a_runaway_push_stops_with_time_body_and_quantity() {
 #[test]
 fn two_characters_in_one_world_fall_independently() {
     use bevy_ecs::world::World;
-    use marionette::experiments::fall::ecs::spawn_fall;
     use marionette::experiments::fall::build_fall;
+    use marionette::experiments::fall::ecs::spawn_fall;
     let a = short(AgeGroup::Elderly);
     let mut b = short(AgeGroup::Adult);
     b.push.force_n = 700.0;

@@ -232,8 +232,8 @@ fn random_genes_within_the_ranges_all_simulate() {
 #[test]
 fn ranges_can_come_from_an_editable_ron_file() {
     use marionette::experiments::fall::Ranges;
-    let path =
-        std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("src/humanoid/data/fall21_adult.ron");
+    let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("src/humanoid/data/fall21_adult.ron");
     let mut cfg = FallConfig::paper(AgeGroup::Adult);
     cfg.duration_s = 0.2;
     let builtin = simulate_fall(&cfg).unwrap();

@@ -4,8 +4,8 @@
 
 use marionette::bvh;
 use marionette::clips::KeyframeClip;
-use marionette::mapping::{Mapping, effector_errors, retarget};
 use marionette::humanoid::{Model, ModelClip};
+use marionette::mapping::{Mapping, effector_errors, retarget};
 use marionette::skeleton::Clip;
 
 /// A clip with known angles: the left knee swings 0 → 95 → 30°, the right knee stays at 10°,

@@ -5,8 +5,8 @@
 use std::path::PathBuf;
 
 use marionette::bvh;
-use marionette::mapping::{Mapping, effector_errors, retarget};
 use marionette::humanoid::Model;
+use marionette::mapping::{Mapping, effector_errors, retarget};
 use marionette::skeleton::Clip;
 
 fn data_dir() -> Option<PathBuf> {

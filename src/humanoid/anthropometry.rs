@@ -56,4 +56,3 @@ pub const DE_LEVA_THIGH: SegmentRow = row(422.2, 14.16, 40.95, 32.9, 32.9, 14.9)
 pub const DE_LEVA_SHANK: SegmentRow = row(434.0, 4.33, 44.59, 25.5, 24.9, 10.3);
 /// Foot (heel → tip of the longest toe).
 pub const DE_LEVA_FOOT: SegmentRow = row(258.1, 1.37, 44.15, 25.7, 24.5, 12.4);
-

@@ -9,12 +9,12 @@
 //! and per side upper arm, forearm, hand, thigh, shank, foot. Each link also carries a box for
 //! floor contact (SPEC §3: "a box on each link").
 
+use crate::dynamics::forces::contact::LinkBox;
 use crate::dynamics::joint::JointType;
 use crate::dynamics::model::{Body, Model, ModelError};
 use crate::dynamics::spatial::{Inertia, SpatialTransform};
-use crate::humanoid::{self as figure, JointKind};
-use crate::dynamics::forces::contact::LinkBox;
 use crate::humanoid::anthropometry::*;
+use crate::humanoid::{self as figure, JointKind};
 use glam::{DMat3, DVec3};
 
 /// The fall21 human ready to simulate.
@@ -97,7 +97,8 @@ fn combine(a: Inertia, b: Inertia) -> Inertia {
     let shift = |x: &Inertia| {
         let d = x.com - c;
         x.inertia_com
-            + (DMat3::IDENTITY * d.length_squared() - crate::dynamics::spatial::outer(d, d)) * x.mass
+            + (DMat3::IDENTITY * d.length_squared() - crate::dynamics::spatial::outer(d, d))
+                * x.mass
     };
     Inertia::new(m, c, shift(&a) + shift(&b))
 }

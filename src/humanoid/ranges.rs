@@ -54,10 +54,7 @@ impl RangeTable {
                 "fall21_elderly.ron",
                 include_str!("data/fall21_elderly.ron"),
             ),
-            AgeGroup::Adult => (
-                "fall21_adult.ron",
-                include_str!("data/fall21_adult.ron"),
-            ),
+            AgeGroup::Adult => ("fall21_adult.ron", include_str!("data/fall21_adult.ron")),
         };
         RangeTable::parse(text, name).expect("built-in range tables are valid")
     }

@@ -105,18 +105,9 @@ const BUILTIN: [(&str, &str); 5] = [
         "marionette_fall21.ron",
         include_str!("builtin/marionette_fall21.ron"),
     ),
-    (
-        "cmu_cgspeed.ron",
-        include_str!("builtin/cmu_cgspeed.ron"),
-    ),
-    (
-        "cmu_acrnn.ron",
-        include_str!("builtin/cmu_acrnn.ron"),
-    ),
-    (
-        "bandai.ron",
-        include_str!("builtin/bandai.ron"),
-    ),
+    ("cmu_cgspeed.ron", include_str!("builtin/cmu_cgspeed.ron")),
+    ("cmu_acrnn.ron", include_str!("builtin/cmu_acrnn.ron")),
+    ("bandai.ron", include_str!("builtin/bandai.ron")),
 ];
 
 impl Mapping {

@@ -10,8 +10,8 @@ use super::source::{ClipSource, LoadedMotion, load_motion};
 use super::{SceneError, draw_tracks, write_output};
 use crate::analysis::clip_contacts;
 use crate::ecs::{Recorder, base_schedule, new_world, spawn_clip_character};
-use crate::mapping::effector_errors;
 use crate::humanoid::Model;
+use crate::mapping::effector_errors;
 use crate::render::{Plot, Series, Track, plot, pose_png};
 use crate::skeleton::Clip;
 

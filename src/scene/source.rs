@@ -8,8 +8,8 @@ use serde::{Deserialize, Serialize};
 use super::SceneError;
 use crate::bvh::{self, Bvh};
 use crate::clips::KeyframeClip;
-use crate::mapping::{Mapping, retarget};
 use crate::humanoid::{Model, ModelClip};
+use crate::mapping::{Mapping, retarget};
 use crate::skeleton::Clip;
 
 /// A clip in a scene: a file (`.bvh`, or `.ron` for a keyframed clip), optionally a window of

@@ -8,8 +8,8 @@ use clap::{Parser, Subcommand};
 
 use marionette::analysis::clip_contacts;
 use marionette::bvh;
-use marionette::mapping::{Mapping, effector_errors, retarget};
 use marionette::humanoid::Model;
+use marionette::mapping::{Mapping, effector_errors, retarget};
 use marionette::render::{Track, animation_gif, filmstrip_png};
 use marionette::scene::{self, ClipSource, Scene, load_motion};
 use marionette::skeleton::Clip;
