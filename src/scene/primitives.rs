@@ -116,7 +116,7 @@ fn rollout(p: &Primitive, dt: f64) -> Result<Trajectory, SceneError> {
 }
 
 fn on_model(model: &Model, traj: &Trajectory) -> Result<ModelClip, SceneError> {
-    ModelClip::from_trajectory(model, traj).map_err(SceneError::Invalid)
+    ModelClip::from_trajectory(model, traj).map_err(SceneError::from)
 }
 
 /// Peak of a DOF over a trajectory, degrees.
