@@ -13,6 +13,7 @@ pub mod bvh;
 pub mod clips;
 pub mod dynamics;
 pub mod ecs;
+pub mod error;
 pub mod experiments;
 pub mod humanoid;
 pub mod io;
@@ -23,3 +24,5 @@ pub mod render;
 #[cfg(feature = "render")]
 pub mod scene;
 pub mod skeleton;
+
+pub use error::{Error, Result};
