@@ -18,6 +18,7 @@ pub mod experiments;
 pub mod humanoid;
 pub mod io;
 pub mod mapping;
+pub mod prelude;
 pub mod primitive;
 #[cfg(feature = "render")]
 pub mod render;
