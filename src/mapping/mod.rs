@@ -3,7 +3,8 @@
 //! A [`Mapping`] (a RON file a user can copy and edit, see `src/mapping/builtin/`) names, for each
 //! anatomical landmark (pelvis, waist, neck, head, and per side clavicle, shoulder, elbow, wrist,
 //! hand, hip, knee, ankle, toe), the source joint or End Site that marks it. [`retarget`] turns a
-//! clip into the model's DOF angle trajectories plus root motion ([`ModelClip`](crate::humanoid::ModelClip)).
+//! clip into the model's DOF angle trajectories plus root motion
+//! ([`ModelClip`](crate::humanoid::ModelClip)).
 
 mod fidelity;
 mod retarget;
