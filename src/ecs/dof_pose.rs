@@ -8,11 +8,11 @@ use bevy_ecs::prelude::*;
 use glam::{DQuat, DVec3};
 
 use super::motion::{Character, JointState, Recorder, SkeletonRef};
+use super::systems::BaseSet;
+use crate::humanoid::{Model, ROOT_CHANNELS};
 use super::primitive::{
     DofPose, PrimitiveClock, PrimitivePlayer, PrimitiveSet, add_primitive_systems,
 };
-use super::systems::BaseSet;
-use crate::humanoid::{Model, ROOT_CHANNELS};
 use crate::primitive::{Primitive, PrimitiveError};
 
 /// Which entries of a character's [`DofPose`] are its model's DOFs and its six root channels

@@ -15,11 +15,11 @@ mod motion;
 pub mod primitive;
 mod systems;
 
+pub use motion::{Character, ClipPlayback, JointState, Recorder, SimulationClock, SkeletonRef};
 pub use dof_pose::{
     ModelBinding, add_primitive_wiring, new_primitive_world, pose_from_dofs, run_primitive_world,
     spawn_primitive_character,
 };
-pub use motion::{Character, ClipPlayback, JointState, Recorder, SimulationClock, SkeletonRef};
 pub use systems::{
     BaseSet, advance_clock, base_schedule, forward_kinematics_system, record_frames, sample_clips,
 };

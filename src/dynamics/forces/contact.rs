@@ -316,11 +316,7 @@ impl ContactModel {
     /// with `w = 1/m + max_c λ_max([r_c]×ᵀ I_c⁻¹ [r_c]×)` the largest inverse effective mass at a
     /// corner of the free link (the tree only adds mass), four corners down give
     /// `ω² ≤ 4 k w`, `2ζω ≤ 4 c w`.
-    pub fn link_frequency(
-        &self,
-        i: usize,
-        inertia: &crate::dynamics::spatial::Inertia,
-    ) -> (f64, f64) {
+    pub fn link_frequency(&self, i: usize, inertia: &crate::dynamics::spatial::Inertia) -> (f64, f64) {
         let p = &self.params;
         let iinv = inertia.inertia_com.inverse();
         let mut w: f64 = 0.0;

@@ -2,14 +2,14 @@
 //! contact, damage, recorder, workspace), plain data that the phases of
 //! [`fall`](super::fall) update and the systems of [`ecs`](super::ecs) query.
 
-use super::result::{FallFrame, SimError};
-use crate::dynamics::data::Data;
 use crate::dynamics::forces::contact::{ContactModel, ContactState};
-use crate::dynamics::forces::external::Push;
-use crate::dynamics::forces::limits::JointLimitParams;
-use crate::dynamics::integrator::{Integrator, IntegratorWorkspace};
-use crate::dynamics::spatial::ForceVec;
+use crate::dynamics::data::Data;
+use super::result::{FallFrame, SimError};
 use crate::humanoid::body::HumanBody;
+use crate::dynamics::integrator::{Integrator, IntegratorWorkspace};
+use crate::dynamics::forces::limits::JointLimitParams;
+use crate::dynamics::forces::external::Push;
+use crate::dynamics::spatial::ForceVec;
 use bevy_ecs::component::Component;
 use std::sync::Arc;
 

@@ -2,9 +2,9 @@
 //! step, integrator, contact and damage weights — everything a scene file (RON) gives.
 
 use crate::dynamics::forces::contact::ContactParams;
-use crate::dynamics::forces::external::Push;
-use crate::dynamics::forces::limits::JointLimitParams;
 use crate::dynamics::integrator::Integrator;
+use crate::dynamics::forces::limits::JointLimitParams;
+use crate::dynamics::forces::external::Push;
 use crate::humanoid::ranges::{AgeGroup, RangeTable};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;

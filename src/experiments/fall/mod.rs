@@ -20,15 +20,15 @@ pub use self::components::{
 pub use self::config::{FallConfig, Ranges};
 pub use self::result::{FallFrame, FallResult, SimError};
 
+use crate::dynamics::forces::contact::{ContactModel, ContactState};
 use crate::dynamics::crba::{cholesky_factor, cholesky_solve, crba};
 use crate::dynamics::data::Data;
-use crate::dynamics::forces::contact::{ContactModel, ContactState};
-use crate::dynamics::forces::limits::joint_torque;
-use crate::dynamics::forces::pd::pd_torque;
+use crate::humanoid::body::{HumanBody, fall21_body};
 use crate::dynamics::integrator::{Dynamics, Integrator, IntegratorWorkspace, step};
 use crate::dynamics::kinematics::kinematics;
+use crate::dynamics::forces::limits::joint_torque;
+use crate::dynamics::forces::pd::pd_torque;
 use crate::dynamics::spatial::ForceVec;
-use crate::humanoid::body::{HumanBody, fall21_body};
 use crate::humanoid::ranges::RangeTable;
 use glam::{DQuat, DVec3};
 use std::sync::Arc;
