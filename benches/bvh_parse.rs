@@ -1,7 +1,7 @@
 //! BVH reading and writing throughput (bytes of BVH text per second).
 //!
 //! Reads the largest public data file (`cmu/acrnn_indian_13.bvh`, 2.5 MB) from `$MARIONETTE_DATA`
-//! or `../shared/data`; when that is absent it says so and measures a generated file of the same
+//! or `../shared/data` (from the working directory, see `marionette::io::data_dir`); when that is absent it says so and measures a generated file of the same
 //! size and shape (43 joints, 132 channels, values with about six significant digits) instead.
 //!
 //! `number_conversion_only` times just `str::parse::<f64>` over the file's motion values (split
@@ -10,16 +10,14 @@
 //! Run: `cargo bench --bench bvh_parse`
 
 use std::hint::black_box;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::DVec3;
 use marionette::bvh::{self, Bvh, BvhJoint, Channel};
 
 fn data_file() -> Option<PathBuf> {
-    let dir = std::env::var_os("MARIONETTE_DATA")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data"));
+    let dir = marionette::io::data_dir();
     let path = dir.join("cmu/acrnn_indian_13.bvh");
     if path.is_file() {
         Some(path)

@@ -33,9 +33,7 @@ fn bench(c: &mut Criterion) {
             .to_model_clip()
             .to_clip(),
     )];
-    let data = std::env::var_os("MARIONETTE_DATA")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| root.join("../shared/data"));
+    let data = marionette::io::data_dir();
     let jumps = data.join("cmu/cmu_01_01_forward_jumps.bvh");
     match marionette::bvh::parse_file(&jumps) {
         Ok((b, _)) => clips.push(("cmu_forward_jumps", Clip::from_bvh(&b, None).unwrap())),

@@ -1,7 +1,8 @@
-//! Output helpers: every file the engine writes is written whole or not at all.
+//! File helpers: atomic writes (every file the engine writes is written whole or not at all),
+//! RON reading with located errors, and where the shared motion data is.
 
 use std::io::Write;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// Writes `bytes` to `path` atomically: into a temporary file beside it, then renamed over it,
 /// so a reader never sees a half-written file and a failed run leaves no partial output.
@@ -30,6 +31,24 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
         let _ = std::fs::remove_file(&tmp);
     }
     result
+}
+
+/// The motion data folder: `$MARIONETTE_DATA`, else `../shared/data`; a relative path is taken
+/// from the current working directory (not the build directory), so `cargo run` and
+/// `cargo test` in the crate's folder find the project's `../shared/data`.
+pub fn data_dir() -> PathBuf {
+    let dir = match std::env::var_os("MARIONETTE_DATA") {
+        Some(d) if !d.is_empty() => PathBuf::from(d),
+        _ => PathBuf::from("../shared/data"),
+    };
+    if dir.is_absolute() {
+        return dir;
+    }
+    let joined = match std::env::current_dir() {
+        Ok(cwd) => cwd.join(&dir),
+        Err(_) => dir,
+    };
+    joined.canonicalize().unwrap_or(joined)
 }
 
 #[cfg(test)]

@@ -13,11 +13,17 @@ pub mod bvh;
 pub mod clips;
 pub mod dynamics;
 pub mod ecs;
+pub mod error;
 pub mod experiments;
 pub mod humanoid;
 pub mod io;
 pub mod mapping;
+pub mod prelude;
 pub mod primitive;
+#[cfg(feature = "render")]
 pub mod render;
+#[cfg(feature = "render")]
 pub mod scene;
 pub mod skeleton;
+
+pub use error::{Error, Result};

@@ -1,24 +1,11 @@
 //! Whole-feature tests of the BVH reader: the public data files, every tolerated variation of
 //! the format, and every malformed input (each must name its line and say what was expected).
 
-use std::path::{Path, PathBuf};
-
 use glam::DVec3;
 use marionette::bvh::{self, Bvh, BvhError, Channel};
 
-/// The data folder: `$MARIONETTE_DATA`, else `../shared/data` beside the crate; `None` (with a
-/// printed note) when it is absent.
-fn data_dir() -> Option<PathBuf> {
-    let dir = std::env::var_os("MARIONETTE_DATA")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data"));
-    if dir.is_dir() {
-        Some(dir)
-    } else {
-        println!("MARIONETTE_DATA not found at {}; skipping", dir.display());
-        None
-    }
-}
+mod common;
+use common::data_dir;
 
 /// A small valid file; line numbers are referred to by the malformed-input tests.
 const BASE: &[&str] = &[

@@ -2,27 +2,13 @@
 //! maps onto both models and renders, and the mapped humanoid24 puts head, hands and feet where the source
 //! does (feet within 5 cm on the CMU jumps).
 
-use std::path::PathBuf;
-
 use marionette::bvh;
 use marionette::humanoid::Model;
 use marionette::mapping::{Mapping, effector_errors, retarget};
 use marionette::skeleton::Clip;
 
-fn data_dir() -> Option<PathBuf> {
-    let dir = std::env::var_os("MARIONETTE_DATA")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/data"));
-    if dir.join("cmu").is_dir() {
-        Some(dir)
-    } else {
-        eprintln!(
-            "MARIONETTE_DATA not found at {}; skipping the real-data mapping tests",
-            dir.display()
-        );
-        None
-    }
-}
+mod common;
+use common::data_dir;
 
 const FILES: [&str; 6] = [
     "cmu/cmu_01_01_forward_jumps.bvh",

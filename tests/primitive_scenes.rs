@@ -1,9 +1,11 @@
 //! The motor-primitive paper's experiments as scenes: the numbers the paper reports, on the
 //! project's own keyframed clips and (when `MARIONETTE_DATA` is present) on the CMU capture.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use marionette::scene::{Scene, run};
+
+mod common;
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -25,20 +27,14 @@ fn run_scene(file: &str) -> serde_json::Value {
     report
 }
 
+/// Whether the CMU files the `_cmu` scenes read are present (else skipped, or failed under CI).
 fn data_present() -> bool {
-    let dir = std::env::var_os("MARIONETTE_DATA")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| root().join("../shared/data"));
-    let ok = Path::new(&dir)
-        .join("cmu/cmu_01_01_forward_jumps.bvh")
-        .is_file();
-    if !ok {
-        eprintln!(
-            "MARIONETTE_DATA not found at {}; skipping the CMU scenes",
-            dir.display()
-        );
-    }
-    ok
+    [
+        "cmu/cmu_01_01_forward_jumps.bvh",
+        "cmu/acrnn_martial_04.bvh",
+    ]
+    .iter()
+    .all(|f| common::data_path(f).is_some())
 }
 
 fn f(v: &serde_json::Value, path: &[&str]) -> f64 {

@@ -4,8 +4,7 @@ use glam::DVec3;
 
 use super::contact::{Contacts, ground_contacts};
 use crate::mapping::Mapping;
-use crate::render::{Side, side_from_name};
-use crate::skeleton::{Clip, Skeleton};
+use crate::skeleton::{Clip, Side, Skeleton, side_from_name};
 
 /// A point of a skeleton: a joint, or (`true`) that joint's End Site.
 pub type PointRef = (usize, bool);

@@ -490,7 +490,11 @@ mod tests {
         let n = 1000;
         let (s, m) = run(&model, &none, n);
         let expected = 0.5 - 9.81 * 1e-6 * (n * (n + 1)) as f64 / 2.0;
-        assert!((s.q[1] - expected).abs() < 1e-9, "y = {} vs {expected}", s.q[1]);
+        assert!(
+            (s.q[1] - expected).abs() < 1e-9,
+            "y = {} vs {expected}",
+            s.q[1]
+        );
         assert_eq!(s.steps, n as u64);
         assert!((s.time_s - 1.0).abs() < 1e-12);
         assert_eq!(m.contact.peak[0], 0.0);

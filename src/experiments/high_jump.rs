@@ -26,8 +26,8 @@ pub enum PrimitiveExperimentError {
     #[error(transparent)]
     Primitive(#[from] PrimitiveError),
     /// A played trajectory does not fit the model (a model DOF or root channel is missing).
-    #[error("{0}")]
-    OnModel(String),
+    #[error(transparent)]
+    OnModel(#[from] crate::humanoid::ModelError),
     /// A DOF the experiment measures is not in the trajectory.
     #[error("no DOF '{0}'")]
     NoDof(String),
@@ -107,7 +107,7 @@ pub(super) fn on_model(
     model: &Model,
     traj: &Trajectory,
 ) -> Result<ModelClip, PrimitiveExperimentError> {
-    ModelClip::from_trajectory(model, traj).map_err(PrimitiveExperimentError::OnModel)
+    Ok(ModelClip::from_trajectory(model, traj)?)
 }
 
 /// Plays `p` over [0, τ] at step `dt`.

@@ -108,6 +108,9 @@ pub enum ModelError {
     /// The name is not one of the engine's models.
     #[error("unknown model '{0}': expected one of humanoid24, fall21")]
     Unknown(String),
+    /// A trajectory lacks a channel the model needs (a DOF or a root channel).
+    #[error("the trajectory has no channel '{0}'")]
+    MissingChannel(String),
 }
 
 impl Model {

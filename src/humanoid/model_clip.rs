@@ -2,7 +2,7 @@
 
 use glam::{DQuat, DVec3};
 
-use crate::humanoid::{Model, rotation_vector_near};
+use crate::humanoid::{Model, ModelError, rotation_vector_near};
 use crate::primitive::Trajectory;
 
 /// Names of the root channels in a primitive trajectory: translation (m), then orientation as a
@@ -125,12 +125,12 @@ impl ModelClip {
 
     /// A motion on `model` from a trajectory holding every model DOF (by name) and the six root
     /// channels of [`ModelClip::to_trajectory`].
-    pub fn from_trajectory(model: &Model, traj: &Trajectory) -> Result<ModelClip, String> {
+    pub fn from_trajectory(model: &Model, traj: &Trajectory) -> Result<ModelClip, ModelError> {
         let index = |name: &str| {
             traj.names
                 .iter()
                 .position(|n| n == name)
-                .ok_or_else(|| format!("the trajectory has no channel '{name}'"))
+                .ok_or_else(|| ModelError::MissingChannel(name.to_string()))
         };
         let dof_cols: Vec<usize> = model
             .dofs

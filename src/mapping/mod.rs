@@ -3,7 +3,8 @@
 //! A [`Mapping`] (a RON file a user can copy and edit, see `src/mapping/builtin/`) names, for each
 //! anatomical landmark (pelvis, waist, neck, head, and per side clavicle, shoulder, elbow, wrist,
 //! hand, hip, knee, ankle, toe), the source joint or End Site that marks it. [`retarget`] turns a
-//! clip into the model's DOF angle trajectories plus root motion ([`ModelClip`]).
+//! clip into the model's DOF angle trajectories plus root motion
+//! ([`ModelClip`](crate::humanoid::ModelClip)).
 
 mod fidelity;
 mod retarget;
@@ -13,6 +14,7 @@ pub use retarget::retarget;
 
 use std::collections::BTreeMap;
 use std::path::Path;
+use std::sync::OnceLock;
 
 use serde::{Deserialize, Serialize};
 
@@ -69,22 +71,36 @@ pub enum MappingError {
     File(#[from] crate::io::FileError),
     /// A landmark missing from the file, or an unknown one.
     #[error("mapping '{mapping}': {message}")]
-    Landmarks { mapping: String, message: String },
+    Landmarks {
+        /// The mapping's name.
+        mapping: String,
+        /// What is missing or unknown.
+        message: String,
+    },
     /// A landmark names a joint the skeleton does not have.
     #[error(
         "mapping '{mapping}': landmark '{landmark}' names '{joint}', which the skeleton does not have{hint}"
     )]
     MissingJoint {
+        /// The mapping's name.
         mapping: String,
+        /// The landmark.
         landmark: String,
+        /// The joint it names.
         joint: String,
+        /// Similar joint names of the skeleton, if any.
         hint: String,
     },
     /// No built-in mapping fits the skeleton.
     #[error(
         "no built-in mapping fits this skeleton (root '{root}'); built-in: {builtins}. Copy one of src/mapping/builtin/*.ron, name your joints in it and pass it with --mapping"
     )]
-    NoMatch { root: String, builtins: String },
+    NoMatch {
+        /// The skeleton's root joint.
+        root: String,
+        /// The built-in mapping files.
+        builtins: String,
+    },
 }
 
 /// A landmark resolved on a skeleton: a joint, or a joint's End Site.
@@ -145,19 +161,26 @@ impl Mapping {
         Mapping::parse(&text, &path.display().to_string())
     }
 
-    /// The built-in mappings (`src/mapping/builtin/*.ron`, embedded in the program).
-    pub fn builtins() -> Vec<Mapping> {
-        BUILTIN
-            .iter()
-            .map(|(name, text)| Mapping::parse(text, name).expect("built-in mappings are valid"))
-            .collect()
+    /// The built-in mappings (`src/mapping/builtin/*.ron`, embedded in the program), parsed
+    /// once on first use.
+    pub fn builtins() -> &'static [Mapping] {
+        static PARSED: OnceLock<Vec<Mapping>> = OnceLock::new();
+        PARSED.get_or_init(|| {
+            BUILTIN
+                .iter()
+                .map(|(name, text)| {
+                    Mapping::parse(text, name).expect("built-in mappings are valid")
+                })
+                .collect()
+        })
     }
 
     /// The built-in mapping whose `detect` joints are all in `skeleton`.
     pub fn detect(skeleton: &Skeleton) -> Result<Mapping, MappingError> {
         Mapping::builtins()
-            .into_iter()
+            .iter()
             .find(|m| m.detect.iter().all(|d| skeleton.index(d).is_some()))
+            .cloned()
             .ok_or_else(|| MappingError::NoMatch {
                 root: skeleton
                     .joints
@@ -214,10 +237,15 @@ mod tests {
     use super::*;
 
     #[test]
+    fn builtins_are_parsed_once() {
+        assert!(std::ptr::eq(Mapping::builtins(), Mapping::builtins()));
+    }
+
+    #[test]
     fn builtins_parse_and_name_every_landmark() {
         let b = Mapping::builtins();
         assert_eq!(b.len(), 5);
-        for m in &b {
+        for m in b {
             assert_eq!(m.landmarks.len(), LANDMARKS.len(), "{}", m.name);
             // Left landmarks name left joints (a swapped mapping would be caught here).
             for side in ["left", "right"] {

@@ -128,10 +128,7 @@ impl FallScene {
     pub fn config(&self, base: &Path) -> Result<FallConfig, SceneError> {
         let mut c = FallConfig::paper(self.age_group);
         if let Some(f) = &self.ranges_file {
-            c.ranges = Ranges::Table(
-                RangeTable::load(&resolve_path(f, base))
-                    .map_err(|e| SceneError::Invalid(e.to_string()))?,
-            );
+            c.ranges = Ranges::Table(RangeTable::load(&resolve_path(f, base))?);
         }
         c.dt_s = self.simulation.dt;
         c.integrator = self.simulation.integrator;
@@ -224,7 +221,7 @@ pub fn run_fall(
     let started = std::time::Instant::now();
     let results: Vec<FallResult> = run_parallel(&configs)
         .into_iter()
-        .map(|r| r.map_err(|e| SceneError::Invalid(e.to_string())))
+        .map(|r| r.map_err(SceneError::from))
         .collect::<Result<_, _>>()?;
     let sim_wall = started.elapsed().as_secs_f64();
 

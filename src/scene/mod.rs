@@ -39,24 +39,39 @@ pub enum Scene {
     Fall(Box<FallScene>),
 }
 
-/// Why a scene could not be read or run.
+/// Why a scene could not be read or run. Module errors keep their own type (and message), so a
+/// runner writes `?`; [`SceneError::Invalid`] is for a scene value that is out of range or
+/// inconsistent.
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
     /// A file could not be read or written.
     #[error("{path}: {source}")]
     Io {
+        /// The file or folder.
         path: String,
+        /// The operating system's reason.
         source: std::io::Error,
     },
     /// RON syntax or schema error (file, line, column, field).
     #[error(transparent)]
     Ron(#[from] crate::io::RonError),
+    /// A data file: unreadable, bad RON, or a newer format version.
+    #[error(transparent)]
+    File(#[from] crate::io::FileError),
     /// A `--set` override that does not fit the scene.
     #[error("--set {assignment}: {message}")]
-    Override { assignment: String, message: String },
+    Override {
+        /// The `field.path=value` assignments.
+        assignment: String,
+        /// Why it does not fit.
+        message: String,
+    },
     /// A value that is out of range or inconsistent.
     #[error("{0}")]
     Invalid(String),
+    /// Converting a scene to or from its JSON form.
+    #[error(transparent)]
+    Json(#[from] serde_json::Error),
     /// Reading a BVH file.
     #[error(transparent)]
     Bvh(#[from] crate::bvh::BvhError),
@@ -72,6 +87,21 @@ pub enum SceneError {
     /// A model.
     #[error(transparent)]
     Model(#[from] crate::humanoid::ModelError),
+    /// A joint-range table.
+    #[error(transparent)]
+    Ranges(#[from] crate::humanoid::ranges::RangeError),
+    /// Motor primitives: learning, playing, blending, connecting, events.
+    #[error(transparent)]
+    Primitive(#[from] crate::primitive::PrimitiveError),
+    /// The fall simulation.
+    #[error(transparent)]
+    Fall(#[from] crate::experiments::fall::SimError),
+    /// A fall that failed in a World (shared with the pool that ran it).
+    #[error(transparent)]
+    FallRun(#[from] std::sync::Arc<crate::experiments::fall::SimError>),
+    /// A motor-primitive experiment.
+    #[error(transparent)]
+    Experiment(#[from] crate::experiments::high_jump::PrimitiveExperimentError),
     /// Drawing.
     #[error(transparent)]
     Render(#[from] crate::render::RenderError),
@@ -100,12 +130,7 @@ impl Scene {
     /// Parses and checks scene text; `origin` names the file in errors.
     pub fn parse(text: &str, origin: &str) -> Result<Scene, SceneError> {
         let scene: Scene = crate::io::parse_ron(text, origin)?;
-        if scene.format_version() > FORMAT_VERSION {
-            return Err(SceneError::Invalid(format!(
-                "{origin}: format_version {} is newer than this build reads ({FORMAT_VERSION})",
-                scene.format_version()
-            )));
-        }
+        crate::io::check_version(origin, scene.format_version(), FORMAT_VERSION)?;
         Ok(scene)
     }
 
@@ -126,7 +151,7 @@ pub fn apply_overrides(scene: &Scene, assignments: &[String]) -> Result<Scene, S
     if assignments.is_empty() {
         return Ok(scene.clone());
     }
-    let mut value = serde_json::to_value(scene).map_err(|e| SceneError::Invalid(e.to_string()))?;
+    let mut value = serde_json::to_value(scene)?;
     for a in assignments {
         let err = |message: String| SceneError::Override {
             assignment: a.clone(),

@@ -16,11 +16,11 @@ use super::{SceneError, draw_tracks, write_output};
 use crate::ecs::{
     Clock, Recorder, kinematic_schedule, new_world, run_ticks, spawn_primitive_character,
 };
-use crate::experiments::high_jump::{self, HighJumpConfig, PrimitiveExperimentError};
+use crate::experiments::high_jump::{self, HighJumpConfig};
 use crate::experiments::knee_kick::{self, KneeKickConfig};
 use crate::humanoid::{Model, ModelClip};
 use crate::primitive::{
-    EventConfig, Gamma, JumpEvents, LearnConfig, Learned, Primitive, PrimitiveError, Trajectory,
+    EventConfig, Gamma, JumpEvents, LearnConfig, Learned, Primitive, Trajectory,
 };
 use crate::render::{Plot, Series, Track, plot};
 
@@ -106,14 +106,6 @@ pub struct JumpingKneeKickScene {
     pub render: PrimitiveRender,
 }
 
-fn primitive_error(e: PrimitiveError) -> SceneError {
-    SceneError::Invalid(e.to_string())
-}
-
-fn experiment_error(e: PrimitiveExperimentError) -> SceneError {
-    SceneError::Invalid(e.to_string())
-}
-
 /// Loads a clip onto humanoid24 as a primitive trajectory.
 fn demo(src: &ClipSource, base: &Path, model: &Model) -> Result<ModelClip, SceneError> {
     load_motion(src, base)?.on_model(model)
@@ -195,7 +187,7 @@ fn save_primitives<'a>(
     for l in learned {
         l.primitive
             .save(&out.join(format!("{}.primitive.ron", l.primitive.name)))
-            .map_err(primitive_error)?;
+            .map_err(SceneError::from)?;
     }
     Ok(())
 }
@@ -212,7 +204,7 @@ pub fn run_high_jump(
 ) -> Result<serde_json::Value, SceneError> {
     let model = Model::by_name("humanoid24")?;
     let config = high_jump_config(scene, base, &model)?;
-    let hj = high_jump::run(&config).map_err(experiment_error)?;
+    let hj = high_jump::run(&config).map_err(SceneError::from)?;
     let learned = &hj.primitives.learned;
     let (clips, rollouts) = (&hj.clips, &hj.rollouts);
     write_output(
@@ -274,7 +266,7 @@ fn play_in_world(
         Arc::new(model.clone()),
         seq,
     )
-    .map_err(primitive_error)?;
+    .map_err(SceneError::from)?;
     let frames = expected.frame_count();
     run_ticks(&mut world, &mut kinematic_schedule(), frames - 1);
     let recorded = &world
@@ -309,7 +301,7 @@ pub fn run_jumping_knee_kick(
         gamma: scene.gamma.clone(),
         events: scene.events,
     };
-    let kk = knee_kick::run(&config).map_err(experiment_error)?;
+    let kk = knee_kick::run(&config).map_err(SceneError::from)?;
     let ecs_gap = play_in_world(&model, &kk.sequence(), &kk.result_clip)?;
     let ev = &kk.events;
 

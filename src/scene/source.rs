@@ -12,6 +12,8 @@ use crate::humanoid::{Model, ModelClip};
 use crate::mapping::{Mapping, retarget};
 use crate::skeleton::Clip;
 
+pub use crate::io::data_dir;
+
 /// A clip in a scene: a file (`.bvh`, or `.ron` for a keyframed clip), optionally a window of
 /// it, the unit scale of a BVH (metres per file unit; estimated when absent) and the mapping
 /// file for its skeleton (detected among the built-ins when absent). Paths are relative to the
@@ -35,15 +37,8 @@ pub struct ClipSource {
     pub mapping: Option<String>,
 }
 
-/// The motion data directory: `$MARIONETTE_DATA`, else `../shared/data` beside the crate.
-pub fn data_dir() -> PathBuf {
-    match std::env::var_os("MARIONETTE_DATA") {
-        Some(d) => PathBuf::from(d),
-        None => Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data"),
-    }
-}
-
-/// Expands `${MARIONETTE_DATA}` and resolves `path` relative to `base` (the scene's folder).
+/// Expands `${MARIONETTE_DATA}` (see [`data_dir`]) and resolves `path` relative to `base` (the
+/// scene's folder).
 pub fn resolve_path(path: &str, base: &Path) -> PathBuf {
     let expanded = path.replace("${MARIONETTE_DATA}", &data_dir().to_string_lossy());
     let p = PathBuf::from(expanded);

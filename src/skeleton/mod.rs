@@ -7,10 +7,12 @@
 mod clip;
 mod euler;
 mod fk;
+mod side;
 
 pub use clip::{Clip, ClipError, estimate_unit_scale};
 pub use euler::{euler_to_quat, quat_to_euler};
 pub use fk::{Transform, forward_kinematics};
+pub use side::{Side, side_from_name};
 
 use glam::{DQuat, DVec3};
 
@@ -93,6 +95,7 @@ impl Skeleton {
     }
 
     /// A stick figure for [`crate::render`]: point names and parents (joints, then End Sites).
+    #[cfg(feature = "render")]
     pub fn figure(&self) -> crate::render::Figure {
         crate::render::Figure {
             names: self.point_names(),

@@ -1,0 +1,117 @@
+//! `marionette inspect FILE.bvh`: skeleton, channels, frames, rate, duration, size, unit scale,
+//! ground contact and flight spans.
+
+use std::path::PathBuf;
+
+use anyhow::Result;
+
+use marionette::analysis::clip_contacts;
+use marionette::skeleton::Clip;
+
+use crate::common::read_bvh;
+
+// The command's arguments (its help text is on `Command::Inspect`).
+#[derive(clap::Args)]
+pub struct Args {
+    /// The BVH file.
+    file: PathBuf,
+    /// Metres per file unit (estimated from the standing height when absent).
+    #[arg(long)]
+    unit_scale: Option<f64>,
+}
+
+/// Runs `inspect`: prints the report to stdout.
+pub fn inspect(args: Args) -> Result<()> {
+    let (file, unit_scale) = (args.file.as_path(), args.unit_scale);
+    let b = read_bvh(file)?;
+    let size = std::fs::metadata(file).map(|m| m.len()).unwrap_or(0);
+    let clip = Clip::from_bvh(&b, unit_scale)?;
+    let scale = clip
+        .skeleton
+        .joints
+        .iter()
+        .zip(&b.joints)
+        .find_map(|(c, j)| {
+            (j.offset.length() > 1e-9).then(|| c.offset.length() / j.offset.length())
+        });
+    println!("file        {}", file.display());
+    println!("size        {} bytes ({:.2} MB)", size, size as f64 / 1e6);
+    println!(
+        "joints      {} ({} channels per frame)",
+        b.joints.len(),
+        b.channel_count
+    );
+    println!("frames      {}", b.frame_count());
+    println!("frame time  {} s ({:.3} fps)", b.frame_time, b.fps());
+    println!("duration    {:.3} s", b.duration());
+    if let Some(s) = scale {
+        println!(
+            "unit scale  {s:.6} m per file unit{}",
+            if unit_scale.is_some() {
+                ""
+            } else {
+                " (estimated)"
+            }
+        );
+    }
+    println!(
+        "height      {:.3} m (median vertical extent)",
+        clip.median_vertical_extent()
+    );
+    println!("skeleton:");
+    for (i, j) in b.joints.iter().enumerate() {
+        let mut depth = 0;
+        let mut p = j.parent;
+        while let Some(q) = p {
+            depth += 1;
+            p = b.joints[q].parent;
+        }
+        let ch: Vec<&str> = j.channels.iter().map(|c| c.name()).collect();
+        let end = j.end_site.map(|_| "  + End Site").unwrap_or("");
+        println!(
+            "  {:>3} {}{}  [{}]{}",
+            i,
+            "  ".repeat(depth),
+            j.name,
+            ch.join(" "),
+            end
+        );
+    }
+    // Ground contact and flight from the feet: the mapping's ankles and toes, else by name.
+    let Some(c) = clip_contacts(&clip, 0.03, 0.1) else {
+        println!("contact     (no feet found: no joint named foot/toe/ankle on each side)");
+        return Ok(());
+    };
+    let spans = |s: &[marionette::analysis::Span]| -> String {
+        s.iter()
+            .map(|x| format!("{:.2}-{:.2}", x.start_s, x.end_s))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    println!(
+        "floor       y = {:.3} m (contact within {:.0} cm)",
+        c.floor_y_m,
+        c.threshold_m * 100.0
+    );
+    println!(
+        "left foot   {} contact spans: {}",
+        c.left.len(),
+        spans(&c.left)
+    );
+    println!(
+        "right foot  {} contact spans: {}",
+        c.right.len(),
+        spans(&c.right)
+    );
+    println!("flights     {}", c.flights.len());
+    for (i, f) in c.flights.iter().enumerate() {
+        println!(
+            "  {:>2}  {:7.3} s .. {:7.3} s  ({:.3} s)",
+            i + 1,
+            f.start_s,
+            f.end_s,
+            f.duration()
+        );
+    }
+    Ok(())
+}

@@ -1,0 +1,89 @@
+//! The crate's one error type, [`Error`]: every module's error as a variant, so `?` carries any
+//! of them to a caller that wants one type. Each variant shows its module error's message as is.
+
+/// Any error of the crate; the variant says which module it came from.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// Reading or writing BVH.
+    #[error(transparent)]
+    Bvh(#[from] crate::bvh::BvhError),
+    /// Building or windowing a clip.
+    #[error(transparent)]
+    Clip(#[from] crate::skeleton::ClipError),
+    /// A keyframed clip.
+    #[error(transparent)]
+    Keyframes(#[from] crate::clips::KeyframeError),
+    /// Mapping a skeleton onto a model.
+    #[error(transparent)]
+    Mapping(#[from] crate::mapping::MappingError),
+    /// An unknown model or a trajectory that does not fit one.
+    #[error(transparent)]
+    Model(#[from] crate::humanoid::ModelError),
+    /// A joint-range table.
+    #[error(transparent)]
+    Ranges(#[from] crate::humanoid::ranges::RangeError),
+    /// Building the human body (height, mass, joints).
+    #[error(transparent)]
+    Body(#[from] crate::humanoid::body::HumanError),
+    /// An articulated-body model description.
+    #[error(transparent)]
+    Dynamics(#[from] crate::dynamics::ModelError),
+    /// A joint-space inertia matrix that is not positive definite.
+    #[error(transparent)]
+    Inertia(#[from] crate::dynamics::crba::NotPositiveDefinite),
+    /// Motor primitives: learning, playing, blending, connecting, files.
+    #[error(transparent)]
+    Primitive(#[from] crate::primitive::PrimitiveError),
+    /// A pushed-fall simulation.
+    #[error(transparent)]
+    Fall(#[from] crate::experiments::fall::SimError),
+    /// A simulation step: a non-finite or runaway state, with time, body and value.
+    #[error(transparent)]
+    Step(#[from] crate::dynamics::StepError),
+    /// A motor-primitive experiment (high jump, jumping knee kick).
+    #[error(transparent)]
+    Experiment(#[from] crate::experiments::high_jump::PrimitiveExperimentError),
+    /// A data file (RON): reading, syntax, version.
+    #[error(transparent)]
+    File(#[from] crate::io::FileError),
+    /// RON syntax or schema, located.
+    #[error(transparent)]
+    Ron(#[from] crate::io::RonError),
+    /// Reading or writing a file.
+    #[error(transparent)]
+    Io(#[from] std::io::Error),
+    /// A scene file: reading, checking, running.
+    #[cfg(feature = "render")]
+    #[error(transparent)]
+    Scene(#[from] crate::scene::SceneError),
+    /// Drawing a picture or plot.
+    #[cfg(feature = "render")]
+    #[error(transparent)]
+    Render(#[from] crate::render::RenderError),
+}
+
+/// A result with the crate's [`Error`].
+pub type Result<T> = std::result::Result<T, Error>;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse_missing_file() -> Result<()> {
+        crate::clips::KeyframeClip::load(std::path::Path::new("/nonexistent/clip.ron"))?;
+        Ok(())
+    }
+
+    #[test]
+    fn module_errors_convert_and_keep_their_message() {
+        let e = parse_missing_file().unwrap_err();
+        assert!(matches!(e, Error::Keyframes(_)), "{e:?}");
+        assert!(e.to_string().contains("/nonexistent/clip.ron"), "{e}");
+        let m: Error = crate::humanoid::Model::by_name("robot").unwrap_err().into();
+        assert_eq!(
+            m.to_string(),
+            "unknown model 'robot': expected one of humanoid24, fall21"
+        );
+    }
+}

@@ -1,0 +1,49 @@
+//! Shared by the integration tests: finding the shared motion-capture data.
+//!
+//! The data folder is [`marionette::io::data_dir`]: `$MARIONETTE_DATA`, else `../shared/data`
+//! relative to the working directory. When what a test needs is absent, the test is skipped
+//! with a `SKIPPED:` line on stderr, except under CI (`CI` set, e.g. `CI=true`), where the
+//! real-data tests must run and the test fails instead.
+
+#![allow(dead_code)] // each test file uses some of these
+
+use std::io::Write;
+use std::path::PathBuf;
+
+/// `rel` inside the shared data folder (a file or a folder), or `None` after reporting that it
+/// is absent; panics instead under CI.
+pub fn data_path(rel: &str) -> Option<PathBuf> {
+    let dir = marionette::io::data_dir();
+    let path = if rel.is_empty() { dir } else { dir.join(rel) };
+    if path.exists() {
+        return Some(path);
+    }
+    let test = std::thread::current()
+        .name()
+        .unwrap_or("this test")
+        .to_string();
+    if in_ci() {
+        panic!(
+            "{test}: the shared motion data is absent ({} not found) and CI is set: the \
+             real-data tests must run in CI; set MARIONETTE_DATA to the data folder",
+            path.display()
+        );
+    }
+    // Straight to stderr, past the test harness's output capture, so the skip is seen.
+    let _ = writeln!(
+        std::io::stderr(),
+        "SKIPPED: {test}: needs the shared motion data, {} not found (set MARIONETTE_DATA)",
+        path.display()
+    );
+    None
+}
+
+/// The shared data folder, or `None` after reporting that it is absent; panics instead under CI.
+pub fn data_dir() -> Option<PathBuf> {
+    data_path("")
+}
+
+/// Whether the tests run under CI: `CI` set to anything but empty, `0` or `false`.
+fn in_ci() -> bool {
+    std::env::var("CI").is_ok_and(|v| !matches!(v.trim(), "" | "0" | "false" | "FALSE"))
+}
