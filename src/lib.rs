@@ -14,6 +14,7 @@ pub mod clips;
 pub mod dynamics;
 pub mod ecs;
 pub mod error;
+pub mod evolve;
 pub mod experiments;
 pub mod humanoid;
 pub mod io;

@@ -3,6 +3,7 @@
 //! This file parses the arguments, dispatches to one module per command and prints errors.
 
 mod common;
+mod eval;
 mod export;
 mod inspect;
 mod render;
@@ -31,6 +32,9 @@ enum Command {
     Render(render::Args),
     /// Run a scene file; outputs go to one folder (default out/<scene name>/) with report.json.
     Run(run::Args),
+    /// Evaluate fall genomes for a GA over the JSON-lines protocol (`--stdin`): the worker a
+    /// cluster runs.
+    Eval(eval::Args),
 }
 
 fn main() -> ExitCode {
@@ -40,6 +44,7 @@ fn main() -> ExitCode {
         Command::Export(a) => export::export(a),
         Command::Render(a) => render::render(a),
         Command::Run(a) => run::run(a),
+        Command::Eval(a) => eval::eval(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,0 +1,270 @@
+//! Who computes the fitness of a generation: the [`Evaluator`] trait, the in-process rayon
+//! backend ([`InProcess`]) and the JSON-lines worker protocol ([`JsonLines`] drives a worker
+//! process; [`serve`] is the worker side, `marionette eval --stdin`), through which a Ray
+//! cluster (`tools/ray_eval.py`) evaluates generations while the GA loop, its checkpoints and
+//! its bits stay in the engine.
+//!
+//! The protocol, one JSON object per line:
+//! 1. client → worker, once: `{"protocol": "marionette-eval/1", "problem": {…}}` (the problem,
+//!    e.g. a [`FallProblem`](super::fall_fitness::FallProblem));
+//! 2. per generation, client → worker: `{"index": i, "genes": [x, …]}` for each genome, then
+//!    `{"evaluate": true}`;
+//! 3. worker → client: `{"index": i, "damage": d}` or `{"index": i, "error": "why"}` for each,
+//!    then `{"done": n}`.
+//!
+//! Numbers travel as shortest round-trip decimals, so genes and damages cross bit for bit.
+
+use std::io::{BufRead, BufReader, Write};
+use std::process::{Child, ChildStdin, ChildStdout, Command, Stdio};
+
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use super::genome::Genome;
+
+/// The protocol's name and version.
+pub const PROTOCOL: &str = "marionette-eval/1";
+
+/// Why a run could not go on.
+#[derive(Debug, thiserror::Error)]
+pub enum EvolveError {
+    /// A setting is invalid.
+    #[error("ga.{field}: {message}")]
+    Config {
+        /// Field.
+        field: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// The evaluator broke (worker died, protocol violated).
+    #[error("evaluator: {0}")]
+    Evaluator(String),
+    /// A checkpoint could not be read or written.
+    #[error("checkpoint {path}: {message}")]
+    Checkpoint {
+        /// The file.
+        path: String,
+        /// What went wrong.
+        message: String,
+    },
+}
+
+/// The result of one evaluation: the damage (lower is fitter) or why the simulation failed.
+pub type Evaluation = Result<f64, String>;
+
+/// Computes the fitness of a generation's genomes, in order.
+pub trait Evaluator {
+    /// The damage of each genome of `generation` (same order and length as `genomes`).
+    fn evaluate(
+        &mut self,
+        generation: u64,
+        genomes: &[Genome],
+    ) -> Result<Vec<Evaluation>, EvolveError>;
+}
+
+/// Evaluates in this process, in parallel on the current rayon pool.
+pub struct InProcess<F: Fn(&[Genome]) -> Vec<Evaluation>> {
+    /// Evaluates a batch (for falls: one World per genome, in parallel).
+    pub batch: F,
+}
+
+impl<F: Fn(&[Genome]) -> Vec<Evaluation>> Evaluator for InProcess<F> {
+    fn evaluate(&mut self, _: u64, genomes: &[Genome]) -> Result<Vec<Evaluation>, EvolveError> {
+        Ok((self.batch)(genomes))
+    }
+}
+
+/// Evaluates a batch one genome at a time in parallel with `f`.
+pub fn par_map(genomes: &[Genome], f: impl Fn(&[f64]) -> Evaluation + Sync) -> Vec<Evaluation> {
+    genomes.par_iter().map(|g| f(g)).collect()
+}
+
+#[derive(Serialize, Deserialize)]
+struct Header {
+    protocol: String,
+    problem: serde_json::Value,
+}
+
+#[derive(Serialize, Deserialize)]
+#[serde(untagged)]
+enum Request {
+    Genome { index: usize, genes: Vec<f64> },
+    Evaluate { evaluate: bool },
+}
+
+#[derive(Serialize, Deserialize)]
+#[serde(untagged)]
+enum Reply {
+    Damage { index: usize, damage: f64 },
+    Error { index: usize, error: String },
+    Done { done: usize },
+}
+
+/// Drives a worker process over the JSON-lines protocol.
+pub struct JsonLines {
+    child: Child,
+    stdin: ChildStdin,
+    stdout: BufReader<ChildStdout>,
+}
+
+impl JsonLines {
+    /// Starts `command` (e.g. `marionette eval --stdin`, or `python3 tools/ray_eval.py`) and
+    /// sends it `problem`.
+    pub fn start(mut command: Command, problem: &impl Serialize) -> Result<Self, EvolveError> {
+        let err = |m: String| EvolveError::Evaluator(m);
+        let mut child = command
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .spawn()
+            .map_err(|e| err(format!("cannot start {command:?}: {e}")))?;
+        let stdin = child.stdin.take().ok_or_else(|| err("no stdin".into()))?;
+        let stdout = BufReader::new(child.stdout.take().ok_or_else(|| err("no stdout".into()))?);
+        let mut me = Self {
+            child,
+            stdin,
+            stdout,
+        };
+        let header = Header {
+            protocol: PROTOCOL.into(),
+            problem: serde_json::to_value(problem).map_err(|e| err(e.to_string()))?,
+        };
+        me.send(&header)?;
+        Ok(me)
+    }
+
+    fn send(&mut self, v: &impl Serialize) -> Result<(), EvolveError> {
+        let mut line =
+            serde_json::to_string(v).map_err(|e| EvolveError::Evaluator(e.to_string()))?;
+        line.push('\n');
+        self.stdin
+            .write_all(line.as_bytes())
+            .map_err(|e| EvolveError::Evaluator(format!("worker stdin: {e}")))
+    }
+}
+
+impl Evaluator for JsonLines {
+    fn evaluate(&mut self, _: u64, genomes: &[Genome]) -> Result<Vec<Evaluation>, EvolveError> {
+        for (index, g) in genomes.iter().enumerate() {
+            self.send(&Request::Genome {
+                index,
+                genes: g.clone(),
+            })?;
+        }
+        self.send(&Request::Evaluate { evaluate: true })?;
+        self.stdin
+            .flush()
+            .map_err(|e| EvolveError::Evaluator(format!("worker stdin: {e}")))?;
+        let mut out: Vec<Option<Evaluation>> = vec![None; genomes.len()];
+        let mut line = String::new();
+        loop {
+            line.clear();
+            let n = self
+                .stdout
+                .read_line(&mut line)
+                .map_err(|e| EvolveError::Evaluator(format!("worker stdout: {e}")))?;
+            if n == 0 {
+                return Err(EvolveError::Evaluator(
+                    "the worker closed its output".into(),
+                ));
+            }
+            let reply: Reply = serde_json::from_str(line.trim()).map_err(|e| {
+                EvolveError::Evaluator(format!("bad reply line {:?}: {e}", line.trim()))
+            })?;
+            let (index, r) = match reply {
+                Reply::Done { .. } => break,
+                Reply::Damage { index, damage } => (index, Ok(damage)),
+                Reply::Error { index, error } => (index, Err(error)),
+            };
+            let slot = out.get_mut(index).ok_or_else(|| {
+                EvolveError::Evaluator(format!("reply for index {index} of {}", genomes.len()))
+            })?;
+            *slot = Some(r);
+        }
+        out.into_iter()
+            .enumerate()
+            .map(|(i, r)| {
+                r.ok_or_else(|| EvolveError::Evaluator(format!("no reply for genome {i}")))
+            })
+            .collect()
+    }
+}
+
+impl Drop for JsonLines {
+    fn drop(&mut self) {
+        // Closing stdin ends the worker; wait so no zombie is left.
+        let _ = self.stdin.flush();
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+/// Longest request line the worker accepts (bytes).
+pub const MAX_LINE: usize = 1 << 20;
+
+/// The worker side: reads the header, builds the evaluator of its problem with `make`, then
+/// answers batches until its input ends.
+pub fn serve<R: BufRead, W: Write, E: Fn(&[Genome]) -> Vec<Evaluation>>(
+    input: R,
+    mut output: W,
+    make: impl FnOnce(serde_json::Value) -> Result<E, String>,
+) -> Result<(), EvolveError> {
+    let err = |m: String| EvolveError::Evaluator(m);
+    let mut lines = input.lines();
+    let first = lines
+        .next()
+        .ok_or_else(|| err("no header line".into()))?
+        .map_err(|e| err(e.to_string()))?;
+    let header: Header = serde_json::from_str(&first).map_err(|e| err(format!("header: {e}")))?;
+    if header.protocol != PROTOCOL {
+        return Err(err(format!(
+            "protocol '{}' is not '{PROTOCOL}'",
+            header.protocol
+        )));
+    }
+    let eval = make(header.problem).map_err(|e| err(format!("problem: {e}")))?;
+    let mut batch: Vec<(usize, Genome)> = Vec::new();
+    for (k, line) in lines.enumerate() {
+        let line = line.map_err(|e| err(e.to_string()))?;
+        if line.len() > MAX_LINE {
+            return Err(err(format!("line {} longer than {MAX_LINE} bytes", k + 2)));
+        }
+        if line.trim().is_empty() {
+            continue;
+        }
+        match serde_json::from_str::<Request>(&line)
+            .map_err(|e| err(format!("line {}: {e}", k + 2)))?
+        {
+            Request::Genome { index, genes } => batch.push((index, genes)),
+            Request::Evaluate { .. } => {
+                let genomes: Vec<Genome> = batch.iter().map(|(_, g)| g.clone()).collect();
+                let results = eval(&genomes);
+                let mut text = String::new();
+                for ((index, _), r) in batch.iter().zip(results) {
+                    let reply = match r {
+                        Ok(damage) if damage.is_finite() => Reply::Damage {
+                            index: *index,
+                            damage,
+                        },
+                        Ok(damage) => Reply::Error {
+                            index: *index,
+                            error: format!("damage {damage}"),
+                        },
+                        Err(error) => Reply::Error {
+                            index: *index,
+                            error,
+                        },
+                    };
+                    text.push_str(&serde_json::to_string(&reply).map_err(|e| err(e.to_string()))?);
+                    text.push('\n');
+                }
+                text.push_str(&format!("{{\"done\":{}}}\n", batch.len()));
+                output
+                    .write_all(text.as_bytes())
+                    .and_then(|_| output.flush())
+                    .map_err(|e| err(e.to_string()))?;
+                batch.clear();
+            }
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,118 @@
+//! The falling paper's fitness (SPEC §3, paper §5): a genome is the key pose θ_d and the
+//! stiffness k_p of every fall21 DOF (2 × 21 = 42 genes; k_v and θ̇_d fixed), its fitness the
+//! damage `D = Σ w_i f_i` of the pushed fall it controls (lower is fitter). θ_d is bounded by the
+//! age group's joint ranges, the quantity the paper studies; k_p by `[0, kp_max]`.
+//!
+//! Genes, in order: `θ_d` (rad) of DOF 0..21, then `k_p` (N·m/rad) of DOF 0..21.
+
+use std::sync::Arc;
+
+use serde::{Deserialize, Serialize};
+
+use super::evaluator::Evaluation;
+use super::genome::{Bounds, Genome};
+use crate::experiments::fall::{FallConfig, Ranges, SimError, ecs::run_parallel};
+use crate::humanoid::fall21;
+use crate::humanoid::ranges::{AgeGroup, RangeTable};
+
+/// One age group's optimisation problem: the fall every genome is tried on and the gene bounds.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FallProblem {
+    /// The age group (its joint ranges bound θ_d and act in the simulation).
+    pub age_group: AgeGroup,
+    /// The fall a genome controls (its key pose and k_p are replaced by the genes; it stops
+    /// once the body rests).
+    pub fall: FallConfig,
+    /// Upper bound of k_p per DOF (N·m/rad).
+    pub kp_max: Vec<f64>,
+}
+
+/// Why a problem is unusable.
+#[derive(Debug, thiserror::Error)]
+pub enum ProblemError {
+    /// The fall's ranges could not be resolved.
+    #[error(transparent)]
+    Fall(#[from] SimError),
+    /// The bounds are not a box.
+    #[error(transparent)]
+    Bounds(#[from] super::genome::BoundsError),
+    /// `kp_max` does not have one value per DOF.
+    #[error("kp_max needs {expected} values (one per fall21 DOF), found {found}")]
+    KpMax {
+        /// DOFs.
+        expected: usize,
+        /// Values given.
+        found: usize,
+    },
+}
+
+/// The default strength bound: `scale` times the paper's stance gains per DOF.
+pub fn default_kp_max(scale: f64) -> Vec<f64> {
+    FallConfig::paper(AgeGroup::Elderly)
+        .stance_kp
+        .iter()
+        .map(|k| k * scale)
+        .collect()
+}
+
+impl FallProblem {
+    /// The paper's problem for `group`: its fall, stopped at rest, k_p up to three times the
+    /// stance gains.
+    pub fn paper(group: AgeGroup) -> Self {
+        let mut fall = FallConfig::paper(group);
+        fall.stop_at_rest = true;
+        Self {
+            age_group: group,
+            fall,
+            kp_max: default_kp_max(3.0),
+        }
+    }
+
+    /// The joint ranges of the problem's fall (rad per DOF).
+    pub fn ranges(&self) -> Result<Vec<(f64, f64)>, ProblemError> {
+        let table = match &self.fall.ranges {
+            Ranges::Builtin(g) => RangeTable::builtin(*g),
+            Ranges::Table(t) => t.clone(),
+            Ranges::File(p) => RangeTable::load(p).map_err(SimError::from)?,
+        };
+        Ok(table.for_model(&fall21()).map_err(SimError::from)?)
+    }
+
+    /// The gene box: θ_d within the ranges, k_p within `[0, kp_max]`.
+    pub fn bounds(&self) -> Result<Bounds, ProblemError> {
+        let ranges = self.ranges()?;
+        if self.kp_max.len() != ranges.len() {
+            return Err(ProblemError::KpMax {
+                expected: ranges.len(),
+                found: self.kp_max.len(),
+            });
+        }
+        let mut lo: Vec<f64> = ranges.iter().map(|r| r.0).collect();
+        let mut hi: Vec<f64> = ranges.iter().map(|r| r.1).collect();
+        lo.extend(std::iter::repeat_n(0.0, self.kp_max.len()));
+        hi.extend(self.kp_max.iter().copied());
+        Ok(Bounds::new(lo, hi)?)
+    }
+
+    /// The fall controlled by `genes`.
+    pub fn config(&self, genes: &[f64]) -> FallConfig {
+        let n = self.kp_max.len();
+        let mut c = self.fall.clone();
+        c.key_pose_deg = genes[..n].iter().map(|x| x.to_degrees()).collect();
+        c.kp = genes[n..2 * n].to_vec();
+        c
+    }
+
+    /// The damage of every genome, each fall in its own World, in parallel.
+    pub fn evaluate(&self, genomes: &[Genome]) -> Vec<Evaluation> {
+        let configs: Vec<FallConfig> = genomes.iter().map(|g| self.config(g)).collect();
+        run_parallel(&configs)
+            .into_iter()
+            .map(|r| {
+                r.map(|f| f.damage)
+                    .map_err(|e: Arc<SimError>| e.to_string())
+            })
+            .collect()
+    }
+}

@@ -1,0 +1,214 @@
+//! The falling paper's evolution (SPEC §3, paper §5–6) as an experiment: for each age group and
+//! each seed, a GA evolves the key pose θ_d and stiffness k_p of every DOF to minimise the damage
+//! of the pushed fall; the runs advance generation by generation together, checkpointing every K
+//! generations, and report per group the initial and final damage over seeds.
+
+use std::path::PathBuf;
+
+use serde::{Deserialize, Serialize};
+
+use crate::evolve::{Evaluator, EvolveError, FallProblem, GaConfig, GaState, checkpoint};
+use crate::experiments::fall::{FallConfig, FallResult, SimError, simulate_fall};
+use crate::humanoid::ranges::AgeGroup;
+
+/// One evolution: an age group's problem and its GA (the seed is in `state.config`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct EvolutionRun {
+    /// The problem.
+    pub problem: FallProblem,
+    /// Where the GA stands.
+    pub state: GaState,
+}
+
+/// Where and how often the runs are checkpointed.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Checkpointing {
+    /// Folder of `checkpoint.json`.
+    pub dir: PathBuf,
+    /// Generations between checkpoints (≥ 1).
+    pub every: u64,
+}
+
+/// The experiment: per age group a problem, per seed a GA run.
+#[derive(Clone, Debug, PartialEq)]
+pub struct EvolveConfig {
+    /// One problem per age group.
+    pub problems: Vec<FallProblem>,
+    /// Seeds; each problem is evolved once per seed.
+    pub seeds: Vec<u64>,
+    /// GA settings (its `seed` is replaced by each of `seeds`).
+    pub ga: GaConfig,
+}
+
+/// Starts every (problem, seed) run: generation 0 drawn and evaluated, with `evaluator(problem)`
+/// giving the evaluator of each problem.
+pub fn start(
+    config: &EvolveConfig,
+    evaluators: &mut [Box<dyn Evaluator>],
+) -> Result<Vec<EvolutionRun>, EvolveError> {
+    if evaluators.len() != config.problems.len() {
+        return Err(EvolveError::Config {
+            field: "evaluators".into(),
+            message: format!(
+                "{} evaluators for {} problems",
+                evaluators.len(),
+                config.problems.len()
+            ),
+        });
+    }
+    let mut runs = Vec::new();
+    for (p, problem) in config.problems.iter().enumerate() {
+        let bounds = problem.bounds().map_err(|e| EvolveError::Config {
+            field: "problem".into(),
+            message: e.to_string(),
+        })?;
+        for &seed in &config.seeds {
+            let ga = GaConfig {
+                seed,
+                ..config.ga.clone()
+            };
+            let state = GaState::initial(ga, bounds.clone(), evaluators[p].as_mut())?;
+            runs.push(EvolutionRun {
+                problem: problem.clone(),
+                state,
+            });
+        }
+    }
+    Ok(runs)
+}
+
+/// Advances every run to its last generation, one generation at a time for all, writing a
+/// checkpoint every `checkpointing.every` generations and at the end, and calling `progress`
+/// after each generation. `evaluator_of(run)` names the index of the run's evaluator.
+pub fn advance(
+    runs: &mut [EvolutionRun],
+    evaluators: &mut [Box<dyn Evaluator>],
+    evaluator_of: impl Fn(&EvolutionRun) -> usize,
+    checkpointing: Option<&Checkpointing>,
+    mut progress: impl FnMut(&[EvolutionRun]),
+) -> Result<(), EvolveError> {
+    loop {
+        let mut stepped = false;
+        for run in runs.iter_mut() {
+            if !run.state.done() {
+                let e = evaluator_of(run);
+                run.state.step(evaluators[e].as_mut())?;
+                stepped = true;
+            }
+        }
+        if !stepped {
+            break;
+        }
+        progress(runs);
+        let g = runs.iter().map(|r| r.state.generation).max().unwrap_or(0);
+        let all_done = runs.iter().all(|r| r.state.done());
+        if let Some(c) = checkpointing
+            && (g % c.every.max(1) == 0 || all_done)
+        {
+            checkpoint::save(&c.dir, runs)?;
+        }
+    }
+    Ok(())
+}
+
+/// The index of `problem`'s age group among `config.problems`.
+pub fn problem_index(config: &EvolveConfig, run: &EvolutionRun) -> usize {
+    config
+        .problems
+        .iter()
+        .position(|p| p.age_group == run.problem.age_group)
+        .unwrap_or(0)
+}
+
+/// A figure over seeds: mean and (population) standard deviation.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Spread {
+    /// Mean.
+    pub mean: f64,
+    /// Standard deviation.
+    pub std: f64,
+    /// Smallest value.
+    pub min: f64,
+    /// Largest value.
+    pub max: f64,
+}
+
+impl Spread {
+    /// Of `xs` (finite values only).
+    pub fn of(xs: &[f64]) -> Spread {
+        let v: Vec<f64> = xs.iter().copied().filter(|x| x.is_finite()).collect();
+        let n = v.len().max(1) as f64;
+        let mean = v.iter().sum::<f64>() / n;
+        let std = (v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / n).sqrt();
+        Spread {
+            mean,
+            std,
+            min: v.iter().copied().fold(f64::INFINITY, f64::min),
+            max: v.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+        }
+    }
+}
+
+/// One age group's outcome over its seeds.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct GroupOutcome {
+    /// The age group.
+    pub age_group: AgeGroup,
+    /// Seeds.
+    pub seeds: Vec<u64>,
+    /// Best damage of generation 0 per seed (N).
+    pub initial_best: Vec<f64>,
+    /// Best damage so far at the last generation per seed (N).
+    pub final_best: Vec<f64>,
+    /// Over seeds.
+    pub initial: Spread,
+    /// Over seeds.
+    pub final_: Spread,
+}
+
+/// Per age group the initial and final damage over seeds.
+pub fn outcomes(runs: &[EvolutionRun]) -> Vec<GroupOutcome> {
+    let mut groups: Vec<AgeGroup> = Vec::new();
+    for r in runs {
+        if !groups.contains(&r.problem.age_group) {
+            groups.push(r.problem.age_group);
+        }
+    }
+    groups
+        .into_iter()
+        .map(|g| {
+            let rs: Vec<&EvolutionRun> = runs.iter().filter(|r| r.problem.age_group == g).collect();
+            let first = |r: &EvolutionRun| r.state.logbook.first().map_or(f64::NAN, |l| l.best);
+            let last =
+                |r: &EvolutionRun| r.state.logbook.last().map_or(f64::NAN, |l| l.best_so_far);
+            let initial_best: Vec<f64> = rs.iter().map(|r| first(r)).collect();
+            let final_best: Vec<f64> = rs.iter().map(|r| last(r)).collect();
+            GroupOutcome {
+                age_group: g,
+                seeds: rs.iter().map(|r| r.state.config.seed).collect(),
+                initial: Spread::of(&initial_best),
+                final_: Spread::of(&final_best),
+                initial_best,
+                final_best,
+            }
+        })
+        .collect()
+}
+
+/// The fall of a run's best genome of generation 0 and of the whole run (the paper's "before"
+/// and "after"), simulated to the end with frames.
+pub fn best_falls(run: &EvolutionRun) -> Result<(FallResult, FallResult), SimError> {
+    let config = |g: Option<&Vec<f64>>| {
+        g.map_or_else(|| run.problem.fall.clone(), |g| run.problem.config(g))
+    };
+    let before = config(run.state.initial_best.as_ref());
+    let after = config(run.state.best.as_ref().map(|b| &b.0));
+    Ok((replay(&before)?, replay(&after)?))
+}
+
+/// A fall simulated to its full duration (not stopped at rest), for pictures.
+pub fn replay(config: &FallConfig) -> Result<FallResult, SimError> {
+    let mut c = config.clone();
+    c.stop_at_rest = false;
+    simulate_fall(&c)
+}
