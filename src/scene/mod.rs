@@ -6,11 +6,13 @@
 //! from the command line (`--set clip.end_s=2.5`) so a parameter can be swept without editing
 //! files.
 
+mod evolve;
 mod fall;
 mod primitives;
 mod show;
 mod source;
 
+pub use evolve::{EvaluatorChoice, EvolveFallScene, run_evolve};
 pub use fall::{Body, Controller, FallScene, Simulation, fall_report, run_fall};
 pub use primitives::{
     HighJumpScene, JumpingKneeKickScene, PrimitiveRender, run_high_jump, run_jumping_knee_kick,
@@ -37,6 +39,8 @@ pub enum Scene {
     JumpingKneeKick(Box<JumpingKneeKickScene>),
     /// The falling paper's pushed figure.
     Fall(Box<FallScene>),
+    /// The falling paper's GA for both age groups over several seeds.
+    EvolveFall(Box<EvolveFallScene>),
 }
 
 /// Why a scene could not be read or run. Module errors keep their own type (and message), so a
@@ -115,6 +119,7 @@ impl Scene {
             Scene::HighJump(s) => &s.name,
             Scene::JumpingKneeKick(s) => &s.name,
             Scene::Fall(s) => &s.name,
+            Scene::EvolveFall(s) => &s.name,
         }
     }
 
@@ -124,6 +129,7 @@ impl Scene {
             Scene::HighJump(s) => s.format_version,
             Scene::JumpingKneeKick(s) => s.format_version,
             Scene::Fall(s) => s.format_version,
+            Scene::EvolveFall(s) => s.format_version,
         }
     }
 
@@ -218,6 +224,7 @@ pub fn run(scene: &Scene, base: &Path, out_dir: &Path) -> Result<serde_json::Val
         Scene::HighJump(s) => run_high_jump(s, base, out_dir)?,
         Scene::JumpingKneeKick(s) => run_jumping_knee_kick(s, base, out_dir)?,
         Scene::Fall(s) => run_fall(s, base, out_dir)?,
+        Scene::EvolveFall(s) => run_evolve(s, base, out_dir)?,
     };
     if let Some(o) = report.as_object_mut() {
         o.insert("scene".into(), scene.name().into());

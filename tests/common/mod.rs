@@ -47,3 +47,39 @@ pub fn data_dir() -> Option<PathBuf> {
 fn in_ci() -> bool {
     std::env::var("CI").is_ok_and(|v| !matches!(v.trim(), "" | "0" | "false" | "FALSE"))
 }
+
+/// A Python interpreter that can `import` every one of `modules` (the project's virtual
+/// environment `.venv`, made by `.ci/run`, or `$MARIONETTE_PYTHON`), or `None` after reporting
+/// that it is absent; panics instead under CI.
+pub fn python_with(modules: &[&str]) -> Option<PathBuf> {
+    let candidates: Vec<PathBuf> = std::env::var_os("MARIONETTE_PYTHON")
+        .map(PathBuf::from)
+        .into_iter()
+        .chain(std::iter::once(
+            PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(".venv/bin/python"),
+        ))
+        .collect();
+    let import = format!("import {}", modules.join(", "));
+    for py in &candidates {
+        let ok = std::process::Command::new(py)
+            .args(["-c", &import])
+            .output()
+            .is_ok_and(|o| o.status.success());
+        if ok {
+            return Some(py.clone());
+        }
+    }
+    let test = std::thread::current()
+        .name()
+        .unwrap_or("this test")
+        .to_string();
+    let tried: Vec<String> = candidates.iter().map(|p| p.display().to_string()).collect();
+    if in_ci() {
+        panic!("{test}: no Python with {import:?} (tried {tried:?}); .ci/run makes .venv");
+    }
+    let _ = writeln!(
+        std::io::stderr(),
+        "SKIPPED: {test}: needs a Python with {import:?} (tried {tried:?}; run .ci/run or set MARIONETTE_PYTHON)"
+    );
+    None
+}

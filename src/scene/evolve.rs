@@ -1,0 +1,491 @@
+//! The `EvolveFall` scene: the falling paper's GA for each age group over several seeds
+//! (SPEC §3, paper §5–6, Figs. 2–7), checkpointed and resumable, with the fitness curves, the
+//! head height of the best fall before and after evolution, the four falls drawn and written as
+//! BVH, the best controller of each group as a file the `Fall` scene replays, and statistics
+//! over seeds.
+
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::time::Instant;
+
+use serde::{Deserialize, Serialize};
+use serde_json::json;
+
+use super::primitives::PrimitiveRender;
+use super::{SceneError, draw_tracks, write_output};
+use crate::evolve::{Evaluator, FallProblem, GaConfig, InProcess, JsonLines, checkpoint, logbook};
+use crate::experiments::evolve_fall::{
+    Checkpointing, EvolutionRun, EvolveConfig, GroupOutcome, advance, best_falls, outcomes,
+    problem_index, start,
+};
+use crate::experiments::fall::{FallConfig, FallResult, simulate_fall};
+use crate::humanoid::fall21;
+use crate::humanoid::ranges::AgeGroup;
+use crate::render::{Plot, Series, Track, plot};
+
+/// Who evaluates the generations.
+#[derive(Clone, Debug, PartialEq, Default, Serialize, Deserialize)]
+pub enum EvaluatorChoice {
+    /// In this process, one World per fall, in parallel with rayon.
+    #[default]
+    InProcess,
+    /// A JSON-lines worker started with this command line, e.g.
+    /// `["marionette", "eval", "--stdin"]` or `["python3", "tools/ray_eval.py"]`; one worker per
+    /// age group.
+    Command(Vec<String>),
+}
+
+fn default_groups() -> Vec<AgeGroup> {
+    vec![AgeGroup::Elderly, AgeGroup::Adult]
+}
+fn default_seeds() -> Vec<u64> {
+    vec![1, 2, 3, 4, 5]
+}
+fn default_kp_scale() -> f64 {
+    3.0
+}
+fn default_every() -> u64 {
+    10
+}
+
+/// Evolution of the fall controller for each age group.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EvolveFallScene {
+    /// Scene format version.
+    pub format_version: u32,
+    /// Scene name.
+    pub name: String,
+    /// Age groups to evolve (default both).
+    #[serde(default = "default_groups")]
+    pub groups: Vec<AgeGroup>,
+    /// Seeds: each group is evolved once per seed (default 1–5).
+    #[serde(default = "default_seeds")]
+    pub seeds: Vec<u64>,
+    /// GA settings (the paper: 30 chromosomes, 500 generations).
+    #[serde(default)]
+    pub ga: GaConfig,
+    /// k_p's upper bound as a multiple of the paper's stance gains.
+    #[serde(default = "default_kp_scale")]
+    pub kp_max_scale: f64,
+    /// The fall every genome is tried on, per field (default: the paper's push of the age
+    /// group; its key pose and k_p are the genes).
+    #[serde(default)]
+    pub fall: Option<FallConfig>,
+    /// Generations between checkpoints.
+    #[serde(default = "default_every")]
+    pub checkpoint_every: u64,
+    /// Folder of the checkpoint (default `out/<name>.checkpoint`).
+    #[serde(default)]
+    pub checkpoint_dir: Option<String>,
+    /// Continue from the checkpoint in this folder (`marionette run … --resume DIR`).
+    #[serde(default)]
+    pub resume: Option<String>,
+    /// Who evaluates.
+    #[serde(default)]
+    pub evaluator: EvaluatorChoice,
+    /// Pictures.
+    #[serde(default)]
+    pub render: PrimitiveRender,
+}
+
+fn group_name(g: AgeGroup) -> &'static str {
+    match g {
+        AgeGroup::Elderly => "elderly",
+        AgeGroup::Adult => "adult",
+    }
+}
+
+fn invalid(m: String) -> SceneError {
+    SceneError::Invalid(m)
+}
+
+impl EvolveFallScene {
+    /// The experiment's configuration.
+    pub fn config(&self) -> Result<EvolveConfig, SceneError> {
+        if self.groups.is_empty() || self.seeds.is_empty() {
+            return Err(invalid("groups and seeds must not be empty".into()));
+        }
+        if !(self.kp_max_scale.is_finite() && self.kp_max_scale > 0.0 && self.kp_max_scale <= 100.0)
+        {
+            return Err(invalid(format!(
+                "kp_max_scale must be in (0, 100], found {}",
+                self.kp_max_scale
+            )));
+        }
+        self.ga.validate().map_err(|e| invalid(e.to_string()))?;
+        let falls = self.groups.len() as u64
+            * self.seeds.len() as u64
+            * self.ga.population as u64
+            * (self.ga.generations + 1);
+        if falls > 100_000_000 {
+            return Err(invalid(format!(
+                "{falls} falls to simulate is past the limit of 100 000 000"
+            )));
+        }
+        let problems = self
+            .groups
+            .iter()
+            .map(|&g| {
+                let mut p = FallProblem::paper(g);
+                if let Some(f) = &self.fall {
+                    p.fall = f.clone();
+                    p.fall.ranges = crate::experiments::fall::Ranges::Builtin(g);
+                    p.fall.stop_at_rest = true;
+                }
+                p.kp_max = crate::evolve::fall_fitness::default_kp_max(self.kp_max_scale);
+                p.bounds().map_err(|e| invalid(e.to_string()))?;
+                Ok(p)
+            })
+            .collect::<Result<Vec<_>, SceneError>>()?;
+        Ok(EvolveConfig {
+            problems,
+            seeds: self.seeds.clone(),
+            ga: self.ga.clone(),
+        })
+    }
+
+    fn evaluators(&self, config: &EvolveConfig) -> Result<Vec<Box<dyn Evaluator>>, SceneError> {
+        config
+            .problems
+            .iter()
+            .map(|p| -> Result<Box<dyn Evaluator>, SceneError> {
+                match &self.evaluator {
+                    EvaluatorChoice::InProcess => {
+                        let p = p.clone();
+                        Ok(Box::new(InProcess {
+                            batch: move |g: &[Vec<f64>]| p.evaluate(g),
+                        }))
+                    }
+                    EvaluatorChoice::Command(argv) => {
+                        let (prog, args) = argv
+                            .split_first()
+                            .ok_or_else(|| invalid("evaluator: Command needs a program".into()))?;
+                        let mut c = Command::new(prog);
+                        c.args(args);
+                        Ok(Box::new(
+                            JsonLines::start(c, p).map_err(|e| invalid(e.to_string()))?,
+                        ))
+                    }
+                }
+            })
+            .collect()
+    }
+}
+
+/// Progress on standard error: one updating line on a terminal, plain lines otherwise.
+struct Progress {
+    started: Instant,
+    total: u64,
+    terminal: bool,
+    last_plain: u64,
+}
+
+impl Progress {
+    fn show(&mut self, runs: &[EvolutionRun]) {
+        let g = runs.iter().map(|r| r.state.generation).min().unwrap_or(0);
+        let best = runs
+            .iter()
+            .filter_map(|r| r.state.best.as_ref().map(|b| b.1))
+            .fold(f64::INFINITY, f64::min);
+        let done = g.max(1) as f64;
+        let eta = self.started.elapsed().as_secs_f64() / done * (self.total as f64 - done);
+        let text = format!(
+            "generation {g}/{} · best damage {best:.0} N · ETA {:.0} s",
+            self.total,
+            eta.max(0.0)
+        );
+        if self.terminal {
+            eprint!("\r{text}   ");
+            if g >= self.total {
+                eprintln!();
+            }
+        } else if g >= self.last_plain + (self.total / 20).max(1) || g >= self.total {
+            self.last_plain = g;
+            eprintln!("{text}");
+        }
+    }
+}
+
+/// The report of one fall (the figures an evolved fall must not win by an artefact).
+fn honesty(config: &FallConfig, result: &FallResult) -> serde_json::Value {
+    let mut half = config.clone();
+    half.dt_s *= 0.5;
+    half.stop_at_rest = false;
+    let half_damage = simulate_fall(&half).map(|r| r.damage);
+    let worst = result
+        .max_limit_excursion_rad
+        .iter()
+        .copied()
+        .fold(0.0, f64::max);
+    json!({
+        "damage": result.damage,
+        "max_penetration_m": result.max_penetration_m,
+        "worst_range_excursion_deg": worst.to_degrees(),
+        "damage_at_half_step": half_damage.as_ref().ok(),
+        "half_step_relative_change": half_damage.as_ref().ok().map(|d| (d - result.damage) / result.damage),
+        "half_step_within_10_percent": half_damage.as_ref().ok().map(|d| ((d - result.damage) / result.damage).abs() <= 0.1),
+        "came_to_rest": result.came_to_rest,
+    })
+}
+
+/// The best controller of a run as a `Fall` scene's `controller` block (degrees, N·m/rad).
+fn controller_ron(problem: &FallProblem, genes: &[f64]) -> String {
+    let names = fall21().dof_names();
+    let n = names.len();
+    let mut s = String::from(
+        "// The evolved key pose and stiffness, for a Fall scene's controller.\n(\n    key_pose_deg: {\n",
+    );
+    for (i, name) in names.iter().enumerate() {
+        s.push_str(&format!(
+            "        \"{name}\": {:?},\n",
+            genes[i].to_degrees()
+        ));
+    }
+    s.push_str("    },\n    kp: {\n");
+    for (i, name) in names.iter().enumerate() {
+        s.push_str(&format!("        \"{name}\": {:?},\n", genes[n + i]));
+    }
+    s.push_str(&format!(
+        "    }},\n    start_s: Some({:?}),\n)\n",
+        problem.fall.control_start_s
+    ));
+    s
+}
+
+/// Runs an [`EvolveFallScene`]; returns the report.
+pub fn run_evolve(
+    scene: &EvolveFallScene,
+    _base: &Path,
+    out: &Path,
+) -> Result<serde_json::Value, SceneError> {
+    let config = scene.config()?;
+    let mut evaluators = scene.evaluators(&config)?;
+    let ck_dir = PathBuf::from(
+        scene
+            .resume
+            .clone()
+            .or_else(|| scene.checkpoint_dir.clone())
+            .unwrap_or_else(|| format!("out/{}.checkpoint", scene.name)),
+    );
+    let started = Instant::now();
+    let mut runs: Vec<EvolutionRun> = match &scene.resume {
+        Some(_) => {
+            let mut runs: Vec<EvolutionRun> =
+                checkpoint::load(&ck_dir).map_err(|e| invalid(e.to_string()))?;
+            // The same experiment, possibly asked to run longer.
+            let same = runs.len() == config.problems.len() * config.seeds.len()
+                && runs.iter().all(|r| {
+                    config.problems.contains(&r.problem)
+                        && GaConfig {
+                            seed: r.state.config.seed,
+                            generations: r.state.config.generations,
+                            ..config.ga.clone()
+                        } == r.state.config
+                        && r.state.generation <= config.ga.generations
+                });
+            if !same {
+                return Err(invalid(format!(
+                    "resume: the checkpoint in {} was made by another scene (groups, seeds, GA or fall differ)",
+                    ck_dir.display()
+                )));
+            }
+            for r in &mut runs {
+                r.state.config.generations = config.ga.generations;
+            }
+            runs
+        }
+        None => start(&config, &mut evaluators).map_err(|e| invalid(e.to_string()))?,
+    };
+    let ck = Checkpointing {
+        dir: ck_dir.clone(),
+        every: scene.checkpoint_every.max(1),
+    };
+    let mut progress = Progress {
+        started: Instant::now(),
+        total: config.ga.generations,
+        terminal: std::io::stderr().is_terminal(),
+        last_plain: 0,
+    };
+    advance(
+        &mut runs,
+        &mut evaluators,
+        |r| problem_index(&config, r),
+        Some(&ck),
+        |r| progress.show(r),
+    )
+    .map_err(|e| invalid(e.to_string()))?;
+    checkpoint::save(&ck_dir, &runs).map_err(|e| invalid(e.to_string()))?;
+    let ga_wall = started.elapsed().as_secs_f64();
+
+    // Logbooks.
+    for r in &runs {
+        let stem = format!(
+            "logbook_{}_seed{}",
+            group_name(r.problem.age_group),
+            r.state.config.seed
+        );
+        write_output(
+            &out.join(format!("{stem}.csv")),
+            logbook::to_csv(&r.state.logbook).as_bytes(),
+        )?;
+        write_output(
+            &out.join(format!("{stem}.jsonl")),
+            logbook::to_json_lines(&r.state.logbook).as_bytes(),
+        )?;
+    }
+    let groups = outcomes(&runs);
+    // Fig. 2: best damage so far per generation, mean over seeds and the best seed, per group.
+    let mut series = Vec::new();
+    for g in &groups {
+        let rs: Vec<&EvolutionRun> = runs
+            .iter()
+            .filter(|r| r.problem.age_group == g.age_group)
+            .collect();
+        let len = rs.iter().map(|r| r.state.logbook.len()).min().unwrap_or(0);
+        series.push(Series {
+            name: format!("{}: mean of {} seeds", group_name(g.age_group), rs.len()),
+            points: (0..len)
+                .map(|k| {
+                    let m = rs
+                        .iter()
+                        .map(|r| r.state.logbook[k].best_so_far)
+                        .sum::<f64>()
+                        / rs.len() as f64;
+                    (k as f64, m)
+                })
+                .collect(),
+        });
+    }
+    plot(
+        &Plot {
+            title: format!("Best damage so far: {}", scene.name),
+            x_label: "generation".into(),
+            y_label: "damage D (N)".into(),
+            series,
+            markers: vec![],
+        },
+        &out.join("fitness.png"),
+    )?;
+    // The best run of each group (lowest final damage): its falls before and after.
+    let mut falls: Vec<(String, FallConfig, FallResult)> = Vec::new();
+    let mut best_runs = Vec::new();
+    for g in &groups {
+        let best = runs
+            .iter()
+            .filter(|r| r.problem.age_group == g.age_group)
+            .min_by(|a, b| {
+                let fa = a.state.best.as_ref().map_or(f64::INFINITY, |b| b.1);
+                let fb = b.state.best.as_ref().map_or(f64::INFINITY, |b| b.1);
+                fa.total_cmp(&fb)
+            })
+            .ok_or_else(|| invalid("no run".into()))?;
+        let (before, after) = best_falls(best)?;
+        let name = group_name(g.age_group);
+        let cfg = |genes: Option<&Vec<f64>>| {
+            genes.map_or_else(|| best.problem.fall.clone(), |g| best.problem.config(g))
+        };
+        falls.push((
+            format!("{name} before"),
+            cfg(best.state.initial_best.as_ref()),
+            before,
+        ));
+        falls.push((
+            format!("{name} evolved"),
+            cfg(best.state.best.as_ref().map(|b| &b.0)),
+            after,
+        ));
+        if let Some((genes, _)) = &best.state.best {
+            write_output(
+                &out.join(format!("best_{name}.controller.ron")),
+                controller_ron(&best.problem, genes).as_bytes(),
+            )?;
+        }
+        best_runs.push(best);
+    }
+    let clips: Vec<_> = falls
+        .iter()
+        .map(|(_, _, r)| r.to_model_clip().to_clip())
+        .collect();
+    for ((label, _, _), clip) in falls.iter().zip(&clips) {
+        write_output(
+            &out.join(format!("fall_{}.bvh", label.replace(' ', "_"))),
+            crate::bvh::to_string(&clip.to_bvh()).as_bytes(),
+        )?;
+    }
+    let figures: Vec<_> = clips.iter().map(|c| c.skeleton.figure()).collect();
+    let frames: Vec<_> = clips.iter().map(|c| c.point_frames()).collect();
+    let tracks: Vec<Track> = (0..clips.len())
+        .map(|k| Track {
+            figure: &figures[k],
+            frames: &frames[k],
+            label: format!("{} (damage {:.0} N)", falls[k].0, falls[k].2.damage),
+            frame_time: clips[k].frame_time,
+        })
+        .collect();
+    draw_tracks(
+        &tracks,
+        scene.render.filmstrip_frames,
+        scene.render.gif.then_some(scene.render.gif_fps),
+        out,
+    )?;
+    // Fig. 3: head height of the best falls before and after.
+    plot(
+        &Plot {
+            title: format!(
+                "Head height, best fall before and after evolution: {}",
+                scene.name
+            ),
+            x_label: "time (s)".into(),
+            y_label: "head height (m)".into(),
+            series: falls
+                .iter()
+                .map(|(label, _, r)| Series {
+                    name: label.clone(),
+                    points: r
+                        .frames
+                        .iter()
+                        .map(|f| (f.time_s, f.head_height_m))
+                        .collect(),
+                })
+                .collect(),
+            markers: vec![],
+        },
+        &out.join("head_height.png"),
+    )?;
+    let group_json = |g: &GroupOutcome| {
+        json!({
+            "age_group": g.age_group,
+            "seeds": g.seeds,
+            "initial_best_damage": g.initial_best,
+            "final_best_damage": g.final_best,
+            "initial": g.initial,
+            "final": g.final_,
+        })
+    };
+    let mut report = json!({
+        "generations": config.ga.generations,
+        "population": config.ga.population,
+        "evaluations": runs.iter().map(|r| r.state.evaluations).sum::<u64>(),
+        "failed_evaluations": runs.iter().map(|r| r.state.failures.len()).sum::<usize>(),
+        "groups": groups.iter().map(group_json).collect::<Vec<_>>(),
+        "ga_wall_time_s": ga_wall,
+        "checkpoint": ck_dir.display().to_string(),
+        "best_falls": falls.iter().map(|(label, c, r)| json!({"fall": label, "honesty": honesty(c, r)})).collect::<Vec<_>>(),
+    });
+    if let [a, b] = groups.as_slice() {
+        let spread = a.final_.std + b.final_.std;
+        let spread0 = a.initial.std + b.initial.std;
+        report["comparison"] = json!({
+            "groups": [a.age_group, b.age_group],
+            "initial_gap": (a.initial.mean - b.initial.mean),
+            "initial_seed_spread": spread0,
+            "initial_within_seed_spread": (a.initial.mean - b.initial.mean).abs() <= spread0,
+            "final_gap": (a.final_.mean - b.final_.mean),
+            "final_seed_spread": spread,
+            "final_gap_exceeds_seed_spread": (a.final_.mean - b.final_.mean).abs() > spread,
+        });
+    }
+    Ok(report)
+}

@@ -1,0 +1,133 @@
+//! The evolution scene from the command line: a short run writes every output, and a run cut
+//! short and resumed ends with the same logbooks and report figures as a run straight through.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn marionette(args: &[&str]) -> std::process::Output {
+    let out = Command::new(env!("CARGO_BIN_EXE_marionette"))
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "marionette {args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
+fn tmp(name: &str) -> PathBuf {
+    std::env::temp_dir().join(format!("marionette-evolve-{}-{name}", std::process::id()))
+}
+
+fn report(dir: &Path) -> serde_json::Value {
+    let mut r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("report.json")).unwrap()).unwrap();
+    let o = r.as_object_mut().unwrap();
+    for k in ["wall_time_s", "ga_wall_time_s", "checkpoint"] {
+        o.remove(k);
+    }
+    r
+}
+
+const QUICK: [&str; 6] = [
+    "--set",
+    "seeds=[1,2]",
+    "--set",
+    "ga.population=6",
+    "--set",
+    "render.gif=false",
+];
+
+#[test]
+fn a_resumed_evolution_ends_where_an_uninterrupted_one_does() {
+    let (a, b, ck_a, ck_b) = (tmp("a"), tmp("b"), tmp("ck_a"), tmp("ck_b"));
+    let s = |p: &Path| p.display().to_string();
+    let ck = |p: &Path| format!("checkpoint_dir=\"{}\"", p.display());
+    let mut straight = vec!["run", "scenes/evolve_fall.ron", "--out"];
+    let (sa, sb, ca, cb) = (s(&a), s(&b), ck(&ck_a), ck(&ck_b));
+    straight.extend([
+        sa.as_str(),
+        "--set",
+        "ga.generations=3",
+        "--set",
+        ca.as_str(),
+    ]);
+    straight.extend(QUICK);
+    marionette(&straight);
+    for f in [
+        "fitness.png",
+        "head_height.png",
+        "filmstrip.png",
+        "fall_elderly_before.bvh",
+        "fall_elderly_evolved.bvh",
+        "fall_adult_before.bvh",
+        "fall_adult_evolved.bvh",
+        "best_elderly.controller.ron",
+        "best_adult.controller.ron",
+        "logbook_elderly_seed1.csv",
+        "logbook_adult_seed2.jsonl",
+    ] {
+        assert!(a.join(f).is_file(), "{f} missing");
+    }
+    // One generation, then resumed to three.
+    let mut first = vec!["run", "scenes/evolve_fall.ron", "--out"];
+    first.extend([
+        sb.as_str(),
+        "--set",
+        "ga.generations=1",
+        "--set",
+        cb.as_str(),
+    ]);
+    first.extend(QUICK);
+    marionette(&first);
+    let ckb = s(&ck_b);
+    let mut resumed = vec!["run", "scenes/evolve_fall.ron", "--out"];
+    resumed.extend([
+        sb.as_str(),
+        "--set",
+        "ga.generations=3",
+        "--resume",
+        ckb.as_str(),
+    ]);
+    resumed.extend(QUICK);
+    marionette(&resumed);
+    assert_eq!(report(&a), report(&b));
+    for f in ["logbook_elderly_seed1.csv", "logbook_adult_seed2.csv"] {
+        assert_eq!(
+            std::fs::read(a.join(f)).unwrap(),
+            std::fs::read(b.join(f)).unwrap(),
+            "{f}"
+        );
+    }
+    let r = report(&a);
+    assert_eq!(r["generations"], 3);
+    let groups = r["groups"].as_array().unwrap();
+    assert_eq!(groups.len(), 2);
+    for g in groups {
+        let initial = g["initial"]["mean"].as_f64().unwrap();
+        let fin = g["final"]["mean"].as_f64().unwrap();
+        assert!(fin <= initial, "best so far rose: {initial} → {fin}");
+    }
+    // A resume from another experiment is refused.
+    let out = Command::new(env!("CARGO_BIN_EXE_marionette"))
+        .args([
+            "run",
+            "scenes/evolve_fall.ron",
+            "--out",
+            &sb,
+            "--resume",
+            &ckb,
+        ])
+        .args(["--set", "seeds=[7]"])
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("another scene"));
+    for d in [a, b, ck_a, ck_b] {
+        std::fs::remove_dir_all(d).ok();
+    }
+}
