@@ -1,0 +1,60 @@
+//! What the paper's GA costs: one generation of 30 chromosomes of the initial population (the
+//! elderly group's problem: 42 genes, falls stopped once the body rests), each fall in its own
+//! World, on a rayon pool of 1 and of 2 threads. Falls per second give the paper's whole GA
+//! (30 × 500 = 15 000 falls for one age group) as 15 000 / rate; the ratio of the two rates is
+//! the parallel efficiency × 2. Also one GA step alone (selection, crossover, mutation) without
+//! evaluation.
+//! Run: `cargo bench --bench evolve`.
+
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use marionette::evolve::{FallProblem, GaConfig, GaState, InProcess};
+use marionette::humanoid::ranges::AgeGroup;
+use std::hint::black_box;
+use std::time::Duration;
+
+fn bench_generation(c: &mut Criterion) {
+    let problem = FallProblem::paper(AgeGroup::Elderly);
+    let bounds = problem.bounds().expect("bounds");
+    let cfg = GaConfig {
+        population: 30,
+        generations: 1,
+        seed: 1,
+        ..GaConfig::default()
+    };
+    let mut count = InProcess {
+        batch: |g: &[Vec<f64>]| problem.evaluate(g),
+    };
+    let state = GaState::initial(cfg.clone(), bounds.clone(), &mut count).expect("GA");
+    let genomes = state.population.clone();
+    let failures = state.fitness.iter().filter(|f| f.is_none()).count();
+    assert_eq!(failures, 0, "falls of the bench population failed");
+    let mut g = c.benchmark_group("ga_generation_30_falls");
+    g.sample_size(10).measurement_time(Duration::from_secs(15));
+    g.throughput(Throughput::Elements(genomes.len() as u64));
+    for threads in [1, 2] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("pool");
+        g.bench_function(format!("threads_{threads}"), |b| {
+            b.iter(|| pool.install(|| black_box(problem.evaluate(black_box(&genomes)))))
+        });
+    }
+    g.finish();
+    // The GA's own work per generation, with a free evaluation.
+    let mut free = InProcess {
+        batch: |g: &[Vec<f64>]| g.iter().map(|x| Ok(x.iter().sum::<f64>())).collect(),
+    };
+    let base = GaState::initial(cfg, bounds, &mut free).expect("GA");
+    c.bench_function("ga_step_operators_only_30x42", |b| {
+        b.iter(|| {
+            let mut s = base.clone();
+            s.config.generations = 2;
+            s.step(&mut free).expect("step");
+            black_box(s.generation)
+        })
+    });
+}
+
+criterion_group!(benches, bench_generation);
+criterion_main!(benches);
