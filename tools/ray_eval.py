@@ -10,10 +10,10 @@ genomes are split into one contiguous chunk per actor, and the replies are retur
 order.
 
 On a laptop (a local Ray started by this program):
-    marionette run scenes/evolve_fall.ron --set 'evaluator=Command(["python3","tools/ray_eval.py"])'
+    marionette run scenes/evolve_fall.ron --set 'evaluator={"Command":["python3","tools/ray_eval.py"]}'
 On a cluster (the engine and this program run on the head node; actors on every node):
     ray job submit --working-dir . -- marionette run scenes/evolve_fall.ron \
-        --set 'evaluator=Command(["python3","tools/ray_eval.py","--address","auto"])'
+        --set 'evaluator={"Command":["python3","tools/ray_eval.py","--address","auto"]}'
 
 Options: --address ADDR (Ray cluster, default: start a local one), --actors N (default: one
 per node, or 1 locally), --worker PATH (the marionette binary, default `marionette` on PATH or
