@@ -8,4 +8,5 @@
 
 pub mod fall;
 pub mod high_jump;
+pub mod jump_figures;
 pub mod knee_kick;
