@@ -92,6 +92,12 @@ pub struct HighJumpConfig {
 /// normal (B) jump blended as `γ·A + (1 − γ)·B`, γ taken where that figure happens in the blend.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct JumpPrediction {
+    /// The blend's span T (the normal jump's duration), seconds: t′ = t / T.
+    pub span_s: f64,
+    /// The normal jump's Bend, seconds.
+    pub normal_bend_s: f64,
+    /// The normal jump's apex (root highest), seconds.
+    pub normal_apex_s: f64,
     /// γ at the normal jump's Bend (its deepest crouch), normalised time t′ = Bend / T.
     pub gamma_at_bend: f64,
     /// γ at the normal jump's apex (its root highest), t′ = apex / T.
@@ -259,6 +265,9 @@ pub fn learn_primitives(
     let mix = |g: f64, a: f64, b: f64| g * a + (1.0 - g) * b;
     let crouch = |c: &ModelClip| crouch_peak_deg(c, dt);
     let prediction = JumpPrediction {
+        span_s: t,
+        normal_bend_s: ev.bend,
+        normal_apex_s: fn_.apex_time_s,
         gamma_at_bend,
         gamma_at_apex,
         crouch_knee_flexion_deg: mix(gamma_at_bend, crouch(&low_clip)?, crouch(&normal_clip)?),

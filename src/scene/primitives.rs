@@ -205,6 +205,7 @@ pub fn run_high_jump(
     base: &Path,
     out: &Path,
 ) -> Result<serde_json::Value, SceneError> {
+    scene.gamma.validate()?;
     let model = Model::by_name("humanoid24")?;
     let config = high_jump_config(scene, base, &model)?;
     let hj = high_jump::run(&config).map_err(SceneError::from)?;
@@ -324,6 +325,8 @@ pub fn run_jumping_knee_kick(
     base: &Path,
     out: &Path,
 ) -> Result<serde_json::Value, SceneError> {
+    scene.gamma.validate()?;
+    scene.jump.gamma.validate()?;
     let model = Model::by_name("humanoid24")?;
     let config = KneeKickConfig {
         jump: high_jump_config(&scene.jump, base, &model)?,
