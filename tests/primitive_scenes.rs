@@ -216,25 +216,27 @@ fn jumping_knee_kick_on_cmu_capture() {
 /// ramp, interpolation and extrapolation.
 #[test]
 fn high_jump_report_follows_gamma() {
-    let ramp = |from: f64, to: f64| move |t: f64| from + (to - from) * t;
-    let cases: [(&str, &str, Box<dyn Fn(f64) -> f64>); 4] = [
-        (r#"{"Constant":-1.0}"#, "γ = −1", Box::new(|_| -1.0)),
-        (r#"{"Constant":0.25}"#, "γ = 0.25", Box::new(|_| 0.25)),
+    // (--set value, label, γ(0), γ(1)): a constant is a ramp from γ to γ.
+    let cases = [
+        (r#"{"Constant":-1.0}"#, "γ = −1", -1.0, -1.0),
+        (r#"{"Constant":0.25}"#, "γ = 0.25", 0.25, 0.25),
         (
             r#"{"Ramp":{"from":0.0,"to":-1.0}}"#,
             "γ = 0 → −1 (ramp)",
-            Box::new(ramp(0.0, -1.0)),
+            0.0,
+            -1.0,
         ),
         (
             r#"{"Ramp":{"from":-0.5,"to":0.5}}"#,
             "γ = −0.5 → 0.5 (ramp)",
-            Box::new(ramp(-0.5, 0.5)),
+            -0.5,
+            0.5,
         ),
     ];
-    for (set, label, gamma_at) in &cases {
+    for (set, label, from, to) in cases {
         let r = run_scene_with("high_jump.ron", &[format!("gamma={set}")], &[]);
-        assert_eq!(r["gamma"], *label, "{set}");
-        check_high_jump_follows(&r, gamma_at.as_ref());
+        assert_eq!(r["gamma"], label, "{set}");
+        check_high_jump_follows(&r, &|t| from + (to - from) * t);
     }
 }
 
