@@ -7,6 +7,7 @@ use serde::Serialize;
 
 use crate::analysis::{Span, clip_contacts};
 use crate::humanoid::ModelClip;
+use crate::primitive::events::median;
 
 /// Height above the floor under which a foot point counts as touching it, metres (as
 /// `marionette inspect` and the show scenes use).
@@ -80,17 +81,6 @@ pub fn jump_figures(clip: &ModelClip, floor_y: f64) -> JumpFigures {
 /// (`None` when the clip has no feet).
 pub fn floor_of(clip: &ModelClip) -> Option<f64> {
     clip_contacts(&clip.to_clip(), CONTACT_THRESHOLD_M, MIN_FLIGHT_S).map(|c| c.floor_y_m)
-}
-
-fn median(v: &[f64]) -> f64 {
-    let mut s = v.to_vec();
-    s.sort_by(f64::total_cmp);
-    let m = s.len() / 2;
-    if s.len() % 2 == 1 {
-        s[m]
-    } else {
-        0.5 * (s[m - 1] + s[m])
-    }
 }
 
 #[cfg(test)]
