@@ -41,13 +41,64 @@ fn high_jump_extrapolates_the_crouch() {
         ["low_jump", "normal_jump", "high_jump"]
     );
     assert!(l.high.fit.median_angle_rmse_deg().unwrap() < 0.5);
-    // Every rollout spans the normal jump's duration at its frame time.
+    // The low jump is blended time-scaled to the normal jump's duration; the high jump is
+    // longer by the stretch of its flight.
     assert_eq!(o.duration_s, l.normal.primitive.duration);
     for r in [&o.rollouts.low, &o.rollouts.normal, &o.rollouts.high] {
         assert_eq!(r.dt, o.primitives.dt);
-        assert_eq!(r.frames(), o.rollouts.normal.frames());
     }
+    assert_eq!(o.rollouts.low.frames(), o.rollouts.normal.frames());
+    let stretch = o.primitives.flight.stretch_s;
+    assert!(stretch > 0.0, "{:?}", o.primitives.flight);
+    assert!((l.high.primitive.duration - (o.duration_s + stretch)).abs() < 1e-9);
     assert_eq!(o.clips.high.frame_count(), o.rollouts.high.frames());
+}
+
+#[test]
+fn high_jump_rises_higher_and_flies_longer() {
+    let o = high_jump::run(&jump_config()).unwrap();
+    let (f, pred) = (&o.figures, &o.primitives.prediction);
+    // The keyframed jumps fly over their whole keyed flights (0.34 s and 0.40 s), less the few
+    // frames the feet take to rise 3 cm.
+    assert!(
+        f.low.flight_s > 0.28 && f.low.flight_s < 0.35,
+        "{:?}",
+        f.low
+    );
+    assert!(
+        f.normal.flight_s > 0.34 && f.normal.flight_s < 0.41,
+        "{:?}",
+        f.normal
+    );
+    // Higher and longer than the normal jump, as extrapolating the two predicts.
+    assert!(f.high.apex_above_standing_m > f.normal.apex_above_standing_m + 0.015);
+    assert!(f.high.flight_s > f.normal.flight_s + 0.015);
+    assert!((f.high.apex_above_standing_m - pred.apex_above_standing_m).abs() < 0.002);
+    assert!(
+        (f.high.flight_s - pred.flight_s).abs() < 0.015,
+        "{f:?} {pred:?}"
+    );
+    // The stretched flight is as ballistic as the normal jump's own: the gravity that would
+    // carry each from its take-off height over its apex to its landing height in the time it
+    // is given agrees to 2 % (the stretch is rounded to whole frames).
+    let plan = &o.primitives.flight;
+    let g_over = |apex: f64, t: f64| {
+        let legs =
+            (2.0 * (apex - plan.take_off_root_m)).sqrt() + (2.0 * (apex - plan.land_root_m)).sqrt();
+        (legs / t).powi(2)
+    };
+    let span = plan.blend_land_s - plan.blend_take_off_s;
+    let g_normal = g_over(plan.normal_apex_root_m, span);
+    let g_high = g_over(plan.apex_root_m, span + plan.stretch_s);
+    assert!(
+        (g_high / g_normal - 1.0).abs() < 0.02,
+        "g {g_high} vs the normal jump's {g_normal} ({plan:?})"
+    );
+    assert!((plan.arc_scale - 1.0).abs() < 0.05, "{plan:?}");
+    // The feet never go through the floor by more than the DMP fit of the demonstrations does.
+    for j in [&f.low, &f.normal, &f.high] {
+        assert!(j.lowest_foot_above_floor_m > -0.003, "{j:?}");
+    }
 }
 
 #[test]
@@ -88,6 +139,15 @@ fn jumping_knee_kick_connects_without_a_jump() {
         o.lands_with_both_feet,
         "{:?}",
         o.feet_above_floor_after_landing_m
+    );
+    // A kick in the air: both feet up at Leap, the root at the jump's apex.
+    assert!(o.airborne_at_leap, "{:?}", o.feet_above_floor_at_leap_m);
+    assert!(o.root_at_leap_minus_jump_apex_m.abs() < 0.005);
+    assert!(o.figures.flight_s > 0.25, "{:?}", o.figures);
+    assert!(
+        o.figures.lowest_foot_above_floor_m > -0.005,
+        "{:?}",
+        o.figures
     );
     assert_eq!(o.result_clip.frame_count(), o.connected.trajectory.frames());
 }

@@ -1,15 +1,36 @@
 //! The motor-primitive paper's §4.1: a high jump by extrapolation. A low jump (A) and a normal
 //! jump (B) are learned as primitives; A is time-scaled to B's duration so both span [0, T], and
 //! the blend `θ = γ·θ_A + (1 − γ)·θ_B` with constant γ = −0.5 gives `1.5·normal − 0.5·low`, a
-//! jump deeper than either demonstration. Blending joint angles and root height separately lifts
-//! the feet during the extrapolated crouch, so the blend's feet are put back on the floor outside
-//! the normal jump's flight before the high jump is learned as one primitive.
+//! jump deeper than either demonstration.
+//!
+//! **The root.** The root channels (`root_ty` …) are blended with the joints, pointwise, as a
+//! user of DMP blending expects: the apex of A and B above standing does not change under
+//! time-scaling, so the blend's apex above standing is about `γ·apex_A + (1 − γ)·apex_B`, γ at
+//! the normal jump's apex. Time-scaling A to B's duration, however, gives both the same flight
+//! time, so a pointwise blend keeps the normal jump's flight however high it rises, which no
+//! ballistic flight does. So the blend's flight (the normal jump's, from foot contact) is
+//! stretched in time by what ballistics says the higher apex needs: from the same take-off and
+//! landing heights, a flight over the high apex takes `√(2h_up/g) + √(2h_down/g)` (gravity
+//! [`GRAVITY`]), longer than one over the normal apex by [`FlightPlan::extra_flight_s`]; the
+//! motion before take-off is unchanged, the landing comes that much later, and the root's arc
+//! is scaled to reach the predicted apex exactly (on the project's ballistic keyframed jumps the
+//! blend's own arc is within a few millimetres of it, and the stretched arc is again ballistic to
+//! within a few per cent; [`FlightPlan::arc_scale`] says how much was needed). Before
+//! that the root is raised or lowered so that the lowest foot point stands on the normal jump's
+//! floor outside the flight (blending joint angles and root height separately lifts or sinks the
+//! feet). The flight time this gives is compared with the blend of the demonstrations' own
+//! flight times, `γ·flight_A + (1 − γ)·flight_B` ([`JumpPrediction`]).
 //!
 //! [`learn_primitives`] makes the three primitives (the jumping knee kick of
-//! [`knee_kick`](super::knee_kick) starts from them); [`run`] also plays them and measures the
-//! paper's Fig. 8: the left knee's crouch flexion of each jump. Plain data in and out: the
-//! demonstrations come as [`ModelClip`]s already on the model, nothing is read or written.
+//! [`knee_kick`](super::knee_kick) starts from them); [`run`] also plays them and measures them:
+//! the paper's Fig. 8 (the left knee's crouch flexion of each jump) and what each jump did
+//! ([`JumpFigures`]: apex above standing, flight from foot contact, the feet's lowest point).
+//! Plain data in and out: the demonstrations come as [`ModelClip`]s already on the model,
+//! nothing is read or written.
 
+use super::jump_figures::{JumpFigures, floor_of, jump_figures};
+use crate::analysis::Span;
+use crate::clips::GRAVITY;
 use crate::humanoid::{Model, ModelClip};
 use crate::primitive::{
     BlendPlacement, EventConfig, Gamma, LearnConfig, Learned, Primitive, PrimitiveError, Relearn,
@@ -34,9 +55,10 @@ pub enum PrimitiveExperimentError {
     /// The blend re-learned no primitive.
     #[error("the blend re-learned no primitive")]
     NothingRelearned,
-    /// The jumping knee kick's blend was not re-learned as two primitives split at Leap.
-    #[error("expected two primitives split at Leap, got {0}")]
-    NotSplitInTwo(usize),
+    /// A jump whose flight cannot be measured or made: no flight in a demonstration, or an
+    /// apex the blend asks for that is not above the take-off and landing heights.
+    #[error("{0}")]
+    NoFlight(String),
 }
 
 /// One value for each of the three jumps.
@@ -66,16 +88,78 @@ pub struct HighJumpConfig {
     pub learn: LearnConfig,
 }
 
+/// What extrapolating the two jumps predicts for the high jump: each figure of the low (A) and
+/// normal (B) jump blended as `γ·A + (1 − γ)·B`, γ taken where that figure happens in the blend.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct JumpPrediction {
+    /// The blend's span T (the normal jump's duration), seconds: t′ = t / T.
+    pub span_s: f64,
+    /// The normal jump's Bend, seconds.
+    pub normal_bend_s: f64,
+    /// The normal jump's apex (root highest), seconds.
+    pub normal_apex_s: f64,
+    /// γ at the normal jump's Bend (its deepest crouch), normalised time t′ = Bend / T.
+    pub gamma_at_bend: f64,
+    /// γ at the normal jump's apex (its root highest), t′ = apex / T.
+    pub gamma_at_apex: f64,
+    /// Left-knee crouch flexion: γ_bend·low + (1 − γ_bend)·normal, degrees.
+    pub crouch_knee_flexion_deg: f64,
+    /// Root apex above standing: γ_apex·low + (1 − γ_apex)·normal, metres (the high jump is made
+    /// to reach it).
+    pub apex_above_standing_m: f64,
+    /// Flight time of the demonstrations at their own durations blended: γ_apex·low +
+    /// (1 − γ_apex)·normal, seconds (the high jump's own flight follows from its apex by
+    /// ballistics and is compared with this).
+    pub flight_s: f64,
+}
+
+/// How the high jump's flight was made from the blend (see the module docs).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct FlightPlan {
+    /// Take-off and landing in the blend: the normal jump's flight from foot contact, widened to
+    /// where its feet leave and touch the floor ([`STANDING_FOOT_M`]), seconds.
+    pub blend_take_off_s: f64,
+    /// See `blend_take_off_s`.
+    pub blend_land_s: f64,
+    /// Root height at take-off and at landing with the feet on the floor, metres.
+    pub take_off_root_m: f64,
+    /// See `take_off_root_m`.
+    pub land_root_m: f64,
+    /// The normal jump's apex above standing, put on the blend's standing height, metres.
+    pub normal_apex_root_m: f64,
+    /// The apex the high jump is to reach (the prediction on the blend's standing height),
+    /// metres.
+    pub apex_root_m: f64,
+    /// How much longer a ballistic flight over `apex_root_m` is than one over
+    /// `normal_apex_root_m`, from the same take-off and landing heights, seconds.
+    pub extra_flight_s: f64,
+    /// How much longer the high jump is than the blend (`extra_flight_s` to whole frames),
+    /// seconds.
+    pub stretch_s: f64,
+    /// The factor on the blend's root arc (over the line from take-off to landing) that puts
+    /// its top at `apex_root_m` (1: the blend's own root already rose that high).
+    pub arc_scale: f64,
+}
+
 /// The three primitives of the high jump, as [`learn_primitives`] makes them.
 #[derive(Clone, Debug, PartialEq)]
 pub struct HighJumpPrimitives {
     /// The learned jumps with their fits: `low_jump` and `normal_jump` from the demonstrations,
-    /// `high_jump` from the blend with its feet put back on the floor.
+    /// `high_jump` from the blend with its feet put back on the floor and its flight made
+    /// ballistic.
     pub learned: Jumps<Learned>,
     /// The time step of the rollouts: the normal jump's frame time, seconds.
     pub dt: f64,
+    /// The floor the jumps stand on: where the normal jump's feet touch, metres.
+    pub floor_y_m: f64,
     /// Largest root-height correction that put the blend's feet back on the floor, metres.
     pub ground_correction_m: f64,
+    /// The low and normal demonstrations measured (at their own durations).
+    pub demo_figures: [JumpFigures; 2],
+    /// What extrapolating them predicts.
+    pub prediction: JumpPrediction,
+    /// How the high jump's flight was made.
+    pub flight: FlightPlan,
 }
 
 /// Everything the high jump found.
@@ -83,20 +167,28 @@ pub struct HighJumpPrimitives {
 pub struct HighJumpOutcome {
     /// The three primitives.
     pub primitives: HighJumpPrimitives,
-    /// The common span T: the normal jump's duration, seconds.
+    /// The common span T of the blend: the normal jump's duration, seconds (the high jump is
+    /// longer by `primitives.flight.stretch_s`).
     pub duration_s: f64,
-    /// Rollouts at `dt` over [0, T]: the low jump time-scaled to T, the normal and the high jump.
+    /// Rollouts at `dt`: the low jump time-scaled to T (as it is blended), the normal jump over
+    /// [0, T] and the high jump over its own, longer, duration.
     pub rollouts: Jumps<Trajectory>,
-    /// The rollouts as clips on the model.
+    /// Each jump played over its own duration (the low jump not time-scaled) as a clip on the
+    /// model.
     pub clips: Jumps<ModelClip>,
+    /// The low jump time-scaled to T as a clip (`rollouts.low`).
+    pub low_time_scaled: ModelClip,
+    /// What each of `clips` did: apex above standing, flight from foot contact, lowest foot.
+    pub figures: Jumps<JumpFigures>,
     /// Left-knee flexion of each jump's crouch, degrees: the peak before take-off (found by
     /// [`find_jump_events`] on each rollout), as in the paper's Fig. 8.
     pub crouch_knee_flexion_deg: Jumps<f64>,
     /// Left-knee flexion peak over each whole rollout, degrees (for a low jump this can be the
     /// landing rather than the crouch).
     pub whole_clip_knee_flexion_deg: Jumps<f64>,
-    /// The paper's expected crouch flexion of the high jump, `1.5·normal − 0.5·low`, degrees (the
-    /// γ = −0.5 extrapolation of the crouch peaks; it does not follow another `gamma`).
+    /// The expected crouch flexion of the high jump, `γ·low + (1 − γ)·normal` with γ at the
+    /// normal jump's Bend (the paper: `1.5·normal − 0.5·low`), degrees
+    /// (`prediction.crouch_knee_flexion_deg`).
     pub expected_high_deg: f64,
     /// `crouch_knee_flexion_deg.high − expected_high_deg`, degrees.
     pub high_minus_expected_deg: f64,
@@ -133,29 +225,61 @@ pub(super) fn heights(clip: &ModelClip) -> (Vec<f64>, Vec<Vec<f64>>) {
     (root, clip.foot_heights().into())
 }
 
-/// The lowest foot point (ankles and toes) of a clip over all frames: its floor, metres.
-pub(super) fn lowest_foot(clip: &ModelClip) -> f64 {
-    heights(clip)
-        .1
-        .iter()
-        .flatten()
-        .copied()
-        .fold(f64::INFINITY, f64::min)
-}
-
 /// Learns the low and normal jumps, blends them with `config.gamma` over the common span
-/// (`a = [0, T]`, `b = [0, T]`, T the normal jump's duration, re-learned whole), puts the
-/// blend's feet back on the normal jump's floor outside its flight (take-off to land) and learns
-/// the result as the high jump.
+/// (`a = [0, T]`, `b = [0, T]`, T the normal jump's duration), puts the blend's feet on the
+/// normal jump's floor outside its flight, makes the flight ballistic up to the predicted apex
+/// ([`JumpPrediction`], see the module docs) and learns the result as the high jump.
 pub fn learn_primitives(
     config: &HighJumpConfig,
 ) -> Result<HighJumpPrimitives, PrimitiveExperimentError> {
+    config.gamma.validate()?;
     let model = &config.model;
     let dt = config.normal.frame_time;
     let low = Primitive::learn("low_jump", &config.low.to_trajectory(), &config.learn)?;
     let normal = Primitive::learn("normal_jump", &config.normal.to_trajectory(), &config.learn)?;
     let t = normal.primitive.duration;
-    // A time-scaled to B's duration; both on [0, T].
+    // What the demonstrations did, each at its own duration, on the normal jump's floor.
+    let normal_clip = on_model(model, &rollout(&normal.primitive, dt)?)?;
+    let low_clip = on_model(model, &rollout(&low.primitive, dt)?)?;
+    let floor = floor_of(&normal_clip)
+        .ok_or_else(|| PrimitiveExperimentError::NoFlight("the model has no feet".into()))?;
+    let demo_figures = [
+        jump_figures(&low_clip, floor),
+        jump_figures(&normal_clip, floor),
+    ];
+    let [fl, fn_] = demo_figures;
+    let normal_flight = fn_.flight.ok_or_else(|| {
+        PrimitiveExperimentError::NoFlight(
+            "the normal jump never has both feet off the floor".into(),
+        )
+    })?;
+    if fl.flight.is_none() {
+        return Err(PrimitiveExperimentError::NoFlight(
+            "the low jump never has both feet off the floor".into(),
+        ));
+    }
+    let (root_y, feet) = heights(&normal_clip);
+    let ev = find_jump_events(&root_y, dt, Some(&feet), &EventConfig::default())?;
+    let gamma_at_bend = config.gamma.at(ev.bend / t);
+    let gamma_at_apex = config.gamma.at(fn_.apex_time_s / t);
+    let mix = |g: f64, a: f64, b: f64| g * a + (1.0 - g) * b;
+    let crouch = |c: &ModelClip| crouch_peak_deg(c, dt);
+    let prediction = JumpPrediction {
+        span_s: t,
+        normal_bend_s: ev.bend,
+        normal_apex_s: fn_.apex_time_s,
+        gamma_at_bend,
+        gamma_at_apex,
+        crouch_knee_flexion_deg: mix(gamma_at_bend, crouch(&low_clip)?, crouch(&normal_clip)?),
+        apex_above_standing_m: mix(
+            gamma_at_apex,
+            fl.apex_above_standing_m,
+            fn_.apex_above_standing_m,
+        ),
+        flight_s: mix(gamma_at_apex, fl.flight_s, fn_.flight_s),
+    };
+
+    // The paper's blend: A time-scaled to B's duration, both on [0, T].
     let placement = BlendPlacement {
         a_start: 0.0,
         a_end: t,
@@ -168,38 +292,181 @@ pub fn learn_primitives(
         &placement,
         &config.gamma,
         dt,
-        Relearn::Whole,
+        Relearn::No,
         &config.learn,
     )?;
-    let blended = result
-        .primitives
-        .into_iter()
-        .next()
-        .ok_or(PrimitiveExperimentError::NothingRelearned)?;
-    // Put the feet back on the floor outside the normal jump's flight, then learn the high jump.
-    let normal_roll = on_model(model, &rollout(&normal.primitive, dt)?)?;
-    let (root_y, feet) = heights(&normal_roll);
-    let ev = find_jump_events(&root_y, dt, Some(&feet), &EventConfig::default())?;
-    let mut high_clip = on_model(model, &rollout(&blended.primitive, dt)?)?;
-    let floor = lowest_foot(&normal_roll);
-    let ground_correction_m = high_clip.keep_feet_on_floor(&[(ev.take_off, ev.land)], floor);
+    let mut blended = on_model(model, &result.trajectory)?;
+    let (take_off, land) = feet_leave_and_touch(&normal_clip, normal_flight, floor);
+    let ground_correction_m = blended.keep_feet_on_floor(&[(take_off, land)], floor);
+    let standing = jump_figures(&blended, floor).standing_root_m;
+    let (high_clip, flight) = lengthen_flight(
+        &blended,
+        take_off,
+        land,
+        standing + prediction.apex_above_standing_m,
+        standing + fn_.apex_above_standing_m,
+    )?;
     let high = Primitive::learn("high_jump", &high_clip.to_trajectory(), &config.learn)?;
     Ok(HighJumpPrimitives {
         learned: Jumps { low, normal, high },
         dt,
+        floor_y_m: floor,
         ground_correction_m,
+        demo_figures,
+        prediction,
+        flight,
     })
 }
 
-/// Runs the high jump: [`learn_primitives`], then plays the three jumps on the common span and
-/// measures each one's left-knee flexion (crouch peak and whole-clip peak).
+/// Height above the floor under which a foot still stands on it when the flight's ends are
+/// placed ([`feet_leave_and_touch`]), metres.
+pub const STANDING_FOOT_M: f64 = 0.005;
+
+/// Where a flight found by foot contact really begins and ends (contact detection counts a foot
+/// as off the floor only some centimetres up, so its flight starts after the feet leave and ends
+/// before they touch): from its start back, and from its end forward, the lowest foot point of
+/// `clip` is followed down to the first frame where it is within [`STANDING_FOOT_M`] of `floor`
+/// or stops coming down. Seconds.
+fn feet_leave_and_touch(clip: &ModelClip, flight: Span, floor: f64) -> (f64, f64) {
+    let [l, r] = clip.foot_heights();
+    let dt = clip.frame_time;
+    let low: Vec<f64> = l.iter().zip(&r).map(|(a, b)| a.min(*b)).collect();
+    let n = low.len();
+    let down = |k: usize, next: usize| low[k] - floor <= STANDING_FOOT_M || low[next] >= low[k];
+    let start = ((flight.start_s / dt).round() as usize).min(n - 1);
+    let end = ((flight.end_s / dt).round() as usize).min(n - 1);
+    let leave = (1..=start).rev().find(|&k| down(k, k - 1)).unwrap_or(0);
+    let touch = (end..n - 1).find(|&k| down(k, k + 1)).unwrap_or(n - 1);
+    (leave as f64 * dt, touch as f64 * dt)
+}
+
+/// Left-knee flexion of a jump's crouch, degrees: its peak before take-off (found by
+/// [`find_jump_events`]), as in the paper's Fig. 8.
+fn crouch_peak_deg(clip: &ModelClip, dt: f64) -> Result<f64, PrimitiveExperimentError> {
+    let (root_y, feet) = heights(clip);
+    let ev = find_jump_events(&root_y, dt, Some(&feet), &EventConfig::default())?;
+    let traj = clip.to_trajectory();
+    let frames = ((ev.take_off / dt).round() as usize).clamp(1, traj.frames() - 1);
+    peak_deg(&traj.slice_frames(0, frames)?, "left_knee")
+}
+
+/// The time a ballistic flight (gravity [`GRAVITY`]) takes from height `y0` over an apex at
+/// `apex` down to `y1`: `√(2(apex − y0)/g) + √(2(apex − y1)/g)`, seconds (a leg below zero
+/// counts as zero).
+pub fn ballistic_flight_s(y0: f64, apex: f64, y1: f64) -> f64 {
+    let leg = |h: f64| (2.0 * h.max(0.0) / GRAVITY).sqrt();
+    leg(apex - y0) + leg(apex - y1)
+}
+
+/// Lengthens the flight of `clip` (feet on the floor outside `[take_off, land]`, seconds) by
+/// what ballistics says an apex at `apex_y` needs beyond one at `normal_apex_y` (metres), from
+/// the same take-off and landing heights ([`ballistic_flight_s`]): the clip's flight frames
+/// (joint angles, root path and orientation) are stretched in time, linearly, to fill the new
+/// flight, later frames follow shifted; the root's arc over the line from take-off to landing is
+/// then scaled so that its top is at `apex_y`.
+fn lengthen_flight(
+    clip: &ModelClip,
+    take_off: f64,
+    land: f64,
+    apex_y: f64,
+    normal_apex_y: f64,
+) -> Result<(ModelClip, FlightPlan), PrimitiveExperimentError> {
+    let dt = clip.frame_time;
+    let n = clip.frame_count();
+    let frame = |t: f64| ((t / dt).round().max(0.0) as usize).min(n - 1);
+    let (fa, fb) = (frame(take_off), frame(land));
+    let (y0, y1) = (clip.root_translation[fa].y, clip.root_translation[fb].y);
+    if fb <= fa || apex_y <= y0.max(y1) {
+        return Err(PrimitiveExperimentError::NoFlight(format!(
+            "the blend asks for a root apex of {apex_y:.3} m, not above the take-off \
+             ({y0:.3} m) and landing ({y1:.3} m) heights: γ gives no flight"
+        )));
+    }
+    let extra = ballistic_flight_s(y0, apex_y, y1) - ballistic_flight_s(y0, normal_apex_y, y1);
+    let nf = (fb - fa) as f64 + extra / dt;
+    if nf < 1.0 {
+        return Err(PrimitiveExperimentError::NoFlight(format!(
+            "the apex γ asks for ({apex_y:.3} m) shortens the normal jump's flight of {:.3} s \
+             by {:.3} s: γ gives no flight",
+            (fb - fa) as f64 * dt,
+            -extra
+        )));
+    }
+    let nf = nf.round() as usize;
+    let shift = nf as isize - (fb - fa) as isize;
+    let m = (n as isize + shift) as usize;
+    let d = clip.dof_count();
+    let mut out = ModelClip {
+        model: clip.model.clone(),
+        frame_time: dt,
+        root_translation: Vec::with_capacity(m),
+        root_rotation: Vec::with_capacity(m),
+        angles: Vec::with_capacity(m * d),
+    };
+    for k in 0..m {
+        let src = if k <= fa {
+            k as f64
+        } else if k < fa + nf {
+            fa as f64 + (k - fa) as f64 * (fb - fa) as f64 / nf as f64
+        } else {
+            (k as isize - shift) as f64
+        };
+        let (i, u) = (src.floor() as usize, src.fract());
+        let j = (i + 1).min(n - 1);
+        let (a, b) = (clip.frame_angles(i), clip.frame_angles(j));
+        out.angles
+            .extend(a.iter().zip(b).map(|(x, y)| x + u * (y - x)));
+        out.root_translation
+            .push(clip.root_translation[i].lerp(clip.root_translation[j], u));
+        out.root_rotation
+            .push(clip.root_rotation[i].slerp(clip.root_rotation[j], u));
+    }
+    // The arc over the chord from take-off to landing, scaled so that its top is at `apex_y`.
+    let (y0, y1) = (out.root_translation[fa].y, out.root_translation[fa + nf].y);
+    let chord = |k: usize| y0 + (y1 - y0) * (k - fa) as f64 / nf as f64;
+    let top = (fa..=fa + nf)
+        .max_by(|a, b| {
+            out.root_translation[*a]
+                .y
+                .total_cmp(&out.root_translation[*b].y)
+        })
+        .unwrap_or(fa);
+    let bump = out.root_translation[top].y - chord(top);
+    if bump <= 0.0 {
+        return Err(PrimitiveExperimentError::NoFlight(format!(
+            "the blend's root does not rise above the line from take-off ({y0:.3} m) to \
+             landing ({y1:.3} m): no flight arc"
+        )));
+    }
+    let arc_scale = (apex_y - chord(top)) / bump;
+    for k in fa + 1..fa + nf {
+        let c = chord(k);
+        let y = &mut out.root_translation[k].y;
+        *y = c + arc_scale * (*y - c);
+    }
+    let plan = FlightPlan {
+        blend_take_off_s: take_off,
+        blend_land_s: land,
+        take_off_root_m: y0,
+        land_root_m: y1,
+        normal_apex_root_m: normal_apex_y,
+        apex_root_m: apex_y,
+        extra_flight_s: extra,
+        stretch_s: shift as f64 * dt,
+        arc_scale,
+    };
+    Ok((out, plan))
+}
+
+/// Runs the high jump: [`learn_primitives`], then plays the three jumps and measures each one:
+/// the left-knee flexion (crouch peak and whole-clip peak) and what it did ([`JumpFigures`]).
 pub fn run(config: &HighJumpConfig) -> Result<HighJumpOutcome, PrimitiveExperimentError> {
     let model = &config.model;
     let primitives = learn_primitives(config)?;
     let dt = primitives.dt;
     let learned = &primitives.learned;
     let t = learned.normal.primitive.duration;
-    // Rollouts on the common span: the low jump time-scaled to the normal jump's duration.
+    // Rollouts: the low jump time-scaled to the normal jump's duration, as it is blended.
     let low_scaled = learned.low.primitive.with_duration(t)?;
     let rollouts = Jumps {
         low: rollout(&low_scaled, dt)?,
@@ -207,33 +474,34 @@ pub fn run(config: &HighJumpConfig) -> Result<HighJumpOutcome, PrimitiveExperime
         high: rollout(&learned.high.primitive, dt)?,
     };
     let clips = Jumps {
-        high: on_model(model, &rollouts.high)?,
-        low: on_model(model, &rollouts.low)?,
+        low: on_model(model, &rollout(&learned.low.primitive, dt)?)?,
         normal: on_model(model, &rollouts.normal)?,
+        high: on_model(model, &rollouts.high)?,
+    };
+    let floor = primitives.floor_y_m;
+    let figures = Jumps {
+        low: jump_figures(&clips.low, floor),
+        normal: jump_figures(&clips.normal, floor),
+        high: jump_figures(&clips.high, floor),
     };
     // The paper's knee flexion of a jump is that of its crouch: the peak before take-off.
-    let crouch_peak =
-        |traj: &Trajectory, clip: &ModelClip| -> Result<f64, PrimitiveExperimentError> {
-            let (root_y, feet) = heights(clip);
-            let ev = find_jump_events(&root_y, dt, Some(&feet), &EventConfig::default())?;
-            let frames = ((ev.take_off / traj.dt).round() as usize).clamp(1, traj.frames() - 1);
-            peak_deg(&traj.slice_frames(0, frames)?, "left_knee")
-        };
     let crouch = Jumps {
-        low: crouch_peak(&rollouts.low, &clips.low)?,
-        normal: crouch_peak(&rollouts.normal, &clips.normal)?,
-        high: crouch_peak(&rollouts.high, &clips.high)?,
+        low: crouch_peak_deg(&clips.low, dt)?,
+        normal: crouch_peak_deg(&clips.normal, dt)?,
+        high: crouch_peak_deg(&clips.high, dt)?,
     };
     let whole = Jumps {
         low: peak_deg(&rollouts.low, "left_knee")?,
         normal: peak_deg(&rollouts.normal, "left_knee")?,
         high: peak_deg(&rollouts.high, "left_knee")?,
     };
-    let expected = 1.5 * crouch.normal - 0.5 * crouch.low;
+    let expected = primitives.prediction.crouch_knee_flexion_deg;
     Ok(HighJumpOutcome {
         duration_s: t,
+        low_time_scaled: on_model(model, &rollouts.low)?,
         rollouts,
         clips,
+        figures,
         high_minus_expected_deg: crouch.high - expected,
         crouch_knee_flexion_deg: crouch,
         whole_clip_knee_flexion_deg: whole,

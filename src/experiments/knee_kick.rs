@@ -5,19 +5,32 @@
 //! as two primitives split at Leap, "jumping knee kick" and "land", which are then connected
 //! (each starts from the state the previous one ended in, so the junction has no jump).
 //!
+//! **What is blended for the root.** The joint angles are blended as the paper says; the root
+//! (pelvis position and orientation) is the jump's (γ = 1 for the root channels). The kick is
+//! demonstrated standing on one foot: blending its root in would, at Leap where γ = 0, put the
+//! pelvis back at standing height, a kick on the ground. A jumping kick is a jump whose legs do
+//! the kick, so the pelvis keeps the jump's ballistic flight and apex. Because the blended legs
+//! are not the jump's, the root height is then solved so that the lowest foot point stands on the
+//! floor before take-off (the correction fading to zero at Leap, the apex), and after the
+//! connection the "land" part is learned again from the landing as it is played (the
+//! connection's pull from the kick posture back onto the jump's course) with the feet on the
+//! floor from Land on, so that the figure lands without sinking.
+//!
 //! [`run`] returns the primitives, the played motions and the paper's checks: the postures at
-//! Bend and Leap, the jumps at the junction, both feet down after landing. Plain data in and out:
-//! the demonstrations come as [`ModelClip`]s already on the model, nothing is read or written.
-//! Playing the connected sequence in an ECS world is left to the caller.
+//! Bend and Leap, the jumps at the junction, the figure airborne at Leap and both feet down
+//! after landing. Plain data in and out: the demonstrations come as [`ModelClip`]s already on
+//! the model, nothing is read or written. Playing the connected sequence in an ECS world is left
+//! to the caller.
 
 use super::high_jump::{
     HighJumpConfig, HighJumpPrimitives, PrimitiveExperimentError, heights, learn_primitives,
-    lowest_foot, on_model, peak_deg, rollout,
+    on_model, peak_deg, rollout,
 };
+use super::jump_figures::{JumpFigures, jump_figures};
 use crate::humanoid::ModelClip;
 use crate::primitive::{
     Arrangement, BlendPlacement, Connected, EventConfig, Gamma, JumpEvents, Learned, Primitive,
-    Relearn, Trajectory, blend, connect, find_jump_events,
+    ROOT_DOF_NAMES, Relearn, Trajectory, blend, connect, find_jump_events,
 };
 
 /// The paper's γ for the kick: a ramp from 1 to 0, γ(t′) = 1 − t′.
@@ -26,9 +39,9 @@ pub const PAPER_GAMMA: Gamma = Gamma::Ramp { from: 1.0, to: 0.0 };
 /// How long after Land both feet must be down, seconds.
 pub const SETTLE_AFTER_LAND_S: f64 = 0.25;
 
-/// Highest a foot may be above the jump's floor at Land + [`SETTLE_AFTER_LAND_S`] to count as
-/// down, metres.
-pub const FOOT_DOWN_M: f64 = 0.05;
+/// Farthest a foot may be from the jump's floor at Land + [`SETTLE_AFTER_LAND_S`] to count as
+/// down (above it, or through it), metres.
+pub const FOOT_DOWN_M: f64 = 0.01;
 
 /// The inputs of the jumping knee kick.
 #[derive(Clone, Debug, PartialEq)]
@@ -97,7 +110,8 @@ pub struct KneeKickOutcome {
     pub kick_placed_rollout: Trajectory,
     /// Which of the six arrangements the placement (A on [0, T_A], B on [Bend, Leap]) is.
     pub arrangement: Arrangement,
-    /// The blend re-learned and split at Leap: `jumping_knee_kick`, then `land`.
+    /// The blend re-learned and split at Leap: `jumping_knee_kick`, then `land` (learned from the
+    /// connected landing with its feet on the floor).
     pub parts: [Learned; 2],
     /// The two parts connected, sampled at `jump.dt`.
     pub connected: Connected,
@@ -111,6 +125,21 @@ pub struct KneeKickOutcome {
     pub feet_above_floor_after_landing_m: Vec<f64>,
     /// Every foot within [`FOOT_DOWN_M`] of the floor then.
     pub lands_with_both_feet: bool,
+    /// Each foot's lowest point above A's floor at Leap, `[left, right]`, metres.
+    pub feet_above_floor_at_leap_m: [f64; 2],
+    /// The result's root at Leap minus A's apex (its root at Leap), metres.
+    pub root_at_leap_minus_jump_apex_m: f64,
+    /// Both feet above the floor (by more than the contact threshold) at Leap.
+    pub airborne_at_leap: bool,
+    /// What A did (apex above standing, flight, lowest foot).
+    pub jump_figures: JumpFigures,
+    /// What the jumping knee kick did, on A's floor.
+    pub figures: JumpFigures,
+    /// Largest root-height correction that stood the blend's feet on the floor before take-off,
+    /// metres.
+    pub ground_correction_m: f64,
+    /// Largest root-height correction that stood the landing's feet on the floor, metres.
+    pub landing_correction_m: f64,
     /// Peak knee flexion of the connected motion.
     pub peak_knee_flexion_deg: KneePeaks,
 }
@@ -124,17 +153,26 @@ impl KneeKickOutcome {
 
 /// Runs the jumping knee kick: learns the high jump A ([`learn_primitives`]) and finds its
 /// events; learns the kick B; blends B placed on [Bend, Leap] into A (on [0, T_A]) with
-/// `config.gamma`, re-learned split at Leap; connects the two parts and measures them.
+/// `config.gamma` for the joints and A's root (see the module docs); stands the feet on the
+/// floor; learns the two parts split at Leap, connects them, learns "land" again from the
+/// connected landing with its feet on the floor, connects again and measures the result.
 pub fn run(config: &KneeKickConfig) -> Result<KneeKickOutcome, PrimitiveExperimentError> {
+    config.gamma.validate()?;
+    config.jump.gamma.validate()?;
     let model = &config.jump.model;
     let learn = &config.jump.learn;
     let jump = learn_primitives(&config.jump)?;
     let dt = jump.dt;
+    let floor = jump.floor_y_m;
     let a = &jump.learned.high.primitive;
     let jump_rollout = rollout(a, dt)?;
     let jump_clip = on_model(model, &jump_rollout)?;
     let (root_y, feet) = heights(&jump_clip);
     let ev = find_jump_events(&root_y, dt, Some(&feet), &config.events)?;
+    let jump_fig = jump_figures(&jump_clip, floor);
+    let flight = jump_fig.flight.ok_or_else(|| {
+        PrimitiveExperimentError::NoFlight("the high jump never has both feet off the floor".into())
+    })?;
 
     let kick_demo = &config.kick;
     let kick = Primitive::learn("knee_kick", &kick_demo.to_trajectory(), learn)?;
@@ -150,16 +188,63 @@ pub fn run(config: &KneeKickConfig) -> Result<KneeKickOutcome, PrimitiveExperime
         &placement,
         &config.gamma,
         dt,
-        Relearn::SplitAtBEnd,
+        Relearn::No,
         learn,
     )?;
-    let found = result.primitives.len();
-    let mut parts: [Learned; 2] = result
-        .primitives
-        .try_into()
-        .map_err(|_| PrimitiveExperimentError::NotSplitInTwo(found))?;
-    parts[0].primitive.name = "jumping_knee_kick".into();
-    parts[1].primitive.name = "land".into();
+    // The joints from the blend, the root from the jump.
+    let mut traj = result.trajectory;
+    let step = traj.dt;
+    let n = traj.frames() - 1;
+    let times: Vec<f64> = (0..=n).map(|k| k as f64 * step).collect();
+    let on_a = a.sample(&times, None)?;
+    let d = traj.dofs();
+    for name in ROOT_DOF_NAMES {
+        let j = traj
+            .index_of(name)
+            .ok_or_else(|| PrimitiveExperimentError::NoDof(name.into()))?;
+        for k in 0..=n {
+            traj.values[k * d + j] = on_a.values[k * d + j];
+        }
+    }
+    let frame = |t: f64| ((t / step).round() as usize).min(n);
+    let (take_off, leap, land) = (
+        frame(flight.start_s),
+        result.b_end_frame,
+        frame(flight.end_s),
+    );
+    let mut blended = on_model(model, &traj)?;
+    let ground_correction_m = stand_on_floor(
+        &mut blended,
+        0,
+        &|k| k <= take_off || k >= land,
+        leap,
+        floor,
+    );
+    let blended = blended.to_trajectory();
+    // Split at Leap; "land" starts from A's pose there (the right limit of the blend).
+    let first = blended.slice_frames(0, leap)?;
+    let mut second = blended.slice_frames(leap, n)?;
+    second.values[..d].copy_from_slice(&on_a.values[leap * d..(leap + 1) * d]);
+    let part = |name: &str, t: &Trajectory| -> Result<Learned, PrimitiveExperimentError> {
+        let mut l = Primitive::learn(name, t, learn)?;
+        l.primitive.name = name.into();
+        Ok(l)
+    };
+    let kick_part = part("jumping_knee_kick", &first)?;
+    let land_part = part("land", &second)?;
+    // The landing as the connection plays it, its feet stood on the floor from Land on, learned
+    // again as "land".
+    let played = connect(
+        &[kick_part.primitive.clone(), land_part.primitive],
+        dt,
+        None,
+    )?;
+    let mut landing = on_model(model, &played.trajectory)?;
+    let last = landing.frame_count() - 1;
+    let landing_correction_m =
+        stand_on_floor(&mut landing, leap, &|k| k >= land.min(last), leap, floor);
+    let landing = landing.to_trajectory().slice_frames(leap, last)?;
+    let parts = [kick_part, part("land", &landing)?];
     let sequence: Vec<Primitive> = parts.iter().map(|l| l.primitive.clone()).collect();
     let connected = connect(&sequence, dt, None)?;
     let junction = connected.junctions.first();
@@ -170,8 +255,8 @@ pub fn run(config: &KneeKickConfig) -> Result<KneeKickOutcome, PrimitiveExperime
     };
     let result_clip = on_model(model, &connected.trajectory)?;
 
-    // Checks of the paper's figure: the jump's posture at Bend, the kick's at Leap, both feet
-    // down after landing.
+    // Checks of the paper's figure: the jump's posture at Bend, the kick's at Leap, in the air at
+    // Leap, both feet down after landing.
     let frame_at = |t: f64| ((t / dt).round() as usize).min(result_clip.frame_count() - 1);
     let posture_gap = |a_clip: &ModelClip, fa: usize, fb: usize| -> f64 {
         a_clip
@@ -186,14 +271,22 @@ pub fn run(config: &KneeKickConfig) -> Result<KneeKickOutcome, PrimitiveExperime
         jump_at_bend_deg: posture_gap(&jump_clip, frame_at(ev.bend), frame_at(ev.bend)),
         kick_at_leap_deg: posture_gap(kick_demo, kick_end, frame_at(ev.leap)),
     };
-    let (_, result_feet) = heights(&result_clip);
+    let (result_root, result_feet) = heights(&result_clip);
+    let at_leap = frame_at(ev.leap);
+    let feet_above_floor_at_leap_m = [
+        result_feet[0][at_leap] - floor,
+        result_feet[1][at_leap] - floor,
+    ];
+    let airborne_at_leap = feet_above_floor_at_leap_m
+        .iter()
+        .all(|h| *h > super::jump_figures::CONTACT_THRESHOLD_M);
+    let root_at_leap_minus_jump_apex_m = result_root[at_leap] - root_y[frame_at(ev.leap)];
     let settle = frame_at(ev.land + SETTLE_AFTER_LAND_S);
-    let floor = lowest_foot(&jump_clip);
     let feet_after_landing: Vec<f64> = result_feet
         .iter()
         .map(|foot| foot[settle.min(foot.len() - 1)] - floor)
         .collect();
-    let lands_with_both_feet = feet_after_landing.iter().all(|h| *h < FOOT_DOWN_M);
+    let lands_with_both_feet = feet_after_landing.iter().all(|h| h.abs() < FOOT_DOWN_M);
 
     let kick_rollout = rollout(&kick.primitive, dt)?;
     let kick_clip = on_model(model, &kick_rollout)?;
@@ -203,6 +296,8 @@ pub fn run(config: &KneeKickConfig) -> Result<KneeKickOutcome, PrimitiveExperime
         left_knee: peak_deg(&connected.trajectory, "left_knee")?,
     };
     Ok(KneeKickOutcome {
+        figures: jump_figures(&result_clip, floor),
+        jump_figures: jump_fig,
         jump,
         jump_rollout,
         jump_clip,
@@ -219,6 +314,55 @@ pub fn run(config: &KneeKickConfig) -> Result<KneeKickOutcome, PrimitiveExperime
         posture_gap_deg,
         feet_above_floor_after_landing_m: feet_after_landing,
         lands_with_both_feet,
+        feet_above_floor_at_leap_m,
+        root_at_leap_minus_jump_apex_m,
+        airborne_at_leap,
+        ground_correction_m,
+        landing_correction_m,
         peak_knee_flexion_deg,
     })
+}
+
+/// Raises or lowers the root of frames `from..` of `clip` so that at every `ground` frame the
+/// lowest foot point (ankles and toes) is at `floor` (metres); at frame `pinned` the correction
+/// is zero, and between these frames it is interpolated linearly (held beyond the last known
+/// one). Returns the largest correction, metres.
+fn stand_on_floor(
+    clip: &mut ModelClip,
+    from: usize,
+    ground: &dyn Fn(usize) -> bool,
+    pinned: usize,
+    floor: f64,
+) -> f64 {
+    let [left, right] = clip.foot_heights();
+    let n = clip.frame_count();
+    let known: Vec<(usize, f64)> = (from..n)
+        .filter_map(|k| {
+            if k == pinned {
+                Some((k, 0.0))
+            } else if ground(k) {
+                Some((k, floor - left[k].min(right[k])))
+            } else {
+                None
+            }
+        })
+        .collect();
+    if known.is_empty() {
+        return 0.0;
+    }
+    let mut largest: f64 = 0.0;
+    for k in from..n {
+        let i = known.partition_point(|(f, _)| *f < k);
+        let c = match (known.get(i.wrapping_sub(1)), known.get(i)) {
+            (_, Some(&(f, c))) if f == k => c,
+            (Some(&(f0, c0)), Some(&(f1, c1))) => {
+                c0 + (c1 - c0) * (k - f0) as f64 / (f1 - f0) as f64
+            }
+            (Some(&(_, c)), None) | (None, Some(&(_, c))) => c,
+            (None, None) => 0.0,
+        };
+        clip.root_translation[k].y += c;
+        largest = largest.max(c.abs());
+    }
+    largest
 }

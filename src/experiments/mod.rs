@@ -10,4 +10,5 @@
 pub mod evolve_fall;
 pub mod fall;
 pub mod high_jump;
+pub mod jump_figures;
 pub mod knee_kick;

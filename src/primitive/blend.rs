@@ -119,6 +119,16 @@ impl BlendPlacement {
     }
 }
 
+/// The range every value of γ must lie in, `[GAMMA_MIN, GAMMA_MAX]` = [−2, 3]: interpolation
+/// (γ ∈ [0, 1]) and extrapolation up to twice the difference between A and B beyond either of
+/// them. Farther out the blend is dominated by the difference itself (γ = −2 already asks for
+/// 3·B − 2·A: a 110° and a 70° crouch give 190°, past any knee), and a γ of 10⁶ gives DMP
+/// weights a million times those of the demonstrations.
+pub const GAMMA_MIN: f64 = -2.0;
+
+/// See [`GAMMA_MIN`].
+pub const GAMMA_MAX: f64 = 3.0;
+
 /// The blend ratio γ(t′) over the normalised overlap time t′ ∈ [0, 1] (clamped outside).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub enum Gamma {
@@ -143,12 +153,30 @@ pub enum Gamma {
 }
 
 impl Gamma {
-    /// Checks: finite values; piecewise-linear knots non-empty with strictly increasing t′.
+    /// Checks: finite values in [[`GAMMA_MIN`], [`GAMMA_MAX`]]; piecewise-linear knots non-empty
+    /// with strictly increasing t′.
     pub fn validate(&self) -> Result<()> {
+        let in_range = |field: &str, values: &[f64]| -> Result<()> {
+            require_finite(field, values)?;
+            match values
+                .iter()
+                .find(|g| !(GAMMA_MIN..=GAMMA_MAX).contains(*g))
+            {
+                Some(g) => Err(PrimitiveError::InvalidParameter {
+                    field: field.into(),
+                    reason: format!(
+                        "γ = {g} is outside the allowed range [{GAMMA_MIN}, {GAMMA_MAX}] \
+                         (interpolation is [0, 1]; extrapolation goes at most twice the \
+                         difference between the two primitives beyond either)"
+                    ),
+                }),
+                None => Ok(()),
+            }
+        };
         match self {
-            Gamma::Constant(g) => require_finite("gamma", &[*g]),
+            Gamma::Constant(g) => in_range("gamma", &[*g]),
             Gamma::Ramp { from, to } | Gamma::Smoothstep { from, to } => {
-                require_finite("gamma", &[*from, *to])
+                in_range("gamma", &[*from, *to])
             }
             Gamma::PiecewiseLinear(k) => {
                 if k.is_empty() {
@@ -158,7 +186,8 @@ impl Gamma {
                     });
                 }
                 for (i, (t, g)) in k.iter().enumerate() {
-                    require_finite(&format!("gamma[{i}]"), &[*t, *g])?;
+                    require_finite(&format!("gamma[{i}]"), &[*t])?;
+                    in_range(&format!("gamma[{i}]"), &[*g])?;
                     if i > 0 && *t <= k[i - 1].0 {
                         return Err(PrimitiveError::InvalidParameter {
                             field: format!("gamma[{i}]"),
@@ -167,6 +196,26 @@ impl Gamma {
                     }
                 }
                 Ok(())
+            }
+        }
+    }
+
+    /// A short label for pictures and reports: `γ = −0.5`, `γ = 1 → 0 (ramp)`,
+    /// `γ = 0 → 1 (smoothstep)`, `γ piecewise (0, 1) (1, 0)`; minus signs as "−".
+    pub fn label(&self) -> String {
+        let n = |v: f64| format!("{v}").replace('-', "−");
+        match self {
+            Gamma::Constant(g) => format!("γ = {}", n(*g)),
+            Gamma::Ramp { from, to } => format!("γ = {} → {} (ramp)", n(*from), n(*to)),
+            Gamma::Smoothstep { from, to } => {
+                format!("γ = {} → {} (smoothstep)", n(*from), n(*to))
+            }
+            Gamma::PiecewiseLinear(k) => {
+                let knots: Vec<String> = k
+                    .iter()
+                    .map(|(t, g)| format!("({}, {})", n(*t), n(*g)))
+                    .collect();
+                format!("γ piecewise {}", knots.join(" "))
             }
         }
     }
@@ -369,6 +418,27 @@ mod tests {
                 .is_err()
         );
         assert!(Gamma::PiecewiseLinear(vec![]).validate().is_err());
+    }
+
+    #[test]
+    fn gamma_outside_its_range_is_refused_with_the_range() {
+        for g in [
+            Gamma::Constant(1e6),
+            Gamma::Constant(-2.5),
+            Gamma::Ramp { from: 1.0, to: 4.0 },
+            Gamma::PiecewiseLinear(vec![(0.0, 0.0), (1.0, -3.0)]),
+        ] {
+            let e = g.validate().unwrap_err().to_string();
+            assert!(e.contains("[-2, 3]"), "{g:?}: {e}");
+        }
+        for g in [GAMMA_MIN, GAMMA_MAX, 0.5] {
+            Gamma::Constant(g).validate().unwrap();
+        }
+        assert_eq!(Gamma::Constant(-0.5).label(), "γ = −0.5");
+        assert_eq!(
+            Gamma::Ramp { from: 1.0, to: 0.0 }.label(),
+            "γ = 1 → 0 (ramp)"
+        );
     }
 
     #[test]

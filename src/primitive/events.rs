@@ -83,7 +83,8 @@ pub fn gaussian_smooth(x: &[f64], sigma: f64) -> Vec<f64> {
         .collect()
 }
 
-fn median(v: &[f64]) -> f64 {
+/// The median of `v` (the mean of the middle two for an even count).
+pub(crate) fn median(v: &[f64]) -> f64 {
     let mut s = v.to_vec();
     s.sort_by(f64::total_cmp);
     let m = s.len() / 2;

@@ -71,7 +71,9 @@ pub mod synthetic;
 pub mod trajectory;
 
 pub use basis::Basis;
-pub use blend::{Arrangement, BlendPlacement, BlendResult, Gamma, Relearn, blend};
+pub use blend::{
+    Arrangement, BlendPlacement, BlendResult, GAMMA_MAX, GAMMA_MIN, Gamma, Relearn, blend,
+};
 pub use connect::{Connected, Junction, connect};
 
 pub use canonical::{CanonicalSystem, Phase};

@@ -194,7 +194,10 @@ fn save_primitives<'a>(
 
 /// Runs the high-jump scene ([`high_jump::run`] on the scene's clips). A jump's knee flexion is
 /// that of its crouch (the peak before take-off), as in the paper's Fig. 8; the whole clip's
-/// peak, which for a low jump can be the landing, is reported apart. Writes `high_jump.bvh`, the
+/// peak, which for a low jump can be the landing, is reported apart. Per jump the report gives
+/// its root apex above standing, its flight (both feet off the floor) and its feet's lowest
+/// point; for the high jump also what extrapolating the two jumps with the scene's γ predicts.
+/// Writes `low_jump.bvh`, `normal_jump.bvh`, `high_jump.bvh` (each at its own duration), the
 /// primitives (`*.primitive.ron`), `filmstrip.png`, `motion.gif`, `left_knee.png` (the paper's
 /// Fig. 8) and returns the report.
 pub fn run_high_jump(
@@ -202,32 +205,37 @@ pub fn run_high_jump(
     base: &Path,
     out: &Path,
 ) -> Result<serde_json::Value, SceneError> {
+    scene.gamma.validate()?;
     let model = Model::by_name("humanoid24")?;
     let config = high_jump_config(scene, base, &model)?;
     let hj = high_jump::run(&config).map_err(SceneError::from)?;
     let learned = &hj.primitives.learned;
     let (clips, rollouts) = (&hj.clips, &hj.rollouts);
-    write_output(
-        &out.join("high_jump.bvh"),
-        crate::bvh::to_string(&clips.high.to_clip().to_bvh()).as_bytes(),
-    )?;
+    for (name, clip) in [
+        ("low_jump", &clips.low),
+        ("normal_jump", &clips.normal),
+        ("high_jump", &clips.high),
+    ] {
+        write_bvh(&out.join(format!("{name}.bvh")), clip)?;
+    }
     save_primitives([&learned.low, &learned.normal, &learned.high], out)?;
+    let label = scene.gamma.label();
     draw(
         &[
-            ("low (time-scaled)", &clips.low),
+            ("low", &clips.low),
             ("normal", &clips.normal),
-            ("high (γ = −0.5)", &clips.high),
+            (&format!("high ({label})"), &clips.high),
         ],
         &scene.render,
         out,
     )?;
     plot(
         &Plot {
-            title: "Left knee flexion: low, normal and extrapolated high jump".into(),
+            title: format!("Left knee flexion: low, normal and blended high jump ({label})"),
             x_label: "time (s)".into(),
             y_label: "left knee flexion (deg)".into(),
             series: vec![
-                dof_series("low", &rollouts.low, "left_knee", 0.0)?,
+                dof_series("low (time-scaled)", &rollouts.low, "left_knee", 0.0)?,
                 dof_series("normal", &rollouts.normal, "left_knee", 0.0)?,
                 dof_series("high", &rollouts.high, "left_knee", 0.0)?,
             ],
@@ -236,7 +244,21 @@ pub fn run_high_jump(
         &out.join("left_knee.png"),
     )?;
     let (p, whole) = (&hj.crouch_knee_flexion_deg, &hj.whole_clip_knee_flexion_deg);
+    let (fig, pred, plan) = (
+        &hj.figures,
+        &hj.primitives.prediction,
+        &hj.primitives.flight,
+    );
     Ok(json!({
+        "gamma": label,
+        "jumps": { "low": fig.low, "normal": fig.normal, "high": fig.high },
+        "prediction": pred,
+        "high_minus_predicted": {
+            "apex_above_standing_m": fig.high.apex_above_standing_m - pred.apex_above_standing_m,
+            "flight_s": fig.high.flight_s - pred.flight_s,
+        },
+        "flight_plan": plan,
+        "floor_y_m": hj.primitives.floor_y_m,
         "peak_knee_flexion_deg": { "low": p.low, "normal": p.normal, "high": p.high },
         "peak_knee_flexion_whole_clip_deg": { "low": whole.low, "normal": whole.normal, "high": whole.high },
         "expected_high_deg": hj.expected_high_deg,
@@ -244,8 +266,17 @@ pub fn run_high_jump(
         "fit_rmse_deg": fit_json(&learned.high),
         "fit_rmse_deg_by_primitive": { "low": fit_json(&learned.low), "normal": fit_json(&learned.normal), "high": fit_json(&learned.high) },
         "duration_s": hj.duration_s,
+        "high_duration_s": learned.high.primitive.duration,
         "ground_correction_m": hj.primitives.ground_correction_m,
     }))
+}
+
+/// Writes a clip on the model as BVH.
+fn write_bvh(path: &Path, clip: &ModelClip) -> Result<(), SceneError> {
+    write_output(
+        path,
+        crate::bvh::to_string(&clip.to_clip().to_bvh()).as_bytes(),
+    )
 }
 
 /// Plays the connected sequence by a character in an ECS world (players → pose → forward
@@ -294,6 +325,8 @@ pub fn run_jumping_knee_kick(
     base: &Path,
     out: &Path,
 ) -> Result<serde_json::Value, SceneError> {
+    scene.gamma.validate()?;
+    scene.jump.gamma.validate()?;
     let model = Model::by_name("humanoid24")?;
     let config = KneeKickConfig {
         jump: high_jump_config(&scene.jump, base, &model)?,
@@ -305,16 +338,19 @@ pub fn run_jumping_knee_kick(
     let ecs_gap = play_in_world(&model, &kk.sequence(), &kk.result_clip)?;
     let ev = &kk.events;
 
-    write_output(
-        &out.join("jumping_knee_kick.bvh"),
-        crate::bvh::to_string(&kk.result_clip.to_clip().to_bvh()).as_bytes(),
-    )?;
+    write_bvh(&out.join("jumping_knee_kick.bvh"), &kk.result_clip)?;
     save_primitives(&kk.parts, out)?;
     draw(
         &[
-            ("high jump (A)", &kk.jump_clip),
+            (
+                &format!("high jump (A, {})", scene.jump.gamma.label()),
+                &kk.jump_clip,
+            ),
             ("knee kick (B)", &kk.kick_clip),
-            ("jumping knee kick", &kk.result_clip),
+            (
+                &format!("jumping knee kick ({})", scene.gamma.label()),
+                &kk.result_clip,
+            ),
         ],
         &scene.render,
         out,
@@ -347,6 +383,17 @@ pub fn run_jumping_knee_kick(
     }
     let (j, gap, parts) = (&kk.junction, &kk.posture_gap_deg, &kk.parts);
     Ok(json!({
+        "gamma": scene.gamma.label(),
+        "jump_gamma": scene.jump.gamma.label(),
+        "jump": kk.jump_figures,
+        "jumping_knee_kick": kk.figures,
+        "at_leap": {
+            "airborne": kk.airborne_at_leap,
+            "feet_above_floor_m": kk.feet_above_floor_at_leap_m,
+            "root_minus_jump_apex_m": kk.root_at_leap_minus_jump_apex_m,
+        },
+        "ground_correction_m": kk.ground_correction_m,
+        "landing_correction_m": kk.landing_correction_m,
         "events_s": events_json(ev),
         "arrangement": format!("{:?}", kk.arrangement),
         "junction": { "time_s": j.time_s, "max_angle_jump_deg": j.max_angle_jump_deg, "max_velocity_jump_deg_s": j.max_velocity_jump_deg_s },

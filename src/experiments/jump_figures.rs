@@ -1,0 +1,116 @@
+//! The figures that say what a jump did: how high the root (pelvis) rose above standing, how long
+//! both feet were off the floor, and how far any foot went below the floor. The flight comes from
+//! foot contact ([`crate::analysis::clip_contacts`]: a flight is when no point of either foot
+//! touches), not from the root, so a deeper crouch without a higher flight shows as such.
+
+use serde::Serialize;
+
+use crate::analysis::{Span, clip_contacts};
+use crate::humanoid::ModelClip;
+use crate::primitive::events::median;
+
+/// Height above the floor under which a foot point counts as touching it, metres (as
+/// `marionette inspect` and the show scenes use).
+pub const CONTACT_THRESHOLD_M: f64 = 0.03;
+
+/// Shortest span without contact that counts as a flight, seconds (shorter ones are noise).
+pub const MIN_FLIGHT_S: f64 = 0.1;
+
+/// Length of the standing window at a clip's start, seconds: the standing root height is the
+/// median of the root heights in it.
+pub const STANDING_WINDOW_S: f64 = 0.2;
+
+/// What one jump did, measured on its clip.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct JumpFigures {
+    /// Root height while standing (the median over the first [`STANDING_WINDOW_S`]), metres.
+    pub standing_root_m: f64,
+    /// Highest root height, metres.
+    pub apex_root_m: f64,
+    /// `apex_root_m − standing_root_m`: the jump height, metres.
+    pub apex_above_standing_m: f64,
+    /// When the root is highest, seconds from the clip's start.
+    pub apex_time_s: f64,
+    /// The longest span with both feet off the floor (`None`: the figure never leaves it).
+    pub flight: Option<Span>,
+    /// Its length, seconds (0 without a flight).
+    pub flight_s: f64,
+    /// The lowest any foot point (ankle or toe) comes relative to `floor_y`, metres: negative is
+    /// how deep a foot went through the floor.
+    pub lowest_foot_above_floor_m: f64,
+}
+
+/// Measures a jump on `clip`, with the floor at height `floor_y` (metres) for the feet's lowest
+/// point; the flight is the longest span in which [`clip_contacts`] (threshold
+/// [`CONTACT_THRESHOLD_M`], shortest flight [`MIN_FLIGHT_S`]) finds no foot touching.
+pub fn jump_figures(clip: &ModelClip, floor_y: f64) -> JumpFigures {
+    let root: Vec<f64> = clip.root_translation.iter().map(|t| t.y).collect();
+    let window = ((STANDING_WINDOW_S / clip.frame_time).round() as usize).clamp(1, root.len());
+    let standing_root_m = median(&root[..window]);
+    let (apex_frame, apex_root_m) =
+        root.iter()
+            .copied()
+            .enumerate()
+            .fold(
+                (0, f64::NEG_INFINITY),
+                |m, (k, y)| if y > m.1 { (k, y) } else { m },
+            );
+    let flight = clip_contacts(&clip.to_clip(), CONTACT_THRESHOLD_M, MIN_FLIGHT_S).and_then(|c| {
+        c.flights
+            .into_iter()
+            .max_by(|a, b| a.duration().total_cmp(&b.duration()))
+    });
+    let lowest_foot_above_floor_m = clip
+        .foot_heights()
+        .iter()
+        .flatten()
+        .fold(f64::INFINITY, |m, h| m.min(*h))
+        - floor_y;
+    JumpFigures {
+        standing_root_m,
+        apex_root_m,
+        apex_above_standing_m: apex_root_m - standing_root_m,
+        apex_time_s: apex_frame as f64 * clip.frame_time,
+        flight,
+        flight_s: flight.map_or(0.0, |f| f.duration()),
+        lowest_foot_above_floor_m,
+    }
+}
+
+/// The floor a clip stands on: the height [`clip_contacts`] finds its feet touching, metres
+/// (`None` when the clip has no feet).
+pub fn floor_of(clip: &ModelClip) -> Option<f64> {
+    clip_contacts(&clip.to_clip(), CONTACT_THRESHOLD_M, MIN_FLIGHT_S).map(|c| c.floor_y_m)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::clips::KeyframeClip;
+
+    #[test]
+    fn a_keyframed_jump_rises_by_its_ballistic_arc_and_flies_as_long_as_keyed() {
+        let text = std::fs::read_to_string(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/scenes/clips/normal_jump.ron"
+        ))
+        .unwrap();
+        let clip = KeyframeClip::parse(&text, "normal_jump.ron")
+            .unwrap()
+            .to_model_clip();
+        let f = jump_figures(&clip, 0.0);
+        // Keyed flight 0.92–1.32 s: the feet are more than 3 cm up for nearly all of it.
+        let fl = f.flight.unwrap();
+        assert!(
+            (fl.start_s - 0.92).abs() < 0.03 && (fl.end_s - 1.32).abs() < 0.03,
+            "{fl:?}"
+        );
+        // The arc g T²/8 = 0.196 m over the take-off height, which is near standing.
+        assert!(
+            f.apex_above_standing_m > 0.1 && f.apex_above_standing_m < 0.3,
+            "{f:?}"
+        );
+        // The keyframed clip's feet never go below its floor.
+        assert!(f.lowest_foot_above_floor_m > -1e-9, "{f:?}");
+    }
+}
