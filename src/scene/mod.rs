@@ -263,13 +263,7 @@ pub fn validate(scene: &Scene) -> Result<(), SceneError> {
                         }
                     }
                 }
-                None if !s.render.plot.is_empty() => {
-                    return Err(SceneError::Invalid(
-                        "render.plot names DOFs, which only a clip on a model has: set model \
-                         (humanoid24 or fall21) or render.plot: []"
-                            .into(),
-                    ));
-                }
+                // Without a model there are no DOFs: the plot is not drawn.
                 None => {}
             }
         }

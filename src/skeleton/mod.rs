@@ -9,7 +9,7 @@ mod euler;
 mod fk;
 mod side;
 
-pub use clip::{Clip, ClipError, estimate_unit_scale};
+pub use clip::{Clip, ClipError, FIGURE_SIZE_M, MAX_FRAME_JOINTS, estimate_unit_scale};
 pub use euler::{euler_to_quat, quat_to_euler};
 pub use fk::{Transform, forward_kinematics};
 pub use side::{Side, side_from_name};

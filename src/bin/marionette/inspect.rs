@@ -59,19 +59,24 @@ pub fn inspect(args: Args) -> Result<()> {
         clip.median_vertical_extent()
     );
     println!("skeleton:");
+    // Depths in one pass (parents come first); indentation stops at INDENT_MAX levels.
+    const INDENT_MAX: usize = 16;
+    let mut depths: Vec<usize> = Vec::with_capacity(b.joints.len());
     for (i, j) in b.joints.iter().enumerate() {
-        let mut depth = 0;
-        let mut p = j.parent;
-        while let Some(q) = p {
-            depth += 1;
-            p = b.joints[q].parent;
-        }
+        let depth = j.parent.map_or(0, |p| depths[p] + 1);
+        depths.push(depth);
         let ch: Vec<&str> = j.channels.iter().map(|c| c.name()).collect();
         let end = j.end_site.map(|_| "  + End Site").unwrap_or("");
+        let deep = if depth > INDENT_MAX {
+            format!("({depth} deep) ")
+        } else {
+            String::new()
+        };
         println!(
-            "  {:>3} {}{}  [{}]{}",
+            "  {:>3} {}{}{}  [{}]{}",
             i,
-            "  ".repeat(depth),
+            "  ".repeat(depth.min(INDENT_MAX)),
+            deep,
             j.name,
             ch.join(" "),
             end
