@@ -133,3 +133,148 @@ fn every_command_has_help() {
         assert!(out.status.success() && !out.stdout.is_empty(), "{cmd}");
     }
 }
+
+/// Runs the command, returning (exit code, stdout, stderr).
+fn run_cli(args: &[&std::ffi::OsStr]) -> (Option<i32>, String, String) {
+    let out = bin().args(args).output().unwrap();
+    (
+        out.status.code(),
+        String::from_utf8_lossy(&out.stdout).to_string(),
+        String::from_utf8_lossy(&out.stderr).to_string(),
+    )
+}
+
+/// A BVH file of two joints: `offset` is the child's OFFSET line, `frame` the one motion line.
+fn tiny_bvh(name: &str, root: &str, child: &str, offset: &str, frame: &str) -> PathBuf {
+    let p = temp(name);
+    std::fs::write(
+        &p,
+        format!(
+            "HIERARCHY\nROOT {root}\n{{\n  OFFSET 0 0 0\n  CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation\n  JOINT {child}\n  {{\n    OFFSET {offset}\n    CHANNELS 3 Zrotation Xrotation Yrotation\n    End Site\n    {{\n      OFFSET 0 -80 0\n    }}\n  }}\n}}\nMOTION\nFrames: 1\nFrame Time: 0.01\n{frame}\n"
+        ),
+    )
+    .unwrap();
+    p
+}
+
+/// The error line of a failing `inspect`, after checking it failed with one line.
+fn inspect_error(file: &std::path::Path) -> String {
+    let (code, _, err) = run_cli(&["inspect".as_ref(), file.as_os_str()]);
+    assert_eq!(code, Some(1), "{err}");
+    assert_eq!(err.lines().count(), 1, "{err}");
+    err
+}
+
+#[test]
+fn garbage_numbers_and_names_are_errors_with_their_line() {
+    let f = tiny_bvh("huge.bvh", "a", "b", "0 1e308 0", "0 90 0 0 0 0 0 0 0");
+    let e = inspect_error(&f);
+    assert!(e.contains("line 8") && e.contains("beyond the limit"), "{e}");
+    let f = tiny_bvh("angle.bvh", "a", "b", "0 -10 0", "0 90 0 1e300 0 0 0 0 0");
+    let e = inspect_error(&f);
+    assert!(e.contains("line 19") && e.contains("rotation"), "{e}");
+    let f = tiny_bvh("dup.bvh", "a", "a", "0 -10 0", "0 90 0 0 0 0 0 0 0");
+    let e = inspect_error(&f);
+    assert!(e.contains("line 6") && e.contains("already defined on line 2"), "{e}");
+    // A 26 km figure: a unit scale that makes no human.
+    let f = jump_bvh("scale.bvh");
+    let (code, _, e) = run_cli(&[
+        "inspect".as_ref(),
+        f.as_os_str(),
+        "--unit-scale".as_ref(),
+        "1000".as_ref(),
+    ]);
+    assert_eq!(code, Some(1));
+    assert!(e.contains("human range 0.3..3 m"), "{e}");
+}
+
+#[test]
+fn a_deep_hierarchy_is_refused_at_the_stated_depth() {
+    let mut s = String::from("HIERARCHY\nROOT j0\n{\nOFFSET 0 0 0\nCHANNELS 3 Zrotation Xrotation Yrotation\n");
+    for i in 1..10_000 {
+        s.push_str(&format!("JOINT j{i}\n{{\nOFFSET 0 1 0\nCHANNELS 3 Zrotation Xrotation Yrotation\n"));
+    }
+    let p = temp("deep.bvh");
+    std::fs::write(&p, s).unwrap();
+    let e = inspect_error(&p);
+    assert!(e.contains("deeper than 64"), "{e}");
+}
+
+#[test]
+fn os_errors_are_said_once() {
+    let (code, _, e) = run_cli(&["inspect".as_ref(), "/nonexistent/x.bvh".as_ref()]);
+    assert_eq!(code, Some(1));
+    assert_eq!(e.matches("No such file").count(), 1, "{e}");
+    let (code, _, e) = run_cli(&["run".as_ref(), "/nonexistent/s.ron".as_ref()]);
+    assert_eq!(code, Some(1));
+    assert_eq!(e.matches("No such file").count(), 1, "{e}");
+}
+
+#[test]
+fn a_bvh_without_frames_is_not_written() {
+    let p = temp("zero.bvh");
+    std::fs::write(&p, "HIERARCHY\nROOT a\n{\n  OFFSET 0 0 0\n  CHANNELS 3 Zrotation Xrotation Yrotation\n}\nMOTION\nFrames: 0\nFrame Time: 0.1\n").unwrap();
+    let out = temp("zero_out.bvh");
+    let (code, _, e) = run_cli(&[
+        "export".as_ref(),
+        p.as_os_str(),
+        "--bvh".as_ref(),
+        out.as_os_str(),
+    ]);
+    assert_eq!(code, Some(1), "{e}");
+    assert!(e.contains("no frames"), "{e}");
+    assert!(!out.exists());
+}
+
+#[test]
+fn render_draws_any_skeleton_as_it_is_and_takes_a_window() {
+    // A skeleton no built-in mapping knows.
+    let f = tiny_bvh("odd.bvh", "thing", "limb", "0 -90 0", "0 170 0 0 0 0 10 0 0");
+    let png = temp("odd.png");
+    let (code, _, e) = run_cli(&[
+        "render".as_ref(),
+        f.as_os_str(),
+        "--out".as_ref(),
+        png.as_os_str(),
+    ]);
+    assert_eq!(code, Some(0), "{e}");
+    assert!(png.exists());
+    // --mapping needs --model; with --model it is taken.
+    let (code, _, _) = run_cli(&[
+        "render".as_ref(),
+        f.as_os_str(),
+        "--out".as_ref(),
+        png.as_os_str(),
+        "--mapping".as_ref(),
+        "m.ron".as_ref(),
+    ]);
+    assert_eq!(code, Some(2));
+    let jump = jump_bvh("window.bvh");
+    let png = temp("window.png");
+    let (code, _, e) = run_cli(&[
+        "render".as_ref(),
+        jump.as_os_str(),
+        "--out".as_ref(),
+        png.as_os_str(),
+        "--start".as_ref(),
+        "0.5".as_ref(),
+        "--end".as_ref(),
+        "1.5".as_ref(),
+        "--model".as_ref(),
+        "humanoid24".as_ref(),
+        "--mapping".as_ref(),
+        concat!(env!("CARGO_MANIFEST_DIR"), "/src/mapping/builtin/marionette_humanoid24.ron").as_ref(),
+    ]);
+    assert_eq!(code, Some(0), "{e}");
+    // A window reaching past the clip (2 s) names the clip's span.
+    let (code, _, e) = run_cli(&[
+        "render".as_ref(),
+        jump.as_os_str(),
+        "--out".as_ref(),
+        png.as_os_str(),
+        "--end".as_ref(),
+        "9".as_ref(),
+    ]);
+    assert_eq!(code, Some(1));
+    assert!(e.contains("spans 0..2.000 s"), "{e}");
+}

@@ -212,9 +212,6 @@ pub const MAX_NAME_LEN: usize = 100;
 /// Most filmstrip frames a scene may ask for.
 pub const MAX_FILMSTRIP_FRAMES: usize = 64;
 
-/// Highest GIF frame rate a scene may ask for, frames per second.
-pub const MAX_GIF_FPS: f64 = 100.0;
-
 /// Checks what can be checked before any work: the scene's name is a plain folder name (it
 /// names the default output folder, so it may not be empty, absolute or climb with `..`), the
 /// picture settings are in range, and a `Show` scene's model and plotted DOFs exist.
@@ -240,9 +237,10 @@ pub fn validate(scene: &Scene) -> Result<(), SceneError> {
                 "render.filmstrip_frames is {frames}, expected 1 to {MAX_FILMSTRIP_FRAMES}"
             )));
         }
-        if gif && !(fps.is_finite() && fps > 0.0 && fps <= MAX_GIF_FPS) {
+        if gif && !(fps.is_finite() && fps > 0.0 && fps <= crate::render::MAX_GIF_FPS) {
             return Err(SceneError::Invalid(format!(
-                "render.gif_fps is {fps}, expected more than 0 and at most {MAX_GIF_FPS}"
+                "render.gif_fps is {fps}, expected more than 0 and at most {}",
+                crate::render::MAX_GIF_FPS
             )));
         }
         Ok(())
