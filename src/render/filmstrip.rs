@@ -32,8 +32,9 @@ const TIME_SHARE: f64 = 0.25;
 /// distance travelled. With D(t) the distance all points of all tracks have travelled up to t
 /// (summed over frames at the finest frame time) and T the longest duration, the progress
 /// u(t) = s·t/T + (1 − s)·D(t)/D(T), s = [`TIME_SHARE`]; column j is at the first t with
-/// u(t) ≥ j/(n − 1), so the first column is t = 0 and the last t = T. A motion that does not
-/// move is spread evenly in time; just t = 0 when n = 1.
+/// u(t) ≥ j/(n − 1), so the first column is t = 0 and the last t = T; inner columns then move
+/// to a jump's apex near them ([`snap_to_apexes`]). A motion that does not move is spread
+/// evenly in time; just t = 0 when n = 1.
 pub(crate) fn column_times(tracks: &[Track], n: usize) -> Vec<f64> {
     let duration = tracks.iter().map(Track::duration).fold(0.0, f64::max);
     if n == 1 {
@@ -69,7 +70,7 @@ pub(crate) fn column_times(tracks: &[Track], n: usize) -> Vec<f64> {
         share * time + (1.0 - share) * moved
     };
     let mut k = 0;
-    (0..n)
+    let mut times: Vec<f64> = (0..n)
         .map(|j| {
             let goal = j as f64 / (n - 1) as f64;
             while k < steps && progress(k) < goal - 1e-12 {
@@ -77,8 +78,39 @@ pub(crate) fn column_times(tracks: &[Track], n: usize) -> Vec<f64> {
             }
             if j == n - 1 { duration } else { (k as f64 * dt).min(duration) }
         })
-        .collect()
+        .collect();
+    snap_to_apexes(&tracks[0], &mut times);
+    times
 }
+
+/// Moves each inner column to the apex of a jump near it: to the highest root of the first
+/// track between the midpoints to its neighbours, when that is a peak inside the span (not at
+/// its ends) rising more than [`APEX_RISE`] of the figure's height above the span's lowest root.
+fn snap_to_apexes(track: &Track, times: &mut [f64]) {
+    let root = track.figure.root();
+    let y = |k: usize| track.frames[k][root].y;
+    let height = track.frames.first().map_or(0.0, |f| {
+        let hi = f.iter().map(|p| p.y).fold(f64::NEG_INFINITY, f64::max);
+        let lo = f.iter().map(|p| p.y).fold(f64::INFINITY, f64::min);
+        hi - lo
+    });
+    for j in 1..times.len().saturating_sub(1) {
+        let a = track.frame_at(0.5 * (times[j - 1] + times[j]));
+        let b = track.frame_at(0.5 * (times[j] + times[j + 1]));
+        if b <= a + 2 {
+            continue;
+        }
+        let top = (a..=b).max_by(|&p, &q| y(p).total_cmp(&y(q))).unwrap_or(a);
+        let low = (a..=b).map(y).fold(f64::INFINITY, f64::min);
+        if top > a && top < b && y(top) - low > APEX_RISE * height {
+            times[j] = top as f64 * track.frame_time;
+        }
+    }
+}
+
+/// Least rise of the root above its lowest in a column's span, as a share of the figure's
+/// height, for the column to move to that apex.
+const APEX_RISE: f64 = 0.08;
 
 /// Draws `n` instants of every track as a PNG at `path`, one row per track (its label above
 /// it), in `view`, each figure turned to face +Z (see [`super::facing`]). Columns share one time
