@@ -1,6 +1,8 @@
 //! The `marionette` command as a user runs it: outputs on good input, a non-zero exit and one
 //! clear line on bad input.
 
+mod common;
+
 use std::path::PathBuf;
 use std::process::Command;
 
@@ -277,4 +279,123 @@ fn render_draws_any_skeleton_as_it_is_and_takes_a_window() {
     ]);
     assert_eq!(code, Some(1));
     assert!(e.contains("spans 0..2.000 s"), "{e}");
+}
+
+#[test]
+fn an_interrupted_run_leaves_the_old_outputs_or_the_whole_new_set() {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let dir = temp("interrupt");
+    let out = dir.join("jump");
+    let run = |extra: &[&str]| {
+        let mut c = bin();
+        c.arg("run")
+            .arg(root.join("scenes/show_normal_jump.ron"))
+            .arg("--out")
+            .arg(&out)
+            .args(extra);
+        c
+    };
+    assert!(run(&["--set", "render.gif=false"]).status().unwrap().success());
+    let old = std::fs::read(out.join("report.json")).unwrap();
+    // The second run (with a GIF) interrupted part-way with SIGINT.
+    let mut child = run(&[]).spawn().unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(150));
+    let _ = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status();
+    let status = child.wait().unwrap();
+    let report = std::fs::read(out.join("report.json")).unwrap();
+    let gif = out.join("motion.gif").exists();
+    if status.success() {
+        // It finished before the signal: the whole new set.
+        assert!(gif && report != old);
+    } else {
+        // Interrupted: the old set as it was, nothing of the new one.
+        assert!(!gif && report == old);
+    }
+    // The next run removes what the interrupted one left and succeeds.
+    assert!(run(&[]).status().unwrap().success());
+    let left: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().to_string())
+        .collect();
+    assert_eq!(left, ["jump"], "{left:?}");
+}
+
+/// The flights `inspect` prints: (start, end) seconds.
+fn inspect_flights(file: &std::path::Path) -> Vec<(f64, f64)> {
+    let (code, text, err) = run_cli(&["inspect".as_ref(), file.as_os_str()]);
+    assert_eq!(code, Some(0), "{err}");
+    let start = text.find("flights ").expect("a flights line");
+    text[start..]
+        .lines()
+        .skip(1)
+        .map(|l| {
+            let v: Vec<f64> = l
+                .split_whitespace()
+                .filter_map(|w| w.parse().ok())
+                .collect();
+            (v[1], v[2])
+        })
+        .collect()
+}
+
+#[test]
+fn lying_after_the_project_s_fall_is_not_flight() {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let out = temp("fall_out");
+    let (code, _, err) = run_cli(&[
+        "run".as_ref(),
+        root.join("scenes/fall.ron").as_os_str(),
+        "--out".as_ref(),
+        out.as_os_str(),
+        "--set".as_ref(),
+        "render.gif=false".as_ref(),
+    ]);
+    assert_eq!(code, Some(0), "{err}");
+    let (_, text, _) = run_cli(&["inspect".as_ref(), out.join("fall.bvh").as_os_str()]);
+    assert!(text.contains("flights     0"), "{text}");
+    // It lies on the floor at the end: the body touches.
+    assert!(!text.contains("body        0 spans"), "{text}");
+}
+
+#[test]
+fn the_cmu_forward_jumps_have_exactly_their_ten_flights() {
+    let Some(file) = common::data_path("cmu/cmu_01_01_forward_jumps.bvh") else {
+        return;
+    };
+    let flights = inspect_flights(&file);
+    assert_eq!(flights.len(), 10, "{flights:?}");
+    // None while standing still at the start (0–1.3 s), each as long as a jump's flight.
+    assert!(flights[0].0 > 1.3, "{flights:?}");
+    for (a, b) in &flights {
+        assert!((0.2..0.6).contains(&(b - a)), "{flights:?}");
+    }
+}
+
+#[test]
+fn the_mapped_cmu_jumps_keep_the_source_s_two_flights() {
+    let Some(_) = common::data_dir() else {
+        return;
+    };
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let out = temp("cmu_jumps");
+    let (code, text, err) = run_cli(&[
+        "run".as_ref(),
+        root.join("scenes/show_cmu_jumps.ron").as_os_str(),
+        "--out".as_ref(),
+        out.as_os_str(),
+        "--set".as_ref(),
+        "render.gif=false".as_ref(),
+    ]);
+    assert_eq!(code, Some(0), "{err}");
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    let flights = report["flights"].as_array().unwrap();
+    assert_eq!(flights.len(), 2, "{text}");
+    // The source's flights in 0–5 s: 1.9–2.3 s and 3.6–3.9 s.
+    for (f, (a, b)) in flights.iter().zip([(1.93, 2.25), (3.61, 3.89)]) {
+        let (s, e) = (f["start_s"].as_f64().unwrap(), f["end_s"].as_f64().unwrap());
+        assert!((s - a).abs() < 0.12 && (e - b).abs() < 0.12, "{f} against {a}..{b}");
+    }
 }

@@ -2,9 +2,10 @@
 //! figure faces +Z, so "front" shows its front and "side" its left side whatever way the
 //! motion faced in its file.
 //!
-//! The figure's left is the mean over the motion of (mean of its left points − mean of its
-//! right points), horizontal (hips, shoulders and limbs by [`super::Figure::sides`]); its facing
-//! is left × up. A figure without named sides is drawn as it is.
+//! The figure's left is the mean over the motion of (mean of its left limb roots − mean of its
+//! right limb roots), horizontal: a limb root is a point on one side (by
+//! [`super::Figure::sides`]) hanging from a mid-line point: hips, clavicles or shoulders, not the
+//! swinging hands and feet. Its facing is left × up. A figure without sides is drawn as it is.
 
 use glam::{DQuat, DVec3};
 
@@ -13,14 +14,21 @@ use super::figure::{Side, Track};
 /// The turn about +Y that makes `track`'s figure face +Z (identity without named sides).
 pub(crate) fn facing_turn(track: &Track) -> DQuat {
     let sides = track.figure.sides();
+    let limb_root: Vec<bool> = (0..sides.len())
+        .map(|i| {
+            sides[i] != Side::Centre
+                && track.figure.parents[i].is_some_and(|p| sides[p] == Side::Centre)
+        })
+        .collect();
     let mut lateral = DVec3::ZERO;
     for frame in track.frames {
         let mean = |want: Side| {
             let (sum, n) = frame
                 .iter()
                 .zip(&sides)
-                .filter(|(_, s)| **s == want)
-                .fold((DVec3::ZERO, 0usize), |(a, n), (p, _)| (a + *p, n + 1));
+                .zip(&limb_root)
+                .filter(|((_, s), root)| **s == want && **root)
+                .fold((DVec3::ZERO, 0usize), |(a, n), ((p, _), _)| (a + *p, n + 1));
             (n > 0).then(|| sum / n as f64)
         };
         if let (Some(l), Some(r)) = (mean(Side::Left), mean(Side::Right)) {

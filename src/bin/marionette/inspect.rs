@@ -94,7 +94,7 @@ pub fn inspect(args: Args) -> Result<()> {
             .join(", ")
     };
     println!(
-        "floor       y = {:.3} m (contact within {:.0} cm)",
+        "floor       y = {:.3} m (a foot point touches within {:.0} cm of its rest height)",
         c.floor_y_m,
         c.threshold_m * 100.0
     );
@@ -107,6 +107,11 @@ pub fn inspect(args: Args) -> Result<()> {
         "right foot  {} contact spans: {}",
         c.right.len(),
         spans(&c.right)
+    );
+    println!(
+        "body        {} spans on the floor (a joint other than the feet within 15 cm): {}",
+        c.body.len(),
+        spans(&c.body)
     );
     println!("flights     {}", c.flights.len());
     for (i, f) in c.flights.iter().enumerate() {
