@@ -171,13 +171,19 @@ fn inspect_error(file: &std::path::Path) -> String {
 fn garbage_numbers_and_names_are_errors_with_their_line() {
     let f = tiny_bvh("huge.bvh", "a", "b", "0 1e308 0", "0 90 0 0 0 0 0 0 0");
     let e = inspect_error(&f);
-    assert!(e.contains("line 8") && e.contains("beyond the limit"), "{e}");
+    assert!(
+        e.contains("line 8") && e.contains("beyond the limit"),
+        "{e}"
+    );
     let f = tiny_bvh("angle.bvh", "a", "b", "0 -10 0", "0 90 0 1e300 0 0 0 0 0");
     let e = inspect_error(&f);
     assert!(e.contains("line 19") && e.contains("rotation"), "{e}");
     let f = tiny_bvh("dup.bvh", "a", "a", "0 -10 0", "0 90 0 0 0 0 0 0 0");
     let e = inspect_error(&f);
-    assert!(e.contains("line 6") && e.contains("already defined on line 2"), "{e}");
+    assert!(
+        e.contains("line 6") && e.contains("already defined on line 2"),
+        "{e}"
+    );
     // A 26 km figure: a unit scale that makes no human.
     let f = jump_bvh("scale.bvh");
     let (code, _, e) = run_cli(&[
@@ -192,9 +198,13 @@ fn garbage_numbers_and_names_are_errors_with_their_line() {
 
 #[test]
 fn a_deep_hierarchy_is_refused_at_the_stated_depth() {
-    let mut s = String::from("HIERARCHY\nROOT j0\n{\nOFFSET 0 0 0\nCHANNELS 3 Zrotation Xrotation Yrotation\n");
+    let mut s = String::from(
+        "HIERARCHY\nROOT j0\n{\nOFFSET 0 0 0\nCHANNELS 3 Zrotation Xrotation Yrotation\n",
+    );
     for i in 1..10_000 {
-        s.push_str(&format!("JOINT j{i}\n{{\nOFFSET 0 1 0\nCHANNELS 3 Zrotation Xrotation Yrotation\n"));
+        s.push_str(&format!(
+            "JOINT j{i}\n{{\nOFFSET 0 1 0\nCHANNELS 3 Zrotation Xrotation Yrotation\n"
+        ));
     }
     let p = temp("deep.bvh");
     std::fs::write(&p, s).unwrap();
@@ -231,7 +241,13 @@ fn a_bvh_without_frames_is_not_written() {
 #[test]
 fn render_draws_any_skeleton_as_it_is_and_takes_a_window() {
     // A skeleton no built-in mapping knows.
-    let f = tiny_bvh("odd.bvh", "thing", "limb", "0 -90 0", "0 170 0 0 0 0 10 0 0");
+    let f = tiny_bvh(
+        "odd.bvh",
+        "thing",
+        "limb",
+        "0 -90 0",
+        "0 170 0 0 0 0 10 0 0",
+    );
     let png = temp("odd.png");
     let (code, _, e) = run_cli(&[
         "render".as_ref(),
@@ -265,7 +281,11 @@ fn render_draws_any_skeleton_as_it_is_and_takes_a_window() {
         "--model".as_ref(),
         "humanoid24".as_ref(),
         "--mapping".as_ref(),
-        concat!(env!("CARGO_MANIFEST_DIR"), "/src/mapping/builtin/marionette_humanoid24.ron").as_ref(),
+        concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/src/mapping/builtin/marionette_humanoid24.ron"
+        )
+        .as_ref(),
     ]);
     assert_eq!(code, Some(0), "{e}");
     // A window reaching past the clip (2 s) names the clip's span.
@@ -295,7 +315,12 @@ fn an_interrupted_run_leaves_the_old_outputs_or_the_whole_new_set() {
             .args(extra);
         c
     };
-    assert!(run(&["--set", "render.gif=false"]).status().unwrap().success());
+    assert!(
+        run(&["--set", "render.gif=false"])
+            .status()
+            .unwrap()
+            .success()
+    );
     let old = std::fs::read(out.join("report.json")).unwrap();
     // The second run (with a GIF) interrupted part-way with SIGINT.
     let mut child = run(&[]).spawn().unwrap();
@@ -396,6 +421,9 @@ fn the_mapped_cmu_jumps_keep_the_source_s_two_flights() {
     // The source's flights in 0–5 s: 1.9–2.3 s and 3.6–3.9 s.
     for (f, (a, b)) in flights.iter().zip([(1.93, 2.25), (3.61, 3.89)]) {
         let (s, e) = (f["start_s"].as_f64().unwrap(), f["end_s"].as_f64().unwrap());
-        assert!((s - a).abs() < 0.12 && (e - b).abs() < 0.12, "{f} against {a}..{b}");
+        assert!(
+            (s - a).abs() < 0.12 && (e - b).abs() < 0.12,
+            "{f} against {a}..{b}"
+        );
     }
 }

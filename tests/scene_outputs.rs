@@ -36,7 +36,10 @@ fn names(dir: &Path) -> Vec<String> {
 fn failing_runs_leave_the_previous_outputs_and_no_partial_set() {
     let d = scratch("fail");
     let out = d.join("jump");
-    let good = show("jump", r#"model: "humanoid24", render: (gif: true, filmstrip_frames: 4)"#);
+    let good = show(
+        "jump",
+        r#"model: "humanoid24", render: (gif: true, filmstrip_frames: 4)"#,
+    );
     scene::run(&good, &d, &out).unwrap();
     let before = names(&out);
     assert!(before.contains(&"motion.gif".to_string()), "{before:?}");
@@ -65,7 +68,10 @@ fn failing_runs_leave_the_previous_outputs_and_no_partial_set() {
 fn a_new_run_leaves_nothing_of_the_old_one_beside_its_files() {
     let d = scratch("replace");
     let out = d.join("jump");
-    let with_gif = show("jump", r#"model: "humanoid24", render: (gif: true, filmstrip_frames: 4)"#);
+    let with_gif = show(
+        "jump",
+        r#"model: "humanoid24", render: (gif: true, filmstrip_frames: 4)"#,
+    );
     scene::run(&with_gif, &d, &out).unwrap();
     assert!(out.join("motion.gif").exists() && out.join("angles.png").exists());
     // On its own skeleton and without a GIF: no angles and no GIF of the old run remain.
@@ -85,7 +91,9 @@ fn a_new_run_leaves_nothing_of_the_old_one_beside_its_files() {
 fn a_folder_that_is_not_a_scene_output_is_not_replaced() {
     let d = scratch("foreign");
     std::fs::write(d.join("notes.txt"), "mine").unwrap();
-    let e = scene::run(&show("jump", ""), &d, &d).unwrap_err().to_string();
+    let e = scene::run(&show("jump", ""), &d, &d)
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("not a scene's output"), "{e}");
     assert_eq!(names(&d), ["notes.txt"]);
     std::fs::remove_dir_all(&d).unwrap();
@@ -108,7 +116,10 @@ fn version_zero_and_huge_keyframed_clips_are_errors() {
         clip.display().to_string()
     );
     let e = Scene::parse(&text, "v.ron").unwrap_err().to_string();
-    assert!(e.contains("format_version 0") && e.contains("start at 1"), "{e}");
+    assert!(
+        e.contains("format_version 0") && e.contains("start at 1"),
+        "{e}"
+    );
 
     let d = scratch("huge");
     let jump = std::fs::read_to_string(&clip).unwrap();
@@ -129,8 +140,11 @@ fn version_zero_and_huge_keyframed_clips_are_errors() {
 #[test]
 fn windows_reaching_outside_the_clip_name_its_span() {
     let d = scratch("window");
-    let s = scene::apply_overrides(&show("w", ""), &["clip.start_s=1.0".into(), "clip.end_s=3.0".into()])
-        .unwrap();
+    let s = scene::apply_overrides(
+        &show("w", ""),
+        &["clip.start_s=1.0".into(), "clip.end_s=3.0".into()],
+    )
+    .unwrap();
     let e = scene::run(&s, &d, &d.join("w")).unwrap_err().to_string();
     assert!(e.contains("spans 0..2.000 s"), "{e}");
     std::fs::remove_dir_all(&d).unwrap();

@@ -91,7 +91,12 @@ pub struct Contacts {
 fn heights(frames: &[Vec<DVec3>]) -> Vec<Vec<f64>> {
     let n = frames.first().map_or(0, Vec::len);
     (0..n)
-        .map(|p| frames.iter().map(|fr| fr.get(p).map_or(f64::NAN, |v| v.y)).collect())
+        .map(|p| {
+            frames
+                .iter()
+                .map(|fr| fr.get(p).map_or(f64::NAN, |v| v.y))
+                .collect()
+        })
         .collect()
 }
 
@@ -224,8 +229,10 @@ pub fn ground_contacts(
     let (rest_r, on_r) = foot(right, &hr);
     let mut on_body: Vec<bool> = (0..frames)
         .map(|f| {
-            hb.iter()
-                .any(|h| h.get(f).is_some_and(|y| y - floor < config.body_threshold_m))
+            hb.iter().any(|h| {
+                h.get(f)
+                    .is_some_and(|y| y - floor < config.body_threshold_m)
+            })
         })
         .collect();
     debounce(&mut on_body, debounce_frames);
@@ -311,12 +318,18 @@ mod tests {
         let c = ground_contacts(&l, &r, &b, dt, &ContactConfig::default());
         assert!(c.flights.is_empty(), "{:?}", c.flights);
         assert_eq!(c.body.len(), 1);
-        assert!(c.body[0].start_s > 0.6 && c.body[0].end_s > 2.99, "{:?}", c.body);
+        assert!(
+            c.body[0].start_s > 0.6 && c.body[0].end_s > 2.99,
+            "{:?}",
+            c.body
+        );
     }
 
     #[test]
     fn debouncing_joins_short_runs() {
-        let mut on = vec![true, true, true, false, true, true, true, true, false, false];
+        let mut on = vec![
+            true, true, true, false, true, true, true, true, false, false,
+        ];
         debounce(&mut on, 2);
         assert_eq!(
             on,

@@ -37,7 +37,9 @@ pub fn foot_points(skeleton: &Skeleton) -> [Vec<PointRef>; 2] {
                 .enumerate()
                 .filter(|(_, j)| {
                     let n = j.name.to_lowercase();
-                    ["foot", "toe", "ankle", "heel"].iter().any(|w| n.contains(w))
+                    ["foot", "toe", "ankle", "heel"]
+                        .iter()
+                        .any(|w| n.contains(w))
                         && side_from_name(&j.name) == side
                 })
                 .map(|(i, _)| i)
@@ -82,9 +84,7 @@ pub fn clip_contacts_with(clip: &Clip, config: &ContactConfig) -> Option<Contact
     let proxy = clip.skeleton.ground_proxy_root();
     let is_foot = |p: &PointRef| lf.contains(p) || rf.contains(p) || Some(p.0) == proxy;
     let others: Vec<PointRef> = (0..joints.len())
-        .flat_map(|j| {
-            std::iter::once((j, false)).chain(joints[j].end_site.map(|_| (j, true)))
-        })
+        .flat_map(|j| std::iter::once((j, false)).chain(joints[j].end_site.map(|_| (j, true))))
         .filter(|p| !is_foot(p))
         .collect();
     let mut g = vec![];

@@ -95,7 +95,9 @@ pub enum BvhError {
         what: String,
     },
     /// Two joints with one name (tools such as Blender cannot read such a file).
-    #[error("line {line}: joint `{name}` is already defined on line {first_line}; joint names must be unique")]
+    #[error(
+        "line {line}: joint `{name}` is already defined on line {first_line}; joint names must be unique"
+    )]
     DuplicateJoint {
         /// Line of the second joint.
         line: usize,

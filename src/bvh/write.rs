@@ -36,7 +36,10 @@ pub fn write_file(bvh: &Bvh, path: &Path) -> Result<(), BvhError> {
     bvh.validate()?;
     if bvh.frame_count() == 0 {
         return Err(BvhError::Invalid {
-            message: format!("{}: the motion has no frames; nothing to write", path.display()),
+            message: format!(
+                "{}: the motion has no frames; nothing to write",
+                path.display()
+            ),
         });
     }
     crate::io::write_atomic(path, to_string(bvh).as_bytes()).map_err(|error| BvhError::Io {

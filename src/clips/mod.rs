@@ -122,7 +122,9 @@ impl KeyframeClip {
         if let Some(h) = c.height {
             let (lo, hi) = crate::skeleton::FIGURE_SIZE_M;
             if !(h.is_finite() && (lo..=hi).contains(&h)) {
-                return bad(format!("height {h} m is outside the human range {lo}..{hi} m"));
+                return bad(format!(
+                    "height {h} m is outside the human range {lo}..{hi} m"
+                ));
             }
         }
         let model = Model::by_name(&c.model).map_err(|e| KeyframeError::Content {

@@ -58,7 +58,10 @@ pub(crate) fn turned_frames(tracks: &[Track]) -> Vec<Vec<Vec<DVec3>>> {
 }
 
 /// `tracks` with their frames replaced by `frames` (from [`turned_frames`]).
-pub(crate) fn with_frames<'a>(tracks: &[Track<'a>], frames: &'a [Vec<Vec<DVec3>>]) -> Vec<Track<'a>> {
+pub(crate) fn with_frames<'a>(
+    tracks: &[Track<'a>],
+    frames: &'a [Vec<Vec<DVec3>>],
+) -> Vec<Track<'a>> {
     tracks
         .iter()
         .zip(frames)

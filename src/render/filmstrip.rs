@@ -57,7 +57,10 @@ pub(crate) fn column_times(tracks: &[Track], n: usize) -> Vec<f64> {
             .iter()
             .map(|tr| {
                 let (a, b) = (&tr.frames[tr.frame_at(t0)], &tr.frames[tr.frame_at(t1)]);
-                a.iter().zip(b).map(|(p, q)| (*q - *p).length()).sum::<f64>()
+                a.iter()
+                    .zip(b)
+                    .map(|(p, q)| (*q - *p).length())
+                    .sum::<f64>()
             })
             .sum();
         travelled[k] = travelled[k - 1] + d;
@@ -65,8 +68,16 @@ pub(crate) fn column_times(tracks: &[Track], n: usize) -> Vec<f64> {
     let total = travelled[steps];
     let share = if total > 0.0 { TIME_SHARE } else { 1.0 };
     let progress = |k: usize| {
-        let time = if steps == 0 { 1.0 } else { k as f64 / steps as f64 };
-        let moved = if total > 0.0 { travelled[k] / total } else { 0.0 };
+        let time = if steps == 0 {
+            1.0
+        } else {
+            k as f64 / steps as f64
+        };
+        let moved = if total > 0.0 {
+            travelled[k] / total
+        } else {
+            0.0
+        };
         share * time + (1.0 - share) * moved
     };
     let mut k = 0;
@@ -76,7 +87,11 @@ pub(crate) fn column_times(tracks: &[Track], n: usize) -> Vec<f64> {
             while k < steps && progress(k) < goal - 1e-12 {
                 k += 1;
             }
-            if j == n - 1 { duration } else { (k as f64 * dt).min(duration) }
+            if j == n - 1 {
+                duration
+            } else {
+                (k as f64 * dt).min(duration)
+            }
         })
         .collect();
     snap_to_apexes(&tracks[0], &mut times);

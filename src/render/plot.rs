@@ -181,7 +181,11 @@ pub(crate) fn hidden_by(plot: &Plot, span: f64) -> Vec<Option<usize>> {
                 .all(|(p, q)| p.0 == q.0 && (p.1 - q.1).abs() <= tol)
     };
     (0..plot.series.len())
-        .map(|i| (i + 1..plot.series.len()).rev().find(|&k| same(&plot.series[i], &plot.series[k])))
+        .map(|i| {
+            (i + 1..plot.series.len())
+                .rev()
+                .find(|&k| same(&plot.series[i], &plot.series[k]))
+        })
         .collect()
 }
 

@@ -220,11 +220,7 @@ pub fn validate(scene: &Scene) -> Result<(), SceneError> {
     let plain = name
         .chars()
         .all(|c| c.is_alphanumeric() || matches!(c, '_' | '-' | '.'));
-    if name.is_empty()
-        || name.starts_with('.')
-        || !plain
-        || name.chars().count() > MAX_NAME_LEN
-    {
+    if name.is_empty() || name.starts_with('.') || !plain || name.chars().count() > MAX_NAME_LEN {
         return Err(SceneError::Invalid(format!(
             "name {name:?}: expected a plain folder name (letters, digits, '_', '-', '.'; not \
              starting with '.'; at most {MAX_NAME_LEN} characters): it names the output folder \
@@ -248,21 +244,18 @@ pub fn validate(scene: &Scene) -> Result<(), SceneError> {
     match scene {
         Scene::Show(s) => {
             pictures(s.render.filmstrip_frames, s.render.gif, s.render.gif_fps)?;
-            match &s.model {
-                Some(name) => {
-                    let model = crate::humanoid::Model::by_name(name)?;
-                    for d in &s.render.plot {
-                        if model.dof_index(d).is_none() {
-                            return Err(SceneError::Invalid(format!(
-                                "render.plot: '{d}' is not a DOF of {}; its DOFs: {}",
-                                model.name,
-                                model.dof_names().join(", ")
-                            )));
-                        }
+            // Without a model there are no DOFs: the plot is not drawn.
+            if let Some(name) = &s.model {
+                let model = crate::humanoid::Model::by_name(name)?;
+                for d in &s.render.plot {
+                    if model.dof_index(d).is_none() {
+                        return Err(SceneError::Invalid(format!(
+                            "render.plot: '{d}' is not a DOF of {}; its DOFs: {}",
+                            model.name,
+                            model.dof_names().join(", ")
+                        )));
                     }
                 }
-                // Without a model there are no DOFs: the plot is not drawn.
-                None => {}
             }
         }
         Scene::HighJump(s) => pictures(s.render.filmstrip_frames, s.render.gif, s.render.gif_fps)?,

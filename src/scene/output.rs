@@ -160,13 +160,19 @@ mod tests {
             let s = Staging::begin(&target).unwrap();
             std::fs::write(s.path().join("motion.bvh"), "new").unwrap();
         }
-        assert_eq!(std::fs::read_to_string(target.join("report.json")).unwrap(), "old");
+        assert_eq!(
+            std::fs::read_to_string(target.join("report.json")).unwrap(),
+            "old"
+        );
         assert!(!target.join("motion.bvh").exists());
         // A run that succeeds: only the new files, nothing of the old run beside them.
         let s = Staging::begin(&target).unwrap();
         std::fs::write(s.path().join("report.json"), "new").unwrap();
         s.commit().unwrap();
-        assert_eq!(std::fs::read_to_string(target.join("report.json")).unwrap(), "new");
+        assert_eq!(
+            std::fs::read_to_string(target.join("report.json")).unwrap(),
+            "new"
+        );
         assert!(!target.join("stale.png").exists());
         let names: Vec<_> = std::fs::read_dir(&d)
             .unwrap()

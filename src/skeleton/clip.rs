@@ -45,9 +45,7 @@ pub enum ClipError {
         max_m: f64,
     },
     /// More frames × joints than [`MAX_FRAME_JOINTS`].
-    #[error(
-        "{frames} frames × {joints} joints is more than the {max} joint poses a clip may hold"
-    )]
+    #[error("{frames} frames × {joints} joints is more than the {max} joint poses a clip may hold")]
     TooLarge {
         /// Frames.
         frames: usize,

@@ -108,7 +108,9 @@ impl Skeleton {
         let pts = self.rest_points();
         let (lo, hi) = pts
             .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| (a.min(p.y), b.max(p.y)));
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| {
+                (a.min(p.y), b.max(p.y))
+            });
         let height = hi - lo;
         (height > 0.0 && self.joints[child].offset.length() > 0.25 * height).then_some(0)
     }
