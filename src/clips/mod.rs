@@ -284,6 +284,36 @@ mod tests {
     }
 
     #[test]
+    fn sizes_and_magnitudes_beyond_the_limits_are_errors() {
+        let cases = [
+            (
+                JUMP.replace("duration: 1.0", "duration: 1e7"),
+                "more than the 1000000",
+            ),
+            (
+                JUMP.replace("\"right_knee\": 90.0", "\"right_knee\": 1e300"),
+                "beyond ±3600°",
+            ),
+            (
+                JUMP.replace("pitch: 20.0", "pitch: 1e9"),
+                "pitch 1000000000 is beyond",
+            ),
+            (
+                JUMP.replace("duration: 1.0,", "duration: 1.0, height: 1000.0,"),
+                "outside the human range",
+            ),
+            (
+                JUMP.replace("format_version: 1", "format_version: 0"),
+                "start at 1",
+            ),
+        ];
+        for (text, want) in cases {
+            let e = KeyframeClip::parse(&text, "t.ron").unwrap_err().to_string();
+            assert!(e.contains(want), "{e}");
+        }
+    }
+
+    #[test]
     fn bad_keys_are_named() {
         let e = KeyframeClip::parse(
             &JUMP.replace("\"right_knee\": 90.0", "\"right_kne\": 90.0"),

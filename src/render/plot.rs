@@ -169,25 +169,39 @@ pub(crate) fn padded(lo: f64, hi: f64, margin: f64) -> (f64, f64) {
     (lo - d, hi + d)
 }
 
-/// For each series, the later series drawn over it that hides it: same x samples and y within
-/// 0.5 % of the y range `span` everywhere (e.g. left and right knee of a symmetric jump).
-pub(crate) fn hidden_by(plot: &Plot, span: f64) -> Vec<Option<usize>> {
+/// Share of series `a`'s points that series `b` (drawn later) covers: same x sample and y
+/// within `tol`; 0 when their samples differ.
+fn covered(a: &Series, b: &Series, tol: f64) -> f64 {
+    if a.points.len() != b.points.len() || a.points.is_empty() {
+        return 0.0;
+    }
+    let same = a
+        .points
+        .iter()
+        .zip(&b.points)
+        .filter(|(p, q)| p.0 == q.0 && (p.1 - q.1).abs() <= tol)
+        .count();
+    same as f64 / a.points.len() as f64
+}
+
+/// For each series, the later series drawn over it and the share of its points that one
+/// hides (the most-covering later series, when it covers at least [`MOSTLY_HIDDEN`]): y within
+/// 0.5 % of the y range `span` (e.g. left and right knee of a symmetric jump).
+pub(crate) fn hidden_by(plot: &Plot, span: f64) -> Vec<Option<(usize, f64)>> {
     let tol = 0.005 * span.abs().max(1e-12);
-    let same = |a: &Series, b: &Series| {
-        a.points.len() == b.points.len()
-            && a.points
-                .iter()
-                .zip(&b.points)
-                .all(|(p, q)| p.0 == q.0 && (p.1 - q.1).abs() <= tol)
-    };
-    (0..plot.series.len())
+    let n = plot.series.len();
+    (0..n)
         .map(|i| {
-            (i + 1..plot.series.len())
-                .rev()
-                .find(|&k| same(&plot.series[i], &plot.series[k]))
+            (i + 1..n)
+                .map(|k| (k, covered(&plot.series[i], &plot.series[k], tol)))
+                .filter(|&(_, c)| c >= MOSTLY_HIDDEN)
+                .max_by(|a, b| a.1.total_cmp(&b.1))
         })
         .collect()
 }
+
+/// Share of a curve's points hidden under a later one from which its legend says so.
+const MOSTLY_HIDDEN: f64 = 0.9;
 
 /// The legend corner with the fewest data points in the 40 % × 35 % box next to it; only the
 /// lower corners when the plot has event markers, whose labels run along the top.
@@ -287,24 +301,29 @@ fn draw<DB: DrawingBackend>(
         chart.draw_series(std::iter::once(text)).map_err(plot_err)?;
     }
 
-    // A series hidden under a later one gets no legend entry; the one on top names both.
+    // A series wholly hidden under a later one gets no legend entry, the one on top names both;
+    // one mostly hidden says under which.
     let hidden = hidden_by(plot, y.1 - y.0);
+    let whole = |j: usize| hidden[j].is_some_and(|(_, c)| c >= 1.0);
     for (i, s) in plot.series.iter().enumerate() {
         let c = COLOURS[i % COLOURS.len()];
         let style = c.stroke_width(2 * k);
         let drawn = chart
             .draw_series(LineSeries::new(s.points.iter().copied(), style))
             .map_err(plot_err)?;
-        if hidden[i].is_none() {
+        if !whole(i) {
             let under: Vec<&str> = (0..i)
-                .filter(|&j| hidden[j] == Some(i))
+                .filter(|&j| whole(j) && hidden[j].is_some_and(|(t, _)| t == i))
                 .map(|j| plot.series[j].name.as_str())
                 .collect();
-            let label = if under.is_empty() {
+            let mut label = if under.is_empty() {
                 s.name.clone()
             } else {
                 format!("{} = {} (overlap)", s.name, under.join(" = "))
             };
+            if let Some((top, _)) = hidden[i] {
+                label.push_str(&format!(" (mostly under {})", plot.series[top].name));
+            }
             drawn.label(label).legend(move |(lx, ly)| {
                 PathElement::new(vec![(lx, ly), (lx + 24 * ki, ly)], c.stroke_width(3 * k))
             });
@@ -354,7 +373,11 @@ mod tests {
             series: vec![line("left", 0.0), line("right", 0.001), line("other", 3.0)],
             markers: vec![],
         };
-        assert_eq!(hidden_by(&p, 12.0), [Some(1), None, None]);
+        assert_eq!(hidden_by(&p, 12.0), [Some((1, 1.0)), None, None]);
+        // Apart in 1 point of 10: mostly hidden.
+        let mut p = p;
+        p.series[1].points[3].1 += 5.0;
+        assert_eq!(hidden_by(&p, 12.0), [Some((1, 0.9)), None, None]);
     }
 
     #[test]

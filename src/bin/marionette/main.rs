@@ -12,7 +12,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
-/// marionette: human character motion — motor primitives, choreography, evolved falls.
+/// marionette: human character motion — motor primitives and simulated falls.
 #[derive(Parser)]
 #[command(version, about, long_about = None)]
 struct Cli {
