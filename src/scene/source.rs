@@ -109,7 +109,8 @@ pub fn load_motion(src: &ClipSource, base: &Path) -> Result<LoadedMotion, SceneE
             for w in warnings {
                 eprintln!("warning: {}:{}: {}", path.display(), w.line, w.message);
             }
-            let mut clip = Clip::from_bvh(&bvh, src.unit_scale)?;
+            let mut clip = Clip::from_bvh(&bvh, src.unit_scale)
+                .map_err(|e| SceneError::Invalid(format!("{}: {e}", path.display())))?;
             if src.start_s.is_some() || src.end_s.is_some() {
                 let (a, b) = window(clip.duration());
                 clip = clip.window(a, b).map_err(|e| {

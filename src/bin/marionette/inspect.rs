@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use anyhow::Result;
+use anyhow::{Context, Result};
 
 use marionette::analysis::clip_contacts;
 use marionette::skeleton::Clip;
@@ -25,7 +25,7 @@ pub fn inspect(args: Args) -> Result<()> {
     let (file, unit_scale) = (args.file.as_path(), args.unit_scale);
     let b = read_bvh(file)?;
     let size = std::fs::metadata(file).map(|m| m.len()).unwrap_or(0);
-    let clip = Clip::from_bvh(&b, unit_scale)?;
+    let clip = Clip::from_bvh(&b, unit_scale).with_context(|| file.display().to_string())?;
     let scale = clip
         .skeleton
         .joints
