@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 
-use marionette::analysis::clip_contacts;
+use marionette::analysis::{ContactConfig, clip_contacts};
 use marionette::skeleton::Clip;
 
 use crate::common::read_bvh;
@@ -109,8 +109,10 @@ pub fn inspect(args: Args) -> Result<()> {
         spans(&c.right)
     );
     println!(
-        "body        {} spans on the floor (a joint other than the feet within 15 cm): {}",
+        "body        {} spans on the floor (a joint other than the feet within {:.0} cm){}{}",
         c.body.len(),
+        ContactConfig::default().body_threshold_m * 100.0,
+        if c.body.is_empty() { "" } else { ": " },
         spans(&c.body)
     );
     println!("flights     {}", c.flights.len());
