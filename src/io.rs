@@ -92,8 +92,12 @@ pub enum FileError {
     /// RON syntax or schema error, with line and column.
     #[error(transparent)]
     Ron(#[from] RonError),
-    /// A format version newer than this build reads.
-    #[error("{path}: format_version {found} is newer than this build reads ({supported})")]
+    /// A format version newer than this build reads, or 0.
+    #[error(
+        "{path}: format_version {found} is not one this build reads (1 to {supported}; \
+         {found} is {})",
+        if *found == 0 { "not a version: versions start at 1" } else { "newer" }
+    )]
     Version {
         /// The file.
         path: String,
@@ -112,8 +116,15 @@ pub fn read_text(path: &Path) -> Result<String, FileError> {
     })
 }
 
-/// Refuses a `format_version` newer than `supported`.
+/// Refuses a `format_version` newer than `supported`, or 0 (versions start at 1).
 pub fn check_version(origin: &str, found: u32, supported: u32) -> Result<(), FileError> {
+    if found == 0 {
+        return Err(FileError::Version {
+            path: origin.to_string(),
+            found,
+            supported,
+        });
+    }
     if found > supported {
         return Err(FileError::Version {
             path: origin.to_string(),

@@ -279,7 +279,7 @@ fn numbers_as_written_in_the_wild() {
     let text = with_line(18, "Frame Time: .0083333")
         .replace(
             "1 2 3 4 5 6 7 8 9",
-            "-0 .5 1e-06 -1.5E+2 +3 7. 0.0000 -2.19456e-16 123456789",
+            "-0 .5 1e-06 -1.5E+2 +3 7. 0.0000 -2.19456e-16 98765",
         )
         .replace("OFFSET 0 10 0", "OFFSET -0.24384 7.07133 1.2192");
     let b = ok(text);
@@ -296,11 +296,27 @@ fn numbers_as_written_in_the_wild() {
             7.0,
             0.0,
             -2.19456e-16,
-            123456789.0
+            98765.0
         ]
     );
     assert!(f[0].is_sign_negative());
     assert_eq!(b.joints[1].offset, DVec3::new(-0.24384, 7.07133, 1.2192));
+}
+
+#[test]
+fn numbers_beyond_the_stated_limits_are_errors() {
+    // A rotation of 1e300° (the limit is ±1e5°), with its line and column.
+    let text =
+        with_line(18, "Frame Time: .0083333").replace("1 2 3 4 5 6 7 8 9", "1 2 3 4 5 6 7 8 1e300");
+    fails(
+        text,
+        19,
+        &["value 9 of frame 1", "rotation", "1e300", "±100000"],
+    );
+    // An OFFSET of 1e308 file units (the limit is ±1e6).
+    let text = with_line(18, "Frame Time: .0083333").replace("OFFSET 0 10 0", "OFFSET 0 1e308 0");
+    let line = text.lines().position(|l| l.contains("1e308")).unwrap() + 1;
+    fails(text, line, &["y of the OFFSET", "±1000000"]);
 }
 
 #[test]

@@ -15,16 +15,20 @@ const CHANNELS: [Channel; 6] = [
     Channel::Zrotation,
 ];
 
-/// Any finite f64: ordinary magnitudes, extremes, subnormals, signed zeros.
+/// Any f64 the reader accepts (within ±[`bvh::MAX_ANGLE_DEG`], the smaller of its limits):
+/// ordinary magnitudes, every bit pattern brought into range, the limits, subnormals, signed
+/// zeros.
 fn finite() -> impl Strategy<Value = f64> {
+    let max = marionette::bvh::MAX_ANGLE_DEG;
     prop_oneof![
         -1000.0..1000.0f64,
         (-1000.0..1000.0f64).prop_map(|v| (v * 1e4).round() / 1e4),
-        any::<f64>().prop_map(|v| if v.is_finite() { v } else { -0.0 }),
+        any::<f64>().prop_map(move |v| if v.is_finite() { v % max } else { -0.0 }),
         Just(0.0),
         Just(-0.0),
         Just(5e-324),
-        Just(f64::MAX),
+        Just(max),
+        Just(-max),
     ]
 }
 
@@ -66,7 +70,8 @@ fn any_bvh() -> impl Strategy<Value = Bvh> {
                 let parent = if i == 0 { None } else { path.last().copied() };
                 let n = channels.len();
                 joints.push(BvhJoint {
-                    name,
+                    // Joint names are unique in a valid file.
+                    name: format!("{name}_{i}"),
                     parent,
                     offset,
                     channels,

@@ -44,7 +44,7 @@ fn sample() -> Bvh {
         frame_time: 1.0 / 120.0,
         channel_count: 12,
         motion: (0..24)
-            .map(|i| (i as f64 - 11.5) * std::f64::consts::PI * 10f64.powi(i % 9 - 4))
+            .map(|i| (i as f64 - 11.5) * std::f64::consts::PI * 10f64.powi(i % 8 - 4))
             .collect(),
     }
 }
@@ -95,7 +95,7 @@ fn written_text_reads_back_to_identical_values() {
     b.motion[3] = -0.0;
     b.motion[4] = f64::MIN_POSITIVE;
     b.motion[5] = 5e-324;
-    b.motion[6] = f64::MAX;
+    b.motion[6] = marionette::bvh::MAX_ANGLE_DEG.next_down();
     let again = bvh::parse(bvh::to_string(&b).as_bytes()).unwrap().0;
     for (x, y) in b.motion.iter().zip(&again.motion) {
         assert_eq!(x.to_bits(), y.to_bits());

@@ -1,6 +1,8 @@
 //! The `marionette` command as a user runs it: outputs on good input, a non-zero exit and one
 //! clear line on bad input.
 
+mod common;
+
 use std::path::PathBuf;
 use std::process::Command;
 
@@ -131,5 +133,297 @@ fn every_command_has_help() {
     for cmd in ["inspect", "export", "render", "run"] {
         let out = bin().args([cmd, "--help"]).output().unwrap();
         assert!(out.status.success() && !out.stdout.is_empty(), "{cmd}");
+    }
+}
+
+/// Runs the command, returning (exit code, stdout, stderr).
+fn run_cli(args: &[&std::ffi::OsStr]) -> (Option<i32>, String, String) {
+    let out = bin().args(args).output().unwrap();
+    (
+        out.status.code(),
+        String::from_utf8_lossy(&out.stdout).to_string(),
+        String::from_utf8_lossy(&out.stderr).to_string(),
+    )
+}
+
+/// A BVH file of two joints: `offset` is the child's OFFSET line, `frame` the one motion line.
+fn tiny_bvh(name: &str, root: &str, child: &str, offset: &str, frame: &str) -> PathBuf {
+    let p = temp(name);
+    std::fs::write(
+        &p,
+        format!(
+            "HIERARCHY\nROOT {root}\n{{\n  OFFSET 0 0 0\n  CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation\n  JOINT {child}\n  {{\n    OFFSET {offset}\n    CHANNELS 3 Zrotation Xrotation Yrotation\n    End Site\n    {{\n      OFFSET 0 -80 0\n    }}\n  }}\n}}\nMOTION\nFrames: 1\nFrame Time: 0.01\n{frame}\n"
+        ),
+    )
+    .unwrap();
+    p
+}
+
+/// The error line of a failing `inspect`, after checking it failed with one line.
+fn inspect_error(file: &std::path::Path) -> String {
+    let (code, _, err) = run_cli(&["inspect".as_ref(), file.as_os_str()]);
+    assert_eq!(code, Some(1), "{err}");
+    assert_eq!(err.lines().count(), 1, "{err}");
+    err
+}
+
+#[test]
+fn garbage_numbers_and_names_are_errors_with_their_line() {
+    let f = tiny_bvh("huge.bvh", "a", "b", "0 1e308 0", "0 90 0 0 0 0 0 0 0");
+    let e = inspect_error(&f);
+    assert!(
+        e.contains("line 8") && e.contains("beyond the limit"),
+        "{e}"
+    );
+    let f = tiny_bvh("angle.bvh", "a", "b", "0 -10 0", "0 90 0 1e300 0 0 0 0 0");
+    let e = inspect_error(&f);
+    assert!(e.contains("line 19") && e.contains("rotation"), "{e}");
+    let f = tiny_bvh("dup.bvh", "a", "a", "0 -10 0", "0 90 0 0 0 0 0 0 0");
+    let e = inspect_error(&f);
+    assert!(
+        e.contains("line 6") && e.contains("already defined on line 2"),
+        "{e}"
+    );
+    // A 26 km figure: a unit scale that makes no human.
+    let f = jump_bvh("scale.bvh");
+    let (code, _, e) = run_cli(&[
+        "inspect".as_ref(),
+        f.as_os_str(),
+        "--unit-scale".as_ref(),
+        "1000".as_ref(),
+    ]);
+    assert_eq!(code, Some(1));
+    assert!(e.contains("human range 0.3..3 m"), "{e}");
+}
+
+#[test]
+fn a_deep_hierarchy_is_refused_at_the_stated_depth() {
+    let mut s = String::from(
+        "HIERARCHY\nROOT j0\n{\nOFFSET 0 0 0\nCHANNELS 3 Zrotation Xrotation Yrotation\n",
+    );
+    for i in 1..10_000 {
+        s.push_str(&format!(
+            "JOINT j{i}\n{{\nOFFSET 0 1 0\nCHANNELS 3 Zrotation Xrotation Yrotation\n"
+        ));
+    }
+    let p = temp("deep.bvh");
+    std::fs::write(&p, s).unwrap();
+    let e = inspect_error(&p);
+    assert!(e.contains("deeper than 64"), "{e}");
+}
+
+#[test]
+fn os_errors_are_said_once() {
+    let (code, _, e) = run_cli(&["inspect".as_ref(), "/nonexistent/x.bvh".as_ref()]);
+    assert_eq!(code, Some(1));
+    assert_eq!(e.matches("No such file").count(), 1, "{e}");
+    let (code, _, e) = run_cli(&["run".as_ref(), "/nonexistent/s.ron".as_ref()]);
+    assert_eq!(code, Some(1));
+    assert_eq!(e.matches("No such file").count(), 1, "{e}");
+}
+
+#[test]
+fn a_bvh_without_frames_is_not_written() {
+    let p = temp("zero.bvh");
+    std::fs::write(&p, "HIERARCHY\nROOT a\n{\n  OFFSET 0 0 0\n  CHANNELS 3 Zrotation Xrotation Yrotation\n}\nMOTION\nFrames: 0\nFrame Time: 0.1\n").unwrap();
+    let out = temp("zero_out.bvh");
+    let (code, _, e) = run_cli(&[
+        "export".as_ref(),
+        p.as_os_str(),
+        "--bvh".as_ref(),
+        out.as_os_str(),
+    ]);
+    assert_eq!(code, Some(1), "{e}");
+    assert!(e.contains("no frames"), "{e}");
+    assert!(!out.exists());
+}
+
+#[test]
+fn render_draws_any_skeleton_as_it_is_and_takes_a_window() {
+    // A skeleton no built-in mapping knows.
+    let f = tiny_bvh(
+        "odd.bvh",
+        "thing",
+        "limb",
+        "0 -90 0",
+        "0 170 0 0 0 0 10 0 0",
+    );
+    let png = temp("odd.png");
+    let (code, _, e) = run_cli(&[
+        "render".as_ref(),
+        f.as_os_str(),
+        "--out".as_ref(),
+        png.as_os_str(),
+    ]);
+    assert_eq!(code, Some(0), "{e}");
+    assert!(png.exists());
+    // --mapping needs --model; with --model it is taken.
+    let (code, _, _) = run_cli(&[
+        "render".as_ref(),
+        f.as_os_str(),
+        "--out".as_ref(),
+        png.as_os_str(),
+        "--mapping".as_ref(),
+        "m.ron".as_ref(),
+    ]);
+    assert_eq!(code, Some(2));
+    let jump = jump_bvh("window.bvh");
+    let png = temp("window.png");
+    let (code, _, e) = run_cli(&[
+        "render".as_ref(),
+        jump.as_os_str(),
+        "--out".as_ref(),
+        png.as_os_str(),
+        "--start".as_ref(),
+        "0.5".as_ref(),
+        "--end".as_ref(),
+        "1.5".as_ref(),
+        "--model".as_ref(),
+        "humanoid24".as_ref(),
+        "--mapping".as_ref(),
+        concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/src/mapping/builtin/marionette_humanoid24.ron"
+        )
+        .as_ref(),
+    ]);
+    assert_eq!(code, Some(0), "{e}");
+    // A window reaching past the clip (2 s) names the clip's span.
+    let (code, _, e) = run_cli(&[
+        "render".as_ref(),
+        jump.as_os_str(),
+        "--out".as_ref(),
+        png.as_os_str(),
+        "--end".as_ref(),
+        "9".as_ref(),
+    ]);
+    assert_eq!(code, Some(1));
+    assert!(e.contains("spans 0..2.000 s"), "{e}");
+}
+
+#[test]
+fn an_interrupted_run_leaves_the_old_outputs_or_the_whole_new_set() {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let dir = temp("interrupt");
+    let out = dir.join("jump");
+    let run = |extra: &[&str]| {
+        let mut c = bin();
+        c.arg("run")
+            .arg(root.join("scenes/show_normal_jump.ron"))
+            .arg("--out")
+            .arg(&out)
+            .args(extra);
+        c
+    };
+    assert!(
+        run(&["--set", "render.gif=false"])
+            .status()
+            .unwrap()
+            .success()
+    );
+    let old = std::fs::read(out.join("report.json")).unwrap();
+    // The second run (with a GIF) interrupted part-way with SIGINT.
+    let mut child = run(&[]).spawn().unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(150));
+    let _ = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status();
+    let status = child.wait().unwrap();
+    let report = std::fs::read(out.join("report.json")).unwrap();
+    let gif = out.join("motion.gif").exists();
+    if status.success() {
+        // It finished before the signal: the whole new set.
+        assert!(gif && report != old);
+    } else {
+        // Interrupted: the old set as it was, nothing of the new one.
+        assert!(!gif && report == old);
+    }
+    // The next run removes what the interrupted one left and succeeds.
+    assert!(run(&[]).status().unwrap().success());
+    let left: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().to_string())
+        .collect();
+    assert_eq!(left, ["jump"], "{left:?}");
+}
+
+/// The flights `inspect` prints: (start, end) seconds.
+fn inspect_flights(file: &std::path::Path) -> Vec<(f64, f64)> {
+    let (code, text, err) = run_cli(&["inspect".as_ref(), file.as_os_str()]);
+    assert_eq!(code, Some(0), "{err}");
+    let start = text.find("flights ").expect("a flights line");
+    text[start..]
+        .lines()
+        .skip(1)
+        .map(|l| {
+            let v: Vec<f64> = l
+                .split_whitespace()
+                .filter_map(|w| w.parse().ok())
+                .collect();
+            (v[1], v[2])
+        })
+        .collect()
+}
+
+#[test]
+fn lying_after_the_project_s_fall_is_not_flight() {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let out = temp("fall_out");
+    let (code, _, err) = run_cli(&[
+        "run".as_ref(),
+        root.join("scenes/fall.ron").as_os_str(),
+        "--out".as_ref(),
+        out.as_os_str(),
+        "--set".as_ref(),
+        "render.gif=false".as_ref(),
+    ]);
+    assert_eq!(code, Some(0), "{err}");
+    let (_, text, _) = run_cli(&["inspect".as_ref(), out.join("fall.bvh").as_os_str()]);
+    assert!(text.contains("flights     0"), "{text}");
+    // It lies on the floor at the end: the body touches.
+    assert!(!text.contains("body        0 spans"), "{text}");
+}
+
+#[test]
+fn the_cmu_forward_jumps_have_exactly_their_ten_flights() {
+    let Some(file) = common::data_path("cmu/cmu_01_01_forward_jumps.bvh") else {
+        return;
+    };
+    let flights = inspect_flights(&file);
+    assert_eq!(flights.len(), 10, "{flights:?}");
+    // None while standing still at the start (0–1.3 s), each as long as a jump's flight.
+    assert!(flights[0].0 > 1.3, "{flights:?}");
+    for (a, b) in &flights {
+        assert!((0.2..0.6).contains(&(b - a)), "{flights:?}");
+    }
+}
+
+#[test]
+fn the_mapped_cmu_jumps_keep_the_source_s_two_flights() {
+    let Some(_) = common::data_dir() else {
+        return;
+    };
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let out = temp("cmu_jumps");
+    let (code, text, err) = run_cli(&[
+        "run".as_ref(),
+        root.join("scenes/show_cmu_jumps.ron").as_os_str(),
+        "--out".as_ref(),
+        out.as_os_str(),
+        "--set".as_ref(),
+        "render.gif=false".as_ref(),
+    ]);
+    assert_eq!(code, Some(0), "{err}");
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    let flights = report["flights"].as_array().unwrap();
+    assert_eq!(flights.len(), 2, "{text}");
+    // The source's flights in 0–5 s: 1.9–2.3 s and 3.6–3.9 s.
+    for (f, (a, b)) in flights.iter().zip([(1.93, 2.25), (3.61, 3.89)]) {
+        let (s, e) = (f["start_s"].as_f64().unwrap(), f["end_s"].as_f64().unwrap());
+        assert!(
+            (s - a).abs() < 0.12 && (e - b).abs() < 0.12,
+            "{f} against {a}..{b}"
+        );
     }
 }

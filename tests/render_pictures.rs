@@ -117,14 +117,19 @@ fn front_view_shows_the_figures_left_on_the_viewers_right() {
 
 #[test]
 fn side_view_looks_at_the_figures_left_so_forward_is_screen_left() {
-    // Legs in a stride: left foot forward (+Z), right foot back.
+    // Legs in a stride: left foot forward (+Z), right foot back; the hips say where the figure
+    // faces (+Z, its left +X).
     let fig = Figure {
-        names: ["Hips", "LeftFoot", "RightFoot"].map(String::from).to_vec(),
-        parents: vec![None, Some(0), Some(0)],
+        names: ["Hips", "LeftHip", "LeftFoot", "RightHip", "RightFoot"]
+            .map(String::from)
+            .to_vec(),
+        parents: vec![None, Some(0), Some(1), Some(0), Some(3)],
     };
     let frames = vec![vec![
         DVec3::new(0.0, 0.9, 0.0),
+        DVec3::new(0.1, 0.9, 0.0),
         DVec3::new(0.1, 0.0, 0.45),
+        DVec3::new(-0.1, 0.9, 0.0),
         DVec3::new(-0.1, 0.0, -0.45),
     ]];
     let t = Track {

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Runs every scene in scenes/ (the ones on ${MARIONETTE_DATA} only when the data is there) and
-# prints each scene's output folder; stops at the first failure.
+# prints each scene's output folder and the pictures to look at; stops at the first failure.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 export MARIONETTE_DATA="${MARIONETTE_DATA:-$(cd .. && pwd)/shared/data}"
@@ -11,5 +11,6 @@ for scene in scenes/*.ron; do
     continue
   fi
   ./target/release/marionette run "$scene" > /dev/null
-  echo "ok   $scene -> out/$(basename "$scene" .ron)/"
+  dir="out/$(basename "$scene" .ron)"
+  echo "ok   $scene -> $dir/ (pictures: $(cd "$dir" && ls *.png *.gif 2>/dev/null | tr '\n' ' '))"
 done

@@ -1,37 +1,58 @@
-//! Which points of a skeleton are its feet, and their contact phases over a clip.
+//! Which points of a skeleton are its feet, and the contact phases of a clip.
 
 use glam::DVec3;
 
-use super::contact::{Contacts, ground_contacts};
+use super::contact::{ContactConfig, Contacts, ground_contacts};
 use crate::mapping::Mapping;
 use crate::skeleton::{Clip, Side, Skeleton, side_from_name};
 
 /// A point of a skeleton: a joint, or (`true`) that joint's End Site.
 pub type PointRef = (usize, bool);
 
-/// The foot points of each side, `[left, right]`: the ankle and toe landmarks of the skeleton's
-/// detected mapping, else every joint named like a foot (`foot`, `toe`, `ankle`) on that side
+/// The joints of the foot below (and including) each of `roots`: the ankle, heel and toe joints.
+fn below(skeleton: &Skeleton, roots: &[usize]) -> Vec<usize> {
+    let mut inside = vec![false; skeleton.joints.len()];
+    for (i, j) in skeleton.joints.iter().enumerate() {
+        // Parents come first, so one pass marks every descendant.
+        inside[i] = roots.contains(&i) || j.parent.is_some_and(|p| inside[p]);
+    }
+    (0..inside.len()).filter(|&i| inside[i]).collect()
+}
+
+/// The foot points of each side, `[left, right]`: every joint and End Site from the ankle down
+/// (ankle, heel, toes, toe End Sites). The ankle is the skeleton's detected mapping's ankle
+/// landmark, else every joint named like a foot (`foot`, `toe`, `ankle`, `heel`) on that side
 /// (see [`side_from_name`]).
 pub fn foot_points(skeleton: &Skeleton) -> [Vec<PointRef>; 2] {
+    let mapping = Mapping::detect(skeleton).ok();
     let side_points = |side: Side, prefix: &str| -> Vec<PointRef> {
-        if let Ok(m) = Mapping::detect(skeleton) {
-            return ["ankle", "toe"]
+        let roots: Vec<usize> = match &mapping {
+            Some(m) => m
+                .resolve(skeleton, &format!("{prefix}_ankle"))
+                .map(|l| vec![l.joint])
+                .unwrap_or_default(),
+            None => skeleton
+                .joints
                 .iter()
-                .filter_map(|p| m.resolve(skeleton, &format!("{prefix}_{p}")).ok())
-                .map(|l| (l.joint, l.end_site))
-                .collect();
+                .enumerate()
+                .filter(|(_, j)| {
+                    let n = j.name.to_lowercase();
+                    ["foot", "toe", "ankle", "heel"]
+                        .iter()
+                        .any(|w| n.contains(w))
+                        && side_from_name(&j.name) == side
+                })
+                .map(|(i, _)| i)
+                .collect(),
+        };
+        let mut pts = vec![];
+        for j in below(skeleton, &roots) {
+            pts.push((j, false));
+            if skeleton.joints[j].end_site.is_some() {
+                pts.push((j, true));
+            }
         }
-        skeleton
-            .joints
-            .iter()
-            .enumerate()
-            .filter(|(_, j)| {
-                let n = j.name.to_lowercase();
-                (n.contains("foot") || n.contains("toe") || n.contains("ankle"))
-                    && side_from_name(&j.name) == side
-            })
-            .map(|(i, _)| (i, false))
-            .collect()
+        pts
     };
     [
         side_points(Side::Left, "left"),
@@ -39,22 +60,42 @@ pub fn foot_points(skeleton: &Skeleton) -> [Vec<PointRef>; 2] {
     ]
 }
 
-/// Ground contact and flight of a clip's feet ([`foot_points`], [`ground_contacts`]); `None`
-/// when a side has no foot point.
+/// Ground contact and flight of a clip with [`ContactConfig::default`] but for the contact
+/// threshold and the shortest flight ([`clip_contacts_with`]).
 pub fn clip_contacts(clip: &Clip, threshold_m: f64, min_flight_s: f64) -> Option<Contacts> {
+    clip_contacts_with(
+        clip,
+        &ContactConfig {
+            threshold_m,
+            min_flight_s,
+            ..ContactConfig::default()
+        },
+    )
+}
+
+/// Ground contact and flight of a clip: its feet ([`foot_points`]) and every other point of the
+/// body but a ground-proxy root ([`Skeleton::ground_proxy_root`], [`ground_contacts`]); `None` when a side has no foot point.
+pub fn clip_contacts_with(clip: &Clip, config: &ContactConfig) -> Option<Contacts> {
     let [lf, rf] = foot_points(&clip.skeleton);
     if lf.is_empty() || rf.is_empty() {
         return None;
     }
+    let joints = &clip.skeleton.joints;
+    let proxy = clip.skeleton.ground_proxy_root();
+    let is_foot = |p: &PointRef| lf.contains(p) || rf.contains(p) || Some(p.0) == proxy;
+    let others: Vec<PointRef> = (0..joints.len())
+        .flat_map(|j| std::iter::once((j, false)).chain(joints[j].end_site.map(|_| (j, true))))
+        .filter(|p| !is_foot(p))
+        .collect();
     let mut g = vec![];
-    let (mut l, mut r) = (vec![], vec![]);
+    let (mut l, mut r, mut b) = (vec![], vec![], vec![]);
     for f in 0..clip.frame_count() {
         clip.globals(f, &mut g);
         let at = |idx: &[PointRef]| -> Vec<DVec3> {
             idx.iter()
                 .map(|&(j, end)| {
                     let e = if end {
-                        clip.skeleton.joints[j].end_site.unwrap_or_default()
+                        joints[j].end_site.unwrap_or_default()
                     } else {
                         DVec3::ZERO
                     };
@@ -64,12 +105,7 @@ pub fn clip_contacts(clip: &Clip, threshold_m: f64, min_flight_s: f64) -> Option
         };
         l.push(at(&lf));
         r.push(at(&rf));
+        b.push(at(&others));
     }
-    Some(ground_contacts(
-        &l,
-        &r,
-        clip.frame_time,
-        threshold_m,
-        min_flight_s,
-    ))
+    Some(ground_contacts(&l, &r, &b, clip.frame_time, config))
 }

@@ -3,5 +3,5 @@
 mod contact;
 mod feet;
 
-pub use contact::{Contacts, Span, ground_contacts};
-pub use feet::{PointRef, clip_contacts, foot_points};
+pub use contact::{ContactConfig, Contacts, Span, ground_contacts};
+pub use feet::{PointRef, clip_contacts, clip_contacts_with, foot_points};

@@ -71,6 +71,41 @@ pub enum BvhError {
         /// The name found.
         found: String,
     },
+    /// A number beyond the limit for its kind ([`super::MAX_LENGTH_UNITS`],
+    /// [`super::MAX_ANGLE_DEG`]).
+    #[error("line {line}, column {column}: {what} is `{found}`, beyond the limit of ±{limit}")]
+    OutOfRange {
+        /// Line of the number.
+        line: usize,
+        /// Byte column of the number.
+        column: usize,
+        /// Which value this is (e.g. "value 4 of frame 12, a rotation in degrees").
+        what: String,
+        /// The text of the number.
+        found: String,
+        /// The limit.
+        limit: f64,
+    },
+    /// A hierarchy deeper or larger than [`super::MAX_DEPTH`] / [`super::MAX_JOINTS`].
+    #[error("line {line}: {what}")]
+    TooLarge {
+        /// Line of the joint past the limit.
+        line: usize,
+        /// What limit was passed.
+        what: String,
+    },
+    /// Two joints with one name (tools such as Blender cannot read such a file).
+    #[error(
+        "line {line}: joint `{name}` is already defined on line {first_line}; joint names must be unique"
+    )]
+    DuplicateJoint {
+        /// Line of the second joint.
+        line: usize,
+        /// The name.
+        name: String,
+        /// Line of the first.
+        first_line: usize,
+    },
     /// A number that parses but is NaN or infinite.
     #[error("line {line}, column {column}: {what} is `{found}`, expected a finite number")]
     NonFinite {
@@ -202,6 +237,9 @@ impl BvhError {
             | UnexpectedEnd { line, .. }
             | UnknownChannel { line, .. }
             | NonFinite { line, .. }
+            | OutOfRange { line, .. }
+            | TooLarge { line, .. }
+            | DuplicateJoint { line, .. }
             | JointItem { line, .. }
             | Unclosed { line, .. }
             | UnmatchedClose { line, .. }
@@ -223,6 +261,7 @@ impl BvhError {
             | Expected { column, .. }
             | UnknownChannel { column, .. }
             | NonFinite { column, .. }
+            | OutOfRange { column, .. }
             | UnmatchedClose { column, .. } => Some(*column),
             InFile { error, .. } => error.column(),
             _ => None,

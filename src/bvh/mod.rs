@@ -26,6 +26,16 @@ mod parse;
 mod write;
 
 pub use error::{BvhError, BvhWarning};
+
+/// Deepest joint nesting read or written (a human skeleton is about 10 levels deep).
+pub const MAX_DEPTH: usize = 64;
+/// Most joints in a hierarchy.
+pub const MAX_JOINTS: usize = 1024;
+/// Largest OFFSET component or position channel value, file units (a kilometre in
+/// millimetres): beyond it a figure's size is not a number a unit scale can make human.
+pub const MAX_LENGTH_UNITS: f64 = 1e6;
+/// Largest rotation channel value, degrees (about 278 turns, room for unwrapped angles).
+pub const MAX_ANGLE_DEG: f64 = 1e5;
 pub use parse::{parse, parse_file};
 pub use write::{to_string, to_string_with_precision, write_file};
 
@@ -147,6 +157,13 @@ impl Bvh {
         if self.joints.is_empty() {
             return invalid("no joints".into());
         }
+        if self.joints.len() > MAX_JOINTS {
+            return invalid(format!(
+                "{} joints, more than the {MAX_JOINTS} allowed",
+                self.joints.len()
+            ));
+        }
+        let mut seen = std::collections::HashMap::new();
         let mut path: Vec<usize> = Vec::new();
         let mut next_channel = 0usize;
         for (i, j) in self.joints.iter().enumerate() {
@@ -172,6 +189,17 @@ impl Bvh {
                 ));
             }
             path.push(i);
+            if path.len() > MAX_DEPTH {
+                return invalid(format!(
+                    "joint {i} `{n}` is nested {} deep, deeper than the {MAX_DEPTH} allowed",
+                    path.len()
+                ));
+            }
+            if let Some(first) = seen.insert(n.as_str(), i) {
+                return invalid(format!(
+                    "joints {first} and {i} are both named `{n}`; joint names must be unique"
+                ));
+            }
             if j.first_channel != next_channel {
                 return invalid(format!(
                     "joint {i} `{n}` has first_channel {}, expected {next_channel}",

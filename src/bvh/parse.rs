@@ -26,7 +26,10 @@ use std::path::Path;
 
 use glam::DVec3;
 
-use super::{Bvh, BvhError, BvhJoint, BvhWarning, Channel};
+use super::{
+    Bvh, BvhError, BvhJoint, BvhWarning, Channel, MAX_ANGLE_DEG, MAX_DEPTH, MAX_JOINTS,
+    MAX_LENGTH_UNITS,
+};
 
 /// The six channel kinds, in the order used to look names up.
 const ALL_CHANNELS: [Channel; 6] = [
@@ -225,6 +228,8 @@ struct Reader<'a> {
     joints: Vec<BvhJoint>,
     channel_count: usize,
     warnings: Vec<BvhWarning>,
+    /// Line of each joint name read so far.
+    names: std::collections::HashMap<String, usize>,
 }
 
 fn expected(tok: Token<'_>, what: impl Into<String>) -> BvhError {
@@ -243,6 +248,7 @@ impl<'a> Reader<'a> {
             joints: Vec::new(),
             channel_count: 0,
             warnings: Vec::new(),
+            names: std::collections::HashMap::new(),
         }
     }
 
@@ -267,13 +273,26 @@ impl<'a> Reader<'a> {
         // The motion starts on the line after `Frame Time:`.
         let text = self.lex.text;
         let start = (self.lex.pos + 1).min(text.len());
+        // Each channel's limit: degrees for rotations, file units for positions.
+        let limits: Vec<f64> = self
+            .joints
+            .iter()
+            .flat_map(|j| j.channels.iter())
+            .map(|c| {
+                if c.is_rotation() {
+                    MAX_ANGLE_DEG
+                } else {
+                    MAX_LENGTH_UNITS
+                }
+            })
+            .collect();
         let motion = read_motion(
             text,
             start,
             self.lex.line + 1,
             frames,
             frames_line,
-            self.channel_count,
+            &limits,
             &mut self.warnings,
         )?;
         let bvh = Bvh {
@@ -346,6 +365,15 @@ impl<'a> Reader<'a> {
                 }
             } else if kw(t, "JOINT") {
                 self.require_items(open, tok)?;
+                if stack.len() >= MAX_DEPTH {
+                    return Err(BvhError::TooLarge {
+                        line: tok.line,
+                        what: format!(
+                            "the hierarchy is nested deeper than {MAX_DEPTH} joints (a human \
+                             skeleton is about 10 deep)"
+                        ),
+                    });
+                }
                 stack.push(self.begin_joint(Some(j))?);
             } else if kw(t, "End") {
                 self.require_items(open, tok)?;
@@ -397,6 +425,20 @@ impl<'a> Reader<'a> {
                 found: "the end of the line".into(),
             });
         }
+        if self.joints.len() >= MAX_JOINTS {
+            return Err(BvhError::TooLarge {
+                line: name.line,
+                what: format!("the hierarchy has more than {MAX_JOINTS} joints"),
+            });
+        }
+        if let Some(&first_line) = self.names.get(name.text) {
+            return Err(BvhError::DuplicateJoint {
+                line: name.line,
+                name: quote(name.text),
+                first_line,
+            });
+        }
+        self.names.insert(name.text.to_string(), name.line);
         let brace = self.next_or_end(|| format!("`{{` opening joint {}", quote(name.text)))?;
         if brace.text != "{" {
             return Err(expected(
@@ -467,6 +509,15 @@ impl<'a> Reader<'a> {
                     column: tok.column,
                     what: format!("{axis} of the {what}"),
                     found: tok.text.chars().take(QUOTE_MAX).collect(),
+                });
+            }
+            if x.abs() > MAX_LENGTH_UNITS {
+                return Err(BvhError::OutOfRange {
+                    line: tok.line,
+                    column: tok.column,
+                    what: format!("{axis} of the {what}"),
+                    found: tok.text.chars().take(QUOTE_MAX).collect(),
+                    limit: MAX_LENGTH_UNITS,
                 });
             }
             v[i] = x;
@@ -597,7 +648,8 @@ impl<'a> Reader<'a> {
     }
 }
 
-/// Reads `frames` lines of `channels` values each, starting at byte `pos` (line `line`).
+/// Reads `frames` lines of `limits.len()` values each, starting at byte `pos` (line `line`);
+/// value `c` of a frame may not exceed `limits[c]` in magnitude.
 ///
 /// The hot loop: for each value find its bytes, `parse::<f64>` them and push into the
 /// pre-sized vector. Blank lines are skipped with a warning; lines after the last declared
@@ -608,9 +660,10 @@ fn read_motion(
     mut line: usize,
     frames: usize,
     frames_line: usize,
-    channels: usize,
+    limits: &[f64],
     warnings: &mut Vec<BvhWarning>,
 ) -> Result<Vec<f64>, BvhError> {
+    let channels = limits.len();
     let bytes = text.as_bytes();
     let n = bytes.len();
     // Every value needs at least two bytes, so the rest of the file bounds the allocation
@@ -668,6 +721,21 @@ fn read_motion(
                     column: start - line_start + 1,
                     what: format!("value {count} of frame {}", frame + 1),
                     found: token.chars().take(QUOTE_MAX).collect(),
+                });
+            }
+            let limit = limits[count - 1];
+            if v.abs() > limit {
+                let kind = if limit == MAX_ANGLE_DEG {
+                    "a rotation in degrees"
+                } else {
+                    "a position in file units"
+                };
+                return Err(BvhError::OutOfRange {
+                    line,
+                    column: start - line_start + 1,
+                    what: format!("value {count} of frame {}, {kind},", frame + 1),
+                    found: token.chars().take(QUOTE_MAX).collect(),
+                    limit,
                 });
             }
             motion.push(v);

@@ -30,9 +30,18 @@ pub fn to_string_with_precision(bvh: &Bvh, decimals: usize) -> String {
 }
 
 /// Writes `bvh` to `path` atomically (whole file or nothing) after checking it with
-/// [`Bvh::validate`].
+/// [`Bvh::validate`] and that it has at least one frame (a file without frames holds no motion
+/// and many readers refuse it).
 pub fn write_file(bvh: &Bvh, path: &Path) -> Result<(), BvhError> {
     bvh.validate()?;
+    if bvh.frame_count() == 0 {
+        return Err(BvhError::Invalid {
+            message: format!(
+                "{}: the motion has no frames; nothing to write",
+                path.display()
+            ),
+        });
+    }
     crate::io::write_atomic(path, to_string(bvh).as_bytes()).map_err(|error| BvhError::Io {
         path: path.to_path_buf(),
         error,
@@ -131,8 +140,10 @@ fn push_offset(out: &mut String, v: [f64; 3]) {
     out.push('\n');
 }
 
+/// Tabs for `depth`, at most [`super::MAX_DEPTH`] (a hierarchy the reader accepts is never
+/// deeper; one built in code that is keeps its lines short).
 fn indent(out: &mut String, depth: usize) {
-    for _ in 0..depth {
+    for _ in 0..depth.min(super::MAX_DEPTH) {
         out.push('\t');
     }
 }

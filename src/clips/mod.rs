@@ -22,6 +22,16 @@ use crate::humanoid::{Model, ModelClip};
 /// The RON format version this build reads.
 pub const FORMAT_VERSION: u32 = 1;
 
+/// Most frames a keyframed clip may sample (`duration × fps`): a million, about 2.3 hours at
+/// 120 fps (a clip of `duration: 1e7` is an error, not an allocation failure).
+pub const MAX_FRAMES: usize = 1_000_000;
+
+/// Largest keyed DOF angle or pelvis angle, degrees (ten turns).
+pub const MAX_KEY_ANGLE_DEG: f64 = 3600.0;
+
+/// Largest keyed root position, metres.
+pub const MAX_KEY_POSITION_M: f64 = 10_000.0;
+
 /// Gravity used for flight arcs, m/s².
 pub const GRAVITY: f64 = 9.81;
 
@@ -101,6 +111,22 @@ impl KeyframeClip {
                 c.fps, c.duration
             ));
         }
+        let frames = c.duration * c.fps;
+        if frames > MAX_FRAMES as f64 {
+            return bad(format!(
+                "duration {} s at {} fps is {frames:.0} frames, more than the {MAX_FRAMES} a clip \
+                 may have",
+                c.duration, c.fps
+            ));
+        }
+        if let Some(h) = c.height {
+            let (lo, hi) = crate::skeleton::FIGURE_SIZE_M;
+            if !(h.is_finite() && (lo..=hi).contains(&h)) {
+                return bad(format!(
+                    "height {h} m is outside the human range {lo}..{hi} m"
+                ));
+            }
+        }
         let model = Model::by_name(&c.model).map_err(|e| KeyframeError::Content {
             path: origin.into(),
             message: e.to_string(),
@@ -114,7 +140,29 @@ impl KeyframeClip {
                 ));
             }
             last = k.t;
+            let root = [
+                ("forward", k.forward, MAX_KEY_POSITION_M, "m"),
+                ("lateral", k.lateral, MAX_KEY_POSITION_M, "m"),
+                ("pitch", k.pitch, MAX_KEY_ANGLE_DEG, "°"),
+                ("turn", k.turn, MAX_KEY_ANGLE_DEG, "°"),
+            ];
+            for (name, v, max, unit) in root {
+                if let Some(v) = v
+                    && !(v.is_finite() && v.abs() <= max)
+                {
+                    return bad(format!(
+                        "key {i} (t = {}): {name} {v} is beyond ±{max} {unit}",
+                        k.t
+                    ));
+                }
+            }
             for (name, v) in &k.dofs {
+                if v.is_finite() && v.abs() > MAX_KEY_ANGLE_DEG {
+                    return bad(format!(
+                        "key {i} (t = {}): '{name}' is {v}°, beyond ±{MAX_KEY_ANGLE_DEG}°",
+                        k.t
+                    ));
+                }
                 if model.dof_index(name).is_none() {
                     return bad(format!(
                         "key {i} (t = {}): '{name}' is not a DOF of {}",
@@ -233,6 +281,36 @@ mod tests {
             (apex - stand - GRAVITY * 0.09 / 8.0).abs() < 0.01,
             "{apex} vs {stand}"
         );
+    }
+
+    #[test]
+    fn sizes_and_magnitudes_beyond_the_limits_are_errors() {
+        let cases = [
+            (
+                JUMP.replace("duration: 1.0", "duration: 1e7"),
+                "more than the 1000000",
+            ),
+            (
+                JUMP.replace("\"right_knee\": 90.0", "\"right_knee\": 1e300"),
+                "beyond ±3600°",
+            ),
+            (
+                JUMP.replace("pitch: 20.0", "pitch: 1e9"),
+                "pitch 1000000000 is beyond",
+            ),
+            (
+                JUMP.replace("duration: 1.0,", "duration: 1.0, height: 1000.0,"),
+                "outside the human range",
+            ),
+            (
+                JUMP.replace("format_version: 1", "format_version: 0"),
+                "start at 1",
+            ),
+        ];
+        for (text, want) in cases {
+            let e = KeyframeClip::parse(&text, "t.ron").unwrap_err().to_string();
+            assert!(e.contains(want), "{e}");
+        }
     }
 
     #[test]

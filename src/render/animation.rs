@@ -117,6 +117,9 @@ pub fn animation_gif(tracks: &[Track], fps: f64, path: &Path) -> Result<(), Rend
             "GIF frame rate must be in (0, {MAX_GIF_FPS}] frames per second, got {fps}"
         )));
     }
+    let turned = super::facing::turned_frames(tracks);
+    let turned_tracks = super::facing::with_frames(tracks, &turned);
+    let tracks = &turned_tracks[..];
     let font = font()?;
     let (mpp, pad) = scale_for(tracks, PANEL_HEIGHT);
     let limits = PanelLimits {

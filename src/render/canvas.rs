@@ -238,20 +238,46 @@ pub(crate) fn draw_figure(
     } else {
         floor_grid(p, cam, centre);
     }
+    let proxy = ground_proxy(fig, pts);
     let mut bones: Vec<(f64, usize, usize)> = fig
         .parents
         .iter()
         .enumerate()
+        .filter(|(_, par)| par.is_none() || **par != proxy)
         .filter_map(|(i, par)| par.map(|j| (cam.view.depth((pts[i] + pts[j]) * 0.5), j, i)))
         .collect();
     bones.sort_by(|a, b| a.0.total_cmp(&b.0));
     for &(_, j, i) in &bones {
         line(p, px(pts[j]), px(pts[i]), style.bone, side_colour(sides[i]));
     }
-    for &q in pts {
-        dot(p, px(q), style.dot, INK);
+    for (i, &q) in pts.iter().enumerate() {
+        if Some(i) != proxy {
+            dot(p, px(q), style.dot, INK);
+        }
     }
     frame(p, cam.width as f32, cam.height as f32);
+}
+
+/// The root when it is a ground proxy, not a part of the body (as Bandai's `joint_Root` on the
+/// floor under `Hips`): a root with one child, lower than a tenth of the figure's height above
+/// its lowest point and farther from that child than a quarter of the height. Its bone would
+/// be drawn as a third leg, so it is not drawn.
+pub(crate) fn ground_proxy(fig: &super::figure::Figure, pts: &[DVec3]) -> Option<usize> {
+    let root = fig.root();
+    let mut children = fig
+        .parents
+        .iter()
+        .enumerate()
+        .filter(|(_, par)| **par == Some(root));
+    let (child, _) = children.next()?;
+    if children.next().is_some() {
+        return None;
+    }
+    let lo = pts.iter().map(|q| q.y).fold(f64::INFINITY, f64::min);
+    let hi = pts.iter().map(|q| q.y).fold(f64::NEG_INFINITY, f64::max);
+    let h = hi - lo;
+    (h > 0.0 && pts[root].y - lo < 0.1 * h && (pts[child] - pts[root]).length() > 0.25 * h)
+        .then_some(root)
 }
 
 fn floor_ticks(p: &mut Pixmap, cam: &Camera, centre: glam::DVec2) {

@@ -1,5 +1,6 @@
-//! A filmstrip: N evenly spaced instants of one or more motions in one PNG, one row per track,
-//! the time of each column above it, like the sequence figures in the papers.
+//! A filmstrip: N instants of one or more motions in one PNG, one row per track, the time of
+//! each column above it, like the sequence figures in the papers. The instants follow the
+//! motion, not the clock: a jump gets columns, a body lying still does not.
 
 use std::path::Path;
 
@@ -24,20 +25,112 @@ pub fn filmstrip_png(tracks: &[Track], n: usize, path: &Path) -> Result<(), Rend
     filmstrip_view_png(tracks, n, View::Side, path)
 }
 
-/// The instants of a filmstrip of `n` columns over `duration` seconds: t_j = duration · j/(n − 1)
-/// for j = 0 … n − 1 (just t = 0 when n = 1).
-pub(crate) fn column_times(duration: f64, n: usize) -> Vec<f64> {
+/// Share of the column spacing given to elapsed time; the rest follows the motion.
+const TIME_SHARE: f64 = 0.25;
+
+/// The instants of a filmstrip of `n` columns: spread evenly in a blend of elapsed time and
+/// distance travelled. With D(t) the distance all points of all tracks have travelled up to t
+/// (summed over frames at the finest frame time) and T the longest duration, the progress
+/// u(t) = s·t/T + (1 − s)·D(t)/D(T), s = [`TIME_SHARE`]; column j is at the first t with
+/// u(t) ≥ j/(n − 1), so the first column is t = 0 and the last t = T; inner columns then move
+/// to a jump's apex near them ([`snap_to_apexes`]). A motion that does not move is spread
+/// evenly in time; just t = 0 when n = 1.
+pub(crate) fn column_times(tracks: &[Track], n: usize) -> Vec<f64> {
+    let duration = tracks.iter().map(Track::duration).fold(0.0, f64::max);
     if n == 1 {
         return vec![0.0];
     }
-    (0..n)
-        .map(|j| duration * j as f64 / (n - 1) as f64)
-        .collect()
+    let dt = tracks
+        .iter()
+        .map(|t| t.frame_time)
+        .fold(f64::INFINITY, f64::min);
+    let steps = if duration > 0.0 && dt.is_finite() && dt > 0.0 {
+        (duration / dt).round() as usize
+    } else {
+        0
+    };
+    // Cumulative distance at every step.
+    let mut travelled = vec![0.0; steps + 1];
+    for k in 1..=steps {
+        let (t0, t1) = ((k - 1) as f64 * dt, k as f64 * dt);
+        let d: f64 = tracks
+            .iter()
+            .map(|tr| {
+                let (a, b) = (&tr.frames[tr.frame_at(t0)], &tr.frames[tr.frame_at(t1)]);
+                a.iter()
+                    .zip(b)
+                    .map(|(p, q)| (*q - *p).length())
+                    .sum::<f64>()
+            })
+            .sum();
+        travelled[k] = travelled[k - 1] + d;
+    }
+    let total = travelled[steps];
+    let share = if total > 0.0 { TIME_SHARE } else { 1.0 };
+    let progress = |k: usize| {
+        let time = if steps == 0 {
+            1.0
+        } else {
+            k as f64 / steps as f64
+        };
+        let moved = if total > 0.0 {
+            travelled[k] / total
+        } else {
+            0.0
+        };
+        share * time + (1.0 - share) * moved
+    };
+    let mut k = 0;
+    let mut times: Vec<f64> = (0..n)
+        .map(|j| {
+            let goal = j as f64 / (n - 1) as f64;
+            while k < steps && progress(k) < goal - 1e-12 {
+                k += 1;
+            }
+            if j == n - 1 {
+                duration
+            } else {
+                (k as f64 * dt).min(duration)
+            }
+        })
+        .collect();
+    snap_to_apexes(&tracks[0], &mut times);
+    times
 }
 
-/// Draws `n` evenly spaced instants of every track as a PNG at `path`, one row per track (its
-/// label above it), in `view`. Columns share one time t_j = T · j/(n − 1), T the longest
-/// track's duration, written above each column; a shorter track holds its last frame. All cells
+/// Moves each inner column to the apex of a jump near it: to the highest root of the first
+/// track between the midpoints to its neighbours, when that is a peak inside the span (not at
+/// its ends) rising more than [`APEX_RISE`] of the figure's height above the span's lowest root.
+fn snap_to_apexes(track: &Track, times: &mut [f64]) {
+    let root = track.figure.root();
+    let y = |k: usize| track.frames[k][root].y;
+    let height = track.frames.first().map_or(0.0, |f| {
+        let hi = f.iter().map(|p| p.y).fold(f64::NEG_INFINITY, f64::max);
+        let lo = f.iter().map(|p| p.y).fold(f64::INFINITY, f64::min);
+        hi - lo
+    });
+    for j in 1..times.len().saturating_sub(1) {
+        let a = track.frame_at(0.5 * (times[j - 1] + times[j]));
+        let b = track.frame_at(0.5 * (times[j] + times[j + 1]));
+        if b <= a + 2 {
+            continue;
+        }
+        let top = (a..=b).max_by(|&p, &q| y(p).total_cmp(&y(q))).unwrap_or(a);
+        let low = (a..=b).map(y).fold(f64::INFINITY, f64::min);
+        if top > a && top < b && y(top) - low > APEX_RISE * height {
+            times[j] = top as f64 * track.frame_time;
+        }
+    }
+}
+
+/// Least rise of the root above its lowest in a column's span, as a share of the figure's
+/// height, for the column to move to that apex.
+const APEX_RISE: f64 = 0.08;
+
+/// Draws `n` instants of every track as a PNG at `path`, one row per track (its label above
+/// it), in `view`, each figure turned to face +Z (see [`super::facing`]). Columns share one time
+/// t_j chosen by motion ([`column_times`]: a jump gets more columns than standing still),
+/// written above each column; a shorter track holds its last frame. All cells
 /// share one scale and one framing of the whole motion, so positions compare across the page;
 /// a motion that travels further than a cell shows follows the root, with floor ticks every
 /// 0.5 m. Footer: 1 m scale bar and left/right colour key.
@@ -54,6 +147,9 @@ pub fn filmstrip_view_png(
             "a filmstrip needs at least one column".into(),
         ));
     }
+    let turned = super::facing::turned_frames(tracks);
+    let turned_tracks = super::facing::with_frames(tracks, &turned);
+    let tracks = &turned_tracks[..];
     let font = font()?;
     let (mpp, pad) = scale_for(tracks, CELL_HEIGHT);
     let limits = PanelLimits {
@@ -63,8 +159,7 @@ pub fn filmstrip_view_png(
     };
     let cam = Camera::fit(tracks, view, mpp, pad, limits);
     let style = Style::for_height(CELL_HEIGHT.max(cam.height));
-    let duration = tracks.iter().map(Track::duration).fold(0.0, f64::max);
-    let times = column_times(duration, n);
+    let times = column_times(tracks, n);
 
     let time_row = (style.small * 1.8) as u32;
     let label_row = (style.text * 1.7) as u32;
@@ -142,10 +237,39 @@ pub fn filmstrip_view_png(
 mod tests {
     use super::*;
 
+    use crate::render::Figure;
+    use glam::DVec3;
+
+    fn track<'a>(fig: &'a Figure, frames: &'a [Vec<DVec3>]) -> Track<'a> {
+        Track {
+            figure: fig,
+            frames,
+            label: "t".into(),
+            frame_time: 0.1,
+        }
+    }
+
     #[test]
-    fn columns_span_the_whole_duration_evenly() {
-        assert_eq!(column_times(2.0, 5), vec![0.0, 0.5, 1.0, 1.5, 2.0]);
-        assert_eq!(column_times(2.0, 1), vec![0.0]);
-        assert_eq!(column_times(0.0, 3), vec![0.0, 0.0, 0.0]);
+    fn columns_follow_the_motion_and_span_the_whole_duration() {
+        let fig = Figure {
+            names: vec!["a".into()],
+            parents: vec![None],
+        };
+        // Still: evenly in time.
+        let still = vec![vec![DVec3::ZERO]; 21];
+        assert_eq!(
+            column_times(&[track(&fig, &still)], 5),
+            vec![0.0, 0.5, 1.0, 1.5, 2.0]
+        );
+        assert_eq!(column_times(&[track(&fig, &still)], 1), vec![0.0]);
+        // Moving during the first 0.5 s of 2 s, then lying still: most columns in the motion.
+        let fall: Vec<Vec<DVec3>> = (0..21)
+            .map(|k| vec![DVec3::new(0.0, (1.0 - k as f64 * 0.2).max(0.0), 0.0)])
+            .collect();
+        let times = column_times(&[track(&fig, &fall)], 8);
+        assert_eq!((times[0], times[7]), (0.0, 2.0));
+        let moving = times.iter().filter(|&&t| t <= 0.5).count();
+        assert!(moving >= 5, "{times:?}");
+        assert!(times.windows(2).all(|w| w[0] <= w[1]), "{times:?}");
     }
 }

@@ -5,15 +5,16 @@
 //! From tracks this module draws
 //!
 //! - [`pose_png`]: one frame, front and side views side by side;
-//! - [`filmstrip_png`] / [`filmstrip_view_png`]: N evenly spaced instants in one PNG, one row per
-//!   track, time labels above the columns (like the figures in the papers);
+//! - [`filmstrip_png`] / [`filmstrip_view_png`]: N instants chosen by motion in one PNG, one row
+//!   per track, time labels above the columns (like the figures in the papers);
 //! - [`animation_gif`]: all tracks side by side (front and side view each), looping, subsampled
 //!   to a chosen frame rate;
 //!
 //! and from numbers [`plot`]: line plots with title, axis labels, legend and labelled event
 //! markers, as PNG or SVG.
 //!
-//! Conventions of every picture: orthographic views ([`View`]); the figure's left limbs blue,
+//! Conventions of every picture: orthographic views ([`View`]) of the figure turned to face +Z
+//! (its facing found from its left and right points, so "front" is its front); the figure's left limbs blue,
 //! its right limbs vermillion, mid-line grey (decided from point names by [`side_from_name`]);
 //! joints as dots; the floor y = 0 as a line over a light ground; one scale (metres per pixel)
 //! for every view of a picture, framed on the whole motion (all frames, all tracks) so figures
@@ -23,6 +24,7 @@
 mod animation;
 mod camera;
 mod canvas;
+mod facing;
 mod figure;
 mod filmstrip;
 mod plot;

@@ -169,7 +169,42 @@ pub(crate) fn padded(lo: f64, hi: f64, margin: f64) -> (f64, f64) {
     (lo - d, hi + d)
 }
 
-/// The legend corner with the fewest data points in the 40 % × 35 % box next to it.
+/// Share of series `a`'s points that series `b` (drawn later) covers: same x sample and y
+/// within `tol`; 0 when their samples differ.
+fn covered(a: &Series, b: &Series, tol: f64) -> f64 {
+    if a.points.len() != b.points.len() || a.points.is_empty() {
+        return 0.0;
+    }
+    let same = a
+        .points
+        .iter()
+        .zip(&b.points)
+        .filter(|(p, q)| p.0 == q.0 && (p.1 - q.1).abs() <= tol)
+        .count();
+    same as f64 / a.points.len() as f64
+}
+
+/// For each series, the later series drawn over it and the share of its points that one
+/// hides (the most-covering later series, when it covers at least [`MOSTLY_HIDDEN`]): y within
+/// 0.5 % of the y range `span` (e.g. left and right knee of a symmetric jump).
+pub(crate) fn hidden_by(plot: &Plot, span: f64) -> Vec<Option<(usize, f64)>> {
+    let tol = 0.005 * span.abs().max(1e-12);
+    let n = plot.series.len();
+    (0..n)
+        .map(|i| {
+            (i + 1..n)
+                .map(|k| (k, covered(&plot.series[i], &plot.series[k], tol)))
+                .filter(|&(_, c)| c >= MOSTLY_HIDDEN)
+                .max_by(|a, b| a.1.total_cmp(&b.1))
+        })
+        .collect()
+}
+
+/// Share of a curve's points hidden under a later one from which its legend says so.
+const MOSTLY_HIDDEN: f64 = 0.9;
+
+/// The legend corner with the fewest data points in the 40 % × 35 % box next to it; only the
+/// lower corners when the plot has event markers, whose labels run along the top.
 fn legend_corner(plot: &Plot, x: (f64, f64), y: (f64, f64)) -> SeriesLabelPosition {
     let fx = |v: f64| (v - x.0) / (x.1 - x.0);
     let fy = |v: f64| (v - y.0) / (y.1 - y.0);
@@ -191,6 +226,9 @@ fn legend_corner(plot: &Plot, x: (f64, f64), y: (f64, f64)) -> SeriesLabelPositi
     };
     let mut best = (usize::MAX, SeriesLabelPosition::UpperRight);
     for (pos, right, upper) in corners {
+        if upper && !plot.markers.is_empty() {
+            continue;
+        }
         let c = count(right, upper);
         if c < best.0 {
             best = (c, pos);
@@ -263,16 +301,33 @@ fn draw<DB: DrawingBackend>(
         chart.draw_series(std::iter::once(text)).map_err(plot_err)?;
     }
 
+    // A series wholly hidden under a later one gets no legend entry, the one on top names both;
+    // one mostly hidden says under which.
+    let hidden = hidden_by(plot, y.1 - y.0);
+    let whole = |j: usize| hidden[j].is_some_and(|(_, c)| c >= 1.0);
     for (i, s) in plot.series.iter().enumerate() {
         let c = COLOURS[i % COLOURS.len()];
         let style = c.stroke_width(2 * k);
-        chart
+        let drawn = chart
             .draw_series(LineSeries::new(s.points.iter().copied(), style))
-            .map_err(plot_err)?
-            .label(s.name.as_str())
-            .legend(move |(lx, ly)| {
+            .map_err(plot_err)?;
+        if !whole(i) {
+            let under: Vec<&str> = (0..i)
+                .filter(|&j| whole(j) && hidden[j].is_some_and(|(t, _)| t == i))
+                .map(|j| plot.series[j].name.as_str())
+                .collect();
+            let mut label = if under.is_empty() {
+                s.name.clone()
+            } else {
+                format!("{} = {} (overlap)", s.name, under.join(" = "))
+            };
+            if let Some((top, _)) = hidden[i] {
+                label.push_str(&format!(" (mostly under {})", plot.series[top].name));
+            }
+            drawn.label(label).legend(move |(lx, ly)| {
                 PathElement::new(vec![(lx, ly), (lx + 24 * ki, ly)], c.stroke_width(3 * k))
             });
+        }
         if s.points.len() <= 40 {
             chart
                 .draw_series(s.points.iter().map(|&p| Circle::new(p, 3 * ki, c.filled())))
@@ -303,6 +358,26 @@ mod tests {
         assert!(lo < 3.0 && hi > 3.0);
         let (lo, hi) = padded(100.0, 100.0, 0.1);
         assert_eq!((lo, hi), (95.0, 105.0));
+    }
+
+    #[test]
+    fn a_curve_hidden_under_another_is_named_with_it() {
+        let line = |name: &str, dy: f64| Series {
+            name: name.into(),
+            points: (0..10).map(|i| (i as f64, i as f64 + dy)).collect(),
+        };
+        let p = Plot {
+            title: "t".into(),
+            x_label: "x".into(),
+            y_label: "y".into(),
+            series: vec![line("left", 0.0), line("right", 0.001), line("other", 3.0)],
+            markers: vec![],
+        };
+        assert_eq!(hidden_by(&p, 12.0), [Some((1, 1.0)), None, None]);
+        // Apart in 1 point of 10: mostly hidden.
+        let mut p = p;
+        p.series[1].points[3].1 += 5.0;
+        assert_eq!(hidden_by(&p, 12.0), [Some((1, 0.9)), None, None]);
     }
 
     #[test]

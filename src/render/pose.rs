@@ -31,6 +31,9 @@ pub fn pose_png(track: &Track, frame: usize, path: &Path) -> Result<(), RenderEr
             len: track.frames.len(),
         });
     }
+    let turned = super::facing::turned_frames(std::slice::from_ref(track));
+    let turned_tracks = super::facing::with_frames(std::slice::from_ref(track), &turned);
+    let track = &turned_tracks[0];
     let font = font()?;
     let tracks = std::slice::from_ref(track);
     let (mpp, pad) = scale_for(tracks, PANEL_HEIGHT);

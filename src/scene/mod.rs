@@ -8,6 +8,7 @@
 
 mod evolve;
 mod fall;
+mod output;
 mod primitives;
 mod show;
 mod source;
@@ -211,31 +212,99 @@ pub fn apply_overrides(scene: &Scene, assignments: &[String]) -> Result<Scene, S
     })
 }
 
-/// Runs a scene, writing every output into `out_dir` (created), the last one `report.json`;
-/// `base` is the folder relative paths in the scene refer to. Returns the report.
+/// Longest scene name, characters.
+pub const MAX_NAME_LEN: usize = 100;
+
+/// Most filmstrip frames a scene may ask for.
+pub const MAX_FILMSTRIP_FRAMES: usize = 64;
+
+/// Checks what can be checked before any work: the scene's name is a plain folder name (it
+/// names the default output folder, so it may not be empty, absolute or climb with `..`), the
+/// picture settings are in range, and a `Show` scene's model and plotted DOFs exist.
+pub fn validate(scene: &Scene) -> Result<(), SceneError> {
+    let name = scene.name();
+    let plain = name
+        .chars()
+        .all(|c| c.is_alphanumeric() || matches!(c, '_' | '-' | '.'));
+    if name.is_empty() || name.starts_with('.') || !plain || name.chars().count() > MAX_NAME_LEN {
+        return Err(SceneError::Invalid(format!(
+            "name {name:?}: expected a plain folder name (letters, digits, '_', '-', '.'; not \
+             starting with '.'; at most {MAX_NAME_LEN} characters): it names the output folder \
+             out/<name>/"
+        )));
+    }
+    let pictures = |frames: usize, gif: bool, fps: f64| -> Result<(), SceneError> {
+        if !(1..=MAX_FILMSTRIP_FRAMES).contains(&frames) {
+            return Err(SceneError::Invalid(format!(
+                "render.filmstrip_frames is {frames}, expected 1 to {MAX_FILMSTRIP_FRAMES}"
+            )));
+        }
+        if gif && !(fps.is_finite() && fps > 0.0 && fps <= crate::render::MAX_GIF_FPS) {
+            return Err(SceneError::Invalid(format!(
+                "render.gif_fps is {fps}, expected more than 0 and at most {}",
+                crate::render::MAX_GIF_FPS
+            )));
+        }
+        Ok(())
+    };
+    match scene {
+        Scene::Show(s) => {
+            pictures(s.render.filmstrip_frames, s.render.gif, s.render.gif_fps)?;
+            // Without a model there are no DOFs: the plot is not drawn.
+            if let Some(name) = &s.model {
+                let model = crate::humanoid::Model::by_name(name)?;
+                for d in &s.render.plot {
+                    if model.dof_index(d).is_none() {
+                        return Err(SceneError::Invalid(format!(
+                            "render.plot: '{d}' is not a DOF of {}; its DOFs: {}",
+                            model.name,
+                            model.dof_names().join(", ")
+                        )));
+                    }
+                }
+            }
+        }
+        Scene::HighJump(s) => pictures(s.render.filmstrip_frames, s.render.gif, s.render.gif_fps)?,
+        Scene::JumpingKneeKick(s) => {
+            pictures(s.render.filmstrip_frames, s.render.gif, s.render.gif_fps)?
+        }
+        Scene::Fall(s) => pictures(s.render.filmstrip_frames, s.render.gif, s.render.gif_fps)?,
+        Scene::EvolveFall(s) => pictures(s.render.filmstrip_frames, s.render.gif, s.render.gif_fps)?,
+    }
+    Ok(())
+}
+
+/// Runs a scene into `out_dir`, all outputs together or none: the scene is checked first
+/// ([`validate`]), every output is written into a temporary folder beside `out_dir` (same file
+/// system, named `.<folder>.partial-<pid>`, never taken for output), the last one `report.json`,
+/// and only when all are written does that folder replace `out_dir`. A failure, or an
+/// interrupted run, leaves the previous outputs as they were; temporary folders left by
+/// interrupted runs are removed by the next run. `out_dir` must be absent, empty or a previous
+/// scene output (holding `report.json`), so that no other files are replaced. `base` is the
+/// folder relative paths in the scene refer to. Returns the report.
 pub fn run(scene: &Scene, base: &Path, out_dir: &Path) -> Result<serde_json::Value, SceneError> {
-    std::fs::create_dir_all(out_dir).map_err(|source| SceneError::Io {
-        path: out_dir.display().to_string(),
-        source,
-    })?;
+    validate(scene)?;
+    let staging = output::Staging::begin(out_dir)?;
     let started = std::time::Instant::now();
+    let tmp = staging.path();
     let mut report = match scene {
-        Scene::Show(s) => run_show(s, base, out_dir)?,
-        Scene::HighJump(s) => run_high_jump(s, base, out_dir)?,
-        Scene::JumpingKneeKick(s) => run_jumping_knee_kick(s, base, out_dir)?,
-        Scene::Fall(s) => run_fall(s, base, out_dir)?,
-        Scene::EvolveFall(s) => run_evolve(s, base, out_dir)?,
+        Scene::Show(s) => run_show(s, base, tmp)?,
+        Scene::HighJump(s) => run_high_jump(s, base, tmp)?,
+        Scene::JumpingKneeKick(s) => run_jumping_knee_kick(s, base, tmp)?,
+        Scene::Fall(s) => run_fall(s, base, tmp)?,
+        Scene::EvolveFall(s) => run_evolve(s, base, tmp)?,
     };
     if let Some(o) = report.as_object_mut() {
         o.insert("scene".into(), scene.name().into());
         o.insert("wall_time_s".into(), started.elapsed().as_secs_f64().into());
     }
     write_output(
-        &out_dir.join("report.json"),
+        &tmp.join("report.json"),
         serde_json::to_string_pretty(&report)
             .unwrap_or_default()
             .as_bytes(),
     )?;
+    staging.commit()?;
     Ok(report)
 }
 

@@ -93,7 +93,7 @@ pub fn run_show(
     if let (
         LoadedMotion::Captured {
             clip: source,
-            mapping,
+            mapping: Some(mapping),
             ..
         },
         Some(m),

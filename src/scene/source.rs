@@ -54,8 +54,10 @@ pub enum LoadedMotion {
         bvh: Box<Bvh>,
         /// The (windowed) clip in metres.
         clip: Clip,
-        /// Its mapping onto the models.
-        mapping: Box<Mapping>,
+        /// Its mapping onto the models: the scene's mapping file, else the built-in one detected
+        /// from the joint names; `None` when none fits (the clip is still drawn as it is;
+        /// mapping it onto a model says why it cannot).
+        mapping: Option<Box<Mapping>>,
     },
     /// A keyframed clip, already on its model.
     Keyframed(ModelClip),
@@ -73,7 +75,15 @@ impl LoadedMotion {
     /// The motion on `model` (retargeted from a capture; a keyframed clip must already be on it).
     pub fn on_model(&self, model: &Model) -> Result<ModelClip, SceneError> {
         match self {
-            LoadedMotion::Captured { clip, mapping, .. } => Ok(retarget(clip, mapping, model)?),
+            LoadedMotion::Captured {
+                clip,
+                mapping: Some(mapping),
+                ..
+            } => Ok(retarget(clip, mapping, model)?),
+            // Detecting again gives the reason no built-in mapping fits.
+            LoadedMotion::Captured { clip, .. } => {
+                Ok(retarget(clip, &Mapping::detect(&clip.skeleton)?, model)?)
+            }
             LoadedMotion::Keyframed(m) if m.model.name == model.name => Ok(m.clone()),
             LoadedMotion::Keyframed(m) => Err(SceneError::Invalid(format!(
                 "the keyframed clip is on model {}, not {}",
@@ -99,29 +109,40 @@ pub fn load_motion(src: &ClipSource, base: &Path) -> Result<LoadedMotion, SceneE
             for w in warnings {
                 eprintln!("warning: {}:{}: {}", path.display(), w.line, w.message);
             }
-            let mut clip = Clip::from_bvh(&bvh, src.unit_scale)?;
+            let mut clip = Clip::from_bvh(&bvh, src.unit_scale)
+                .map_err(|e| SceneError::Invalid(format!("{}: {e}", path.display())))?;
             if src.start_s.is_some() || src.end_s.is_some() {
                 let (a, b) = window(clip.duration());
-                clip = clip.window(a, b)?;
+                clip = clip.window(a, b).map_err(|e| {
+                    SceneError::Invalid(format!("{}: clip window: {e}", path.display()))
+                })?;
             }
             let mapping = match &src.mapping {
-                Some(m) => Mapping::load(&resolve_path(m, base))?,
-                None => Mapping::detect(&clip.skeleton)?,
+                Some(m) => Some(Mapping::load(&resolve_path(m, base))?),
+                None => Mapping::detect(&clip.skeleton).ok(),
             };
             Ok(LoadedMotion::Captured {
                 bvh: Box::new(bvh),
                 clip,
-                mapping: Box::new(mapping),
+                mapping: mapping.map(Box::new),
             })
         }
         "ron" => {
             let k = KeyframeClip::load(&path)?;
             let mut m = k.to_model_clip();
             if src.start_s.is_some() || src.end_s.is_some() {
-                let (a, b) = window(m.frame_count() as f64 * m.frame_time);
-                m = m.window(a, b).ok_or_else(|| {
+                let span = m.frame_count() as f64 * m.frame_time;
+                let (a, b) = window(span);
+                let inside = a.is_finite()
+                    && b.is_finite()
+                    && a >= 0.0
+                    && a < b
+                    && b <= span + 0.5 * m.frame_time;
+                let windowed = if inside { m.window(a, b) } else { None };
+                m = windowed.ok_or_else(|| {
                     SceneError::Invalid(format!(
-                        "window {a}..{b} s is outside {} or empty",
+                        "{}: clip window {a}..{b} s is empty or reaches outside the clip, which \
+                         spans 0..{span:.3} s",
                         path.display()
                     ))
                 })?;

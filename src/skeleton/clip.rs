@@ -16,16 +16,53 @@ pub enum ClipError {
     /// A unit scale that is not a positive finite number.
     #[error("unit scale must be a positive finite number of metres per file unit, found {0}")]
     BadScale(f64),
-    /// A time window outside the clip.
+    /// A time window that is empty or reaches outside the clip.
     #[error(
-        "time window {start_s:.3}..{end_s:.3} s is outside the clip (0..{duration_s:.3} s) or empty"
+        "time window {start_s:.3}..{end_s:.3} s is empty or reaches outside the clip, which spans \
+         0..{duration_s:.3} s"
     )]
     Window {
+        /// Start asked for, seconds.
         start_s: f64,
+        /// End asked for, seconds.
         end_s: f64,
+        /// The clip's duration, seconds.
         duration_s: f64,
     },
+    /// A figure whose size in metres is not a human's: a wrong unit scale or garbage offsets.
+    #[error(
+        "the figure is {size_m:.4} m tall (or wide) at {scale} m per file unit, outside the human \
+         range {min_m}..{max_m} m: give the right unit scale (metres per file unit)"
+    )]
+    FigureSize {
+        /// The figure's size, metres.
+        size_m: f64,
+        /// The unit scale used.
+        scale: f64,
+        /// Smallest size accepted.
+        min_m: f64,
+        /// Largest size accepted.
+        max_m: f64,
+    },
+    /// More frames × joints than [`MAX_FRAME_JOINTS`].
+    #[error("{frames} frames × {joints} joints is more than the {max} joint poses a clip may hold")]
+    TooLarge {
+        /// Frames.
+        frames: usize,
+        /// Joints.
+        joints: usize,
+        /// The limit.
+        max: usize,
+    },
 }
+
+/// Most joint poses (frames × joints) a clip may hold: 20 million, about 1.1 GB of
+/// translations and rotations (CMU's 23 s forward jumps hold 85 000).
+pub const MAX_FRAME_JOINTS: usize = 20_000_000;
+
+/// The sizes a figure may have, metres (its height, or its largest rest-pose side): a toddler
+/// to well over the tallest human, so that a wrong unit scale is an error, not a 26 km figure.
+pub const FIGURE_SIZE_M: (f64, f64) = (0.3, 3.0);
 
 /// A motion on a skeleton: for every frame, one local translation and one local rotation per
 /// joint (row-major, `frame * joints + joint`). Metres, seconds.
@@ -137,6 +174,13 @@ impl Clip {
             return Err(ClipError::Empty { what: "no frames" });
         }
         let n = bvh.joints.len();
+        if frames.saturating_mul(n) > MAX_FRAME_JOINTS {
+            return Err(ClipError::TooLarge {
+                frames,
+                joints: n,
+                max: MAX_FRAME_JOINTS,
+            });
+        }
         let mut clip = Clip {
             skeleton: Skeleton {
                 joints: bvh
@@ -198,7 +242,28 @@ impl Clip {
             None => estimate_unit_scale(clip.median_vertical_extent()),
         };
         clip.scale(scale);
+        let size = clip.figure_size();
+        let (min_m, max_m) = FIGURE_SIZE_M;
+        if !(size.is_finite() && (min_m..=max_m).contains(&size)) {
+            return Err(ClipError::FigureSize {
+                size_m: size,
+                scale,
+                min_m,
+                max_m,
+            });
+        }
         Ok(clip)
+    }
+
+    /// The figure's size, metres: the larger of its median vertical extent over the motion
+    /// and the largest side of its rest pose's bounding box (a lying figure is still its height).
+    pub fn figure_size(&self) -> f64 {
+        let rest = self.skeleton.rest_points();
+        let (lo, hi) = rest.iter().fold(
+            (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+            |(a, b), p| (a.min(*p), b.max(*p)),
+        );
+        (hi - lo).max_element().max(self.median_vertical_extent())
     }
 
     /// Multiplies every length (offsets, end sites, translations) by `s`.
@@ -233,11 +298,15 @@ impl Clip {
         extents[extents.len() / 2]
     }
 
-    /// The frames whose times lie in `[start_s, end_s)` (seconds from the clip's start).
+    /// The frames whose times lie in `[start_s, end_s)` (seconds from the clip's start); a
+    /// window reaching outside `0..duration` (by more than half a frame) is an error, not
+    /// silently cut.
     pub fn window(&self, start_s: f64, end_s: f64) -> Result<Clip, ClipError> {
         let first = (start_s / self.frame_time).round().max(0.0) as usize;
         let last = ((end_s / self.frame_time).round() as usize).min(self.frame_count());
-        if !(start_s.is_finite() && end_s.is_finite()) || start_s < 0.0 || first >= last {
+        let outside = end_s > self.duration() + 0.5 * self.frame_time;
+        if !(start_s.is_finite() && end_s.is_finite()) || start_s < 0.0 || outside || first >= last
+        {
             return Err(ClipError::Window {
                 start_s,
                 end_s,

@@ -9,7 +9,7 @@ mod euler;
 mod fk;
 mod side;
 
-pub use clip::{Clip, ClipError, estimate_unit_scale};
+pub use clip::{Clip, ClipError, FIGURE_SIZE_M, MAX_FRAME_JOINTS, estimate_unit_scale};
 pub use euler::{euler_to_quat, quat_to_euler};
 pub use fk::{Transform, forward_kinematics};
 pub use side::{Side, side_from_name};
@@ -92,6 +92,27 @@ impl Skeleton {
         let mut pts = vec![];
         self.points(&g, &mut pts);
         pts
+    }
+
+    /// The root when it is a ground proxy rather than a part of the body: a root with a single
+    /// child joint that is farther from it than a quarter of the rest figure's height (e.g.
+    /// Bandai's `joint_Root` on the floor under `Hips`). Contact analysis ignores it and
+    /// pictures do not draw its bone (it would look like a third leg).
+    pub fn ground_proxy_root(&self) -> Option<usize> {
+        let children: Vec<usize> = (0..self.joints.len())
+            .filter(|&i| self.joints[i].parent == Some(0))
+            .collect();
+        let [child] = children[..] else {
+            return None;
+        };
+        let pts = self.rest_points();
+        let (lo, hi) = pts
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| {
+                (a.min(p.y), b.max(p.y))
+            });
+        let height = hi - lo;
+        (height > 0.0 && self.joints[child].offset.length() > 0.25 * height).then_some(0)
     }
 
     /// A stick figure for [`crate::render`]: point names and parents (joints, then End Sites).

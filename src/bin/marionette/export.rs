@@ -52,7 +52,7 @@ pub fn export(args: Args) -> Result<()> {
     let file = file.as_path();
     let b = read_bvh(file)?;
     if let Some(out) = positions {
-        let clip = Clip::from_bvh(&b, unit_scale)?;
+        let clip = Clip::from_bvh(&b, unit_scale).with_context(|| file.display().to_string())?;
         let mut s = String::from("frame,time_s");
         for j in &clip.skeleton.joints {
             s.push_str(&format!(",{0}.x,{0}.y,{0}.z", j.name));
@@ -79,7 +79,7 @@ pub fn export(args: Args) -> Result<()> {
     } else if let Some(a) = angles {
         let (model_name, out) = (&a[0], PathBuf::from(&a[1]));
         let model = Model::by_name(model_name)?;
-        let clip = Clip::from_bvh(&b, unit_scale)?;
+        let clip = Clip::from_bvh(&b, unit_scale).with_context(|| file.display().to_string())?;
         let m = mapping_for(&clip, &mapping)?;
         let mapped = retarget(&clip, &m, &model)?;
         marionette::io::write_atomic(&out, mapped.angles_csv().as_bytes())
@@ -100,7 +100,8 @@ pub fn export(args: Args) -> Result<()> {
             }
             Some(name) => {
                 let model = Model::by_name(&name)?;
-                let clip = Clip::from_bvh(&b, unit_scale)?;
+                let clip =
+                    Clip::from_bvh(&b, unit_scale).with_context(|| file.display().to_string())?;
                 let m = mapping_for(&clip, &mapping)?;
                 let mapped = retarget(&clip, &m, &model)?;
                 bvh::write_file(&mapped.to_clip().to_bvh(), &out)?;

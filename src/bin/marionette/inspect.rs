@@ -3,9 +3,9 @@
 
 use std::path::PathBuf;
 
-use anyhow::Result;
+use anyhow::{Context, Result};
 
-use marionette::analysis::clip_contacts;
+use marionette::analysis::{ContactConfig, clip_contacts};
 use marionette::skeleton::Clip;
 
 use crate::common::read_bvh;
@@ -25,7 +25,7 @@ pub fn inspect(args: Args) -> Result<()> {
     let (file, unit_scale) = (args.file.as_path(), args.unit_scale);
     let b = read_bvh(file)?;
     let size = std::fs::metadata(file).map(|m| m.len()).unwrap_or(0);
-    let clip = Clip::from_bvh(&b, unit_scale)?;
+    let clip = Clip::from_bvh(&b, unit_scale).with_context(|| file.display().to_string())?;
     let scale = clip
         .skeleton
         .joints
@@ -59,19 +59,24 @@ pub fn inspect(args: Args) -> Result<()> {
         clip.median_vertical_extent()
     );
     println!("skeleton:");
+    // Depths in one pass (parents come first); indentation stops at INDENT_MAX levels.
+    const INDENT_MAX: usize = 16;
+    let mut depths: Vec<usize> = Vec::with_capacity(b.joints.len());
     for (i, j) in b.joints.iter().enumerate() {
-        let mut depth = 0;
-        let mut p = j.parent;
-        while let Some(q) = p {
-            depth += 1;
-            p = b.joints[q].parent;
-        }
+        let depth = j.parent.map_or(0, |p| depths[p] + 1);
+        depths.push(depth);
         let ch: Vec<&str> = j.channels.iter().map(|c| c.name()).collect();
         let end = j.end_site.map(|_| "  + End Site").unwrap_or("");
+        let deep = if depth > INDENT_MAX {
+            format!("({depth} deep) ")
+        } else {
+            String::new()
+        };
         println!(
-            "  {:>3} {}{}  [{}]{}",
+            "  {:>3} {}{}{}  [{}]{}",
             i,
-            "  ".repeat(depth),
+            "  ".repeat(depth.min(INDENT_MAX)),
+            deep,
             j.name,
             ch.join(" "),
             end
@@ -89,7 +94,7 @@ pub fn inspect(args: Args) -> Result<()> {
             .join(", ")
     };
     println!(
-        "floor       y = {:.3} m (contact within {:.0} cm)",
+        "floor       y = {:.3} m (a foot point touches within {:.0} cm of its rest height)",
         c.floor_y_m,
         c.threshold_m * 100.0
     );
@@ -102,6 +107,13 @@ pub fn inspect(args: Args) -> Result<()> {
         "right foot  {} contact spans: {}",
         c.right.len(),
         spans(&c.right)
+    );
+    println!(
+        "body        {} spans on the floor (a joint other than the feet within {:.0} cm){}{}",
+        c.body.len(),
+        ContactConfig::default().body_threshold_m * 100.0,
+        if c.body.is_empty() { "" } else { ": " },
+        spans(&c.body)
     );
     println!("flights     {}", c.flights.len());
     for (i, f) in c.flights.iter().enumerate() {

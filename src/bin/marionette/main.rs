@@ -13,7 +13,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
-/// marionette: human character motion — motor primitives, choreography, evolved falls.
+/// marionette: human character motion — motor primitives and simulated falls.
 #[derive(Parser)]
 #[command(version, about, long_about = None)]
 struct Cli {
@@ -55,10 +55,19 @@ fn main() -> ExitCode {
     }
 }
 
-/// The error and its causes on one line.
+/// The error and its causes on one line, each said once: a cause whose text the message
+/// already ends with (an error that prints its source, such as "file: reason") is not repeated.
 fn format_chain(e: &anyhow::Error) -> String {
-    e.chain()
-        .map(|c| c.to_string())
-        .collect::<Vec<_>>()
-        .join(": ")
+    let mut out = String::new();
+    for c in e.chain() {
+        let text = c.to_string();
+        if out.ends_with(&text) {
+            continue;
+        }
+        if !out.is_empty() {
+            out.push_str(": ");
+        }
+        out.push_str(&text);
+    }
+    out
 }

@@ -6,20 +6,33 @@ use anyhow::{Result, bail};
 
 use marionette::humanoid::Model;
 use marionette::render::{Track, animation_gif, filmstrip_png};
-use marionette::scene::{ClipSource, load_motion};
+use marionette::scene::{ClipSource, MAX_FILMSTRIP_FRAMES, load_motion};
 
 // The command's arguments (its help text is on `Command::Render`).
 #[derive(clap::Args)]
 pub struct Args {
-    /// The motion file.
+    /// The motion file (.bvh, or .ron for a keyframed clip).
     file: PathBuf,
     /// OUT.png (filmstrip) or OUT.gif (animation).
     #[arg(long)]
     out: PathBuf,
-    /// Map onto this model first (humanoid24 or fall21).
+    /// Map onto this model first (humanoid24 or fall21); without it the skeleton is drawn as it
+    /// is, whatever its joints.
     #[arg(long)]
     model: Option<String>,
-    /// Frames in a filmstrip.
+    /// With --model: a mapping file for the skeleton (default: detected among the built-ins).
+    #[arg(long, requires = "model")]
+    mapping: Option<PathBuf>,
+    /// Start of the time window, seconds (default: the clip's start).
+    #[arg(long)]
+    start: Option<f64>,
+    /// End of the time window, seconds (default: the clip's end).
+    #[arg(long)]
+    end: Option<f64>,
+    /// Metres per file unit of a BVH (estimated from the standing height when absent).
+    #[arg(long)]
+    unit_scale: Option<f64>,
+    /// Frames in a filmstrip (1 to 64).
     #[arg(long, default_value_t = 8)]
     frames: usize,
 }
@@ -30,16 +43,33 @@ pub fn render(args: Args) -> Result<()> {
         file,
         out,
         model,
+        mapping,
+        start,
+        end,
+        unit_scale,
         frames,
     } = args;
+    if !(1..=MAX_FILMSTRIP_FRAMES).contains(&frames) {
+        bail!("--frames {frames}: expected 1 to {MAX_FILMSTRIP_FRAMES}");
+    }
     let (file, out) = (file.as_path(), out.as_path());
+    let kind = out
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(|e| e.to_ascii_lowercase());
+    if !matches!(kind.as_deref(), Some("png" | "gif")) {
+        bail!(
+            "--out {}: expected a .png (filmstrip) or .gif (animation) file",
+            out.display()
+        );
+    }
     let base = Path::new(".");
     let src = ClipSource {
         file: file.display().to_string(),
-        start_s: None,
-        end_s: None,
-        unit_scale: None,
-        mapping: None,
+        start_s: start,
+        end_s: end,
+        unit_scale,
+        mapping: mapping.map(|m| m.display().to_string()),
     };
     let motion = load_motion(&src, base)?;
     let clip = match &model {
@@ -58,18 +88,10 @@ pub fn render(args: Args) -> Result<()> {
         label,
         frame_time: clip.frame_time,
     };
-    match out
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(|e| e.to_ascii_lowercase())
-        .as_deref()
-    {
-        Some("png") => filmstrip_png(&[track], frames.max(1), out)?,
-        Some("gif") => animation_gif(&[track], 25.0, out)?,
-        _ => bail!(
-            "--out {}: expected a .png (filmstrip) or .gif (animation) file",
-            out.display()
-        ),
+    if kind.as_deref() == Some("png") {
+        filmstrip_png(&[track], frames, out)?;
+    } else {
+        animation_gif(&[track], 25.0, out)?;
     }
     println!("wrote {}", out.display());
     Ok(())
