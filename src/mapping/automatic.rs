@@ -226,20 +226,7 @@ fn found(
         .map(|(slot, p)| {
             let mut node = v.nodes[p.index];
             let name = v.tree.name(skeleton, node);
-            let agrees = p.index == p.structural
-                || (v.pos(p.index) - v.pos(p.structural)).length() < v.eps;
-            let (confidence, mut reason) = match (p.by_name, agrees) {
-                (true, true) => (1.0, format!("name '{name}' and structure ({}) agree", slot.rule)),
-                (true, false) => (
-                    0.85,
-                    format!(
-                        "name '{name}'; structure ({}) would say '{}'",
-                        slot.rule,
-                        v.tree.name(skeleton, v.nodes[p.structural])
-                    ),
-                ),
-                (false, _) => (0.7, format!("structure: {}", slot.rule)),
-            };
+            let mut end_note = "";
             // A head or hand named on the joint that ends its chain: that joint's far end.
             if p.by_name && matches!(slot.role, "head" | "hand") {
                 let n = &v.tree.nodes[node];
@@ -251,9 +238,27 @@ fn found(
                     && let Some(&end) = n.children.iter().find(|&&c| v.tree.nodes[c].end_site)
                 {
                     node = end;
-                    reason.push_str(&format!("; its End Site, the {} end", slot.role));
+                    end_note = "; its End Site, the far end";
                 }
             }
+            let structural = v.nodes[p.structural];
+            let agrees = node == structural
+                || (v.tree.nodes[node].pos - v.tree.nodes[structural].pos).length() < v.eps;
+            let (confidence, reason) = match (p.by_name, agrees) {
+                (true, true) => (
+                    1.0,
+                    format!("name '{name}'{end_note} and structure ({}) agree", slot.rule),
+                ),
+                (true, false) => (
+                    0.85,
+                    format!(
+                        "name '{name}'{end_note}; structure ({}) would say '{}'",
+                        slot.rule,
+                        v.tree.name(skeleton, structural)
+                    ),
+                ),
+                (false, _) => (0.7, format!("structure: {}", slot.rule)),
+            };
             Found {
                 role: slot.role,
                 node,
@@ -503,17 +508,7 @@ fn detect_inner(
 
     // Assemble.
     let mut by_landmark: BTreeMap<String, (usize, f64, String)> = BTreeMap::new();
-    let pelvis_name = syn.normalise(&skeleton.joints[tree.nodes[pelvis].joint].name);
-    let pelvis_reason = if syn.names("pelvis", &pelvis_name.base) {
-        format!(
-            "name '{}' and structure (where the legs and the head chain part) agree",
-            tree.name(skeleton, pelvis)
-        )
-    } else {
-        "structure: where the legs and the head chain part".to_string()
-    };
-    let pelvis_conf = if syn.names("pelvis", &pelvis_name.base) { 1.0 } else { 0.7 };
-    by_landmark.insert("pelvis".into(), (pelvis, pelvis_conf, pelvis_reason));
+    by_landmark.insert("pelvis".into(), pelvis_landmark(&tree, skeleton, syn, pelvis));
     for f in spine_found {
         by_landmark.insert(f.role.into(), (f.node, f.confidence, f.reason));
     }
@@ -566,6 +561,39 @@ fn detect_inner(
         findings,
         notes,
     })
+}
+
+/// The pelvis: where the legs and the head chain part (`part`), or the nearest joint at or
+/// above it named as a pelvis within 10 % of the height (Biped hangs the legs from a spine joint
+/// just above `Bip01 Pelvis`).
+fn pelvis_landmark(
+    tree: &Tree,
+    skeleton: &Skeleton,
+    syn: &Synonyms,
+    part: usize,
+) -> (usize, f64, String) {
+    let rule = "where the legs and the head chain part";
+    let mut n = Some(part);
+    while let Some(j) = n {
+        let node = &tree.nodes[j];
+        if (node.pos - tree.nodes[part].pos).length() > 0.1 * tree.height {
+            break;
+        }
+        if syn.names("pelvis", &syn.normalise(&skeleton.joints[node.joint].name).base) {
+            let name = tree.name(skeleton, j);
+            return if j == part {
+                (j, 1.0, format!("name '{name}' and structure ({rule}) agree"))
+            } else {
+                (
+                    j,
+                    0.85,
+                    format!("name '{name}', just above '{}' ({rule})", tree.name(skeleton, part)),
+                )
+            };
+        }
+        n = node.parent;
+    }
+    (part, 0.7, format!("structure: {rule}"))
 }
 
 fn side_word(conf: f64) -> &'static str {

@@ -229,9 +229,26 @@ impl Synonyms {
             .is_some_and(|v| v.iter().any(|b| b == base))
     }
 
-    /// `name` normalised with these prefixes.
+    /// `name` normalised with these prefixes ([`normalise`]); a one-word lower-case name whose
+    /// first letter is `l` or `r` and whose rest is a synonym takes that letter as its side
+    /// (the CMU/Vicon ASF names `lfemur`, `rhumerus`, `lhand`).
     pub fn normalise(&self, name: &str) -> NormalName {
-        normalise(name, &self.prefixes)
+        let mut n = normalise(name, &self.prefixes);
+        if n.side == Side::Centre && n.base.len() > 2 {
+            let (first, rest) = n.base.split_at(1);
+            let side = match first {
+                "l" => Side::Left,
+                "r" => Side::Right,
+                _ => Side::Centre,
+            };
+            if side != Side::Centre && self.roles.values().any(|v| v.iter().any(|b| b == rest)) {
+                n = NormalName {
+                    side,
+                    base: rest.to_string(),
+                };
+            }
+        }
+        n
     }
 }
 
@@ -275,6 +292,10 @@ mod tests {
             ("HeadTop_End", C, "headtopend"),
             ("Armature|hand.R", R, "hand"),
             ("Character1_LeftUpLeg", L, "upleg"),
+            ("lfemur", L, "femur"),
+            ("rhumerus", R, "humerus"),
+            ("lowerback", C, "lowerback"),
+            ("root", C, "root"),
         ] {
             assert_eq!(n(name), (side, base.to_string()), "{name}");
         }

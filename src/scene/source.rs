@@ -106,7 +106,7 @@ pub fn load_motion(src: &ClipSource, base: &Path) -> Result<LoadedMotion, SceneE
             }
             let mapping = match &src.mapping {
                 Some(m) => Mapping::load(&resolve_path(m, base))?,
-                None => Mapping::detect(&clip.skeleton)?,
+                None => Mapping::detect_clip(&clip)?,
             };
             Ok(LoadedMotion::Captured {
                 bvh: Box::new(bvh),
