@@ -508,7 +508,12 @@ fn build(rig: &Rig, motion: &ModelClip) -> (Clip, BTreeMap<String, String>) {
     let mut prev = spine_parent;
     let ns = rig.spine.len();
     for (i, s) in rig.spine.iter().enumerate() {
-        prev = b.add(s, Some(prev), link("waist"), y(neck_h * i as f64 / ns as f64));
+        prev = b.add(
+            s,
+            Some(prev),
+            link("waist"),
+            y(neck_h * i as f64 / ns as f64),
+        );
         if i == 0 {
             expect.insert("waist".into(), b.joints[prev].name.clone());
         }
@@ -532,7 +537,9 @@ fn build(rig: &Rig, motion: &ModelClip) -> (Clip, BTreeMap<String, String>) {
         }
         neck_parent = j;
     }
-    let head_top = model.joints[model.joint_index("neck").unwrap()].end_site.unwrap();
+    let head_top = model.joints[model.joint_index("neck").unwrap()]
+        .end_site
+        .unwrap();
     let head = b.add(rig.head, Some(neck_parent), link("neck"), y(0.15));
     let head_name = b.joints[head].name.clone();
     match rig.head_end {
@@ -584,7 +591,12 @@ fn build(rig: &Rig, motion: &ModelClip) -> (Clip, BTreeMap<String, String>) {
                 expect.insert(sided("clavicle"), n);
             }
         }
-        let sh = b.add(&f(rig.shoulder), Some(arm_parent), lk("shoulder"), DVec3::ZERO);
+        let sh = b.add(
+            &f(rig.shoulder),
+            Some(arm_parent),
+            lk("shoulder"),
+            DVec3::ZERO,
+        );
         expect.insert(sided("shoulder"), b.joints[sh].name.clone());
         if let Some(t) = rig.twist {
             b.add(&f(t), Some(sh), lk("shoulder"), y(-0.15));
@@ -685,7 +697,11 @@ fn rest_rotations(model: &Model, rest: Rest) -> Vec<DQuat> {
             let arm = ["shoulder", "elbow", "wrist"]
                 .iter()
                 .any(|p| j.name.ends_with(p));
-            let sign = if j.name.starts_with("left_") { 1.0 } else { -1.0 };
+            let sign = if j.name.starts_with("left_") {
+                1.0
+            } else {
+                -1.0
+            };
             match rest {
                 Rest::Standing => DQuat::IDENTITY,
                 Rest::T if arm => DQuat::from_rotation_z(sign * 90f64.to_radians()),
@@ -717,9 +733,8 @@ fn clip_of(joints: &[RigJoint], rest: Rest, motion: &ModelClip) -> Clip {
             None => j.offset,
         };
     }
-    let world = |link: Option<usize>, at: DVec3| -> DVec3 {
-        link.map_or(at, |l| origin[l] + p[l] * at)
-    };
+    let world =
+        |link: Option<usize>, at: DVec3| -> DVec3 { link.map_or(at, |l| origin[l] + p[l] * at) };
     let rest_pos: Vec<DVec3> = joints.iter().map(|j| world(j.link, j.at)).collect();
     let skeleton = Skeleton {
         joints: joints
@@ -746,7 +761,10 @@ fn clip_of(joints: &[RigJoint], rest: Rest, motion: &ModelClip) -> Clip {
         mclip.globals(f, &mut g);
         for (k, j) in joints.iter().enumerate() {
             let (pos, rot) = match j.link {
-                Some(l) => (g[l].translation + g[l].rotation * j.at, g[l].rotation * p[l].inverse()),
+                Some(l) => (
+                    g[l].translation + g[l].rotation * j.at,
+                    g[l].rotation * p[l].inverse(),
+                ),
                 None => (j.at, DQuat::IDENTITY),
             };
             rig_g[k] = Transform {
@@ -854,15 +872,14 @@ fn check_rig(rig: &Rig, motion: &ModelClip) -> AutoMapping {
 #[test]
 fn every_convention_maps_automatically_with_every_landmark_and_side_right() {
     let motion = motion();
-    for rig in rigs().iter().filter(|r| !r.mirrored && r.name != "meaningless names") {
+    for rig in rigs()
+        .iter()
+        .filter(|r| !r.mirrored && r.name != "meaningless names")
+    {
         let auto = check_rig(rig, &motion);
         // The names carry the sides here, and geometry agrees.
         for n in &auto.notes[auto.notes.len() - 2..] {
-            assert!(
-                n.contains("geometry and names agree"),
-                "{}: {n}",
-                rig.name
-            );
+            assert!(n.contains("geometry and names agree"), "{}: {n}", rig.name);
         }
     }
 }
@@ -894,15 +911,28 @@ fn a_mirrored_rig_is_mapped_by_its_geometry_not_its_side_words() {
     let rig = rigs().into_iter().find(|r| r.mirrored).unwrap();
     let auto = check_rig(&rig, &motion);
     assert!(auto.mapping.landmarks["left_hip"].contains("Right"));
-    assert!(auto.notes.iter().any(|n| n.contains("geometry wins")), "{:?}", auto.notes);
-    let f = auto.findings.iter().find(|f| f.landmark == "left_knee").unwrap();
-    assert!(f.confidence < 1.0 && f.reason.contains("against the names"), "{f:?}");
+    assert!(
+        auto.notes.iter().any(|n| n.contains("geometry wins")),
+        "{:?}",
+        auto.notes
+    );
+    let f = auto
+        .findings
+        .iter()
+        .find(|f| f.landmark == "left_knee")
+        .unwrap();
+    assert!(
+        f.confidence < 1.0 && f.reason.contains("against the names"),
+        "{f:?}"
+    );
     // Had the names won, the feet would be far off: the check above can fail.
     let mut by_names = auto.mapping.clone();
     for (k, v) in &auto.mapping.landmarks {
         if let Some(rest) = k.strip_prefix("left_") {
             let r = format!("right_{rest}");
-            by_names.landmarks.insert(k.clone(), auto.mapping.landmarks[&r].clone());
+            by_names
+                .landmarks
+                .insert(k.clone(), auto.mapping.landmarks[&r].clone());
             by_names.landmarks.insert(r, v.clone());
         }
     }
@@ -911,7 +941,11 @@ fn a_mirrored_rig_is_mapped_by_its_geometry_not_its_side_words() {
     let mapped = retarget(&clip, &by_names, &model).unwrap();
     let errs = effector_errors(&clip, &auto.mapping, &mapped).unwrap();
     let foot = errs.iter().find(|e| e.effector == "right_foot").unwrap();
-    assert!(foot.max_m > 0.1, "mapped by the names, the right foot is off by only {}", foot.max_m);
+    assert!(
+        foot.max_m > 0.1,
+        "mapped by the names, the right foot is off by only {}",
+        foot.max_m
+    );
 }
 
 #[test]
@@ -974,7 +1008,11 @@ fn non_humanoids_are_refused_naming_what_is_missing() {
         (2, ["LeftArm", "LeftForeArm", "LeftHand"]),
         (2, ["RightArm", "RightForeArm", "RightHand"]),
     ] {
-        let x = if names[0].starts_with("Left") { 0.1 } else { -0.1 };
+        let x = if names[0].starts_with("Left") {
+            0.1
+        } else {
+            -0.1
+        };
         let a = q.len();
         q.push((names[0], Some(root), [x, -0.05, 0.0]));
         q.push((names[1], Some(a), [0.0, -0.25, 0.0]));

@@ -132,7 +132,11 @@ impl ChainView<'_> {
         for (s, slot) in slots.iter().enumerate() {
             for i in slot.lo..=slot.hi.min(n.saturating_sub(1)) {
                 let here = self.name_score(syn, slot.role, i)
-                    + if i == slot.structural { STRUCTURE_BONUS } else { 0.0 };
+                    + if i == slot.structural {
+                        STRUCTURE_BONUS
+                    } else {
+                        0.0
+                    };
                 if s == 0 {
                     best[i] = here;
                     continue;
@@ -152,7 +156,11 @@ impl ChainView<'_> {
         }
         let last = (0..n)
             .filter(|&i| best[(k - 1) * n + i] > neg)
-            .max_by(|&a, &b| best[(k - 1) * n + a].total_cmp(&best[(k - 1) * n + b]).then(b.cmp(&a)));
+            .max_by(|&a, &b| {
+                best[(k - 1) * n + a]
+                    .total_cmp(&best[(k - 1) * n + b])
+                    .then(b.cmp(&a))
+            });
         let Some(mut i) = last else {
             return Err(format!(
                 "the {what} chain has {n} points, too few for {}",
@@ -198,7 +206,12 @@ struct Found {
     reason: String,
 }
 
-fn view<'a>(tree: &'a Tree, skeleton: &Skeleton, nodes: &'a [usize], syn: &Synonyms) -> ChainView<'a> {
+fn view<'a>(
+    tree: &'a Tree,
+    skeleton: &Skeleton,
+    nodes: &'a [usize],
+    syn: &Synonyms,
+) -> ChainView<'a> {
     ChainView {
         tree,
         nodes,
@@ -214,12 +227,7 @@ fn view<'a>(tree: &'a Tree, skeleton: &Skeleton, nodes: &'a [usize], syn: &Synon
 }
 
 /// Findings of placed slots: node, confidence and reason.
-fn found(
-    v: &ChainView,
-    skeleton: &Skeleton,
-    slots: &[Slot],
-    placed: &[Placed],
-) -> Vec<Found> {
+fn found(v: &ChainView, skeleton: &Skeleton, slots: &[Slot], placed: &[Placed]) -> Vec<Found> {
     slots
         .iter()
         .zip(placed)
@@ -243,11 +251,15 @@ fn found(
             }
             let structural = v.nodes[p.structural];
             let agrees = node == structural
+                || v.nodes[p.index] == structural
                 || (v.tree.nodes[node].pos - v.tree.nodes[structural].pos).length() < v.eps;
             let (confidence, reason) = match (p.by_name, agrees) {
                 (true, true) => (
                     1.0,
-                    format!("name '{name}'{end_note} and structure ({}) agree", slot.rule),
+                    format!(
+                        "name '{name}'{end_note} and structure ({}) agree",
+                        slot.rule
+                    ),
                 ),
                 (true, false) => (
                     0.85,
@@ -293,10 +305,34 @@ fn leg_slots(v: &ChainView) -> Result<Vec<Slot>, String> {
     let toe = d.get(j + 3).copied().unwrap_or(n - 1);
     let thigh = "the two longest consecutive bones of the leg are thigh and shin";
     Ok(vec![
-        Slot { role: "hip", lo: 1, hi: n - 1, structural: d[j], rule: thigh },
-        Slot { role: "knee", lo: 1, hi: n - 1, structural: d[j + 1], rule: thigh },
-        Slot { role: "ankle", lo: 1, hi: n - 1, structural: d[j + 2], rule: thigh },
-        Slot { role: "toe", lo: 1, hi: n - 1, structural: toe, rule: "the next point after the ankle" },
+        Slot {
+            role: "hip",
+            lo: 1,
+            hi: n - 1,
+            structural: d[j],
+            rule: thigh,
+        },
+        Slot {
+            role: "knee",
+            lo: 1,
+            hi: n - 1,
+            structural: d[j + 1],
+            rule: thigh,
+        },
+        Slot {
+            role: "ankle",
+            lo: 1,
+            hi: n - 1,
+            structural: d[j + 2],
+            rule: thigh,
+        },
+        Slot {
+            role: "toe",
+            lo: 1,
+            hi: n - 1,
+            structural: toe,
+            rule: "the next point after the ankle",
+        },
     ])
 }
 
@@ -330,9 +366,27 @@ fn arm_slots(v: &ChainView) -> Result<Vec<Slot>, String> {
             structural: d[k],
             rule: "the first point of the arm 5 % of the height out from the chest",
         },
-        Slot { role: "elbow", lo: 1, hi: n - 1, structural: d[k + 1], rule: "the next point of the arm" },
-        Slot { role: "wrist", lo: 1, hi: n - 1, structural: d[k + 2], rule: "the next point of the arm" },
-        Slot { role: "hand", lo: 1, hi: n - 1, structural: hand, rule: "the next point after the wrist" },
+        Slot {
+            role: "elbow",
+            lo: 1,
+            hi: n - 1,
+            structural: d[k + 1],
+            rule: "the next point of the arm",
+        },
+        Slot {
+            role: "wrist",
+            lo: 1,
+            hi: n - 1,
+            structural: d[k + 2],
+            rule: "the next point of the arm",
+        },
+        Slot {
+            role: "hand",
+            lo: 1,
+            hi: n - 1,
+            structural: hand,
+            rule: "the next point after the wrist",
+        },
     ])
 }
 
@@ -354,9 +408,27 @@ fn spine_slots(v: &ChainView, chest: usize) -> Result<Vec<Slot>, String> {
         ));
     }
     Ok(vec![
-        Slot { role: "waist", lo: 1, hi: c, structural: waist, rule: "the first point above the pelvis" },
-        Slot { role: "neck", lo: c, hi: n - 2, structural: neck, rule: "the first point above the chest hub" },
-        Slot { role: "head", lo: 1, hi: n - 1, structural: n - 1, rule: "the end of the head chain" },
+        Slot {
+            role: "waist",
+            lo: 1,
+            hi: c,
+            structural: waist,
+            rule: "the first point above the pelvis",
+        },
+        Slot {
+            role: "neck",
+            lo: c,
+            hi: n - 2,
+            structural: neck,
+            rule: "the first point above the chest hub",
+        },
+        Slot {
+            role: "head",
+            lo: 1,
+            hi: n - 1,
+            structural: n - 1,
+            rule: "the end of the head chain",
+        },
     ])
 }
 
@@ -385,7 +457,11 @@ fn tell_sides(
                  wrong, the positions are what the model must follow)"
             ),
         )),
-        (Some(g), None) => Ok((g, 0.9, format!("{what}: by geometry (the names carry no side)"))),
+        (Some(g), None) => Ok((
+            g,
+            0.9,
+            format!("{what}: by geometry (the names carry no side)"),
+        )),
         (None, Some(n)) => Ok((n, 0.7, format!("{what}: by names (geometry undecided)"))),
         (None, None) => Err(format!(
             "cannot tell the left {what} from the right: the feet give no forward direction or the \
@@ -408,7 +484,8 @@ pub fn detect_automatic(
         .first()
         .map(|j| j.name.clone())
         .unwrap_or_default();
-    detect_inner(skeleton, globals, synonyms).map_err(|reason| MappingError::NotHumanoid { root, reason })
+    detect_inner(skeleton, globals, synonyms)
+        .map_err(|reason| MappingError::NotHumanoid { root, reason })
 }
 
 fn detect_inner(
@@ -420,7 +497,13 @@ fn detect_inner(
         return Err("the skeleton has no joints".into());
     }
     let tree = Tree::new(skeleton, globals);
-    let Chains { pelvis, chest, spine, legs, arms } = find_chains(&tree, skeleton)?;
+    let Chains {
+        pelvis,
+        chest,
+        spine,
+        legs,
+        arms,
+    } = find_chains(&tree, skeleton)?;
     let up = tree.up;
     let h = tree.height;
     let mut notes = vec![format!(
@@ -500,7 +583,10 @@ fn detect_inner(
     )?;
     let (arms_first_left, arm_conf, arm_note) = tell_sides(
         "arms",
-        geometric(pos(&arm_found[0], "shoulder"), pos(&arm_found[1], "shoulder")),
+        geometric(
+            pos(&arm_found[0], "shoulder"),
+            pos(&arm_found[1], "shoulder"),
+        ),
         (arm_views[0].named_side(), arm_views[1].named_side()),
     )?;
     notes.push(leg_note);
@@ -508,7 +594,10 @@ fn detect_inner(
 
     // Assemble.
     let mut by_landmark: BTreeMap<String, (usize, f64, String)> = BTreeMap::new();
-    by_landmark.insert("pelvis".into(), pelvis_landmark(&tree, skeleton, syn, pelvis));
+    by_landmark.insert(
+        "pelvis".into(),
+        pelvis_landmark(&tree, skeleton, syn, pelvis),
+    );
     for f in spine_found {
         by_landmark.insert(f.role.into(), (f.node, f.confidence, f.reason));
     }
@@ -518,7 +607,11 @@ fn detect_inner(
     ];
     for (found, first_left, conf) in sided {
         for (k, chain) in found.into_iter().enumerate() {
-            let side = if (k == 0) == first_left { "left" } else { "right" };
+            let side = if (k == 0) == first_left {
+                "left"
+            } else {
+                "right"
+            };
             for f in chain {
                 by_landmark.insert(
                     format!("{side}_{}", f.role),
@@ -545,7 +638,13 @@ fn detect_inner(
         });
     }
     let mut detect: Vec<String> = vec![];
-    for l in ["pelvis", "left_hip", "right_hip", "left_shoulder", "right_shoulder"] {
+    for l in [
+        "pelvis",
+        "left_hip",
+        "right_hip",
+        "left_shoulder",
+        "right_shoulder",
+    ] {
         let j = landmarks[l].trim_end_matches(":end").to_string();
         if !detect.contains(&j) {
             detect.push(j);
@@ -579,15 +678,25 @@ fn pelvis_landmark(
         if (node.pos - tree.nodes[part].pos).length() > 0.1 * tree.height {
             break;
         }
-        if syn.names("pelvis", &syn.normalise(&skeleton.joints[node.joint].name).base) {
+        if syn.names(
+            "pelvis",
+            &syn.normalise(&skeleton.joints[node.joint].name).base,
+        ) {
             let name = tree.name(skeleton, j);
             return if j == part {
-                (j, 1.0, format!("name '{name}' and structure ({rule}) agree"))
+                (
+                    j,
+                    1.0,
+                    format!("name '{name}' and structure ({rule}) agree"),
+                )
             } else {
                 (
                     j,
                     0.85,
-                    format!("name '{name}', just above '{}' ({rule})", tree.name(skeleton, part)),
+                    format!(
+                        "name '{name}', just above '{}' ({rule})",
+                        tree.name(skeleton, part)
+                    ),
                 )
             };
         }

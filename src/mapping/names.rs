@@ -312,7 +312,9 @@ mod tests {
     #[test]
     fn synonyms_parse_extend_and_refuse_unknown_roles() {
         let b = Synonyms::builtin();
-        assert!(b.names("hip", "upleg") && b.names("knee", "calf") && b.names("clavicle", "collar"));
+        assert!(
+            b.names("hip", "upleg") && b.names("knee", "calf") && b.names("clavicle", "collar")
+        );
         let more = Synonyms::parse(
             "(format_version: 1, prefixes: [\"MyRig\"], landmarks: {\"knee\": [\"Genou\"]})",
             "more.ron",
@@ -326,6 +328,9 @@ mod tests {
             "bad.ron",
         )
         .unwrap_err();
-        assert!(err.to_string().contains("'tail' is not a landmark role"), "{err}");
+        assert!(
+            err.to_string().contains("'tail' is not a landmark role"),
+            "{err}"
+        );
     }
 }

@@ -284,7 +284,10 @@ pub(crate) fn find_chains(tree: &Tree, skeleton: &Skeleton) -> Result<Chains, St
         .iter()
         .map(|&n| tree.nodes[n].pos.dot(tree.up))
         .fold(f64::MAX, f64::min);
-    ends.sort_by(|&a, &b| tree.rel_height(a, floor).total_cmp(&tree.rel_height(b, floor)));
+    ends.sort_by(|&a, &b| {
+        tree.rel_height(a, floor)
+            .total_cmp(&tree.rel_height(b, floor))
+    });
     let second = tree.rel_height(ends[1], floor);
     let on_floor: Vec<usize> = ends
         .iter()

@@ -142,7 +142,10 @@ fn print_mapping(clip: &Clip) {
     }
     match &auto {
         Ok(a) => {
-            println!("  {:<15} {:<22} {:>4}  how (automatic detection)", "landmark", "source", "conf");
+            println!(
+                "  {:<15} {:<22} {:>4}  how (automatic detection)",
+                "landmark", "source", "conf"
+            );
             for f in &a.findings {
                 let used = builtin.map(|m| m.landmarks[&f.landmark].as_str());
                 let source = match used {

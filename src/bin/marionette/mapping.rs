@@ -44,7 +44,10 @@ pub fn mapping(args: Args) -> Result<()> {
     let text = auto.to_ron(&title);
     // What is written must read back as exactly this mapping.
     let back = Mapping::parse(&text, &args.out.display().to_string())?;
-    anyhow::ensure!(back == auto.mapping, "the mapping written does not read back the same");
+    anyhow::ensure!(
+        back == auto.mapping,
+        "the mapping written does not read back the same"
+    );
     marionette::io::write_atomic(&args.out, text.as_bytes())
         .with_context(|| args.out.display().to_string())?;
     let by_name = auto
@@ -59,7 +62,7 @@ pub fn mapping(args: Args) -> Result<()> {
         .map(|f| f.landmark.as_str())
         .collect::<Vec<_>>();
     println!(
-        "wrote {} ({} landmarks: {} by name and structure or name, {} by structure alone{})",
+        "wrote {} ({} landmarks: {} by name, {} by structure alone{})",
         args.out.display(),
         auto.findings.len(),
         by_name,
