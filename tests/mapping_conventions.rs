@@ -466,6 +466,20 @@ impl Builder {
         });
         self.joints.len() - 1
     }
+
+    /// Adds a joint at its link's origin (a model joint) and expects `landmark` there.
+    fn add_as(
+        &mut self,
+        expect: &mut BTreeMap<String, String>,
+        landmark: String,
+        name: &str,
+        parent: usize,
+        link: Option<usize>,
+    ) -> usize {
+        let j = self.add(name, Some(parent), link, DVec3::ZERO);
+        expect.insert(landmark, self.joints[j].name.clone());
+        j
+    }
 }
 
 fn fill(t: &str, left: bool) -> String {
@@ -591,21 +605,19 @@ fn build(rig: &Rig, motion: &ModelClip) -> (Clip, BTreeMap<String, String>) {
                 expect.insert(sided("clavicle"), n);
             }
         }
-        let sh = b.add(
+        let sh = b.add_as(
+            &mut expect,
+            sided("shoulder"),
             &f(rig.shoulder),
-            Some(arm_parent),
+            arm_parent,
             lk("shoulder"),
-            DVec3::ZERO,
         );
-        expect.insert(sided("shoulder"), b.joints[sh].name.clone());
         if let Some(t) = rig.twist {
             b.add(&f(t), Some(sh), lk("shoulder"), y(-0.15));
         }
-        let el = b.add(&f(rig.elbow), Some(sh), lk("elbow"), DVec3::ZERO);
-        expect.insert(sided("elbow"), b.joints[el].name.clone());
-        let wr = b.add(&f(rig.wrist), Some(el), lk("wrist"), DVec3::ZERO);
+        let el = b.add_as(&mut expect, sided("elbow"), &f(rig.elbow), sh, lk("elbow"));
+        let wr = b.add_as(&mut expect, sided("wrist"), &f(rig.wrist), el, lk("wrist"));
         let wr_name = b.joints[wr].name.clone();
-        expect.insert(sided("wrist"), wr_name.clone());
         let hand_end = model.joints[model.joint_index(&sided("wrist")).unwrap()]
             .end_site
             .unwrap();
@@ -654,16 +666,19 @@ fn build(rig: &Rig, motion: &ModelClip) -> (Clip, BTreeMap<String, String>) {
         if let Some(bt) = rig.buttock {
             leg_parent = b.add(&f(bt), Some(leg_parent), link("pelvis"), hip_at + y(0.05));
         }
-        let th = b.add(&f(rig.thigh), Some(leg_parent), lk("hip"), DVec3::ZERO);
-        expect.insert(sided("hip"), b.joints[th].name.clone());
+        let th = b.add_as(
+            &mut expect,
+            sided("hip"),
+            &f(rig.thigh),
+            leg_parent,
+            lk("hip"),
+        );
         if let Some(t) = rig.thigh_twist {
             b.add(&f(t), Some(th), lk("hip"), y(-0.2));
         }
-        let kn = b.add(&f(rig.knee), Some(th), lk("knee"), DVec3::ZERO);
-        expect.insert(sided("knee"), b.joints[kn].name.clone());
-        let ft = b.add(&f(rig.foot), Some(kn), lk("ankle"), DVec3::ZERO);
+        let kn = b.add_as(&mut expect, sided("knee"), &f(rig.knee), th, lk("knee"));
+        let ft = b.add_as(&mut expect, sided("ankle"), &f(rig.foot), kn, lk("ankle"));
         let ft_name = b.joints[ft].name.clone();
-        expect.insert(sided("ankle"), ft_name.clone());
         let toe_tip = model.joints[model.joint_index(&sided("ankle")).unwrap()]
             .end_site
             .unwrap();

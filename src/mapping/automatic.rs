@@ -281,6 +281,22 @@ fn found(v: &ChainView, skeleton: &Skeleton, slots: &[Slot], placed: &[Placed]) 
         .collect()
 }
 
+/// Places the landmarks of one chain: its view, the placement, the findings.
+fn place<'a>(
+    tree: &'a Tree,
+    skeleton: &Skeleton,
+    nodes: &'a [usize],
+    syn: &Synonyms,
+    what: &str,
+    slots: impl Fn(&ChainView) -> Result<Vec<Slot>, String>,
+) -> Result<(ChainView<'a>, Vec<Placed>, Vec<Found>), String> {
+    let v = view(tree, skeleton, nodes, syn);
+    let slots = slots(&v)?;
+    let placed = v.align(syn, &slots, what)?;
+    let f = found(&v, skeleton, &slots, &placed);
+    Ok((v, placed, f))
+}
+
 /// Horizontal distance of `a` from `b` (perpendicular to `up`).
 fn horizontal(a: DVec3, b: DVec3, up: DVec3) -> f64 {
     let d = a - b;
@@ -519,29 +535,23 @@ fn detect_inner(
     )];
 
     // Spine: waist, neck, head.
-    let sv = view(&tree, skeleton, &spine, syn);
-    let slots = spine_slots(&sv, chest)?;
-    let placed = sv.align(syn, &slots, "spine")?;
-    let spine_found = found(&sv, skeleton, &slots, &placed);
+    let (_, _, spine_found) = place(&tree, skeleton, &spine, syn, "spine", |v| {
+        spine_slots(v, chest)
+    })?;
     let neck_node = spine_found[1].node;
 
     // Legs and arms, sides not yet told.
     let mut leg_found = vec![];
     let mut leg_views = vec![];
     for leg in &legs {
-        let v = view(&tree, skeleton, leg, syn);
-        let slots = leg_slots(&v)?;
-        let placed = v.align(syn, &slots, "leg")?;
-        leg_found.push(found(&v, skeleton, &slots, &placed));
+        let (v, _, f) = place(&tree, skeleton, leg, syn, "leg", leg_slots)?;
+        leg_found.push(f);
         leg_views.push(v);
     }
     let mut arm_found = vec![];
     let mut arm_views = vec![];
     for arm in &arms {
-        let v = view(&tree, skeleton, arm, syn);
-        let slots = arm_slots(&v)?;
-        let placed = v.align(syn, &slots, "arm")?;
-        let mut f = found(&v, skeleton, &slots, &placed);
+        let (v, placed, mut f) = place(&tree, skeleton, arm, syn, "arm", arm_slots)?;
         // No clavicle joint (the arm starts at the chest hub): the neck base stands in for the
         // clavicle's inner end, as in the engine's own fall21 skeleton.
         if placed[0].index == 0 && !placed[0].by_name {
