@@ -974,6 +974,11 @@ fn the_mapping_file_written_reads_back_as_the_same_mapping() {
     // And detect() falls back to it when no built-in file fits.
     assert!(Mapping::builtin_for(&clip.skeleton).is_none());
     assert_eq!(Mapping::detect_clip(&clip).unwrap(), auto.mapping);
+    // Without a clip, detect() looks at the rest pose (a T pose here) and finds the same.
+    assert_eq!(
+        Mapping::detect(&clip.skeleton).unwrap().landmarks,
+        auto.mapping.landmarks
+    );
 }
 
 /// A one-frame clip of a skeleton at rest.

@@ -413,16 +413,16 @@ fn spine_slots(v: &ChainView, chest: usize) -> Result<Vec<Slot>, String> {
         .iter()
         .position(|&x| x == chest)
         .expect("the chest hub is on the spine");
-    let d = v.distinct();
-    let waist = d.get(1).copied().unwrap_or(c).min(c);
-    let neck = (c + 1..n - 1)
-        .find(|&i| (v.pos(i) - v.pos(c)).length() >= v.eps)
-        .unwrap_or(c);
     if n < 4 || c + 1 >= n {
         return Err(format!(
             "the spine chain has {n} points, too few for pelvis, waist, neck and head"
         ));
     }
+    let d = v.distinct();
+    let waist = d.get(1).copied().unwrap_or(c).min(c);
+    let neck = (c + 1..n - 1)
+        .find(|&i| (v.pos(i) - v.pos(c)).length() >= v.eps)
+        .unwrap_or(c);
     Ok(vec![
         Slot {
             role: "waist",
