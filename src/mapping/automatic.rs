@@ -8,10 +8,11 @@
 //! toe; clavicle, shoulder, elbow, wrist, hand; waist ≤ chest hub ≤ neck, head). By structure:
 //! the hip, knee and ankle start the two longest consecutive bones of the leg (thigh and shin),
 //! the toe is the next point after the ankle; the shoulder is the first point of the arm 5 % of
-//! `H` out from the chest hub, the clavicle the point before it, elbow, wrist and hand the next
-//! distinct points; the waist is the first point above the pelvis, the neck the first above the
-//! chest hub, the head the end of the chain. Points within 0.1 % of `H` of the point before are
-//! the same place (zero-length helper joints). The placement actually used is the order-keeping
+//! `H` out from the chest hub (or the next one, when the two bones from there are longer: a long
+//! clavicle), the clavicle the point before it, elbow, wrist and hand the next distinct points;
+//! the waist is the first point above the pelvis, the neck the first above the chest hub, the
+//! head the joint where the chain's end branches (eyes, face), else its end. Points within 0.1 %
+//! of `H` of the point before are the same place (zero-length helper joints). The placement actually used is the order-keeping
 //! assignment of maximum score (dynamic programming over the chain), a point scoring 1 for a name
 //! that is a synonym of the landmark (0.9 if it sits on its parent: a zero-length helper) plus 0.2
 //! where structure puts the landmark: names decide where they exist, structure fills the rest and
@@ -363,9 +364,17 @@ fn arm_slots(v: &ChainView) -> Result<Vec<Slot>, String> {
         ));
     }
     let out = 0.05 * v.tree.height;
-    let k = (1..d.len() - 3)
+    let k0 = (1..d.len() - 3)
         .find(|&k| horizontal(v.pos(d[k]), v.pos(0), v.tree.up) >= out)
         .unwrap_or(1);
+    // A long clavicle reaches that far out itself: then the upper arm and forearm (the two
+    // longest consecutive bones) start one point later.
+    let seg = |a: usize| (v.pos(d[a]) - v.pos(d[a + 1])).length();
+    let k = if k0 + 3 < d.len() && seg(k0 + 1) + seg(k0 + 2) > seg(k0) + seg(k0 + 1) {
+        k0 + 1
+    } else {
+        k0
+    };
     let hand = d.get(k + 3).copied().unwrap_or(n - 1);
     Ok(vec![
         Slot {
@@ -380,7 +389,8 @@ fn arm_slots(v: &ChainView) -> Result<Vec<Slot>, String> {
             lo: 1,
             hi: n - 1,
             structural: d[k],
-            rule: "the first point of the arm 5 % of the height out from the chest",
+            rule: "the first point of the arm 5 % of the height out from the chest, or the next \
+                   one when that starts the two longest bones (upper arm, forearm)",
         },
         Slot {
             role: "elbow",
@@ -423,6 +433,11 @@ fn spine_slots(v: &ChainView, chest: usize) -> Result<Vec<Slot>, String> {
     let neck = (c + 1..n - 1)
         .find(|&i| (v.pos(i) - v.pos(c)).length() >= v.eps)
         .unwrap_or(c);
+    // The head: where the chain's end branches (eyes, jaw, face), else the chain's end.
+    let head = (neck + 1..n)
+        .rev()
+        .find(|&i| v.tree.nodes[v.nodes[i]].children.len() >= 2)
+        .unwrap_or(n - 1);
     Ok(vec![
         Slot {
             role: "waist",
@@ -442,8 +457,8 @@ fn spine_slots(v: &ChainView, chest: usize) -> Result<Vec<Slot>, String> {
             role: "head",
             lo: 1,
             hi: n - 1,
-            structural: n - 1,
-            rule: "the end of the head chain",
+            structural: head,
+            rule: "where the head chain's end branches (eyes, face), else its end",
         },
     ])
 }
