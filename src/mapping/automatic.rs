@@ -779,3 +779,29 @@ impl AutoMapping {
         s
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn geometry_tells_the_sides_names_only_when_it_cannot() {
+        use Side::{Centre, Left, Right};
+        // Agreement, and geometry against the names: geometry wins with a note.
+        assert_eq!(
+            tell_sides("legs", Some(true), (Left, Right)).unwrap().1,
+            1.0
+        );
+        let (first_left, conf, note) = tell_sides("legs", Some(false), (Left, Right)).unwrap();
+        assert!(!first_left && conf < 1.0 && note.contains("geometry wins"));
+        // Geometry undecided: the names decide; one side word is enough.
+        let (first_left, conf, _) = tell_sides("arms", None, (Centre, Left)).unwrap();
+        assert!(!first_left && conf < 0.9);
+        // Neither: a clear refusal.
+        let e = tell_sides("arms", None, (Centre, Centre)).unwrap_err();
+        assert!(
+            e.contains("cannot tell the left arms from the right"),
+            "{e}"
+        );
+    }
+}

@@ -350,3 +350,59 @@ pub(crate) fn find_chains(tree: &Tree, skeleton: &Skeleton) -> Result<Chains, St
         arms: [tree.path(chest, hands[0]), tree.path(chest, hands[1])],
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::skeleton::Joint;
+
+    /// A T: a root with a long arm each way, a short twig on the left arm's bone and a short
+    /// finger off its end.
+    fn t_tree() -> (Skeleton, Tree) {
+        let j = |name: &str, parent: Option<usize>, o: [f64; 3]| Joint {
+            name: name.into(),
+            parent,
+            offset: DVec3::from_array(o),
+            end_site: None,
+        };
+        let sk = Skeleton {
+            joints: vec![
+                j("root", None, [0.0, 1.0, 0.0]),
+                j("a", Some(0), [0.5, 0.0, 0.0]),
+                j("b", Some(1), [0.5, 0.0, 0.0]),
+                j("twist", Some(1), [0.2, 0.0, 0.0]),
+                j("finger", Some(2), [0.05, 0.0, 0.0]),
+                j("c", Some(0), [-0.5, 0.0, 0.0]),
+                j("d", Some(5), [-0.5, 0.0, 0.0]),
+                j("e", Some(0), [0.0, -1.0, 0.0]),
+            ],
+        };
+        let mut g = vec![Transform::IDENTITY; sk.joints.len()];
+        let t: Vec<DVec3> = sk.joints.iter().map(|j| j.offset).collect();
+        crate::skeleton::forward_kinematics(&sk, &t, &vec![glam::DQuat::IDENTITY; t.len()], &mut g);
+        let tree = Tree::new(&sk, &g);
+        (sk, tree)
+    }
+
+    #[test]
+    fn limb_ends_skip_bones_lying_on_a_bone_and_short_twigs() {
+        let (sk, tree) = t_tree();
+        let mut ends: Vec<String> = limb_ends(&tree)
+            .iter()
+            .map(|&n| tree.name(&sk, n))
+            .collect();
+        ends.sort();
+        assert_eq!(ends, ["d", "e", "finger"]);
+        assert!((tree.dist(4, 6) - 2.05).abs() < 1e-12);
+        assert_eq!(tree.lca(4, 3), 1);
+        assert_eq!(tree.path(0, 4), [0, 1, 2, 4]);
+    }
+
+    #[test]
+    fn segment_distance_is_to_the_nearest_point_of_the_segment() {
+        let (a, b) = (DVec3::ZERO, DVec3::X);
+        assert!((segment_distance(DVec3::new(0.5, 1.0, 0.0), a, b) - 1.0).abs() < 1e-12);
+        assert!((segment_distance(DVec3::new(2.0, 0.0, 0.0), a, b) - 1.0).abs() < 1e-12);
+        assert!((segment_distance(DVec3::new(3.0, 4.0, 0.0), a, a) - 5.0).abs() < 1e-12);
+    }
+}
