@@ -5,11 +5,21 @@
 //! hand, hip, knee, ankle, toe), the source joint or End Site that marks it. [`retarget`] turns a
 //! clip into the model's DOF angle trajectories plus root motion
 //! ([`ModelClip`](crate::humanoid::ModelClip)).
+//!
+//! A skeleton none of the built-in files fits is mapped automatically ([`detect_automatic`]):
+//! the five chains by structure ([`structure`]), the landmarks along them by names
+//! ([`names`], synonyms in `builtin/synonyms.ron`) and bone lengths, left and right by
+//! geometry, each landmark with a confidence and a reason.
 
+mod automatic;
 mod fidelity;
+pub mod names;
 mod retarget;
+mod structure;
 
+pub use automatic::{AutoMapping, Finding, detect_automatic};
 pub use fidelity::{EffectorError, effector_errors};
+pub use names::{NormalName, Synonyms};
 pub use retarget::retarget;
 
 use std::collections::BTreeMap;
@@ -18,7 +28,7 @@ use std::sync::OnceLock;
 
 use serde::{Deserialize, Serialize};
 
-use crate::skeleton::Skeleton;
+use crate::skeleton::{Clip, Skeleton, Transform, forward_kinematics};
 
 /// The RON format version this build reads.
 pub const FORMAT_VERSION: u32 = 1;
@@ -91,15 +101,16 @@ pub enum MappingError {
         /// Similar joint names of the skeleton, if any.
         hint: String,
     },
-    /// No built-in mapping fits the skeleton.
+    /// Neither a built-in mapping nor the automatic detection fits: not a humanoid (or not
+    /// standing in the frame looked at).
     #[error(
-        "no built-in mapping fits this skeleton (root '{root}'); built-in: {builtins}. Copy one of src/mapping/builtin/*.ron, name your joints in it and pass it with --mapping"
+        "no mapping for this skeleton (root '{root}'): no built-in mapping fits and it was not recognised as a humanoid: {reason}. Write a mapping (marionette mapping FILE.bvh --out my.ron gives a start when the figure is a humanoid) and pass it with --mapping"
     )]
-    NoMatch {
+    NotHumanoid {
         /// The skeleton's root joint.
         root: String,
-        /// The built-in mapping files.
-        builtins: String,
+        /// What could not be found.
+        reason: String,
     },
 }
 
@@ -175,24 +186,44 @@ impl Mapping {
         })
     }
 
-    /// The built-in mapping whose `detect` joints are all in `skeleton`.
-    pub fn detect(skeleton: &Skeleton) -> Result<Mapping, MappingError> {
+    /// The built-in mapping whose `detect` joints are all in `skeleton`, if any.
+    pub fn builtin_for(skeleton: &Skeleton) -> Option<&'static Mapping> {
         Mapping::builtins()
             .iter()
             .find(|m| m.detect.iter().all(|d| skeleton.index(d).is_some()))
-            .cloned()
-            .ok_or_else(|| MappingError::NoMatch {
-                root: skeleton
-                    .joints
-                    .first()
-                    .map(|j| j.name.clone())
-                    .unwrap_or_default(),
-                builtins: BUILTIN
-                    .iter()
-                    .map(|(n, _)| *n)
-                    .collect::<Vec<_>>()
-                    .join(", "),
-            })
+    }
+
+    /// The mapping of a skeleton: the built-in one whose `detect` joints it has, else the
+    /// automatic one ([`detect_automatic`]) found on its rest pose. With a clip at hand prefer
+    /// [`Mapping::detect_clip`], which looks at the first frame (rest poses are often not
+    /// standing figures).
+    pub fn detect(skeleton: &Skeleton) -> Result<Mapping, MappingError> {
+        if let Some(m) = Mapping::builtin_for(skeleton) {
+            return Ok(m.clone());
+        }
+        let rest = rest_globals(skeleton);
+        Ok(detect_automatic(skeleton, &rest, Synonyms::builtin())?.mapping)
+    }
+
+    /// The mapping of a clip's skeleton: the built-in one whose `detect` joints it has, else the
+    /// automatic one found on the clip's first frame.
+    pub fn detect_clip(clip: &Clip) -> Result<Mapping, MappingError> {
+        if let Some(m) = Mapping::builtin_for(&clip.skeleton) {
+            return Ok(m.clone());
+        }
+        Ok(Mapping::automatic(clip, Synonyms::builtin())?.mapping)
+    }
+
+    /// The automatic mapping of a clip's skeleton (built-in files not consulted), found on its
+    /// first frame with these synonyms.
+    pub fn automatic(clip: &Clip, synonyms: &Synonyms) -> Result<AutoMapping, MappingError> {
+        let mut g = vec![];
+        if clip.frame_count() > 0 {
+            clip.globals(0, &mut g);
+        } else {
+            g = rest_globals(&clip.skeleton);
+        }
+        detect_automatic(&clip.skeleton, &g, synonyms)
     }
 
     /// Resolves a landmark's source name on `skeleton`.
@@ -230,6 +261,15 @@ impl Mapping {
         }
         Ok(Landmark { joint, end_site })
     }
+}
+
+/// Global transforms of the rest pose (every rotation identity, the root at its offset).
+fn rest_globals(skeleton: &Skeleton) -> Vec<Transform> {
+    let n = skeleton.joints.len();
+    let t: Vec<glam::DVec3> = skeleton.joints.iter().map(|j| j.offset).collect();
+    let mut g = vec![Transform::IDENTITY; n];
+    forward_kinematics(skeleton, &t, &vec![glam::DQuat::IDENTITY; n], &mut g);
+    g
 }
 
 #[cfg(test)]

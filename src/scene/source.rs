@@ -119,7 +119,7 @@ pub fn load_motion(src: &ClipSource, base: &Path) -> Result<LoadedMotion, SceneE
             }
             let mapping = match &src.mapping {
                 Some(m) => Some(Mapping::load(&resolve_path(m, base))?),
-                None => Mapping::detect(&clip.skeleton).ok(),
+                None => Mapping::detect_clip(&clip).ok(),
             };
             Ok(LoadedMotion::Captured {
                 bvh: Box::new(bvh),

@@ -17,10 +17,11 @@ pub fn read_bvh(file: &Path) -> Result<bvh::Bvh> {
     Ok(b)
 }
 
-/// The mapping file given, else the built-in mapping detected from the clip's joint names.
+/// The mapping file given, else the built-in mapping detected from the clip's joint names, else
+/// the automatic one.
 pub fn mapping_for(clip: &Clip, mapping: &Option<PathBuf>) -> Result<Mapping> {
     Ok(match mapping {
         Some(p) => Mapping::load(p)?,
-        None => Mapping::detect(&clip.skeleton)?,
+        None => Mapping::detect_clip(clip)?,
     })
 }

@@ -82,6 +82,7 @@ pub fn inspect(args: Args) -> Result<()> {
             end
         );
     }
+    print_mapping(&clip);
     // Ground contact and flight from the feet: the mapping's ankles and toes, else by name.
     let Some(c) = clip_contacts(&clip, 0.03, 0.1) else {
         println!("contact     (no feet found: no joint named foot/toe/ankle on each side)");
@@ -126,4 +127,60 @@ pub fn inspect(args: Args) -> Result<()> {
         );
     }
     Ok(())
+}
+
+// ---- The mapping section (landmarks onto the models) ----
+
+/// Prints the landmark mapping `export`/`render` would use without `--mapping` (the built-in
+/// file that fits, else the automatic one) and how each landmark was found.
+fn print_mapping(clip: &Clip) {
+    use marionette::mapping::{Mapping, Synonyms};
+    let builtin = Mapping::builtin_for(&clip.skeleton);
+    let auto = Mapping::automatic(clip, Synonyms::builtin());
+    match (builtin, &auto) {
+        (Some(m), _) => println!(
+            "mapping     built-in '{}' (its joints {} are all present; --mapping FILE overrides)",
+            m.name,
+            m.detect.join(", ")
+        ),
+        (None, Ok(_)) => println!(
+            "mapping     automatic, from the names and the structure of the first frame (no \
+             built-in mapping fits; `marionette mapping FILE --out my.ron` writes it to edit)"
+        ),
+        (None, Err(e)) => {
+            println!("mapping     none: {e}");
+            return;
+        }
+    }
+    match &auto {
+        Ok(a) => {
+            println!(
+                "  {:<15} {:<22} {:>4}  how (automatic detection)",
+                "landmark", "source", "conf"
+            );
+            for f in &a.findings {
+                let used = builtin.map(|m| m.landmarks[&f.landmark].as_str());
+                let source = match used {
+                    Some(u) if u != f.source => format!("{u} (auto: {})", f.source),
+                    Some(u) => u.to_string(),
+                    None => f.source.clone(),
+                };
+                println!(
+                    "  {:<15} {:<22} {:>4.2}  {}",
+                    f.landmark, source, f.confidence, f.reason
+                );
+            }
+            for n in &a.notes {
+                println!("  note: {n}");
+            }
+        }
+        Err(e) => {
+            println!("  automatic detection: {e}");
+            if let Some(m) = builtin {
+                for (l, src) in &m.landmarks {
+                    println!("  {l:<15} {src}");
+                }
+            }
+        }
+    }
 }

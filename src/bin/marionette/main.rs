@@ -6,6 +6,7 @@ mod common;
 mod eval;
 mod export;
 mod inspect;
+mod mapping;
 mod render;
 mod run;
 
@@ -28,6 +29,9 @@ enum Command {
     Inspect(inspect::Args),
     /// Export a BVH file's motion: global joint positions, joint angles on a model, or BVH.
     Export(export::Args),
+    /// Find a BVH skeleton's landmark mapping automatically (names and structure) and write it
+    /// as an editable mapping file for --mapping.
+    Mapping(mapping::Args),
     /// Draw a motion (BVH or keyframed .ron clip) as a filmstrip PNG or an animated GIF.
     Render(render::Args),
     /// Run a scene file; outputs go to one folder (default out/<scene name>/) with report.json.
@@ -42,6 +46,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Inspect(a) => inspect::inspect(a),
         Command::Export(a) => export::export(a),
+        Command::Mapping(a) => mapping::mapping(a),
         Command::Render(a) => render::render(a),
         Command::Run(a) => run::run(a),
         Command::Eval(a) => eval::eval(a),
