@@ -6,6 +6,7 @@ use crate::dynamics::forces::external::Push;
 use crate::dynamics::forces::limits::JointLimitParams;
 use crate::dynamics::integrator::Integrator;
 use crate::humanoid::ranges::{AgeGroup, RangeTable};
+use crate::humanoid::strength::torque_limits;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
@@ -37,6 +38,10 @@ pub struct FallConfig {
     pub ranges: Ranges,
     /// Joint-model gains (friction inside the range, spring and damper past it).
     pub limits: JointLimitParams,
+    /// Strength: the PD torque range `(τ_min, τ_max)` per DOF (N·m, model order) the dynamics
+    /// clamps to; [`FallConfig::paper`] takes [`torque_limits`] of the age group; `None` =
+    /// unbounded.
+    pub torque_limits_nm: Option<Vec<(f64, f64)>>,
     /// Initial standing pose (deg, 21 DOFs), held by the stance gains until `control_start_s`.
     pub stance_pose_deg: Vec<f64>,
     /// Stance PD stiffness per DOF (N·m/rad).
@@ -57,8 +62,10 @@ pub struct FallConfig {
     pub dt_s: f64,
     /// Integration scheme.
     pub integrator: Integrator,
-    /// Simulated time (s).
+    /// Simulated time (s), counted from the end of the settling phase.
     pub duration_s: f64,
+    /// Longest settling phase before the run (s): the standing body is relaxed to rest first.
+    pub settle_max_s: f64,
     /// Floor contact parameters.
     pub contact: ContactParams,
     /// Damage weight w_i per link name (links not listed weigh 1).
@@ -140,6 +147,7 @@ impl FallConfig {
             gravity: 9.81,
             ranges: Ranges::Builtin(group),
             limits: JointLimitParams::default(),
+            torque_limits_nm: Some(torque_limits(group)),
             stance_pose_deg: stance.clone(),
             stance_kp: kp.clone(),
             stance_kv: kv.clone(),
@@ -153,6 +161,7 @@ impl FallConfig {
                 implicit_damping: true,
             },
             duration_s: 3.0,
+            settle_max_s: 3.0,
             contact: ContactParams::default(),
             damage_weights: w,
             record_hz: 60.0,
