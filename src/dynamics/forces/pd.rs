@@ -95,7 +95,8 @@ mod tests {
             .with_torque_limits(vec![(-30.0, 50.0)]);
         assert_eq!(pd.torque(0, 0.0, 0.0), (50.0, 0.0));
         assert_eq!(pd.torque(0, 2.0, 0.0), (-30.0, 0.0));
-        assert_eq!(pd.torque(0, 0.9, 0.0), (10.0, 10.0));
+        let (tau, kv) = pd.torque(0, 0.9, 0.0);
+        assert!((tau - 10.0).abs() < 1e-9 && kv == 10.0);
         assert!(pd.saturates(0, 50.0) && !pd.saturates(0, 10.0));
     }
 }

@@ -90,10 +90,11 @@ pub struct LinkImpact {
     pub damage_n: f64,
 }
 
-/// The pelvis in the fall: published video analyses of real falls of older adults give a hip
+/// The pelvis in the fall, to set beside video analyses of real falls of older adults: a hip
 /// impact velocity of about 2.1 ± 0.6 m/s and a descent time of 0.58 ± 0.26 s from the start of
-/// descent (Choi, Wakeling & Robinovitch 2015, *Kinematic analysis of video-captured falls
-/// experienced by older adults in long-term care*, J. Biomech. 48:911–920).
+/// descent (the values issue 9 quotes; the study is Choi, Wakeling & Robinovitch 2015,
+/// *Kinematic analysis of video-captured falls experienced by older adults in long-term care*,
+/// J. Biomech. 48:911–920).
 #[derive(Clone, Copy, Debug, PartialEq, Default, Serialize, Deserialize)]
 pub struct PelvisImpact {
     /// Speed into the floor of the pelvis box's centre at touchdown (m/s).
