@@ -16,6 +16,7 @@
 pub mod anthropometry;
 pub mod body;
 mod definition;
+pub mod export;
 mod joint_angles;
 mod model_clip;
 pub mod ranges;

@@ -2,6 +2,7 @@
 //!
 //! This file parses the arguments, dispatches to one module per command and prints errors.
 
+mod body;
 mod common;
 mod export;
 mod inspect;
@@ -31,6 +32,9 @@ enum Command {
     Render(render::Args),
     /// Run a scene file; outputs go to one folder (default out/<scene name>/) with report.json.
     Run(run::Args),
+    /// Write the articulated fall21 body (links, joints, axes, ranges, masses, centres of mass,
+    /// inertias, contact boxes) as URDF and/or MJCF for an age group, height and mass.
+    Body(body::Args),
 }
 
 fn main() -> ExitCode {
@@ -40,6 +44,7 @@ fn main() -> ExitCode {
         Command::Export(a) => export::export(a),
         Command::Render(a) => render::render(a),
         Command::Run(a) => run::run(a),
+        Command::Body(a) => body::body(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
