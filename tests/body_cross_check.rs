@@ -1,5 +1,8 @@
 //! The body as standard files, cross-checked by independent engines: the URDF loaded in
-//! Pinocchio gives the engine's RNEA and ABA to 1e-9 on random states (`tools/pinocchio_check.py`).
+//! Pinocchio gives the engine's RNEA and ABA to 1e-9 on random states (`tools/pinocchio_check.py`);
+//! the MJCF loaded in MuJoCo, driven by the same joint torques and push, follows the pushed fall's
+//! head height until the first link other than the feet touches the floor
+//! (`tools/mujoco_check.py`; within 3 cm: MuJoCo's own contact holds the feet).
 //! The Python side runs with the virtual environment `.ci/run` creates (`.venv/`, with `pin`);
 //! when it is missing the test prints a SKIPPED line, except under CI, where it fails.
 
@@ -125,4 +128,94 @@ fn pinocchio_agrees_with_the_engines_rnea_and_aba_on_the_urdf() {
     println!("{text}");
     std::fs::remove_dir_all(&dir).ok();
     assert!(out.status.success(), "pinocchio check failed: {text}");
+}
+
+#[test]
+fn mujoco_follows_the_pushed_fall_until_first_contact() {
+    use marionette::experiments::fall::{FallConfig, simulate_fall};
+    use marionette::humanoid::export::to_mjcf;
+    let Some(py) = venv_python() else { return };
+    let cfg = FallConfig::paper(AgeGroup::Elderly);
+    let r = simulate_fall(&cfg).unwrap();
+    let body = fall21_body(cfg.height_m, cfg.mass_kg, cfg.gravity).unwrap();
+    let ranges = RangeTable::builtin(AgeGroup::Elderly)
+        .for_model(&body.figure)
+        .unwrap();
+    let mjcf = to_mjcf(&body, &ranges, cfg.gravity);
+    // Until the first link other than the feet touches the floor.
+    let until = r
+        .impacts
+        .iter()
+        .filter(|i| !i.link.ends_with("_foot"))
+        .filter_map(|i| i.touchdown_s)
+        .fold(f64::INFINITY, f64::min);
+    assert!(until.is_finite());
+    let limits = cfg.torque_limits_nm.clone().unwrap();
+    // The paper's controller holds one pose throughout (key pose = stance, same gains).
+    assert_eq!(cfg.key_pose_deg, cfg.stance_pose_deg);
+    assert_eq!(cfg.kp, cfg.stance_kp);
+    let dofs: Vec<_> = body
+        .figure
+        .dofs
+        .iter()
+        .enumerate()
+        .map(|(d, dof)| {
+            json!({
+                "name": dof.name, "target": cfg.stance_pose_deg[d].to_radians(),
+                "kp": cfg.stance_kp[d], "kv": cfg.stance_kv[d],
+                "torque_min": limits[d].0, "torque_max": limits[d].1,
+                "range": [ranges[d].0, ranges[d].1],
+            })
+        })
+        .collect();
+    let neck = body.link_index("head").unwrap();
+    let JointType::Ball { axes } = body.model.bodies[neck].joint else {
+        panic!("the neck is a ball joint")
+    };
+    let start = &r.frames[0];
+    let head: Vec<[f64; 2]> = r
+        .frames
+        .iter()
+        .take_while(|f| f.time_s < until)
+        .map(|f| [f.time_s, f.head_height_m])
+        .collect();
+    let fall = json!({
+        "dt_s": cfg.dt_s, "dofs": dofs, "until_s": until,
+        "neck_axes": [
+            [axes.x_axis.x, axes.y_axis.x, axes.z_axis.x],
+            [axes.x_axis.y, axes.y_axis.y, axes.z_axis.y],
+            [axes.x_axis.z, axes.y_axis.z, axes.z_axis.z],
+        ],
+        "start": {
+            "root_position": start.root_position.to_array(),
+            "root_orientation": start.root_orientation.to_array(),
+            "angles": start.angles,
+        },
+        "push": cfg.push,
+        "limits": cfg.limits,
+        "head_height": head,
+    });
+    let dir = std::env::temp_dir().join(format!("marionette-mujoco-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (xml, fall_path) = (dir.join("fall21.xml"), dir.join("fall.json"));
+    std::fs::write(&xml, mjcf).unwrap();
+    std::fs::write(&fall_path, serde_json::to_string(&fall).unwrap()).unwrap();
+    let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tools/mujoco_check.py");
+    let out = Command::new(&py)
+        .arg(&script)
+        .arg(&xml)
+        .arg(&fall_path)
+        // MuJoCo's own soft contact holds the feet (not the engine's corner springs), so the two
+        // falls part by about 2.6 cm of head height by the first non-foot touchdown (measured).
+        .arg("0.03")
+        .output()
+        .unwrap();
+    let text = format!(
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    println!("{text}");
+    std::fs::remove_dir_all(&dir).ok();
+    assert!(out.status.success(), "mujoco check failed: {text}");
 }

@@ -114,7 +114,8 @@ pub fn to_urdf(body: &HumanBody, ranges: &[(f64, f64)], strength: &[(f64, f64)])
 }
 
 /// The body as MJCF (MuJoCo). `ranges` are per fall21 DOF (rad); the ball joint's range is not
-/// written (MuJoCo limits a ball by one cone angle, the engine per component).
+/// written (MuJoCo limits a ball by one cone angle, the engine per component). The boxes collide
+/// with the floor only, as in the engine (no self-contact).
 pub fn to_mjcf(body: &HumanBody, ranges: &[(f64, f64)], gravity: f64) -> String {
     let mut s = String::new();
     let _ = writeln!(
@@ -129,7 +130,7 @@ pub fn to_mjcf(body: &HumanBody, ranges: &[(f64, f64)], gravity: f64) -> String 
     let _ = writeln!(s, "  <worldbody>");
     let _ = writeln!(
         s,
-        "    <geom name=\"floor\" type=\"plane\" size=\"10 10 0.1\" quat=\"0.7071067811865476 -0.7071067811865476 0 0\"/>"
+        "    <geom name=\"floor\" type=\"plane\" size=\"10 10 0.1\" contype=\"0\" conaffinity=\"1\" quat=\"0.7071067811865476 -0.7071067811865476 0 0\"/>"
     );
     fn write_body(s: &mut String, body: &HumanBody, b: usize, ranges: &[(f64, f64)], depth: usize) {
         let pad = "  ".repeat(depth + 2);
@@ -180,7 +181,7 @@ pub fn to_mjcf(body: &HumanBody, ranges: &[(f64, f64)], gravity: f64) -> String 
         let bx = &body.boxes[b];
         let _ = writeln!(
             s,
-            "{pad}  <geom name=\"{}_box\" type=\"box\" pos=\"{}\" size=\"{}\"/>",
+            "{pad}  <geom name=\"{}_box\" type=\"box\" pos=\"{}\" size=\"{}\" contype=\"1\" conaffinity=\"0\"/>",
             mb.name,
             v3(bx.center),
             v3(bx.half)
