@@ -136,7 +136,13 @@ fn a_step_above_the_stability_bound_is_refused_up_front() {
     let mut cfg = FallConfig::paper(AgeGroup::Elderly);
     cfg.dt_s = 5e-3;
     let bound = match simulate_fall(&cfg) {
-        Err(SimError::Unstable { what, bound_s, .. }) => {
+        Err(SimError::Unstable {
+            what,
+            bound_s,
+            body,
+            ..
+        }) => {
+            println!("stability bound {bound_s:.3e} s: {what} of {body}");
             assert!(bound_s < 5e-3);
             assert!(!what.is_empty());
             bound_s

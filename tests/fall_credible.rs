@@ -49,9 +49,12 @@ fn the_elderly_fall_lands_the_pelvis_as_real_falls_do() {
     let f = r.impacts[p].peak_force_n;
     // Hip impact forces of standing-height falls: about 2.6–5.6 kN.
     assert!((2600.0..=5600.0).contains(&f), "pelvis peak {f} N");
-    assert!(r.pelvis.rebound_m < 0.05, "pelvis rebound {} m", r.pelvis.rebound_m);
+    assert!(
+        r.pelvis.rebound_m < 0.05,
+        "pelvis rebound {} m",
+        r.pelvis.rebound_m
+    );
 }
-
 
 #[test]
 fn the_standing_start_is_at_rest_before_the_push() {
@@ -59,9 +62,17 @@ fn the_standing_start_is_at_rest_before_the_push() {
     let s = r.standing;
     println!("{s:?}");
     for f in [s.min_foot_force_n, s.max_foot_force_n] {
-        assert!((f - s.weight_n).abs() < 0.01 * s.weight_n, "foot force {f} N of {} N", s.weight_n);
+        assert!(
+            (f - s.weight_n).abs() < 0.01 * s.weight_n,
+            "foot force {f} N of {} N",
+            s.weight_n
+        );
     }
-    assert!(s.max_kinetic_energy_j < 2.5e-3, "kinetic energy {} J", s.max_kinetic_energy_j);
+    assert!(
+        s.max_kinetic_energy_j < 2.5e-3,
+        "kinetic energy {} J",
+        s.max_kinetic_energy_j
+    );
 }
 
 /// Relative change of `b` from `a`.
@@ -100,6 +111,10 @@ fn damage_is_stable_under_half_the_step_and_contact_changes_of_20_percent() {
         );
         worst = worst.max(d);
     }
-    println!("base damage {:.0} N; largest change {:.1} %", base.damage, 100.0 * worst);
+    println!(
+        "base damage {:.0} N; largest change {:.1} %",
+        base.damage,
+        100.0 * worst
+    );
     assert!(worst < 0.10, "damage changed by {:.1} %", 100.0 * worst);
 }

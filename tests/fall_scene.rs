@@ -45,7 +45,10 @@ fn pushed_from_the_front_the_figure_falls_backward_and_rests() {
     let pelvis = &r["pelvis"];
     assert!(pelvis["impact_velocity_m_s"].as_f64().unwrap() > 0.5);
     assert!(pelvis["descent_time_s"].as_f64().unwrap() > 0.1);
-    assert_eq!(pelvis["published_older_adults"]["impact_velocity_m_s"]["mean"], 2.1);
+    assert_eq!(
+        pelvis["published_older_adults"]["impact_velocity_m_s"]["mean"],
+        2.1
+    );
     let standing = &r["standing_start"];
     assert!(standing["weight_n"].as_f64().unwrap() > 600.0);
     assert!(
@@ -119,7 +122,9 @@ fn impossible_runs_are_refused_up_front() {
     ] {
         let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
         let s = apply_overrides(&scene, &sets).unwrap();
-        let e = run(&s, path.parent().unwrap(), &out).unwrap_err().to_string();
+        let e = run(&s, path.parent().unwrap(), &out)
+            .unwrap_err()
+            .to_string();
         assert!(e.contains(expect), "{sets:?}: {e}");
     }
     std::fs::remove_dir_all(&out).ok();

@@ -279,7 +279,12 @@ fn contact_stage(
     let e = &mut ws.eval;
     e.f_ext.fill(ForceVec::ZERO);
     if let Some(cm) = forces.contact {
-        cm.update_and_apply(&e.data, &mut state.anchors, &mut e.f_ext, &mut monitor.sample);
+        cm.update_and_apply(
+            &e.data,
+            &mut state.anchors,
+            &mut e.f_ext,
+            &mut monitor.sample,
+        );
         monitor
             .contact
             .accumulate(&monitor.sample, state.time_s, dt);

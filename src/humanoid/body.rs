@@ -74,7 +74,14 @@ pub enum HumanError {
 /// `Y ← r_sagittal`, `Z ← r_longitudinal`. The shapes agree: the trunk is wider than deep, so its
 /// sagittal radius (50.5 % for the upper trunk) exceeds its transverse one (32.0 %); the head is
 /// deeper than wide and the order flips (37.6 % > 36.2 %).
-fn segment(row: &SegmentRow, mass: f64, len: f64, p0: DVec3, dir: DVec3, long_axis: usize) -> Inertia {
+fn segment(
+    row: &SegmentRow,
+    mass: f64,
+    len: f64,
+    p0: DVec3,
+    dir: DVec3,
+    long_axis: usize,
+) -> Inertia {
     let m = row.mass_pct / 100.0 * mass;
     let com = p0 + dir * (row.com_pct / 100.0 * len);
     let i = |r_pct: f64| m * (r_pct / 100.0 * len).powi(2);
@@ -191,9 +198,9 @@ pub fn fall21_body(height: f64, mass: f64, g: f64) -> Result<HumanBody, HumanErr
             }
             "head" => {
                 // Head + neck from the vertex (the head's end site) down to the neck joint.
-                let top = j
-                    .end_site
-                    .unwrap_or(DVec3::new(0.0, table_length(&DE_LEVA_HEAD, h), 0.0));
+                let top =
+                    j.end_site
+                        .unwrap_or(DVec3::new(0.0, table_length(&DE_LEVA_HEAD, h), 0.0));
                 (
                     segment(&DE_LEVA_HEAD, mass, top.y, top, down, 1),
                     LinkBox {
@@ -224,7 +231,14 @@ pub fn fall21_body(height: f64, mass: f64, g: f64) -> Result<HumanBody, HumanErr
                 // Wrist → third metacarpale (de Leva's length) inside the box to the fingertips.
                 let end = j.end_site.unwrap_or(DVec3::new(0.0, -0.108 * h, 0.0));
                 (
-                    segment(&DE_LEVA_HAND, mass, table_length(&DE_LEVA_HAND, h), DVec3::ZERO, down, 1),
+                    segment(
+                        &DE_LEVA_HAND,
+                        mass,
+                        table_length(&DE_LEVA_HAND, h),
+                        DVec3::ZERO,
+                        down,
+                        1,
+                    ),
                     LinkBox {
                         center: end * 0.5,
                         half: DVec3::new(0.01 * h, end.length() * 0.5, 0.025 * h),
@@ -379,7 +393,11 @@ mod tests {
     /// Principal moments of a uniform box of half extents `a` about its X, Y, Z axes (up to the
     /// common factor m/3).
     fn box_moments(a: DVec3) -> DVec3 {
-        DVec3::new(a.y * a.y + a.z * a.z, a.x * a.x + a.z * a.z, a.x * a.x + a.y * a.y)
+        DVec3::new(
+            a.y * a.y + a.z * a.z,
+            a.x * a.x + a.z * a.z,
+            a.x * a.x + a.y * a.y,
+        )
     }
 
     #[test]
@@ -421,12 +439,21 @@ mod tests {
         let neck_y = b.figure.joints[b.link_index("head").unwrap()].offset.y;
         let pc = b.model.bodies[pelvis].inertia.com.y;
         let tc = b.model.bodies[torso].inertia.com.y;
-        assert!(pc > 0.0 && pc < waist_y, "pelvis COM {pc} vs waist {waist_y}");
-        assert!(tc > 0.0 && tc < neck_y, "torso COM {tc} (torso frame) vs neck {neck_y}");
+        assert!(
+            pc > 0.0 && pc < waist_y,
+            "pelvis COM {pc} vs waist {waist_y}"
+        );
+        assert!(
+            tc > 0.0 && tc < neck_y,
+            "torso COM {tc} (torso frame) vs neck {neck_y}"
+        );
         // The pelvis box ends at the waist, the torso box starts there.
         let top = b.boxes[pelvis].center.y + b.boxes[pelvis].half.y;
         let bottom = b.boxes[torso].center.y - b.boxes[torso].half.y;
-        assert!((top - waist_y).abs() < 1e-9 && bottom.abs() < 1e-9, "{top} {bottom}");
+        assert!(
+            (top - waist_y).abs() < 1e-9 && bottom.abs() < 1e-9,
+            "{top} {bottom}"
+        );
     }
 
     #[test]

@@ -125,7 +125,10 @@ pub fn to_mjcf(body: &HumanBody, ranges: &[(f64, f64)], gravity: f64) -> String 
         body.model.total_mass()
     );
     let _ = writeln!(s, "<mujoco model=\"fall21\">");
-    let _ = writeln!(s, "  <compiler angle=\"radian\" inertiafromgeom=\"false\"/>");
+    let _ = writeln!(
+        s,
+        "  <compiler angle=\"radian\" inertiafromgeom=\"false\"/>"
+    );
     let _ = writeln!(s, "  <option gravity=\"0 {} 0\"/>", -gravity);
     let _ = writeln!(s, "  <worldbody>");
     let _ = writeln!(
@@ -207,14 +210,24 @@ mod tests {
     #[test]
     fn the_files_name_every_dof_once_and_carry_the_whole_mass() {
         let b = crate::humanoid::body::fall21_body(1.70, 65.0, 9.81).unwrap();
-        let r = RangeTable::builtin(AgeGroup::Elderly).for_model(&b.figure).unwrap();
+        let r = RangeTable::builtin(AgeGroup::Elderly)
+            .for_model(&b.figure)
+            .unwrap();
         let t = crate::humanoid::strength::torque_limits(AgeGroup::Elderly);
         let urdf = to_urdf(&b, &r, &t);
         let mjcf = to_mjcf(&b, &r, 9.81);
         for d in b.figure.dof_names() {
-            assert_eq!(urdf.matches(&format!("<joint name=\"{d}\"")).count(), 1, "{d}");
+            assert_eq!(
+                urdf.matches(&format!("<joint name=\"{d}\"")).count(),
+                1,
+                "{d}"
+            );
             if !d.starts_with("neck") {
-                assert_eq!(mjcf.matches(&format!("<joint name=\"{d}\"")).count(), 1, "{d}");
+                assert_eq!(
+                    mjcf.matches(&format!("<joint name=\"{d}\"")).count(),
+                    1,
+                    "{d}"
+                );
             }
         }
         let mass: f64 = urdf
@@ -224,6 +237,9 @@ mod tests {
             .sum();
         assert!((mass - 65.0).abs() < 1e-9, "{mass}");
         assert_eq!(mjcf.matches("<body ").count(), 15);
-        assert_eq!(mjcf.matches("<body ").count(), mjcf.matches("</body>").count());
+        assert_eq!(
+            mjcf.matches("<body ").count(),
+            mjcf.matches("</body>").count()
+        );
     }
 }

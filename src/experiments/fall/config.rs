@@ -95,8 +95,10 @@ impl FallConfig {
     /// (34°: the elderly knee range of the paper's Table 1 starts at 32°, so both groups stand
     /// alike inside their ranges), pushed with 1000 N on the chest from the front for 0.1 s from
     /// t = 0.1 s; the reaction toward the key pose (here the stance itself) starts at 0.25 s;
-    /// semi-implicit Euler with implicit damping at 0.5 ms (the contact stability bound is
-    /// 0.63 ms) for 3 s; damage weights protect the head most (w = 10).
+    /// semi-implicit Euler with implicit damping at 0.5 ms (the stiffest mode, the foot's heel
+    /// pad contact, bounds it at 0.92 ms) for 3 s after a settling phase of at most 3 s; PD
+    /// torques capped at the group's strength ([`torque_limits`]); damage weights protect the
+    /// head most (w = 10).
     pub fn paper(group: AgeGroup) -> Self {
         let names = crate::humanoid::fall21().dof_names();
         let stance = per_dof(&names, |n| match strip_side(n) {

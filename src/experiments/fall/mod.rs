@@ -206,7 +206,10 @@ fn validate(cfg: &FallConfig) -> Result<Resolved, SimError> {
         if t.len() != n {
             return Err(cfg_err(
                 "torque_limits_nm",
-                format!("needs {n} (min, max) pairs (one per fall21 DOF), found {}", t.len()),
+                format!(
+                    "needs {n} (min, max) pairs (one per fall21 DOF), found {}",
+                    t.len()
+                ),
             ));
         }
         if let Some((d, (lo, hi))) = t

@@ -2,10 +2,10 @@
 //! fail ([`SimError`]: bad configuration, an unstable step, or a runaway state with its time,
 //! body and quantity).
 
+pub use super::recorder::StandingStart;
 use crate::dynamics::pipeline::StepError;
 use crate::humanoid::body::HumanError;
 use crate::humanoid::ranges::RangeError;
-pub use super::recorder::StandingStart;
 use glam::{DQuat, DVec3};
 use serde::{Deserialize, Serialize};
 
