@@ -7,7 +7,7 @@
 //! when it is missing the test prints a SKIPPED line, except under CI, where it fails.
 
 use std::io::Write;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use glam::DQuat;
@@ -43,6 +43,26 @@ fn venv_python() -> Option<PathBuf> {
         py.display()
     );
     None
+}
+
+/// Runs `tools/<script>` with `args` under `py`, prints its output; returns success and output.
+fn run_tool(py: &Path, script: &str, args: &[&dyn AsRef<std::ffi::OsStr>]) -> (bool, String) {
+    let script = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("tools")
+        .join(script);
+    let mut cmd = Command::new(py);
+    cmd.arg(&script);
+    for a in args {
+        cmd.arg(a.as_ref());
+    }
+    let out = cmd.output().expect("python runs");
+    let text = format!(
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    println!("{text}");
+    (out.status.success(), text)
 }
 
 #[test]
@@ -113,21 +133,9 @@ fn pinocchio_agrees_with_the_engines_rnea_and_aba_on_the_urdf() {
         serde_json::to_string(&json!({"gravity": g, "dofs": dofs, "states": states})).unwrap(),
     )
     .unwrap();
-    let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tools/pinocchio_check.py");
-    let out = Command::new(&py)
-        .arg(&script)
-        .arg(&urdf_path)
-        .arg(&states_path)
-        .output()
-        .unwrap();
-    let text = format!(
-        "{}{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    );
-    println!("{text}");
+    let ok = run_tool(&py, "pinocchio_check.py", &[&urdf_path, &states_path]);
     std::fs::remove_dir_all(&dir).ok();
-    assert!(out.status.success(), "pinocchio check failed: {text}");
+    assert!(ok.0, "pinocchio check failed: {}", ok.1);
 }
 
 #[test]
@@ -200,22 +208,10 @@ fn mujoco_follows_the_pushed_fall_until_first_contact() {
     let (xml, fall_path) = (dir.join("fall21.xml"), dir.join("fall.json"));
     std::fs::write(&xml, mjcf).unwrap();
     std::fs::write(&fall_path, serde_json::to_string(&fall).unwrap()).unwrap();
-    let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tools/mujoco_check.py");
-    let out = Command::new(&py)
-        .arg(&script)
-        .arg(&xml)
-        .arg(&fall_path)
-        // MuJoCo's own soft contact holds the feet (not the engine's corner springs), so the two
-        // falls part by about 2.6 cm of head height by the first non-foot touchdown (measured).
-        .arg("0.03")
-        .output()
-        .unwrap();
-    let text = format!(
-        "{}{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    );
-    println!("{text}");
+    // MuJoCo's own soft contact holds the feet (not the engine's corner springs), so the two
+    // falls part by about 2.6 cm of head height by the first non-foot touchdown (measured).
+    let tol = std::ffi::OsString::from("0.03");
+    let ok = run_tool(&py, "mujoco_check.py", &[&xml, &fall_path, &tol]);
     std::fs::remove_dir_all(&dir).ok();
-    assert!(out.status.success(), "mujoco check failed: {text}");
+    assert!(ok.0, "mujoco check failed: {}", ok.1);
 }
