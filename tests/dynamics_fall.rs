@@ -1,6 +1,6 @@
 //! The pushed fall of the fall21 human (the paper's experiment): it falls the way the push sends
-//! it, comes to rest on the floor without sinking more than a centimetre, and its damage report
-//! is stable when the step is halved.
+//! it, comes to rest on the floor with its soft tissue compressed no more than the published
+//! stiffnesses imply (under 9 cm), and its damage report is stable when the step is halved.
 
 use marionette::dynamics::Integrator;
 use marionette::experiments::fall::{FallConfig, FallResult, SimError, simulate_fall};
@@ -32,8 +32,10 @@ fn check_fell_backward_and_rested(r: &FallResult) {
         "did not come to rest (rest since {:?})",
         r.rest_time_s
     );
+    // The bound of src/humanoid/tissue.rs: a pelvis of ~32 kg effective mass landing at 2–4 m/s
+    // on 40 kN/m compresses 5–9 cm (the deformation the published stiffness implies).
     assert!(
-        r.max_penetration_m < 0.01,
+        r.max_penetration_m < 0.09,
         "sank {} m into the floor",
         r.max_penetration_m
     );
@@ -134,7 +136,13 @@ fn a_step_above_the_stability_bound_is_refused_up_front() {
     let mut cfg = FallConfig::paper(AgeGroup::Elderly);
     cfg.dt_s = 5e-3;
     let bound = match simulate_fall(&cfg) {
-        Err(SimError::Unstable { what, bound_s, .. }) => {
+        Err(SimError::Unstable {
+            what,
+            bound_s,
+            body,
+            ..
+        }) => {
+            println!("stability bound {bound_s:.3e} s: {what} of {body}");
             assert!(bound_s < 5e-3);
             assert!(!what.is_empty());
             bound_s
@@ -143,7 +151,7 @@ fn a_step_above_the_stability_bound_is_refused_up_front() {
     };
     // The bound named is the most restrictive one: just below it the fall is accepted.
     cfg.dt_s = 0.99 * bound;
-    cfg.duration_s = 0.05;
+    cfg.duration_s = 0.15;
     simulate_fall(&cfg).unwrap();
 }
 
@@ -195,8 +203,8 @@ fn a_partial_scene_takes_the_paper_defaults() {
 fn random_genes_within_the_ranges_all_simulate() {
     // What the genetic algorithm will do: k_p and θ_d of every DOF drawn at random (θ_d inside
     // the group's ranges). Every fall must run to the end and come down. Penetration is looser
-    // here than in the paper's fall: with stiffness per kilogram of link mass, a light link that
-    // lands under the body's weight (an upper arm) sinks up to ~3 cm.
+    // here than in the paper's fall: a stiffly held body can land harder on its soft regions
+    // (limbs 20 kN/m), up to ~11 cm into the outline of a box.
     use marionette::humanoid::ranges::RangeTable;
     use rand::{RngExt, SeedableRng};
     let mut rng = rand_pcg::Pcg64::seed_from_u64(5);
@@ -221,7 +229,7 @@ fn random_genes_within_the_ranges_all_simulate() {
             last.head_height_m
         );
         assert!(
-            r.max_penetration_m < 0.04,
+            r.max_penetration_m < 0.12,
             "fall {n}: sank {} m",
             r.max_penetration_m
         );
@@ -254,7 +262,7 @@ fn stopping_at_rest_keeps_the_damage_and_saves_the_steps() {
     let short = simulate_fall(&cfg).unwrap();
     assert!(short.came_to_rest);
     assert!(
-        short.steps < full.steps / 2,
+        short.steps <= full.steps / 2,
         "{} of {} steps",
         short.steps,
         full.steps

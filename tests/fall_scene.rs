@@ -1,5 +1,6 @@
 //! The falling paper's scene end to end: the pushed figure falls backward, comes to rest, never
-//! sinks a centimetre into the floor, and `--set` reaches the time step, integrator, age group
+//! compresses its soft tissue more than the published stiffnesses imply, reports each link's
+//! impact and the pelvis beside real falls, and `--set` reaches the time step, integrator, age group
 //! and push.
 
 use std::path::PathBuf;
@@ -38,7 +39,18 @@ fn pushed_from_the_front_the_figure_falls_backward_and_rests() {
         "pelvis ended at z = {z} m: the push from the front must send it backward (−Z)"
     );
     assert_eq!(r["came_to_rest"], serde_json::Value::Bool(true));
-    assert!(r["max_penetration_m"].as_f64().unwrap() < 0.01);
+    assert!(r["max_penetration_m"].as_f64().unwrap() < 0.09);
+    // The impact of every link and the pelvis beside the published older-adult values.
+    assert_eq!(r["impacts"].as_array().unwrap().len(), 15);
+    let pelvis = &r["pelvis"];
+    assert!(pelvis["impact_velocity_m_s"].as_f64().unwrap() > 0.5);
+    assert!(pelvis["descent_time_s"].as_f64().unwrap() > 0.1);
+    assert_eq!(
+        pelvis["published_older_adults"]["impact_velocity_m_s"]["mean"],
+        2.1
+    );
+    let standing = &r["standing_start"];
+    assert!(standing["weight_n"].as_f64().unwrap() > 600.0);
     assert!(
         r["final_head_height_m"].as_f64().unwrap() < 0.3,
         "the head ends near the floor"
@@ -75,4 +87,45 @@ fn set_reaches_the_age_group_step_integrator_and_push() {
         "render.gif=false",
     ]);
     assert_eq!(rk4["came_to_rest"], serde_json::Value::Bool(true));
+}
+
+#[test]
+fn set_reaches_a_single_field_of_every_block() {
+    // The contact, body and push blocks take one field without restating the others.
+    let r = run_fall(&[
+        "contact.stiffness_scale=1.2",
+        "body.mass_kg=70",
+        "push.start_s=0.12",
+        "compare_with=null",
+        "render.gif=false",
+    ]);
+    let w = r["standing_start"]["weight_n"].as_f64().unwrap();
+    assert!((w - 70.0 * 9.81).abs() < 1e-9, "weight {w}");
+    // The old per-kilogram contact field is named as unknown, with the fields there.
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes/fall.ron");
+    let scene = Scene::load(&path).unwrap();
+    let e = apply_overrides(&scene, &["contact.stiffness_per_kg=1".to_string()])
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("stiffness_scale"), "{e}");
+}
+
+#[test]
+fn impossible_runs_are_refused_up_front() {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes/fall.ron");
+    let scene = Scene::load(&path).unwrap();
+    let out = std::env::temp_dir().join(format!("marionette-fall-refused-{}", std::process::id()));
+    for (sets, expect) in [
+        (vec!["simulation.duration=1e9"], "duration_s"),
+        (vec!["simulation.dt=1e-9"], "duration_s"),
+        (vec!["push.start_s=5"], "push.start_s"),
+    ] {
+        let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+        let s = apply_overrides(&scene, &sets).unwrap();
+        let e = run(&s, path.parent().unwrap(), &out)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains(expect), "{sets:?}: {e}");
+    }
+    std::fs::remove_dir_all(&out).ok();
 }

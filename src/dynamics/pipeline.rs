@@ -4,7 +4,8 @@
 //!
 //! 1. **position**: forward kinematics at the step start (reused when the previous step's check
 //!    left it in the workspace);
-//! 2. **limits**: each DOF's excursion past its range, for the [`StepMonitor`];
+//! 2. **limits**: each DOF's excursion past its range and whether its PD torque is at its
+//!    strength limit, for the [`StepMonitor`];
 //! 3. **contact**: friction anchors brought to the step start, contact forces there, per-link
 //!    statistics ([`ContactStats`]);
 //! 4. **integrate**: the scheme's evaluations of `q̈ = ABA(q, v, τ, f_ext)`, each summing PD
@@ -16,7 +17,7 @@
 
 use super::aba::aba_passes;
 use super::data::Data;
-use super::forces::contact::{ContactModel, ContactState, ContactStats};
+use super::forces::contact::{ContactModel, ContactSample, ContactState, ContactStats};
 use super::forces::external::{ExternalForce, apply_external};
 use super::forces::limits::JointRanges;
 use super::forces::pd::PdTargets;
@@ -80,32 +81,33 @@ pub struct StepSettings {
     pub dt: f64,
 }
 
-/// What the steps saw: at the start of the latest step the normal force (N) and deepest corner
-/// penetration (m) per link and of the body; over all steps the contact statistics and the
-/// largest range excursion per DOF (rad).
+/// What the steps saw: at the start of the latest step what each link felt from the floor
+/// ([`ContactSample`]); over all steps the contact statistics, the largest range excursion per
+/// DOF (rad), and per DOF how long its PD torque was held at its strength limit (s) and when
+/// that first happened.
 #[derive(Clone, Debug, PartialEq)]
 pub struct StepMonitor {
-    /// Normal force per link at the latest step start (N).
-    pub normal: Vec<f64>,
-    /// Deepest penetration per link at the latest step start (m).
-    pub depth: Vec<f64>,
-    /// Deepest penetration at the latest step start (m).
-    pub penetration: f64,
-    /// Peaks, impulses and depths over all steps.
+    /// The floor at the latest step start.
+    pub sample: ContactSample,
+    /// Peaks, impulses, depths, touchdowns and absorbed energies over all steps.
     pub contact: ContactStats,
     /// Largest excursion past the range per DOF so far (rad).
     pub max_excursion: Vec<f64>,
+    /// Time each DOF's PD torque spent at its strength limit (s, sampled at step starts).
+    pub saturated_s: Vec<f64>,
+    /// First step start at which each DOF's PD torque was at its limit (s).
+    pub first_saturated_s: Vec<Option<f64>>,
 }
 
 impl StepMonitor {
     /// Zeros for `nlinks` links and `ndofs` actuated DOFs.
     pub fn new(nlinks: usize, ndofs: usize) -> Self {
         Self {
-            normal: vec![0.0; nlinks],
-            depth: vec![0.0; nlinks],
-            penetration: 0.0,
+            sample: ContactSample::new(nlinks),
             contact: ContactStats::new(nlinks),
             max_excursion: vec![0.0; ndofs],
+            saturated_s: vec![0.0; ndofs],
+            first_saturated_s: vec![None; ndofs],
         }
     }
 }
@@ -224,7 +226,7 @@ pub fn step(
     monitor: &mut StepMonitor,
 ) -> Result<(), StepError> {
     position_stage(model, state, ws);
-    limits_stage(model, forces, state, ws, monitor);
+    limits_stage(model, forces, state, ws, monitor, settings.dt);
     contact_stage(forces, state, ws, monitor, settings.dt);
     integrate_stage(model, settings, forces, state, ws)?;
     check_stage(model, state, ws)
@@ -235,20 +237,33 @@ fn position_stage(model: &Model, state: &State, ws: &mut StepWorkspace) {
     ws.kinematics_of(model, state);
 }
 
-/// Stage 2: the largest excursion past each DOF's range at the step start.
+/// Stage 2: the largest excursion past each DOF's range at the step start, and which PD
+/// torques are at their strength limit.
 fn limits_stage(
     model: &Model,
     forces: &Forces,
     state: &State,
     ws: &mut StepWorkspace,
     monitor: &mut StepMonitor,
+    dt: f64,
 ) {
-    if let Some(l) = forces.limits {
-        let e = &mut ws.eval;
-        model.angles(&state.q, &mut e.angles);
-        for (d, &k) in forces.dofs.iter().enumerate() {
+    let limited = forces.pd.filter(|pd| !pd.torque_limits.is_empty());
+    if forces.limits.is_none() && limited.is_none() {
+        return;
+    }
+    let e = &mut ws.eval;
+    model.angles(&state.q, &mut e.angles);
+    for (d, &k) in forces.dofs.iter().enumerate() {
+        if let Some(l) = forces.limits {
             let ex = l.excursion(d, e.angles[k]);
             monitor.max_excursion[d] = monitor.max_excursion[d].max(ex);
+        }
+        if let Some(pd) = limited {
+            let (tau, _) = pd.torque(d, e.angles[k], state.v[k]);
+            if pd.saturates(d, tau) {
+                monitor.saturated_s[d] += dt;
+                monitor.first_saturated_s[d].get_or_insert(state.time_s);
+            }
         }
     }
 }
@@ -264,16 +279,15 @@ fn contact_stage(
     let e = &mut ws.eval;
     e.f_ext.fill(ForceVec::ZERO);
     if let Some(cm) = forces.contact {
-        monitor.penetration = cm.update_and_apply(
+        cm.update_and_apply(
             &e.data,
             &mut state.anchors,
             &mut e.f_ext,
-            &mut monitor.normal,
-            &mut monitor.depth,
+            &mut monitor.sample,
         );
         monitor
             .contact
-            .accumulate(&monitor.normal, &monitor.depth, monitor.penetration, dt);
+            .accumulate(&monitor.sample, state.time_s, dt);
     }
     e.step_start_ready = true;
 }
@@ -435,7 +449,7 @@ impl Dynamics for Evaluation<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::dynamics::forces::contact::{ContactParams, LinkBox};
+    use crate::dynamics::forces::contact::{ContactGains, ContactParams, LinkBox};
     use crate::dynamics::joint::JointType;
     use crate::dynamics::model::Body;
     use crate::dynamics::spatial::{Inertia, SpatialTransform};
@@ -505,6 +519,7 @@ mod tests {
                 half: SIZE * 0.5,
             }],
             &[2.0],
+            &[ContactGains::per_kg(2.0, 1.2e5 * 4.0, 160.0)],
             ContactParams::default(),
         );
         let floor = Forces {
@@ -513,7 +528,7 @@ mod tests {
         };
         let (s, m) = run(&model, &floor, 3000);
         assert!(s.q[1] > 0.09 && s.q[1] < 0.1, "y = {}", s.q[1]);
-        assert!((m.normal[0] - 2.0 * 9.81).abs() < 0.05 * 2.0 * 9.81);
+        assert!((m.sample.normal[0] - 2.0 * 9.81).abs() < 0.05 * 2.0 * 9.81);
         assert!(m.contact.peak[0] > 2.0 * 9.81);
         // An upward external force equal to the weight holds it in the air.
         let lift = [ExternalForce {
@@ -539,6 +554,7 @@ mod tests {
             target_velocity: vec![2.0],
             kp: vec![100.0],
             kv: vec![10.0],
+            torque_limits: Vec::new(),
         };
         let (tau, d) = pd.torque(0, 0.3, 0.5);
         assert!((tau - 15.0).abs() < 1e-12);

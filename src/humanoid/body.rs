@@ -2,8 +2,14 @@
 //! [`crate::humanoid::fall21`] (scaled to the subject's height), with segment masses, centres of mass
 //! and inertias from **de Leva (1996)**, *Adjustments to Zatsiorsky–Seluyanov's segment inertia
 //! parameters*, J. Biomech. 29(9):1223–1230, Table 4 (males: stature 1741 mm, 73.0 kg), scaled
-//! to the subject's height `H` and mass `M`: `m_i = μ_i M`, lengths `ℓ_i = ℓ_i,ref · H / 1.741`,
-//! `I = m (r ℓ)²` with the table's radii of gyration `r` (sagittal, transverse, longitudinal).
+//! to the subject's mass `M` (`m_i = μ_i M`). Segment lengths `ℓ_i` come from the figure's own joint
+//! positions (the waist → hip line for the lower trunk, neck → waist for the upper and middle
+//! trunk in de Leva's proportions, joint to joint along the limbs, the head's end site for
+//! head + neck), so neighbouring segments meet at their joints and never overlap; only hand and
+//! foot, whose end points are not joints, keep de Leva's lengths scaled by `H / 1.741`. Centres
+//! of mass sit at the table's fraction of `ℓ_i`, inertias are `I = m (r ℓ)²` with the table's radii
+//! of gyration about the sagittal, transverse and longitudinal axes (see [`segment`] for how
+//! they map onto link axes).
 //!
 //! The 15 links: pelvis (de Leva's lower trunk), torso (upper + middle trunk), head (head + neck),
 //! and per side upper arm, forearm, hand, thigh, shank, foot. Each link also carries a box for
@@ -58,36 +64,46 @@ pub enum HumanError {
     Model(#[from] ModelError),
 }
 
-/// Inertia of a straight segment along `dir` (unit, from its proximal point `p0`) from a table
-/// row, with the longitudinal radius about `long_axis` (link axes X, Y, Z).
+/// Inertia of a straight segment of length `len` (m) along `dir` (unit, from its proximal end
+/// point `p0`) from a table row: mass `μ M`, centre of mass at the row's fraction of `len`, and
+/// principal moments `m (r ℓ)²` with de Leva's radii of gyration assigned by his definitions:
+/// the *sagittal* radius is about the sagittal (antero-posterior) axis, the *transverse* radius
+/// about the transverse (medio-lateral) axis and the *longitudinal* radius about the segment's
+/// long axis. In link axes (X left, Y up, Z forward) a vertical segment gets `X ← r_transverse`,
+/// `Y ← r_longitudinal`, `Z ← r_sagittal`; the foot (long axis Z) gets `X ← r_transverse`,
+/// `Y ← r_sagittal`, `Z ← r_longitudinal`. The shapes agree: the trunk is wider than deep, so its
+/// sagittal radius (50.5 % for the upper trunk) exceeds its transverse one (32.0 %); the head is
+/// deeper than wide and the order flips (37.6 % > 36.2 %).
 fn segment(
     row: &SegmentRow,
     mass: f64,
-    h: f64,
+    len: f64,
     p0: DVec3,
     dir: DVec3,
     long_axis: usize,
 ) -> Inertia {
-    let len = row.length_mm / 1000.0 * h / DE_LEVA_STATURE;
     let m = row.mass_pct / 100.0 * mass;
     let com = p0 + dir * (row.com_pct / 100.0 * len);
     let i = |r_pct: f64| m * (r_pct / 100.0 * len).powi(2);
-    // Vertical segments: X sagittal axis, Z transverse, Y longitudinal. Foot: Z longitudinal,
-    // Y transverse.
     let d = if long_axis == 1 {
         DVec3::new(
-            i(row.r_sagittal_pct),
-            i(row.r_longitudinal_pct),
             i(row.r_transverse_pct),
+            i(row.r_longitudinal_pct),
+            i(row.r_sagittal_pct),
         )
     } else {
         DVec3::new(
-            i(row.r_sagittal_pct),
             i(row.r_transverse_pct),
+            i(row.r_sagittal_pct),
             i(row.r_longitudinal_pct),
         )
     };
     Inertia::new(m, com, DMat3::from_diagonal(d))
+}
+
+/// de Leva's length of `row` for a subject of height `h` (m).
+fn table_length(row: &SegmentRow, h: f64) -> f64 {
+    row.length_mm / 1000.0 * h / DE_LEVA_STATURE
 }
 
 /// Sum of rigid inertias expressed in one frame (parallel-axis theorem).
@@ -142,13 +158,12 @@ pub fn fall21_body(height: f64, mass: f64, g: f64) -> Result<HumanBody, HumanErr
         };
         let (inertia, bx) = match link {
             "pelvis" => {
-                let top = DVec3::new(
-                    0.0,
-                    DE_LEVA_LOWER_TRUNK.length_mm / 1000.0 * h / DE_LEVA_STATURE,
-                    0.0,
-                );
+                // de Leva's lower trunk runs from the omphalion down to the hip-joint centres:
+                // here from the waist joint down to the hip line (the pelvis origin), so that
+                // pelvis and torso meet at the waist without overlapping.
+                let top = child_offset("waist").unwrap_or(DVec3::new(0.0, 0.07 * h, 0.0));
                 (
-                    segment(&DE_LEVA_LOWER_TRUNK, mass, h, top, down, 1),
+                    segment(&DE_LEVA_LOWER_TRUNK, mass, top.y, top, down, 1),
                     LinkBox {
                         center: DVec3::new(0.0, 0.02 * h, 0.0),
                         half: DVec3::new(0.095, 0.05, 0.06) * h,
@@ -156,10 +171,23 @@ pub fn fall21_body(height: f64, mass: f64, g: f64) -> Result<HumanBody, HumanErr
                 )
             }
             "torso" => {
+                // Upper trunk (cervicale → xiphion) over middle trunk (xiphion → omphalion),
+                // filling the waist → neck span in de Leva's proportions.
                 let neck = child_offset("neck").unwrap_or(DVec3::new(0.0, 0.23 * h, 0.0));
-                let upt = segment(&DE_LEVA_UPPER_TRUNK, mass, h, neck, down, 1);
-                let l_upt = DE_LEVA_UPPER_TRUNK.length_mm / 1000.0 * h / DE_LEVA_STATURE;
-                let mpt = segment(&DE_LEVA_MIDDLE_TRUNK, mass, h, neck + down * l_upt, down, 1);
+                let (lu, lm) = (
+                    table_length(&DE_LEVA_UPPER_TRUNK, h),
+                    table_length(&DE_LEVA_MIDDLE_TRUNK, h),
+                );
+                let scale = neck.y / (lu + lm);
+                let upt = segment(&DE_LEVA_UPPER_TRUNK, mass, lu * scale, neck, down, 1);
+                let mpt = segment(
+                    &DE_LEVA_MIDDLE_TRUNK,
+                    mass,
+                    lm * scale,
+                    neck + down * (lu * scale),
+                    down,
+                    1,
+                );
                 (
                     combine(upt, mpt),
                     LinkBox {
@@ -169,10 +197,12 @@ pub fn fall21_body(height: f64, mass: f64, g: f64) -> Result<HumanBody, HumanErr
                 )
             }
             "head" => {
-                let l = DE_LEVA_HEAD.length_mm / 1000.0 * h / DE_LEVA_STATURE;
-                let top = j.end_site.unwrap_or(DVec3::new(0.0, l, 0.0));
+                // Head + neck from the vertex (the head's end site) down to the neck joint.
+                let top =
+                    j.end_site
+                        .unwrap_or(DVec3::new(0.0, table_length(&DE_LEVA_HEAD, h), 0.0));
                 (
-                    segment(&DE_LEVA_HEAD, mass, h, DVec3::new(0.0, l, 0.0), down, 1),
+                    segment(&DE_LEVA_HEAD, mass, top.y, top, down, 1),
                     LinkBox {
                         center: DVec3::new(0.0, top.y * 0.5, 0.01 * h),
                         half: DVec3::new(0.045 * h, top.y * 0.5, 0.055 * h),
@@ -180,6 +210,7 @@ pub fn fall21_body(height: f64, mass: f64, g: f64) -> Result<HumanBody, HumanErr
                 )
             }
             "upper_arm" | "forearm" | "thigh" | "shin" => {
+                // From this joint to the next one down the limb.
                 let (row, width, child) = match link {
                     "upper_arm" => (&DE_LEVA_UPPER_ARM, 0.05, "elbow"),
                     "forearm" => (&DE_LEVA_FOREARM, 0.04, "wrist"),
@@ -187,18 +218,27 @@ pub fn fall21_body(height: f64, mass: f64, g: f64) -> Result<HumanBody, HumanErr
                     _ => (&DE_LEVA_SHANK, 0.06, "ankle"),
                 };
                 let end = child_offset(child).unwrap_or(DVec3::new(0.0, -0.2 * h, 0.0));
+                let len = end.length();
                 (
-                    segment(row, mass, h, DVec3::ZERO, down, 1),
+                    segment(row, mass, len, DVec3::ZERO, end / len, 1),
                     LinkBox {
                         center: end * 0.5,
-                        half: DVec3::new(width * h * 0.5, end.length() * 0.5, width * h * 0.5),
+                        half: DVec3::new(width * h * 0.5, len * 0.5, width * h * 0.5),
                     },
                 )
             }
             "hand" => {
+                // Wrist → third metacarpale (de Leva's length) inside the box to the fingertips.
                 let end = j.end_site.unwrap_or(DVec3::new(0.0, -0.108 * h, 0.0));
                 (
-                    segment(&DE_LEVA_HAND, mass, h, DVec3::ZERO, down, 1),
+                    segment(
+                        &DE_LEVA_HAND,
+                        mass,
+                        table_length(&DE_LEVA_HAND, h),
+                        DVec3::ZERO,
+                        down,
+                        1,
+                    ),
                     LinkBox {
                         center: end * 0.5,
                         half: DVec3::new(0.01 * h, end.length() * 0.5, 0.025 * h),
@@ -206,12 +246,13 @@ pub fn fall21_body(height: f64, mass: f64, g: f64) -> Result<HumanBody, HumanErr
                 )
             }
             "foot" => {
+                // Heel → toe tip, de Leva's length ending at the toe end site.
                 let toe = j.end_site.unwrap_or(DVec3::new(0.0, -0.039 * h, 0.117 * h));
-                let l = DE_LEVA_FOOT.length_mm / 1000.0 * h / DE_LEVA_STATURE;
+                let l = table_length(&DE_LEVA_FOOT, h);
                 let heel = DVec3::new(0.0, toe.y * 0.5, toe.z - l);
                 let fwd = DVec3::Z;
                 (
-                    segment(&DE_LEVA_FOOT, mass, h, heel, fwd, 2),
+                    segment(&DE_LEVA_FOOT, mass, l, heel, fwd, 2),
                     LinkBox {
                         center: DVec3::new(0.0, toe.y * 0.5, toe.z - l * 0.5),
                         half: DVec3::new(0.03 * h, -toe.y * 0.5, l * 0.5),
@@ -347,6 +388,72 @@ mod tests {
         println!("COM at {ratio:.4} of stature");
         assert!((0.54..0.58).contains(&ratio), "COM at {ratio} of stature");
         assert!(c.x.abs() < 1e-9, "left-right symmetric: {}", c.x);
+    }
+
+    /// Principal moments of a uniform box of half extents `a` about its X, Y, Z axes (up to the
+    /// common factor m/3).
+    fn box_moments(a: DVec3) -> DVec3 {
+        DVec3::new(
+            a.y * a.y + a.z * a.z,
+            a.x * a.x + a.z * a.z,
+            a.x * a.x + a.y * a.y,
+        )
+    }
+
+    #[test]
+    fn de_leva_axes_follow_the_segment_shapes() {
+        // The sagittal radius is about the antero-posterior axis (Z), the transverse one about
+        // the medio-lateral axis (X): the trunk, wider than deep, has more inertia about Z than
+        // about X; the head, deeper than wide, the other way round; the foot, wider than high,
+        // more about Y than about X. Each matches the order of its contact box's moments.
+        let b = fall21_body(1.70, 65.0, 9.81).unwrap();
+        for (link, (ax, bx)) in [
+            ("torso", (2usize, 0usize)),
+            ("pelvis", (2, 0)),
+            ("head", (0, 2)),
+            ("right_foot", (1, 0)),
+        ] {
+            let i = b.link_index(link).unwrap();
+            let ic = b.model.bodies[i].inertia.inertia_com;
+            let d = [ic.x_axis.x, ic.y_axis.y, ic.z_axis.z];
+            let boxm = box_moments(b.boxes[i].half).to_array();
+            assert!(d[ax] > d[bx], "{link}: I = {d:?}");
+            assert!(boxm[ax] > boxm[bx], "{link} box: {boxm:?}");
+        }
+        // The torso's flexion inertia (about X) from de Leva's transverse radii.
+        let torso = b.link_index("torso").unwrap();
+        let flex = b.model.bodies[torso].inertia.inertia_com.x_axis.x;
+        let lat = b.model.bodies[torso].inertia.inertia_com.z_axis.z;
+        println!("torso flexion inertia {flex:.3} kg·m², lateral {lat:.3} kg·m²");
+        assert!(flex < lat);
+    }
+
+    #[test]
+    fn trunk_segments_meet_at_the_waist_without_overlap() {
+        // The pelvis's centre of mass lies between the hip line and the waist, the torso's
+        // between the waist and the neck: each inside its own span, none across the joint.
+        let b = fall21_body(1.70, 65.0, 9.81).unwrap();
+        let torso = b.link_index("torso").unwrap();
+        let pelvis = b.link_index("pelvis").unwrap();
+        let waist_y = b.figure.joints[torso].offset.y;
+        let neck_y = b.figure.joints[b.link_index("head").unwrap()].offset.y;
+        let pc = b.model.bodies[pelvis].inertia.com.y;
+        let tc = b.model.bodies[torso].inertia.com.y;
+        assert!(
+            pc > 0.0 && pc < waist_y,
+            "pelvis COM {pc} vs waist {waist_y}"
+        );
+        assert!(
+            tc > 0.0 && tc < neck_y,
+            "torso COM {tc} (torso frame) vs neck {neck_y}"
+        );
+        // The pelvis box ends at the waist, the torso box starts there.
+        let top = b.boxes[pelvis].center.y + b.boxes[pelvis].half.y;
+        let bottom = b.boxes[torso].center.y - b.boxes[torso].half.y;
+        assert!(
+            (top - waist_y).abs() < 1e-9 && bottom.abs() < 1e-9,
+            "{top} {bottom}"
+        );
     }
 
     #[test]

@@ -16,9 +16,12 @@
 pub mod anthropometry;
 pub mod body;
 mod definition;
+pub mod export;
 mod joint_angles;
 mod model_clip;
 pub mod ranges;
+pub mod strength;
+pub mod tissue;
 
 pub use definition::{fall21, humanoid24};
 pub use joint_angles::{local_rotation, project_rotation, rotation_vector_near, unwrap_near};

@@ -16,11 +16,12 @@ use crate::experiments::fall::ecs::run_parallel;
 use crate::experiments::fall::{FallConfig, FallResult, Ranges};
 use crate::humanoid::fall21;
 use crate::humanoid::ranges::{AgeGroup, RangeTable};
+use crate::humanoid::strength::torque_limits;
 use crate::render::{Plot, Series, Track, plot};
 
-/// Time stepping of a simulation.
+/// Time stepping of a simulation (a field left out keeps the paper's value).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, default)]
 pub struct Simulation {
     /// Step, seconds.
     pub dt: f64,
@@ -30,14 +31,35 @@ pub struct Simulation {
     pub duration: f64,
 }
 
-/// The subject.
+impl Default for Simulation {
+    fn default() -> Self {
+        let c = FallConfig::default();
+        Self {
+            dt: c.dt_s,
+            integrator: c.integrator,
+            duration: c.duration_s,
+        }
+    }
+}
+
+/// The subject (default 1.70 m, 65 kg).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, default)]
 pub struct Body {
     /// Standing height, metres.
     pub height_m: f64,
     /// Mass, kilograms.
     pub mass_kg: f64,
+}
+
+impl Default for Body {
+    fn default() -> Self {
+        let c = FallConfig::default();
+        Self {
+            height_m: c.height_m,
+            mass_kg: c.mass_kg,
+        }
+    }
 }
 
 /// PD settings per DOF, by full DOF name (`left_knee`) or side-less name (`knee`, both sides);
@@ -69,21 +91,23 @@ pub struct FallScene {
     #[serde(default)]
     pub ranges_file: Option<String>,
     /// Time stepping.
+    #[serde(default)]
     pub simulation: Simulation,
     /// The push.
+    #[serde(default)]
     pub push: Push,
     /// The subject (default 1.70 m, 65 kg).
     #[serde(default)]
-    pub body: Option<Body>,
+    pub body: Body,
     /// PD control toward a key pose.
     #[serde(default)]
     pub controller: Controller,
     /// Damage weight w_i per link (links not named keep the default; the head is protected most).
     #[serde(default)]
     pub damage_weights: BTreeMap<String, f64>,
-    /// Floor contact parameters.
+    /// Floor contact parameters (scales on the published tissue gains, friction, floor).
     #[serde(default)]
-    pub contact: Option<ContactParams>,
+    pub contact: ContactParams,
     /// Also simulate this age group (same push and controller), beside the first.
     #[serde(default)]
     pub compare_with: Option<AgeGroup>,
@@ -134,13 +158,9 @@ impl FallScene {
         c.integrator = self.simulation.integrator;
         c.duration_s = self.simulation.duration;
         c.push = self.push.clone();
-        if let Some(b) = &self.body {
-            c.height_m = b.height_m;
-            c.mass_kg = b.mass_kg;
-        }
-        if let Some(p) = &self.contact {
-            c.contact = *p;
-        }
+        c.height_m = self.body.height_m;
+        c.mass_kg = self.body.mass_kg;
+        c.contact = self.contact;
         let names = fall21().dof_names();
         override_per_dof(
             "key_pose_deg",
@@ -189,6 +209,26 @@ pub fn fall_report(r: &FallResult, sim_wall_s: f64) -> serde_json::Value {
         "peak_vertical_force_n": per_link(&r.link_names, &r.peak_vertical_force_n),
         "impulse_n_s": per_link(&r.link_names, &r.impulse_n_s),
         "max_penetration_m": r.max_penetration_m,
+        "max_penetration_by_link_m": per_link(&r.link_names, &r.max_penetration_by_link_m),
+        "impacts": r.impacts,
+        "pelvis": {
+            "impact_velocity_m_s": r.pelvis.impact_velocity_m_s,
+            "descent_start_s": r.pelvis.descent_start_s,
+            "touchdown_s": r.pelvis.touchdown_s,
+            "descent_time_s": r.pelvis.descent_time_s,
+            "rebound_m": r.pelvis.rebound_m,
+            "published_older_adults": {
+                "source": "video-captured falls of older adults in long-term care (Choi, Wakeling & Robinovitch 2015, J. Biomech. 48:911-920), as quoted in issue 9",
+                "impact_velocity_m_s": {"mean": 2.1, "sd": 0.6},
+                "descent_time_s": {"mean": 0.58, "sd": 0.26},
+            },
+            "published_hip_impact_force_n": {
+                "range": [2600.0, 5600.0],
+                "note": "standing-height falls onto the hip",
+            },
+        },
+        "standing_start": r.standing,
+        "torque_saturation": r.torque_saturation,
         "came_to_rest": r.came_to_rest,
         "rest_time_s": r.rest_time_s,
         "steps": r.steps,
@@ -215,6 +255,7 @@ pub fn run_fall(
         if scene.ranges_file.is_none() {
             c.ranges = Ranges::Builtin(other);
         }
+        c.torque_limits_nm = Some(torque_limits(other));
         groups.push((other, c));
     }
     let configs: Vec<FallConfig> = groups.iter().map(|(_, c)| c.clone()).collect();

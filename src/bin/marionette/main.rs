@@ -2,6 +2,7 @@
 //!
 //! This file parses the arguments, dispatches to one module per command and prints errors.
 
+mod body;
 mod common;
 mod eval;
 mod export;
@@ -39,6 +40,9 @@ enum Command {
     /// Evaluate fall genomes for a GA over the JSON-lines protocol (`--stdin`): the worker a
     /// cluster runs.
     Eval(eval::Args),
+    /// Write the articulated fall21 body (links, joints, axes, ranges, masses, centres of mass,
+    /// inertias, contact boxes) as URDF and/or MJCF for an age group, height and mass.
+    Body(body::Args),
 }
 
 fn main() -> ExitCode {
@@ -50,6 +54,7 @@ fn main() -> ExitCode {
         Command::Render(a) => render::render(a),
         Command::Run(a) => run::run(a),
         Command::Eval(a) => eval::eval(a),
+        Command::Body(a) => body::body(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

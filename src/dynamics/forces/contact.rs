@@ -7,10 +7,13 @@
 //! clipped to the friction cone `|f_t| ≤ μ f_n`. The anchor is set where the corner first
 //! touches and is dragged along when the spring would exceed the cone (slip), so a body below the
 //! friction angle sticks (no creep) and one above it slides with `|f_t| = μ f_n`.
-//! Gains are given per kilogram of link mass (`k_p = k̂_p m_link`), so every link has about the
-//! same contact frequency (hence one stable step for all) and the same static sink
-//! `g / (corners · k̂_p)` under its own weight. The price: a light link that lands under much of
-//! the body's weight (an upper arm under the torso) sinks deeper than a heavy one would.
+//!
+//! The normal gains are per link, the effective stiffness `k` (N/m) and damping `c` (N·s/m) of
+//! the body region the link is ([`ContactGains`]; for the human body the published values of
+//! [`crate::humanoid::tissue`]), shared by the corners in contact: a corner carries `k/4` and
+//! `c/4`, so a box face landing flat (four corners) meets exactly the region's `k` and `c`, an
+//! edge half of it. The tangential (stick) spring and damper stay per kilogram of link mass:
+//! they only hold a corner where it touched and are capped by the friction cone.
 
 use crate::dynamics::data::Data;
 use crate::dynamics::spatial::ForceVec;
@@ -47,15 +50,38 @@ impl LinkBox {
     }
 }
 
-/// Floor and contact parameters.
+/// The normal contact gains of one link: the effective stiffness and damping of its body
+/// region, as a lumped spring–damper between the region and a rigid floor.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
+pub struct ContactGains {
+    /// Effective normal stiffness `k` (N/m).
+    pub stiffness_n_per_m: f64,
+    /// Effective normal damping `c` (N·s/m).
+    pub damping_n_s_per_m: f64,
+}
+
+impl ContactGains {
+    /// Gains proportional to a link's mass `m` (kg): `k = k̂ m`, `c = ĉ m`, for bodies with no
+    /// tissue data (test boxes).
+    pub fn per_kg(mass: f64, stiffness_per_kg: f64, damping_per_kg: f64) -> Self {
+        Self {
+            stiffness_n_per_m: stiffness_per_kg * mass,
+            damping_n_s_per_m: damping_per_kg * mass,
+        }
+    }
+}
+
+/// Floor and contact parameters shared by every link; each link's own normal gains are its
+/// [`ContactGains`], multiplied by `stiffness_scale` and `damping_scale` (1 = as published).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
 pub struct ContactParams {
-    /// Normal stiffness per corner per kg of link mass, `k̂_p` (N/m/kg).
-    pub stiffness_per_kg: f64,
-    /// Normal damping per corner per kg of link mass, `k̂_v` (N·s/m/kg).
-    pub damping_per_kg: f64,
-    /// Tangential (stick) stiffness per corner per kg (N/m/kg).
+    /// Factor on every link's normal stiffness (1 = the published values).
+    pub stiffness_scale: f64,
+    /// Factor on every link's normal damping (1 = the published values).
+    pub damping_scale: f64,
+    /// Tangential (stick) stiffness per corner per kg of link mass (N/m/kg).
     pub tangential_stiffness_per_kg: f64,
     /// Tangential damping per corner per kg (N·s/m/kg).
     pub tangential_damping_per_kg: f64,
@@ -70,8 +96,8 @@ pub struct ContactParams {
 impl Default for ContactParams {
     fn default() -> Self {
         Self {
-            stiffness_per_kg: 1.2e5,
-            damping_per_kg: 40.0,
+            stiffness_scale: 1.0,
+            damping_scale: 1.0,
             tangential_stiffness_per_kg: 2.0e4,
             tangential_damping_per_kg: 100.0,
             friction: 0.8,
@@ -104,21 +130,73 @@ pub struct ContactModel {
     pub corners: Vec<[DVec3; 8]>,
     /// Box centre (link frame) and bounding radius per link, for a quick rejection.
     pub bounds: Vec<(DVec3, f64)>,
-    /// Link masses (kg).
+    /// Link masses (kg), for the tangential gains.
     pub masses: Vec<f64>,
+    /// Per link the normal stiffness and damping of one corner, `(k/4, c/4)` with the scales
+    /// applied (N/m, N·s/m).
+    pub corner_gains: Vec<(f64, f64)>,
     /// The parameters.
     pub params: ContactParams,
 }
 
+/// What the contact stage saw at one step start, per link: normal force (N), deepest corner
+/// penetration (m), the power the normal forces take out of the body (W, `−Σ f_n ż`) and the
+/// vertical velocity of the box centre (m/s); and the deepest penetration of any link (m).
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct ContactSample {
+    /// Normal force per link (N).
+    pub normal: Vec<f64>,
+    /// Deepest corner penetration per link (m).
+    pub depth: Vec<f64>,
+    /// Power absorbed by the normal contact per link (W).
+    pub absorbed_power: Vec<f64>,
+    /// Velocity of each box centre along the floor normal (m/s).
+    pub center_normal_velocity: Vec<f64>,
+    /// Deepest penetration of any link (m).
+    pub penetration: f64,
+}
+
+impl ContactSample {
+    /// Zeros for `nlinks` links.
+    pub fn new(nlinks: usize) -> Self {
+        Self {
+            normal: vec![0.0; nlinks],
+            depth: vec![0.0; nlinks],
+            absorbed_power: vec![0.0; nlinks],
+            center_normal_velocity: vec![0.0; nlinks],
+            penetration: 0.0,
+        }
+    }
+}
+
 impl ContactModel {
-    /// Contact model for `boxes` on links of `masses`.
-    pub fn new(boxes: &[LinkBox], masses: &[f64], params: ContactParams) -> Self {
+    /// Contact model for `boxes` on links of `masses` (kg) with normal gains `gains`.
+    pub fn new(
+        boxes: &[LinkBox],
+        masses: &[f64],
+        gains: &[ContactGains],
+        params: ContactParams,
+    ) -> Self {
         Self {
             corners: boxes.iter().map(|b| b.corners()).collect(),
             bounds: boxes.iter().map(|b| (b.center, b.radius())).collect(),
             masses: masses.to_vec(),
+            corner_gains: gains
+                .iter()
+                .map(|g| {
+                    (
+                        0.25 * g.stiffness_n_per_m * params.stiffness_scale,
+                        0.25 * g.damping_n_s_per_m * params.damping_scale,
+                    )
+                })
+                .collect(),
             params,
         }
+    }
+
+    /// The static sink (m) of link `i` carrying `load` newtons flat on its four lower corners.
+    pub fn static_sink(&self, i: usize, load: f64) -> f64 {
+        load / (4.0 * self.corner_gains[i].0)
     }
 
     /// Normal and tangential force on one corner at world point `x` with velocity `xd`.
@@ -138,8 +216,9 @@ impl ContactModel {
             return None;
         }
         let m = self.masses[link];
+        let (k, c) = self.corner_gains[link];
         let zd = n.dot(xd);
-        let fnorm = (-p.stiffness_per_kg * m * z - p.damping_per_kg * m * zd).max(0.0);
+        let fnorm = (-k * z - c * zd).max(0.0);
         let vt = xd - n * zd;
         let stretch = match anchor {
             Some(a) => {
@@ -163,14 +242,14 @@ impl ContactModel {
     /// `anchors` (its 8 corners). With `UPDATE` the anchors are first brought to this state: a
     /// corner that left the floor loses its anchor, a new contact anchors where it touches, and a
     /// corner whose spring would leave the friction cone drags its anchor to the cone's edge
-    /// (slip).
+    /// (slip). Also returns the power the normal forces absorb (W).
     #[inline]
     fn link_contact<const UPDATE: bool>(
         &self,
         data: &Data,
         i: usize,
         anchors: &mut [Option<DVec3>],
-    ) -> (ForceVec, f64, f64) {
+    ) -> (ForceVec, f64, f64, f64) {
         let p = &self.params;
         let n = p.floor_normal;
         let rot = data.rot[i];
@@ -180,11 +259,12 @@ impl ContactModel {
             if UPDATE {
                 anchors.fill(None);
             }
-            return (ForceVec::ZERO, 0.0, 0.0);
+            return (ForceVec::ZERO, 0.0, 0.0, 0.0);
         }
         let v = data.v[i];
         let m = self.masses[i];
-        let (mut f_body, mut normal, mut depth) = (ForceVec::ZERO, 0.0, 0.0f64);
+        let (k_c, c_c) = self.corner_gains[i];
+        let (mut f_body, mut normal, mut depth, mut power) = (ForceVec::ZERO, 0.0, 0.0f64, 0.0);
         for (k, &cl) in self.corners[i].iter().enumerate() {
             let x = pos + rot * cl;
             let z = n.dot(x) - p.floor_height;
@@ -201,8 +281,7 @@ impl ContactModel {
                     None => anchors[k] = Some(on_floor),
                     Some(a) => {
                         let zd = n.dot(xd);
-                        let fnorm =
-                            (-p.stiffness_per_kg * m * z - p.damping_per_kg * m * zd).max(0.0);
+                        let fnorm = (-k_c * z - c_c * zd).max(0.0);
                         let d = x - a;
                         let stretch = d - n * n.dot(d);
                         let max_stretch = p.friction * fnorm / (p.tangential_stiffness_per_kg * m);
@@ -217,11 +296,12 @@ impl ContactModel {
             if let Some((fnorm, ft, z)) = self.corner_force(i, x, xd, anchors[k]) {
                 depth = depth.max(-z);
                 normal += fnorm;
+                power -= fnorm * n.dot(xd);
                 let f_world = n * fnorm + ft;
                 f_body += ForceVec::at_point(rot.transpose() * f_world, cl);
             }
         }
-        (f_body, normal, depth)
+        (f_body, normal, depth, power)
     }
 
     /// Adds the contact force of every link to `f_ext` (body coordinates) after
@@ -239,7 +319,7 @@ impl ContactModel {
         for i in 0..self.corners.len() {
             let mut anchors = [None; 8];
             anchors.copy_from_slice(&state.anchors[i * 8..i * 8 + 8]);
-            let (f, fn_i, d) = self.link_contact::<false>(data, i, &mut anchors);
+            let (f, fn_i, d, _) = self.link_contact::<false>(data, i, &mut anchors);
             normal[i] = fn_i;
             deepest = deepest.max(d);
             f_ext[i] += f;
@@ -248,26 +328,30 @@ impl ContactModel {
     }
 
     /// The step-start evaluation: updates the friction anchors for the state in `data` (once
-    /// per step), then does what [`apply`](Self::apply) does, also writing each link's deepest
-    /// corner penetration (m) into `depth`.
+    /// per step), then does what [`apply`](Self::apply) does, writing what each link felt into
+    /// `sample`.
     pub fn update_and_apply(
         &self,
         data: &Data,
         state: &mut ContactState,
         f_ext: &mut [ForceVec],
-        normal: &mut [f64],
-        depth: &mut [f64],
-    ) -> f64 {
+        sample: &mut ContactSample,
+    ) {
         let mut deepest: f64 = 0.0;
+        let n = self.params.floor_normal;
         for i in 0..self.corners.len() {
             let anchors = &mut state.anchors[i * 8..i * 8 + 8];
-            let (f, fn_i, d) = self.link_contact::<true>(data, i, anchors);
-            normal[i] = fn_i;
-            depth[i] = d;
+            let (f, fn_i, d, power) = self.link_contact::<true>(data, i, anchors);
+            let (c, _) = self.bounds[i];
+            let v = data.v[i];
+            sample.normal[i] = fn_i;
+            sample.depth[i] = d;
+            sample.absorbed_power[i] = power;
+            sample.center_normal_velocity[i] = n.dot(data.rot[i] * (v.lin + v.ang.cross(c)));
             deepest = deepest.max(d);
             f_ext[i] += f;
         }
-        deepest
+        sample.penetration = deepest;
     }
 
     /// An upper bound on the contact natural frequency of link `i` (rad/s) and its damping ratio:
@@ -279,7 +363,6 @@ impl ContactModel {
         i: usize,
         inertia: &crate::dynamics::spatial::Inertia,
     ) -> (f64, f64) {
-        let p = &self.params;
         let iinv = inertia.inertia_com.inverse();
         let mut w: f64 = 0.0;
         for &cl in &self.corners[i] {
@@ -299,9 +382,7 @@ impl ContactModel {
             }
             w = w.max(1.0 / inertia.mass + lam);
         }
-        let m = inertia.mass;
-        let k = p.stiffness_per_kg * m;
-        let c = p.damping_per_kg * m;
+        let (k, c) = self.corner_gains[i];
         let omega = (4.0 * k * w).sqrt();
         let zeta = if omega > 0.0 {
             2.0 * c * w / omega
@@ -313,8 +394,11 @@ impl ContactModel {
 }
 
 /// What the floor did to each link over a run: peak normal force (N), normal impulse (N·s),
-/// deepest corner penetration (m), and the deepest penetration of any link (m). The paper's
-/// damage (eq. 5.1) weighs the peaks.
+/// deepest corner penetration (m), the first touchdown (time, and the box centre's velocity
+/// along the normal then, m/s, negative when moving into the floor), the energy the normal
+/// contact absorbed (J, `∫ −Σ f_n ż dt`: the spring's stored energy comes back, so this is what
+/// the damping dissipated plus what is still stored), and the deepest penetration of any link
+/// (m). The paper's damage (eq. 5.1) weighs the peaks.
 #[derive(Clone, Debug, PartialEq, Default)]
 pub struct ContactStats {
     /// Peak normal force per link (N).
@@ -323,6 +407,12 @@ pub struct ContactStats {
     pub impulse: Vec<f64>,
     /// Deepest penetration per link (m).
     pub max_depth: Vec<f64>,
+    /// Time of the first step start at which the link touched (s).
+    pub touchdown_s: Vec<Option<f64>>,
+    /// Box-centre velocity along the floor normal at touchdown (m/s).
+    pub touchdown_velocity: Vec<f64>,
+    /// Energy absorbed by the normal contact per link (J).
+    pub absorbed_j: Vec<f64>,
     /// Deepest penetration of any link (m).
     pub max_penetration: f64,
 }
@@ -334,19 +424,26 @@ impl ContactStats {
             peak: vec![0.0; nlinks],
             impulse: vec![0.0; nlinks],
             max_depth: vec![0.0; nlinks],
+            touchdown_s: vec![None; nlinks],
+            touchdown_velocity: vec![0.0; nlinks],
+            absorbed_j: vec![0.0; nlinks],
             max_penetration: 0.0,
         }
     }
 
-    /// Accounts for one step of `dt` seconds whose start saw per-link normal forces `normal`
-    /// (N), depths `depth` (m) and deepest penetration `penetration` (m).
-    pub fn accumulate(&mut self, normal: &[f64], depth: &[f64], penetration: f64, dt: f64) {
-        for i in 0..normal.len() {
-            let f = normal[i];
+    /// Accounts for one step of `dt` seconds starting at time `t` (s) whose start saw `sample`.
+    pub fn accumulate(&mut self, sample: &ContactSample, t: f64, dt: f64) {
+        for i in 0..sample.normal.len() {
+            let f = sample.normal[i];
             self.peak[i] = self.peak[i].max(f);
             self.impulse[i] += f * dt;
-            self.max_depth[i] = self.max_depth[i].max(depth[i]);
+            self.max_depth[i] = self.max_depth[i].max(sample.depth[i]);
+            self.absorbed_j[i] += sample.absorbed_power[i] * dt;
+            if f > 0.0 && self.touchdown_s[i].is_none() {
+                self.touchdown_s[i] = Some(t);
+                self.touchdown_velocity[i] = sample.center_normal_velocity[i];
+            }
         }
-        self.max_penetration = self.max_penetration.max(penetration);
+        self.max_penetration = self.max_penetration.max(sample.penetration);
     }
 }

@@ -8,9 +8,9 @@ use crate::dynamics::spatial::ForceVec;
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 
-/// A push.
+/// A push. A field left out of a scene takes the paper's push ([`Push::default`]).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, default)]
 pub struct Push {
     /// Link that is pushed (e.g. "torso").
     pub link: String,
@@ -25,6 +25,14 @@ pub struct Push {
     pub start_s: f64,
     /// Duration (s).
     pub duration_s: f64,
+}
+
+impl Default for Push {
+    /// The paper's push on a 1.70 m figure: 1000 N on the chest from the front for 0.1 s from
+    /// t = 0.1 s.
+    fn default() -> Self {
+        paper_push(0.1, 0.16 * 1.70)
+    }
 }
 
 impl Push {

@@ -1,4 +1,7 @@
-//! PD control toward a key pose (the paper's eq. 4.1): `τ = k_p(θ_d − θ) + k_v(θ̇_d − θ̇)` per DOF.
+//! PD control toward a key pose (the paper's eq. 4.1): `τ = k_p(θ_d − θ) + k_v(θ̇_d − θ̇)` per DOF,
+//! saturated at the DOF's strength: `τ ← clamp(τ, τ_min, τ_max)` (a muscle cannot give more than
+//! its maximal voluntary torque; see [`crate::humanoid::strength`]). A saturated torque no
+//! longer depends on θ̇, so its velocity coefficient is 0.
 
 /// Per-DOF PD settings: targets θ_d (rad), target velocities θ̇_d (rad/s), gains k_p
 /// (N·m/rad) and k_v (N·m·s/rad), one entry per actuated DOF.
@@ -12,6 +15,9 @@ pub struct PdTargets {
     pub kp: Vec<f64>,
     /// Derivative gain k_v per DOF (N·m·s/rad).
     pub kv: Vec<f64>,
+    /// Strength per DOF: the torque range `(τ_min, τ_max)` (N·m, `τ_min ≤ 0 ≤ τ_max`) the PD
+    /// torque is clamped to; empty = unbounded.
+    pub torque_limits: Vec<(f64, f64)>,
 }
 
 impl PdTargets {
@@ -23,20 +29,40 @@ impl PdTargets {
             target_velocity: vec![0.0; n],
             kp,
             kv,
+            torque_limits: Vec::new(),
         }
+    }
+
+    /// The same targets with the PD torque of each DOF clamped to `limits` (N·m).
+    pub fn with_torque_limits(mut self, limits: Vec<(f64, f64)>) -> Self {
+        self.torque_limits = limits;
+        self
+    }
+
+    /// True if the PD torque `tau` (N·m) of DOF `d` lies at or past its strength limit.
+    #[inline]
+    pub fn saturates(&self, d: usize, tau: f64) -> bool {
+        self.torque_limits
+            .get(d)
+            .is_some_and(|&(lo, hi)| tau <= lo || tau >= hi)
     }
 
     /// The torque (N·m) and velocity coefficient on DOF `d` at angle `theta`, rate `theta_dot`.
     #[inline]
     pub fn torque(&self, d: usize, theta: f64, theta_dot: f64) -> (f64, f64) {
-        pd_torque(
+        let (tau, kv) = pd_torque(
             self.kp[d],
             self.kv[d],
             self.target[d],
             self.target_velocity[d],
             theta,
             theta_dot,
-        )
+        );
+        match self.torque_limits.get(d) {
+            Some(&(_, hi)) if tau > hi => (hi, 0.0),
+            Some(&(lo, _)) if tau < lo => (lo, 0.0),
+            _ => (tau, kv),
+        }
     }
 }
 
@@ -61,5 +87,16 @@ mod tests {
     fn pd_pulls_toward_the_target_and_damps() {
         assert!((pd_torque(100.0, 10.0, 0.5, 0.0, 0.3, 0.0).0 - 20.0).abs() < 1e-12);
         assert!((pd_torque(100.0, 10.0, 0.0, 0.0, 0.0, 1.0).0 + 10.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn strength_clamps_the_torque_and_drops_its_velocity_term() {
+        let pd = PdTargets::hold(vec![1.0], vec![100.0], vec![10.0])
+            .with_torque_limits(vec![(-30.0, 50.0)]);
+        assert_eq!(pd.torque(0, 0.0, 0.0), (50.0, 0.0));
+        assert_eq!(pd.torque(0, 2.0, 0.0), (-30.0, 0.0));
+        let (tau, kv) = pd.torque(0, 0.9, 0.0);
+        assert!((tau - 10.0).abs() < 1e-9 && kv == 10.0);
+        assert!(pd.saturates(0, 50.0) && !pd.saturates(0, 10.0));
     }
 }

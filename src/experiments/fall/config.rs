@@ -6,6 +6,7 @@ use crate::dynamics::forces::external::Push;
 use crate::dynamics::forces::limits::JointLimitParams;
 use crate::dynamics::integrator::Integrator;
 use crate::humanoid::ranges::{AgeGroup, RangeTable};
+use crate::humanoid::strength::torque_limits;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
@@ -37,6 +38,10 @@ pub struct FallConfig {
     pub ranges: Ranges,
     /// Joint-model gains (friction inside the range, spring and damper past it).
     pub limits: JointLimitParams,
+    /// Strength: the PD torque range `(τ_min, τ_max)` per DOF (N·m, model order) the dynamics
+    /// clamps to; [`FallConfig::paper`] takes [`torque_limits`] of the age group; `None` =
+    /// unbounded.
+    pub torque_limits_nm: Option<Vec<(f64, f64)>>,
     /// Initial standing pose (deg, 21 DOFs), held by the stance gains until `control_start_s`.
     pub stance_pose_deg: Vec<f64>,
     /// Stance PD stiffness per DOF (N·m/rad).
@@ -57,8 +62,10 @@ pub struct FallConfig {
     pub dt_s: f64,
     /// Integration scheme.
     pub integrator: Integrator,
-    /// Simulated time (s).
+    /// Simulated time (s), counted from the end of the settling phase.
     pub duration_s: f64,
+    /// Longest settling phase before the run (s): the standing body is relaxed to rest first.
+    pub settle_max_s: f64,
     /// Floor contact parameters.
     pub contact: ContactParams,
     /// Damage weight w_i per link name (links not listed weigh 1).
@@ -88,8 +95,10 @@ impl FallConfig {
     /// (34°: the elderly knee range of the paper's Table 1 starts at 32°, so both groups stand
     /// alike inside their ranges), pushed with 1000 N on the chest from the front for 0.1 s from
     /// t = 0.1 s; the reaction toward the key pose (here the stance itself) starts at 0.25 s;
-    /// semi-implicit Euler with implicit damping at 0.5 ms (the contact stability bound is
-    /// 0.63 ms) for 3 s; damage weights protect the head most (w = 10).
+    /// semi-implicit Euler with implicit damping at 0.5 ms (the stiffest mode, the foot's heel
+    /// pad contact, bounds it at 0.92 ms) for 3 s after a settling phase of at most 3 s; PD
+    /// torques capped at the group's strength ([`torque_limits`]); damage weights protect the
+    /// head most (w = 10).
     pub fn paper(group: AgeGroup) -> Self {
         let names = crate::humanoid::fall21().dof_names();
         let stance = per_dof(&names, |n| match strip_side(n) {
@@ -140,6 +149,7 @@ impl FallConfig {
             gravity: 9.81,
             ranges: Ranges::Builtin(group),
             limits: JointLimitParams::default(),
+            torque_limits_nm: Some(torque_limits(group)),
             stance_pose_deg: stance.clone(),
             stance_kp: kp.clone(),
             stance_kv: kv.clone(),
@@ -153,6 +163,7 @@ impl FallConfig {
                 implicit_damping: true,
             },
             duration_s: 3.0,
+            settle_max_s: 3.0,
             contact: ContactParams::default(),
             damage_weights: w,
             record_hz: 60.0,

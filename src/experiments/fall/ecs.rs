@@ -38,16 +38,17 @@ pub fn fall_record_system(
         &PhysicsBody,
         &BodyState,
         &mut PhysicsWorkspace,
+        &PhysicsMonitor,
         &mut FallRecorder,
         &mut PhysicsStatus,
     )>,
 ) {
-    for (body, state, mut ws, mut recorder, mut status) in &mut q {
+    for (body, state, mut ws, monitor, mut recorder, mut status) in &mut q {
         if status.error.is_some() {
             continue;
         }
         let b = &*body.body;
-        recorder.record(b, state, ws.kinematics_of(&b.model, state));
+        recorder.record(b, state, ws.kinematics_of(&b.model, state), monitor);
         if recorder.finished(state) {
             status.stopped = true;
         }
@@ -90,7 +91,7 @@ pub fn spawn_fall(world: &mut World, mut ch: FallCharacter) -> Result<Entity, Si
     let p = &mut ch.physics;
     let b = &*p.body.body;
     let data = p.workspace.kinematics_of(&b.model, &p.state);
-    ch.recorder.record(b, &p.state, data);
+    ch.recorder.record(b, &p.state, data, &p.monitor);
     if ch.recorder.finished(&p.state) {
         p.status.stopped = true;
     }

@@ -18,7 +18,9 @@ pub mod result;
 pub use self::config::{FallConfig, Ranges};
 pub use self::controller::FallController;
 pub use self::recorder::FallRecorder;
-pub use self::result::{FallFrame, FallResult, SimError};
+pub use self::result::{
+    FallFrame, FallResult, LinkImpact, PelvisImpact, SimError, StandingStart, TorqueSaturation,
+};
 
 use std::sync::Arc;
 
@@ -34,6 +36,12 @@ use crate::dynamics::stability::{DofStiffness, scheme_name, stiffest_mode};
 use crate::ecs::physics::{ExternalForces, FloorContact, JointLimits, PdController, PhysicsBundle};
 use crate::humanoid::body::{HumanBody, fall21_body};
 use crate::humanoid::ranges::RangeTable;
+use crate::humanoid::tissue;
+
+/// The most steps one fall may take (checked before it runs): 3 s at 0.15 µs.
+pub const MAX_STEPS: u64 = 20_000_000;
+/// The most frames one fall may record.
+pub const MAX_FRAMES: u64 = 1_000_000;
 
 fn cfg_err(field: &str, message: impl Into<String>) -> SimError {
     SimError::Config {
@@ -94,9 +102,44 @@ fn validate(cfg: &FallConfig) -> Result<Resolved, SimError> {
             return Err(cfg_err(f, format!("gains must be ≥ 0, found {x}")));
         }
     }
+    positive("settle_max_s", cfg.settle_max_s)?;
+    // Sizes are checked before anything is allocated or run.
+    let steps = cfg.duration_s / cfg.dt_s;
+    if steps > MAX_STEPS as f64 {
+        return Err(cfg_err(
+            "duration_s",
+            format!(
+                "{} s at dt = {} s is {steps:.3e} steps; at most {MAX_STEPS} are allowed \
+                 (shorten the duration or enlarge the step)",
+                cfg.duration_s, cfg.dt_s
+            ),
+        ));
+    }
+    let frames = cfg.duration_s * cfg.record_hz;
+    if frames > MAX_FRAMES as f64 {
+        return Err(cfg_err(
+            "record_hz",
+            format!(
+                "{} s at {} Hz is {frames:.3e} frames; at most {MAX_FRAMES} are allowed",
+                cfg.duration_s, cfg.record_hz
+            ),
+        ));
+    }
+    if !(cfg.push.start_s.is_finite() && cfg.push.start_s >= 0.0)
+        || cfg.push.start_s >= cfg.duration_s
+    {
+        return Err(cfg_err(
+            "push.start_s",
+            format!(
+                "the push starts at {} s, but the simulation runs from 0 to {} s: \
+                 it must start inside the run",
+                cfg.push.start_s, cfg.duration_s
+            ),
+        ));
+    }
     let c = &cfg.contact;
     for (f, x) in [
-        ("contact.stiffness_per_kg", c.stiffness_per_kg),
+        ("contact.stiffness_scale", c.stiffness_scale),
         (
             "contact.tangential_stiffness_per_kg",
             c.tangential_stiffness_per_kg,
@@ -104,7 +147,7 @@ fn validate(cfg: &FallConfig) -> Result<Resolved, SimError> {
     ] {
         positive(f, x)?;
     }
-    if !(c.damping_per_kg >= 0.0 && c.tangential_damping_per_kg >= 0.0 && c.friction >= 0.0) {
+    if !(c.damping_scale >= 0.0 && c.tangential_damping_per_kg >= 0.0 && c.friction >= 0.0) {
         return Err(cfg_err("contact", "damping and friction must be ≥ 0"));
     }
     if c.floor_normal.is_nan() || (c.floor_normal.length() - 1.0).abs() >= 1e-9 {
@@ -159,6 +202,30 @@ fn validate(cfg: &FallConfig) -> Result<Resolved, SimError> {
         Ranges::File(p) => RangeTable::load(p)?,
     };
     let ranges = table.for_model(&body.figure)?;
+    if let Some(t) = &cfg.torque_limits_nm {
+        if t.len() != n {
+            return Err(cfg_err(
+                "torque_limits_nm",
+                format!(
+                    "needs {n} (min, max) pairs (one per fall21 DOF), found {}",
+                    t.len()
+                ),
+            ));
+        }
+        if let Some((d, (lo, hi))) = t
+            .iter()
+            .enumerate()
+            .find(|(_, (lo, hi))| !(lo.is_finite() && hi.is_finite() && *lo <= 0.0 && *hi >= 0.0))
+        {
+            return Err(cfg_err(
+                "torque_limits_nm",
+                format!(
+                    "{}: ({lo}, {hi}) must be finite with min ≤ 0 ≤ max",
+                    body.figure.dofs[d].name
+                ),
+            ));
+        }
+    }
     Ok(Resolved {
         body,
         push_link,
@@ -213,7 +280,10 @@ fn standing_configuration(
             lowest = lowest.min(n_up.dot(data.pos[i] + data.rot[i] * cl));
         }
     }
-    let sink = cfg.gravity / (4.0 * cfg.contact.stiffness_per_kg);
+    // Sink of the feet under the whole weight, half on each (the settling phase finds the rest).
+    let weight = body.model.total_mass() * cfg.gravity;
+    let foot = body.link_index("right_foot").unwrap_or(0);
+    let sink = contact.static_sink(foot, 0.5 * weight);
     let shift = n_up * (cfg.contact.floor_height - lowest - sink);
     for k in 0..3 {
         q[k] += shift[k];
@@ -284,13 +354,25 @@ pub fn build_fall(cfg: &FallConfig) -> Result<FallCharacter, SimError> {
     let rad = |v: &[f64]| v.iter().map(|x| x.to_radians()).collect::<Vec<_>>();
     let stance_pose = rad(&cfg.stance_pose_deg);
     let masses: Vec<f64> = body.model.bodies.iter().map(|b| b.inertia.mass).collect();
-    let contact = ContactModel::new(&body.boxes, &masses, cfg.contact);
+    let gains: Vec<_> = body
+        .link_names
+        .iter()
+        .map(|n| {
+            tissue::region(n)
+                .map(|r| r.gains())
+                .ok_or_else(|| cfg_err("body", format!("link '{n}' has no tissue region")))
+        })
+        .collect::<Result<_, _>>()?;
+    let contact = ContactModel::new(&body.boxes, &masses, &gains, cfg.contact);
     let q = standing_configuration(cfg, &body, &contact, &stance_pose);
-    let stance = PdTargets::hold(stance_pose, cfg.stance_kp.clone(), cfg.stance_kv.clone());
-    let key = PdTargets::hold(rad(&cfg.key_pose_deg), cfg.kp.clone(), cfg.kv.clone());
+    let strength = cfg.torque_limits_nm.clone().unwrap_or_default();
+    let stance = PdTargets::hold(stance_pose, cfg.stance_kp.clone(), cfg.stance_kv.clone())
+        .with_torque_limits(strength.clone());
+    let key = PdTargets::hold(rad(&cfg.key_pose_deg), cfg.kp.clone(), cfg.kv.clone())
+        .with_torque_limits(strength);
     let nv = body.model.nv;
     let body = Arc::new(body);
-    let ch = FallCharacter {
+    let mut ch = FallCharacter {
         physics: PhysicsBundle::new(body, cfg.integrator, q),
         pd: PdController(stance.clone()),
         limits: JointLimits(JointRanges {
@@ -308,7 +390,73 @@ pub fn build_fall(cfg: &FallConfig) -> Result<FallCharacter, SimError> {
         recorder: FallRecorder::new(cfg, weights, nv),
     };
     check_stability(cfg, &ch)?;
+    let settled = settle(cfg, &ch)?;
+    ch.recorder.settle_s = settled.time_s;
+    let st = &mut ch.physics.state.0;
+    st.q = settled.q;
+    st.anchors = settled.anchors;
     Ok(ch)
+}
+
+/// Relaxation time of the settling phase's velocity damping (s).
+const SETTLE_TAU_S: f64 = 0.02;
+/// The body counts as settled once its kinetic energy stays below this (J)… (a standing body
+/// keeps a residual ~1e-5 J of chatter where foot corners sit at the floor's surface)
+const SETTLED_KE_J: f64 = 1e-4;
+/// …for this long (s).
+const SETTLED_HOLD_S: f64 = 0.05;
+
+/// The settling phase: from the standing configuration the body is stepped with the stance
+/// control, joint model and floor (no push), its velocity relaxed by `v ← v e^{−h/τ}` (τ =
+/// 20 ms) after each step, until the kinetic energy has stayed below 1e-4 J for 50 ms. Returns
+/// that state (its friction anchors where the feet came to rest, its time the settling time);
+/// the fall starts there with `v = 0`, so the push acts on a body at rest: forces in
+/// equilibrium, foot force equal to the weight.
+fn settle(cfg: &FallConfig, ch: &FallCharacter) -> Result<pipeline::State, SimError> {
+    let body = &*ch.physics.body.body;
+    let model = &body.model;
+    let mut state = ch.physics.state.0.clone();
+    let mut ws = pipeline::StepWorkspace::new(model);
+    let mut monitor = pipeline::StepMonitor::new(model.nbodies(), body.dof_v.len());
+    let settings = StepSettings {
+        integrator: ch.physics.body.integrator,
+        dt: cfg.dt_s,
+    };
+    let forces = Forces {
+        dofs: &body.dof_v,
+        pd: Some(&ch.pd.0),
+        limits: Some(&ch.limits.0),
+        contact: Some(&ch.contact.0),
+        external: &[],
+    };
+    let relax = (-cfg.dt_s / SETTLE_TAU_S).exp();
+    let mut quiet_since: Option<f64> = None;
+    while state.time_s < cfg.settle_max_s {
+        pipeline::step(model, settings, &forces, &mut state, &mut ws, &mut monitor)?;
+        state.v.iter_mut().for_each(|x| *x *= relax);
+        ws.eval.kinematics_at_step = None;
+        let data = ws.kinematics_of(model, &state);
+        let ke: f64 = (0..model.nbodies())
+            .map(|i| model.bodies[i].inertia.kinetic_energy(data.v[i]))
+            .sum();
+        if ke < SETTLED_KE_J {
+            let t0 = *quiet_since.get_or_insert(state.time_s);
+            if state.time_s - t0 >= SETTLED_HOLD_S {
+                state.v.iter_mut().for_each(|x| *x = 0.0);
+                return Ok(state);
+            }
+        } else {
+            quiet_since = None;
+        }
+    }
+    Err(cfg_err(
+        "settle_max_s",
+        format!(
+            "the standing body did not come to rest within {} s (stance gains too weak or the \
+             stance pose out of balance)",
+            cfg.settle_max_s
+        ),
+    ))
 }
 
 /// Simulates one pushed fall from `config` without a World (the same parts and steps as
@@ -332,7 +480,7 @@ pub fn simulate_fall(config: &FallConfig) -> Result<FallResult, SimError> {
         integrator: physics.body.integrator,
         dt: config.dt_s,
     };
-    recorder.record(body, state, ws.kinematics_of(&body.model, state));
+    recorder.record(body, state, ws.kinematics_of(&body.model, state), monitor);
     while !recorder.finished(state) {
         controller.apply(state.time_s, &mut pd.0);
         let forces = Forces {
@@ -343,7 +491,7 @@ pub fn simulate_fall(config: &FallConfig) -> Result<FallResult, SimError> {
             external: &external.0,
         };
         pipeline::step(&body.model, settings, &forces, state, ws, monitor)?;
-        recorder.record(body, state, ws.kinematics_of(&body.model, state));
+        recorder.record(body, state, ws.kinematics_of(&body.model, state), monitor);
     }
     Ok(recorder.result(body, state, monitor))
 }

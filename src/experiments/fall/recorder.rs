@@ -5,7 +5,7 @@ use bevy_ecs::prelude::*;
 use glam::{DQuat, DVec3};
 
 use super::config::FallConfig;
-use super::result::{FallFrame, FallResult};
+use super::result::{FallFrame, FallResult, LinkImpact, PelvisImpact, TorqueSaturation};
 use crate::dynamics::data::Data;
 use crate::dynamics::pipeline::{State, StepMonitor};
 use crate::humanoid::body::HumanBody;
@@ -37,7 +37,38 @@ pub struct FallRecorder {
     pub weights: Vec<f64>,
     /// The step the last record was taken at.
     pub recorded_step: Option<u64>,
+    /// Length of the settling phase that preceded the run (s).
+    pub settle_s: f64,
+    /// Start of the push (s): the standing figures are taken before it.
+    pub push_start: f64,
+    /// Before the push: the largest kinetic energy (J) and the smallest and largest total foot
+    /// force (N).
+    pub before_push: StandingStart,
+    /// Pelvis: first time its centre of mass moves down faster than 0.1 m/s after the push
+    /// starts (s), the start of descent.
+    pub descent_start_s: Option<f64>,
+    /// Floor height (m), level floor.
+    pub floor_height: f64,
+    /// Highest the pelvis box's lowest corner rose above the floor after the pelvis's first
+    /// touchdown (m): the rebound.
+    pub pelvis_rebound_m: f64,
     angles: Vec<f64>,
+}
+
+/// The standing start before the push: the body's weight (N), the smallest and largest total
+/// normal force on the feet (N) and the largest kinetic energy (J) over the steps before it.
+#[derive(Clone, Copy, Debug, PartialEq, Default, serde::Serialize, serde::Deserialize)]
+pub struct StandingStart {
+    /// Body weight `M g` (N).
+    pub weight_n: f64,
+    /// Smallest total foot normal force before the push (N).
+    pub min_foot_force_n: f64,
+    /// Largest total foot normal force before the push (N).
+    pub max_foot_force_n: f64,
+    /// Largest kinetic energy before the push (J).
+    pub max_kinetic_energy_j: f64,
+    /// Length of the settling phase that found this rest (s).
+    pub settle_s: f64,
 }
 
 impl FallRecorder {
@@ -58,6 +89,18 @@ impl FallRecorder {
             stop_at_rest: cfg.stop_at_rest,
             weights,
             recorded_step: None,
+            settle_s: 0.0,
+            push_start: cfg.push.start_s,
+            before_push: StandingStart {
+                weight_n: cfg.mass_kg * cfg.gravity,
+                min_foot_force_n: f64::INFINITY,
+                max_foot_force_n: 0.0,
+                max_kinetic_energy_j: 0.0,
+                settle_s: 0.0,
+            },
+            descent_start_s: None,
+            floor_height: cfg.contact.floor_height,
+            pelvis_rebound_m: 0.0,
             angles: vec![0.0; nv],
         }
     }
@@ -72,10 +115,11 @@ impl FallRecorder {
                     .is_some_and(|t0| state.time_s - t0 >= self.rest_hold))
     }
 
-    /// Records `state` (whose kinematics are in `data`): at step 0 the first frame; after a
-    /// step the rest detection (kinetic energy below the threshold once the push is over) and
-    /// a frame when one is due.
-    pub fn record(&mut self, body: &HumanBody, state: &State, data: &Data) {
+    /// Records `state` (whose kinematics are in `data`; `monitor` what the steps saw): at step
+    /// 0 the first frame; after a step the standing start (before the push), the pelvis's
+    /// descent and rebound, the rest detection (kinetic energy below the threshold once the
+    /// push is over) and a frame when one is due.
+    pub fn record(&mut self, body: &HumanBody, state: &State, data: &Data, monitor: &StepMonitor) {
         if self.recorded_step == Some(state.steps) {
             return;
         }
@@ -91,6 +135,39 @@ impl FallRecorder {
         let mut ke = 0.0;
         for i in 0..model.nbodies() {
             ke += model.bodies[i].inertia.kinetic_energy(data.v[i]);
+        }
+        // The monitor's sample is the floor at the start of the step that just ended.
+        let step_start = t - self.dt;
+        if step_start < self.push_start {
+            let feet: f64 = body
+                .link_names
+                .iter()
+                .zip(&monitor.sample.normal)
+                .filter(|(n, _)| n.ends_with("_foot"))
+                .map(|(_, f)| f)
+                .sum();
+            let b = &mut self.before_push;
+            b.min_foot_force_n = b.min_foot_force_n.min(feet);
+            b.max_foot_force_n = b.max_foot_force_n.max(feet);
+            if t <= self.push_start {
+                b.max_kinetic_energy_j = b.max_kinetic_energy_j.max(ke);
+            }
+        }
+        let p = body.link_index("pelvis").unwrap_or(0);
+        let com = model.bodies[p].inertia.com;
+        let vp = data.rot[p] * (data.v[p].lin + data.v[p].ang.cross(com));
+        if self.descent_start_s.is_none() && t >= self.push_start && vp.y < -0.1 {
+            self.descent_start_s = Some(t);
+        }
+        if monitor.contact.touchdown_s[p].is_some() {
+            // Rebound: how high the pelvis box's lowest corner lifts off the floor after the
+            // pelvis first touched it.
+            let lowest = body.boxes[p]
+                .corners()
+                .iter()
+                .map(|&c| (data.pos[p] + data.rot[p] * c).y)
+                .fold(f64::INFINITY, f64::min);
+            self.pelvis_rebound_m = self.pelvis_rebound_m.max(lowest - self.floor_height);
         }
         // Rest counts only once the push is over (a figure standing still before it is not
         // "at rest" on the floor).
@@ -131,6 +208,36 @@ impl FallRecorder {
     pub fn result(&self, body: &HumanBody, state: &State, monitor: &StepMonitor) -> FallResult {
         let c = &monitor.contact;
         let damage = self.weights.iter().zip(&c.peak).map(|(w, f)| w * f).sum();
+        let impacts = (0..body.link_names.len())
+            .map(|i| LinkImpact {
+                link: body.link_names[i].clone(),
+                touchdown_s: c.touchdown_s[i],
+                impact_velocity_m_s: -c.touchdown_velocity[i],
+                peak_force_n: c.peak[i],
+                impulse_n_s: c.impulse[i],
+                energy_absorbed_j: c.absorbed_j[i],
+                max_penetration_m: c.max_depth[i],
+                damage_weight: self.weights[i],
+                damage_n: self.weights[i] * c.peak[i],
+            })
+            .collect();
+        let p = body.link_index("pelvis").unwrap_or(0);
+        let pelvis_touch = c.touchdown_s[p];
+        let strength = body
+            .figure
+            .dofs
+            .iter()
+            .enumerate()
+            .filter_map(|(d, dof)| {
+                monitor.first_saturated_s[d].map(|first| TorqueSaturation {
+                    dof: dof.name.clone(),
+                    first_s: first,
+                    duration_s: monitor.saturated_s[d],
+                })
+            })
+            .collect();
+        let mut standing = self.before_push;
+        standing.settle_s = self.settle_s;
         let end = state.time_s;
         let rest_time_s = self.rest_since.filter(|&t0| end - t0 >= self.rest_hold);
         FallResult {
@@ -149,6 +256,18 @@ impl FallRecorder {
             steps: state.steps,
             dt_s: self.dt,
             height_m: body.figure.height,
+            impacts,
+            pelvis: PelvisImpact {
+                impact_velocity_m_s: pelvis_touch.map(|_| -c.touchdown_velocity[p]),
+                descent_start_s: self.descent_start_s,
+                touchdown_s: pelvis_touch,
+                descent_time_s: pelvis_touch
+                    .zip(self.descent_start_s)
+                    .map(|(t1, t0)| t1 - t0),
+                rebound_m: self.pelvis_rebound_m,
+            },
+            standing,
+            torque_saturation: strength,
         }
     }
 }

@@ -1,0 +1,106 @@
+//! Strength: the maximal voluntary joint torque per fall21 DOF and age group, the bound on what
+//! PD control can ask of a joint (the dynamics clamps the PD torque to it, see
+//! [`crate::dynamics::forces::pd`]; a genetic algorithm reads it to bound its gains).
+//!
+//! Source: **Harbo, Brincks & Andersen (2012)**, *Maximal isokinetic and isometric muscle
+//! strength of major muscle groups related to age, body mass, height, and sex in 178 healthy
+//! subjects*, Eur. J. Appl. Physiol. 112:267–275 (isometric maxima of the shoulder, elbow, wrist,
+//! hip, knee and ankle flexors and extensors, ages 15–83). The values below are rounded
+//! representative isometric maxima of men of about 70–75 kg: `Adult` for ages 20–40, `Elderly`
+//! for ages 60–80, where the lower-limb extensors have lost the most (about 35–40 %), the upper
+//! limb less (about 25 %). They were transcribed as orders of magnitude, not row by row from the
+//! paper's regression tables: check them against it before relying on a single value. Trunk and
+//! neck are not in that study; their values (trunk flexion/extension about 150/200 N·m, neck
+//! 25/40 N·m in young men) are this project's rounded reading of the dynamometry literature, with
+//! the same age decline.
+//!
+//! Signs follow the DOFs' anatomical convention (positive = flexion, abduction, external
+//! rotation, dorsiflexion, lateral bend to the right, turn to the left): a DOF's range is
+//! `(−τ_negative, τ_positive)`, e.g. the knee `(−extension, +flexion)`.
+
+use crate::humanoid::ranges::AgeGroup;
+
+/// Maximal torques of one DOF (N·m, both ≥ 0): in its negative and positive directions.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Strength {
+    /// Side-less DOF name (`knee`, `hip_flexion`, …).
+    pub dof: &'static str,
+    /// Largest torque in the negative direction (N·m), young adults.
+    pub adult_negative: f64,
+    /// Largest torque in the positive direction (N·m), young adults.
+    pub adult_positive: f64,
+    /// Largest torque in the negative direction (N·m), older adults.
+    pub elderly_negative: f64,
+    /// Largest torque in the positive direction (N·m), older adults.
+    pub elderly_positive: f64,
+}
+
+const fn s(dof: &'static str, an: f64, ap: f64, en: f64, ep: f64) -> Strength {
+    Strength {
+        dof,
+        adult_negative: an,
+        adult_positive: ap,
+        elderly_negative: en,
+        elderly_positive: ep,
+    }
+}
+
+/// The table: per side-less fall21 DOF, (adult −, adult +, elderly −, elderly +) in N·m.
+pub const TABLE: [Strength; 13] = [
+    s("waist_flexion", 200.0, 150.0, 130.0, 100.0), // extension / flexion
+    s("waist_rotation", 60.0, 60.0, 40.0, 40.0),
+    s("neck_flexion", 40.0, 25.0, 28.0, 18.0), // extension / flexion
+    s("neck_lateral", 30.0, 30.0, 20.0, 20.0),
+    s("neck_rotation", 15.0, 15.0, 10.0, 10.0),
+    s("shoulder_flexion", 70.0, 60.0, 52.0, 45.0), // extension / flexion
+    s("shoulder_rotation", 35.0, 35.0, 26.0, 26.0),
+    s("elbow", 50.0, 70.0, 38.0, 52.0), // extension / flexion
+    s("wrist", 12.0, 12.0, 9.0, 9.0),
+    s("hip_flexion", 200.0, 150.0, 130.0, 100.0), // extension / flexion
+    s("hip_abduction", 110.0, 120.0, 75.0, 80.0), // adduction / abduction
+    s("knee", 240.0, 120.0, 150.0, 75.0),         // extension / flexion
+    s("ankle", 150.0, 40.0, 95.0, 28.0),          // plantar flexion / dorsiflexion
+];
+
+/// The strength row of a fall21 DOF (full or side-less name).
+pub fn strength(dof: &str) -> Option<&'static Strength> {
+    let d = dof
+        .strip_prefix("left_")
+        .or_else(|| dof.strip_prefix("right_"))
+        .unwrap_or(dof);
+    TABLE.iter().find(|r| r.dof == d)
+}
+
+/// The torque range `(τ_min, τ_max)` (N·m) of every fall21 DOF in model order for `group`.
+pub fn torque_limits(group: AgeGroup) -> Vec<(f64, f64)> {
+    crate::humanoid::fall21()
+        .dof_names()
+        .iter()
+        .map(|n| {
+            let r = strength(n).unwrap_or_else(|| unreachable!("fall21 DOF {n} has a row"));
+            match group {
+                AgeGroup::Adult => (-r.adult_negative, r.adult_positive),
+                AgeGroup::Elderly => (-r.elderly_negative, r.elderly_positive),
+            }
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_dof_has_a_limit_and_older_adults_are_weaker() {
+        let a = torque_limits(AgeGroup::Adult);
+        let e = torque_limits(AgeGroup::Elderly);
+        assert_eq!(a.len(), 21);
+        for (x, y) in a.iter().zip(&e) {
+            assert!(x.0 < 0.0 && x.1 > 0.0);
+            assert!(y.0 > x.0 && y.1 < x.1);
+        }
+        // Knee extension (negative) is the strongest lower-limb action.
+        let k = crate::humanoid::fall21().dof_index("left_knee").unwrap();
+        assert_eq!(a[k], (-240.0, 120.0));
+    }
+}
