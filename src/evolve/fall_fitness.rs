@@ -1,7 +1,10 @@
 //! The falling paper's fitness (SPEC §3, paper §5): a genome is the key pose θ_d and the
 //! stiffness k_p of every fall21 DOF (2 × 21 = 42 genes; k_v and θ̇_d fixed), its fitness the
 //! damage `D = Σ w_i f_i` of the pushed fall it controls (lower is fitter). θ_d is bounded by the
-//! age group's joint ranges, the quantity the paper studies; k_p by `[0, kp_max]`.
+//! age group's joint ranges, the quantity the paper studies; k_p by `[0, kp_max]` with `kp_max`
+//! the gain at which a 5° error already asks for the age group's maximal torque
+//! ([`crate::humanoid::strength`]): the dynamics saturates PD at that torque, so strength, not
+//! the gain, is what bounds an individual, and no one wins by superhuman gains.
 //!
 //! Genes, in order: `θ_d` (rad) of DOF 0..21, then `k_p` (N·m/rad) of DOF 0..21.
 
@@ -11,7 +14,9 @@ use serde::{Deserialize, Serialize};
 
 use super::evaluator::Evaluation;
 use super::genome::{Bounds, Genome};
-use crate::experiments::fall::{FallConfig, Ranges, SimError, ecs::run_parallel};
+use crate::experiments::fall::{
+    FallConfig, Ranges, SettledStart, SimError, ecs::run_parallel_from,
+};
 use crate::humanoid::fall21;
 use crate::humanoid::ranges::{AgeGroup, RangeTable};
 
@@ -47,25 +52,28 @@ pub enum ProblemError {
     },
 }
 
-/// The default strength bound: `scale` times the paper's stance gains per DOF.
-pub fn default_kp_max(scale: f64) -> Vec<f64> {
-    FallConfig::paper(AgeGroup::Elderly)
-        .stance_kp
+/// The angle error (rad) at which the largest k_p asks for the maximal torque: 5°.
+pub const KP_SATURATION_RAD: f64 = 5.0 * std::f64::consts::PI / 180.0;
+
+/// The k_p bound of `group` per DOF (N·m/rad): `scale · max(|τ_min|, τ_max) / 5°`, with the age
+/// group's torque limits.
+pub fn strength_kp_max(group: AgeGroup, scale: f64) -> Vec<f64> {
+    crate::humanoid::strength::torque_limits(group)
         .iter()
-        .map(|k| k * scale)
+        .map(|(lo, hi)| scale * lo.abs().max(*hi) / KP_SATURATION_RAD)
         .collect()
 }
 
 impl FallProblem {
-    /// The paper's problem for `group`: its fall, stopped at rest, k_p up to three times the
-    /// stance gains.
+    /// The paper's problem for `group`: its fall, stopped at rest, k_p up to the strength
+    /// bound ([`strength_kp_max`] with scale 1).
     pub fn paper(group: AgeGroup) -> Self {
         let mut fall = FallConfig::paper(group);
         fall.stop_at_rest = true;
         Self {
             age_group: group,
             fall,
-            kp_max: default_kp_max(3.0),
+            kp_max: strength_kp_max(group, 1.0),
         }
     }
 
@@ -104,10 +112,12 @@ impl FallProblem {
         c
     }
 
-    /// The damage of every genome, each fall in its own World, in parallel.
+    /// The damage of every genome, each fall in its own World, in parallel; the standing body
+    /// is settled once for all (the genes do not change how it stands).
     pub fn evaluate(&self, genomes: &[Genome]) -> Vec<Evaluation> {
         let configs: Vec<FallConfig> = genomes.iter().map(|g| self.config(g)).collect();
-        run_parallel(&configs)
+        let start = SettledStart::of(&self.fall).ok();
+        run_parallel_from(&configs, start.as_ref())
             .into_iter()
             .map(|r| {
                 r.map(|f| f.damage)

@@ -43,7 +43,7 @@ fn default_seeds() -> Vec<u64> {
     vec![1, 2, 3, 4, 5]
 }
 fn default_kp_scale() -> f64 {
-    3.0
+    1.0
 }
 fn default_every() -> u64 {
     10
@@ -66,7 +66,8 @@ pub struct EvolveFallScene {
     /// GA settings (the paper: 30 chromosomes, 500 generations).
     #[serde(default)]
     pub ga: GaConfig,
-    /// k_p's upper bound as a multiple of the paper's stance gains.
+    /// k_p's upper bound as a multiple of the strength bound (the gain at which a 5° error asks
+    /// for the age group's maximal torque).
     #[serde(default = "default_kp_scale")]
     pub kp_max_scale: f64,
     /// The fall every genome is tried on, per field (default: the paper's push of the age
@@ -134,7 +135,7 @@ impl EvolveFallScene {
                     p.fall.ranges = crate::experiments::fall::Ranges::Builtin(g);
                     p.fall.stop_at_rest = true;
                 }
-                p.kp_max = crate::evolve::fall_fitness::default_kp_max(self.kp_max_scale);
+                p.kp_max = crate::evolve::fall_fitness::strength_kp_max(g, self.kp_max_scale);
                 p.bounds().map_err(|e| invalid(e.to_string()))?;
                 Ok(p)
             })

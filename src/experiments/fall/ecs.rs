@@ -161,9 +161,19 @@ struct NotBuilt(Arc<SimError>);
 /// current rayon pool; the results are in input order and do not depend on the number of
 /// threads.
 pub fn run_parallel(configs: &[FallConfig]) -> Vec<Result<FallResult, Arc<SimError>>> {
+    run_parallel_from(configs, None)
+}
+
+/// [`run_parallel`] with the falls' settled standing start taken from `start` where it fits
+/// (see [`super::SettledStart`]): the same results, without settling each fall anew.
+pub fn run_parallel_from(
+    configs: &[FallConfig],
+    start: Option<&super::SettledStart>,
+) -> Vec<Result<FallResult, Arc<SimError>>> {
     let pool = WorldPool::new(configs.len(), 0, |k, world| {
         world.insert_resource(Clock::physics(configs[k].dt_s));
-        let built = super::build_fall(&configs[k]).and_then(|ch| spawn_fall(world, ch));
+        let built =
+            super::build_fall_from(&configs[k], start).and_then(|ch| spawn_fall(world, ch));
         if let Err(e) = built {
             world.insert_resource(NotBuilt(Arc::new(e)));
         }

@@ -343,8 +343,65 @@ pub fn check_stability(cfg: &FallConfig, ch: &FallCharacter) -> Result<(), SimEr
 }
 
 /// Validates `cfg`, builds the body standing on the floor with its controller, push and
-/// recorder, and checks the step against the stability bounds.
+/// recorder, checks the step against the stability bounds and settles the standing body.
 pub fn build_fall(cfg: &FallConfig) -> Result<FallCharacter, SimError> {
+    build_fall_from(cfg, None)
+}
+
+/// A settled standing start: the state the settling phase of a configuration ends in. It
+/// depends only on what the body stands with (subject, stance pose and gains, strength, joint
+/// model, floor, step), not on the key pose, its gains or the push, so many falls that differ only
+/// in those (a GA's population) can share one.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SettledStart {
+    /// The configuration it was settled for, with the fields that do not affect settling
+    /// normalised.
+    key: FallConfig,
+    /// The settled state (at rest).
+    state: pipeline::State,
+}
+
+/// `cfg` with every field that does not affect the settling phase set to a fixed value.
+fn settle_key(cfg: &FallConfig) -> FallConfig {
+    let base = FallConfig::default();
+    FallConfig {
+        key_pose_deg: base.key_pose_deg,
+        kp: base.kp,
+        kv: base.kv,
+        control_start_s: base.control_start_s,
+        push: base.push,
+        duration_s: base.duration_s,
+        damage_weights: base.damage_weights,
+        record_hz: base.record_hz,
+        rest_kinetic_energy_j: base.rest_kinetic_energy_j,
+        rest_hold_s: base.rest_hold_s,
+        stop_at_rest: base.stop_at_rest,
+        ..cfg.clone()
+    }
+}
+
+impl SettledStart {
+    /// Settles the standing body of `cfg`.
+    pub fn of(cfg: &FallConfig) -> Result<Self, SimError> {
+        let ch = build_fall(cfg)?;
+        Ok(Self {
+            key: settle_key(cfg),
+            state: ch.physics.state.0,
+        })
+    }
+
+    /// True when `cfg` stands as this start was settled for.
+    pub fn fits(&self, cfg: &FallConfig) -> bool {
+        self.key == settle_key(cfg)
+    }
+}
+
+/// [`build_fall`], taking the settled state from `start` when it fits `cfg` (the same bits as
+/// settling anew), else settling.
+pub fn build_fall_from(
+    cfg: &FallConfig,
+    start: Option<&SettledStart>,
+) -> Result<FallCharacter, SimError> {
     let Resolved {
         body,
         push_link,
@@ -390,7 +447,10 @@ pub fn build_fall(cfg: &FallConfig) -> Result<FallCharacter, SimError> {
         recorder: FallRecorder::new(cfg, weights, nv),
     };
     check_stability(cfg, &ch)?;
-    let settled = settle(cfg, &ch)?;
+    let settled = match start {
+        Some(s) if s.fits(cfg) => s.state.clone(),
+        _ => settle(cfg, &ch)?,
+    };
     ch.recorder.settle_s = settled.time_s;
     let st = &mut ch.physics.state.0;
     st.q = settled.q;
