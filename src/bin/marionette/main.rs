@@ -5,6 +5,7 @@
 mod common;
 mod export;
 mod inspect;
+mod music;
 mod render;
 mod run;
 
@@ -29,6 +30,9 @@ enum Command {
     Export(export::Args),
     /// Draw a motion (BVH or keyframed .ron clip) as a filmstrip PNG or an animated GIF.
     Render(render::Args),
+    /// Analyse a song (WAV, OGG/Vorbis, MP3): tempo, beats, bars of 4 and each bar's intensity;
+    /// draw them with --out, print JSON with --json.
+    Music(music::Args),
     /// Run a scene file; outputs go to one folder (default out/<scene name>/) with report.json.
     Run(run::Args),
 }
@@ -39,6 +43,7 @@ fn main() -> ExitCode {
         Command::Inspect(a) => inspect::inspect(a),
         Command::Export(a) => export::export(a),
         Command::Render(a) => render::render(a),
+        Command::Music(a) => music::music(a),
         Command::Run(a) => run::run(a),
     };
     match result {

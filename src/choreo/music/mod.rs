@@ -10,7 +10,8 @@
 //! - [`intensity`]: each bar's RMS and its level in dB;
 //! - [`synth`]: a drum track with exact ground truth (tempo, beats, bar loudness) for tests and
 //!   the project's own demo song;
-//! - `decode` (feature `audio`): WAV, OGG/Vorbis and MP3 to mono samples with symphonia.
+//! - `decode` (feature `audio`): WAV, OGG/Vorbis and MP3 to mono samples with symphonia;
+//! - `picture` (feature `render`): waveform, onsets, beats, bars and bar intensity in one PNG.
 //!
 //! [`analyze`] runs them in order.
 
@@ -20,6 +21,8 @@ pub mod beats;
 pub mod decode;
 pub mod intensity;
 pub mod onsets;
+#[cfg(feature = "render")]
+pub mod picture;
 pub mod synth;
 pub mod tempo;
 

@@ -3,9 +3,11 @@
 //! The song is cut into Hann-windowed frames of `window_s` (rounded up to a power of two
 //! samples), centred every `hop_s`; each frame's power spectrum (`realfft`) is summed into bands
 //! a sixth of an octave wide from 30 Hz up to 11 kHz (or the Nyquist frequency), and taken in dB
-//! with a floor `floor_db` below the loudest band of the song, so that the envelope does not
-//! depend on the song's gain. The flux of frame t is the mean over bands of the half-wave
-//! rectified rise, o(t) = (1/K) Σ_k max(0, L_t(k) − L_{t−1}(k)); a moving mean over
+//! log-compressed relative to the loudest band of the song, L = ln(1 + γ P / P_max), so that the
+//! envelope does not depend on the song's gain and soft sounds (γ P / P_max ≪ 1) count less than
+//! in a pure log (a hi-hat weighs less than a kick drum). The flux of frame t is the mean over bands of the half-wave
+//! rectified rise, o(t) = (1/K) Σ_k max(0, L_t(k) − L_{t−1}(k)) (L_{−1} = 0: silence before the
+//! song); a moving mean over
 //! `detrend_s` is subtracted (and the result rectified again) so that a noise floor or a
 //! sustained sound does not count as onsets. A second envelope, over the bands below
 //! `low_hz`, carries the bass and kick drum for the downbeat phase.
@@ -191,13 +193,18 @@ pub fn onset_envelope(
     let max = power.iter().fold(0f32, |m, &p| m.max(p)) as f64;
     let gamma = 10f64.powf(params.compression_db / 10.0) / max.max(f64::MIN_POSITIVE);
     let level: Vec<f64> = power.iter().map(|&p| (gamma * p as f64).ln_1p()).collect();
+    // Before the song is silence (L = 0), so a song that starts on a hit has an onset at 0.
     let flux = |t: usize, range: std::ops::Range<usize>| -> f64 {
-        if t == 0 {
-            return 0.0;
-        }
         let n = range.len() as f64;
         range
-            .map(|b| (level[t * bands + b] - level[(t - 1) * bands + b]).max(0.0))
+            .map(|b| {
+                let prev = if t == 0 {
+                    0.0
+                } else {
+                    level[(t - 1) * bands + b]
+                };
+                (level[t * bands + b] - prev).max(0.0)
+            })
             .sum::<f64>()
             / n
     };

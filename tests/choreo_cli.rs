@@ -1,0 +1,84 @@
+//! `marionette music` on a song the test synthesizes and writes as WAV: the text report, the
+//! JSON object other tools read, the picture, and a clear error for a file that is not audio.
+
+use std::process::Command;
+
+use marionette::choreo::music::synth::{SynthSong, synthesize};
+
+/// A 16-bit PCM mono WAV file.
+fn wav(samples: &[f32], sample_rate: u32) -> Vec<u8> {
+    let data_len = (samples.len() * 2) as u32;
+    let mut b = Vec::new();
+    b.extend(b"RIFF");
+    b.extend((36 + data_len).to_le_bytes());
+    b.extend(b"WAVEfmt ");
+    b.extend(16u32.to_le_bytes());
+    b.extend(1u16.to_le_bytes());
+    b.extend(1u16.to_le_bytes());
+    b.extend(sample_rate.to_le_bytes());
+    b.extend((sample_rate * 2).to_le_bytes());
+    b.extend(2u16.to_le_bytes());
+    b.extend(16u16.to_le_bytes());
+    b.extend(b"data");
+    b.extend(data_len.to_le_bytes());
+    for s in samples {
+        b.extend(((s.clamp(-1.0, 1.0) * 32767.0).round() as i16).to_le_bytes());
+    }
+    b
+}
+
+#[test]
+fn music_prints_tempo_beats_bars_as_text_and_json_and_draws_them() {
+    let song = SynthSong {
+        bpm: 104.5,
+        bars: 8,
+        ..SynthSong::default()
+    };
+    let t = synthesize(&song).unwrap();
+    let dir = std::env::temp_dir().join(format!("marionette-music-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("song.wav");
+    std::fs::write(&path, wav(&t.samples, t.sample_rate)).unwrap();
+    let png = dir.join("song.png");
+    let out = Command::new(env!("CARGO_BIN_EXE_marionette"))
+        .args(["music", path.to_str().unwrap(), "--json", "--out"])
+        .arg(&png)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let tempo = v["tempo_bpm"].as_f64().unwrap();
+    assert!((tempo / 104.5 - 1.0).abs() < 0.01, "{tempo}");
+    let beats = v["beats_s"].as_array().unwrap();
+    assert!(beats.len() >= 30, "{}", beats.len());
+    let bars = v["bars"].as_array().unwrap();
+    assert!(bars.len() >= 7, "{}", bars.len());
+    for key in ["start_s", "end_s", "rms", "rms_db"] {
+        assert!(bars[0][key].is_f64(), "bars[0].{key}: {}", bars[0]);
+    }
+    let bytes = std::fs::read(&png).unwrap();
+    assert_eq!(&bytes[1..4], b"PNG");
+    let text = Command::new(env!("CARGO_BIN_EXE_marionette"))
+        .args(["music", path.to_str().unwrap()])
+        .output()
+        .unwrap();
+    let s = String::from_utf8_lossy(&text.stdout);
+    assert!(
+        s.contains("tempo") && s.contains("BPM") && s.contains("RMS (dB)"),
+        "{s}"
+    );
+    let junk = dir.join("junk.mp3");
+    std::fs::write(&junk, b"not audio at all").unwrap();
+    let bad = Command::new(env!("CARGO_BIN_EXE_marionette"))
+        .args(["music", junk.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(!bad.status.success());
+    let e = String::from_utf8_lossy(&bad.stderr);
+    assert!(e.contains("junk.mp3") && e.contains("cannot decode"), "{e}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
