@@ -4,28 +4,7 @@
 use std::process::Command;
 
 use marionette::choreo::music::synth::{SynthSong, synthesize};
-
-/// A 16-bit PCM mono WAV file.
-fn wav(samples: &[f32], sample_rate: u32) -> Vec<u8> {
-    let data_len = (samples.len() * 2) as u32;
-    let mut b = Vec::new();
-    b.extend(b"RIFF");
-    b.extend((36 + data_len).to_le_bytes());
-    b.extend(b"WAVEfmt ");
-    b.extend(16u32.to_le_bytes());
-    b.extend(1u16.to_le_bytes());
-    b.extend(1u16.to_le_bytes());
-    b.extend(sample_rate.to_le_bytes());
-    b.extend((sample_rate * 2).to_le_bytes());
-    b.extend(2u16.to_le_bytes());
-    b.extend(16u16.to_le_bytes());
-    b.extend(b"data");
-    b.extend(data_len.to_le_bytes());
-    for s in samples {
-        b.extend(((s.clamp(-1.0, 1.0) * 32767.0).round() as i16).to_le_bytes());
-    }
-    b
-}
+use marionette::choreo::music::wav::wav_bytes;
 
 #[test]
 fn music_prints_tempo_beats_bars_as_text_and_json_and_draws_them() {
@@ -38,7 +17,7 @@ fn music_prints_tempo_beats_bars_as_text_and_json_and_draws_them() {
     let dir = std::env::temp_dir().join(format!("marionette-music-cli-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("song.wav");
-    std::fs::write(&path, wav(&t.samples, t.sample_rate)).unwrap();
+    std::fs::write(&path, wav_bytes(&t.samples, 1, t.sample_rate).unwrap()).unwrap();
     let png = dir.join("song.png");
     let out = Command::new(env!("CARGO_BIN_EXE_marionette"))
         .args(["music", path.to_str().unwrap(), "--json", "--out"])

@@ -6,6 +6,7 @@ mod common;
 
 use marionette::choreo::music::beats::f_measure;
 use marionette::choreo::music::synth::{SynthSong, synthesize};
+use marionette::choreo::music::wav::wav_bytes;
 use marionette::choreo::music::{MusicError, MusicParams, analyze};
 
 /// The MIREX beat tolerance (s).
@@ -139,29 +140,6 @@ fn silent_short_and_broken_songs_are_refused() {
     }
 }
 
-/// A 16-bit PCM WAV file of `channels` interleaved channels.
-#[cfg(feature = "audio")]
-fn wav(samples: &[f32], channels: u16, sample_rate: u32) -> Vec<u8> {
-    let data_len = (samples.len() * 2) as u32;
-    let mut b = Vec::new();
-    b.extend(b"RIFF");
-    b.extend((36 + data_len).to_le_bytes());
-    b.extend(b"WAVEfmt ");
-    b.extend(16u32.to_le_bytes());
-    b.extend(1u16.to_le_bytes());
-    b.extend(channels.to_le_bytes());
-    b.extend(sample_rate.to_le_bytes());
-    b.extend((sample_rate * channels as u32 * 2).to_le_bytes());
-    b.extend((channels * 2).to_le_bytes());
-    b.extend(16u16.to_le_bytes());
-    b.extend(b"data");
-    b.extend(data_len.to_le_bytes());
-    for s in samples {
-        b.extend(((s.clamp(-1.0, 1.0) * 32767.0).round() as i16).to_le_bytes());
-    }
-    b
-}
-
 #[cfg(feature = "audio")]
 #[test]
 fn a_stereo_wav_decodes_to_its_mono_mix_and_analyses_like_the_buffer() {
@@ -181,7 +159,7 @@ fn a_stereo_wav_decodes_to_its_mono_mix_and_analyses_like_the_buffer() {
     let dir = std::env::temp_dir().join(format!("marionette-choreo-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("song.wav");
-    std::fs::write(&path, wav(&inter, 2, t.sample_rate)).unwrap();
+    std::fs::write(&path, wav_bytes(&inter, 2, t.sample_rate).unwrap()).unwrap();
     let audio = decode_file(&path).unwrap();
     assert_eq!((audio.channels, audio.sample_rate), (2, t.sample_rate));
     assert_eq!(audio.samples.len(), t.samples.len());

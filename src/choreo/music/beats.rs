@@ -224,13 +224,7 @@ mod tests {
             truth.push(t.round());
             t += period;
         }
-        let env = OnsetEnvelope {
-            sample_rate: 100,
-            hop: 1,
-            window: 4,
-            low: values.clone(),
-            values,
-        };
+        let env = OnsetEnvelope::at_100_hz(values);
         let beats = track_beats(&env, period, &BeatParams::default()).unwrap();
         assert_eq!(beats.len(), truth.len(), "{beats:?}");
         for (b, r) in beats.iter().zip(&truth) {

@@ -10,6 +10,7 @@
 //! - [`intensity`]: each bar's RMS and its level in dB;
 //! - [`synth`]: a drum track with exact ground truth (tempo, beats, bar loudness) for tests and
 //!   the project's own demo song;
+//! - [`wav`]: a buffer written as a 16-bit PCM WAV file;
 //! - `decode` (feature `audio`): WAV, OGG/Vorbis and MP3 to mono samples with symphonia;
 //! - `picture` (feature `render`): waveform, onsets, beats, bars and bar intensity in one PNG.
 //!
@@ -25,6 +26,7 @@ pub mod onsets;
 pub mod picture;
 pub mod synth;
 pub mod tempo;
+pub mod wav;
 
 use std::path::PathBuf;
 

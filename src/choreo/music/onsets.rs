@@ -69,6 +69,18 @@ impl OnsetEnvelope {
         self.sample_rate as f64 / self.hop as f64
     }
 
+    /// An envelope of `values` at 100 frames per second (both bands the same), for tests.
+    #[cfg(test)]
+    pub(crate) fn at_100_hz(values: Vec<f64>) -> OnsetEnvelope {
+        OnsetEnvelope {
+            sample_rate: 100,
+            hop: 1,
+            window: 4,
+            low: values.clone(),
+            values,
+        }
+    }
+
     /// Time (s) of frame `frame` (fractional frames allowed): its window's centre.
     pub fn time_of(&self, frame: f64) -> f64 {
         frame * self.hop as f64 / self.sample_rate as f64

@@ -188,13 +188,7 @@ mod tests {
             }
             t += period;
         }
-        OnsetEnvelope {
-            sample_rate: 100,
-            hop: 1,
-            window: 4,
-            low: values.clone(),
-            values,
-        }
+        OnsetEnvelope::at_100_hz(values)
     }
 
     #[test]
@@ -215,13 +209,7 @@ mod tests {
                 (s >> 11) as f64 / (1u64 << 53) as f64
             })
             .collect();
-        let env = OnsetEnvelope {
-            sample_rate: 100,
-            hop: 1,
-            window: 4,
-            low: values.clone(),
-            values,
-        };
+        let env = OnsetEnvelope::at_100_hz(values);
         if let Ok(t) = estimate_tempo(&env, &TempoPrior::default()) {
             assert!(t.strength < 0.2, "{}", t.strength);
         }
