@@ -59,5 +59,18 @@ fn music_prints_tempo_beats_bars_as_text_and_json_and_draws_them() {
     assert!(!bad.status.success());
     let e = String::from_utf8_lossy(&bad.stderr);
     assert!(e.contains("junk.mp3") && e.contains("cannot decode"), "{e}");
+    // A silent song: the error names the file and says why.
+    let silent = dir.join("silent.wav");
+    std::fs::write(&silent, wav_bytes(&vec![0.0; 44_100], 1, 22_050).unwrap()).unwrap();
+    let bad = Command::new(env!("CARGO_BIN_EXE_marionette"))
+        .args(["music", silent.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(!bad.status.success());
+    let e = String::from_utf8_lossy(&bad.stderr);
+    assert!(
+        e.contains("silent.wav") && e.contains("the song is silent"),
+        "{e}"
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use anyhow::Result;
+use anyhow::{Context, Result};
 use serde::Serialize;
 
 use marionette::choreo::music::decode::decode_file;
@@ -55,7 +55,8 @@ pub fn music(args: Args) -> Result<()> {
         ..MusicParams::default()
     };
     params.prior.centre_bpm = args.prior_bpm;
-    let a = analyze(&audio.samples, audio.sample_rate, &params)?;
+    let a = analyze(&audio.samples, audio.sample_rate, &params)
+        .with_context(|| args.song.display().to_string())?;
     if let Some(out) = &args.out {
         let name = args
             .song

@@ -42,9 +42,9 @@ pub fn decode_file(path: &Path) -> Result<Audio, MusicError> {
         path: path.to_path_buf(),
         message,
     };
-    let file = File::open(path).map_err(|source| MusicError::Io {
+    let file = File::open(path).map_err(|reason| MusicError::Io {
         path: path.to_path_buf(),
-        source,
+        reason,
     })?;
     let mss = MediaSourceStream::new(Box::new(file), Default::default());
     let mut hint = Hint::new();

@@ -43,12 +43,12 @@ pub use tempo::{TempoEstimate, TempoPrior, estimate_tempo};
 #[non_exhaustive]
 pub enum MusicError {
     /// The song file could not be opened or read.
-    #[error("{path}: cannot read the song: {source}")]
+    #[error("{path}: cannot read the song: {reason}")]
     Io {
         /// The song file.
         path: PathBuf,
-        /// The cause.
-        source: std::io::Error,
+        /// The operating system's reason (in the message, so not repeated as a source).
+        reason: std::io::Error,
     },
     /// The file is not audio symphonia can read (format, codec or a corrupt stream).
     #[error("{path}: cannot decode the song: {message}")]
