@@ -85,9 +85,9 @@ fn parabolic(r: &[f64], l: usize) -> (f64, f64) {
     (l as f64 + off, b - 0.25 * (a - c) * off)
 }
 
-/// Estimates the tempo of an onset envelope (see the module docs). Errors: a prior out of range,
-/// an envelope shorter than two periods of the slowest tempo... (shorter songs are rejected by
-/// [`super::analyze`] before), an envelope without any periodicity.
+/// Estimates the tempo of an onset envelope (see the module docs). Errors: a prior out of
+/// range, an envelope too short for two beats at the slowest tempo considered, an envelope
+/// without any positive autocorrelation peak in the range.
 pub fn estimate_tempo(
     env: &OnsetEnvelope,
     prior: &TempoPrior,
