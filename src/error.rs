@@ -44,6 +44,9 @@ pub enum Error {
     /// A motor-primitive experiment (high jump, jumping knee kick).
     #[error(transparent)]
     Experiment(#[from] crate::experiments::high_jump::PrimitiveExperimentError),
+    /// Decoding or analysing a song.
+    #[error(transparent)]
+    Music(#[from] crate::choreo::music::MusicError),
     /// A data file (RON): reading, syntax, version.
     #[error(transparent)]
     File(#[from] crate::io::FileError),

@@ -10,6 +10,7 @@
 
 pub mod analysis;
 pub mod bvh;
+pub mod choreo;
 pub mod clips;
 pub mod dynamics;
 pub mod ecs;

@@ -8,6 +8,7 @@ mod eval;
 mod export;
 mod inspect;
 mod mapping;
+mod music;
 mod render;
 mod run;
 
@@ -35,6 +36,9 @@ enum Command {
     Mapping(mapping::Args),
     /// Draw a motion (BVH or keyframed .ron clip) as a filmstrip PNG or an animated GIF.
     Render(render::Args),
+    /// Analyse a song (WAV, OGG/Vorbis, MP3): tempo, beats, bars of 4 and each bar's intensity;
+    /// draw them with --out, print JSON with --json.
+    Music(music::Args),
     /// Run a scene file; outputs go to one folder (default out/<scene name>/) with report.json.
     Run(run::Args),
     /// Evaluate fall genomes for a GA over the JSON-lines protocol (`--stdin`): the worker a
@@ -52,6 +56,7 @@ fn main() -> ExitCode {
         Command::Export(a) => export::export(a),
         Command::Mapping(a) => mapping::mapping(a),
         Command::Render(a) => render::render(a),
+        Command::Music(a) => music::music(a),
         Command::Run(a) => run::run(a),
         Command::Eval(a) => eval::eval(a),
         Command::Body(a) => body::body(a),

@@ -1,0 +1,12 @@
+//! Choreography (SPEC §2, the dance-editing paper): music analysis of a song (beats, bars, each
+//! bar's intensity) that a dance is cut to.
+//!
+//! - [`music`]: the music kernel over a plain sample buffer (onset envelope, tempo, beats, bars,
+//!   bar intensity), song decoding behind the `audio` feature, and a drum-track synthesizer with
+//!   exact ground truth;
+//! - [`eros`]: the eigen-analysis (PCA) similarity between motion segments (Eros);
+//! - [`features`]: per-frame motion intensity W(f) and the features of a segment for Eros.
+
+pub mod eros;
+pub mod features;
+pub mod music;

@@ -1,0 +1,270 @@
+//! Music analysis for choreography: from a mono sample buffer to the song's tempo, its beats, its
+//! bars of 4 beats and each bar's intensity (RMS), as the dance-editing paper needs them.
+//!
+//! One algorithm per file, each a kernel over plain numbers:
+//!
+//! - [`onsets`]: the onset-strength envelope (spectral flux on a log-magnitude spectrogram);
+//! - [`tempo`]: the tempo (autocorrelation of the envelope weighted by a log-normal tempo prior);
+//! - [`beats`]: beat placement by dynamic programming on the envelope (Ellis 2007);
+//! - [`bars`]: bars of 4 beats with the downbeat phase chosen from the signal or given;
+//! - [`intensity`]: each bar's RMS and its level in dB;
+//! - [`synth`]: a drum track with exact ground truth (tempo, beats, bar loudness) for tests and
+//!   the project's own demo song;
+//! - [`wav`]: a buffer written as a 16-bit PCM WAV file;
+//! - `decode` (feature `audio`): WAV, OGG/Vorbis and MP3 to mono samples with symphonia;
+//! - `picture` (feature `render`): waveform, onsets, beats, bars and bar intensity in one PNG.
+//!
+//! [`analyze`] runs them in order.
+
+pub mod bars;
+pub mod beats;
+#[cfg(feature = "audio")]
+pub mod decode;
+pub mod intensity;
+pub mod onsets;
+#[cfg(feature = "render")]
+pub mod picture;
+pub mod synth;
+pub mod tempo;
+pub mod wav;
+
+use std::path::PathBuf;
+
+use serde::{Deserialize, Serialize};
+
+pub use bars::{Bar, bars_from_beats, downbeat_phase};
+pub use beats::{BeatParams, track_beats};
+pub use intensity::{bar_intensity, rms_db};
+pub use onsets::{OnsetEnvelope, OnsetParams, onset_envelope};
+pub use tempo::{TempoEstimate, TempoPrior, estimate_tempo};
+
+/// Errors of music decoding and analysis.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum MusicError {
+    /// The song file could not be opened or read.
+    #[error("{path}: cannot read the song: {reason}")]
+    Io {
+        /// The song file.
+        path: PathBuf,
+        /// The operating system's reason (in the message, so not repeated as a source).
+        reason: std::io::Error,
+    },
+    /// The file is not audio symphonia can read (format, codec or a corrupt stream).
+    #[error("{path}: cannot decode the song: {message}")]
+    Decode {
+        /// The song file.
+        path: PathBuf,
+        /// What the decoder said.
+        message: String,
+    },
+    /// The sample rate is zero or absurd.
+    #[error("sample rate {0} Hz: expected 4000 to 384000 Hz")]
+    SampleRate(u32),
+    /// A sample is NaN or infinite.
+    #[error("sample {index} is not finite: {value}")]
+    NonFinite {
+        /// Index of the sample.
+        index: usize,
+        /// Its value.
+        value: f32,
+    },
+    /// The song is silent: no onsets to find beats in.
+    #[error("the song is silent (peak level {peak_db:.1} dB): no beats to find")]
+    Silent {
+        /// Peak absolute sample in dB (−inf for all zeros).
+        peak_db: f64,
+    },
+    /// The song is shorter than the analysis needs.
+    #[error("the song lasts {duration_s:.3} s: at least {needed_s:.3} s ({what}) are needed")]
+    TooShort {
+        /// Its duration (s).
+        duration_s: f64,
+        /// The least duration needed (s).
+        needed_s: f64,
+        /// What it is needed for.
+        what: &'static str,
+    },
+    /// Fewer beats than one bar were found.
+    #[error("found {beats} beats: a bar needs {needed} (is the song rhythmic?)")]
+    TooFewBeats {
+        /// Beats found.
+        beats: usize,
+        /// Beats needed.
+        needed: usize,
+    },
+    /// A parameter is out of its range.
+    #[error("music parameter {name} = {value}: expected {expected}")]
+    Parameter {
+        /// The parameter.
+        name: &'static str,
+        /// Its value.
+        value: f64,
+        /// Its valid range.
+        expected: &'static str,
+    },
+}
+
+/// Parameters of [`analyze`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct MusicParams {
+    /// The onset envelope.
+    pub onsets: OnsetParams,
+    /// The tempo prior.
+    pub prior: TempoPrior,
+    /// The beat tracker.
+    pub beats: BeatParams,
+    /// Beats per bar (4 for 4/4).
+    pub beats_per_bar: usize,
+    /// Index of the first downbeat among the beats (0 .. beats_per_bar); chosen from the signal
+    /// when `None`.
+    pub downbeat: Option<usize>,
+}
+
+impl Default for MusicParams {
+    fn default() -> Self {
+        MusicParams {
+            onsets: OnsetParams::default(),
+            prior: TempoPrior::default(),
+            beats: BeatParams::default(),
+            beats_per_bar: 4,
+            downbeat: None,
+        }
+    }
+}
+
+/// The analysis of one song: tempo, beats, bars and their intensity.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MusicAnalysis {
+    /// Sample rate of the analysed buffer (Hz).
+    pub sample_rate: u32,
+    /// Duration of the song (s).
+    pub duration_s: f64,
+    /// Tempo (beats per minute): 60 over the least-squares beat period of the tracked beats.
+    pub tempo_bpm: f64,
+    /// The tempo the autocorrelation found before tracking (BPM).
+    pub tempo_prior_bpm: f64,
+    /// Every beat time (s), increasing.
+    pub beats_s: Vec<f64>,
+    /// Beats per bar.
+    pub beats_per_bar: usize,
+    /// Index in `beats_s` of the first downbeat.
+    pub downbeat: usize,
+    /// Whether `downbeat` was given (true) or chosen from the signal (false).
+    pub downbeat_given: bool,
+    /// The bars of `beats_per_bar` beats with their RMS.
+    pub bars: Vec<Bar>,
+    /// The onset-strength envelope the beats were placed on.
+    pub onsets: OnsetEnvelope,
+}
+
+impl MusicAnalysis {
+    /// Checks that the song has at least `n` bars (a dance needs one per segment). Error:
+    /// [`MusicError::TooShort`] with the song's duration and the length of `n` bars.
+    pub fn require_bars(&self, n: usize) -> Result<(), MusicError> {
+        if self.bars.len() >= n {
+            return Ok(());
+        }
+        let bar_s = self.beats_per_bar as f64 * 60.0 / self.tempo_bpm;
+        Err(MusicError::TooShort {
+            duration_s: self.duration_s,
+            needed_s: n as f64 * bar_s,
+            what: "whole bars from its first downbeat",
+        })
+    }
+}
+
+/// Least samples per second [`analyze`] accepts.
+pub const MIN_SAMPLE_RATE: u32 = 4_000;
+/// Most samples per second [`analyze`] accepts.
+pub const MAX_SAMPLE_RATE: u32 = 384_000;
+
+/// Checks the sample rate and that every sample is finite.
+pub fn check_samples(samples: &[f32], sample_rate: u32) -> Result<(), MusicError> {
+    if !(MIN_SAMPLE_RATE..=MAX_SAMPLE_RATE).contains(&sample_rate) {
+        return Err(MusicError::SampleRate(sample_rate));
+    }
+    if let Some(index) = samples.iter().position(|s| !s.is_finite()) {
+        return Err(MusicError::NonFinite {
+            index,
+            value: samples[index],
+        });
+    }
+    Ok(())
+}
+
+/// Analyses a mono song `samples` at `sample_rate` Hz: onset envelope, tempo, beats, bars and
+/// bar RMS. A song with beats but less than a whole bar gets no bars (see
+/// [`MusicAnalysis::require_bars`]). Errors: a bad rate, sample or parameter, a silent song, a
+/// song shorter than four beats at the fastest tempo considered, fewer than two beats.
+pub fn analyze(
+    samples: &[f32],
+    sample_rate: u32,
+    params: &MusicParams,
+) -> Result<MusicAnalysis, MusicError> {
+    check_samples(samples, sample_rate)?;
+    let bpb = params.beats_per_bar;
+    if !(1..=16).contains(&bpb) {
+        return Err(MusicError::Parameter {
+            name: "beats_per_bar",
+            value: bpb as f64,
+            expected: "1 to 16",
+        });
+    }
+    if let Some(d) = params.downbeat
+        && d >= bpb
+    {
+        return Err(MusicError::Parameter {
+            name: "downbeat",
+            value: d as f64,
+            expected: "0 to beats_per_bar − 1",
+        });
+    }
+    let duration_s = samples.len() as f64 / sample_rate as f64;
+    let needed_s = 4.0 * 60.0 / params.prior.max_bpm;
+    if duration_s < needed_s {
+        return Err(MusicError::TooShort {
+            duration_s,
+            needed_s,
+            what: "four beats at the fastest tempo considered",
+        });
+    }
+    let peak = samples.iter().fold(0f32, |m, s| m.max(s.abs()));
+    let peak_db = 20.0 * (peak as f64).log10();
+    if peak_db < -90.0 {
+        return Err(MusicError::Silent { peak_db });
+    }
+    let env = onset_envelope(samples, sample_rate, &params.onsets)?;
+    if env.values.iter().all(|&v| v <= 0.0) {
+        return Err(MusicError::Silent { peak_db });
+    }
+    let tempo = estimate_tempo(&env, &params.prior)?;
+    let beat_frames = track_beats(&env, tempo.period_frames, &params.beats)?;
+    let beats_s: Vec<f64> = beat_frames.iter().map(|&f| env.time_of(f)).collect();
+    if beats_s.len() < 2 {
+        return Err(MusicError::TooFewBeats {
+            beats: beats_s.len(),
+            needed: 2,
+        });
+    }
+    let tempo_bpm = 60.0 / beats::fitted_period(&beats_s);
+    let (downbeat, downbeat_given) = match params.downbeat {
+        Some(d) => (d, true),
+        None => (downbeat_phase(&env, &beat_frames, bpb), false),
+    };
+    let spans = bars_from_beats(&beats_s, downbeat, bpb, duration_s);
+    let bars = bar_intensity(samples, sample_rate, &spans);
+    Ok(MusicAnalysis {
+        sample_rate,
+        duration_s,
+        tempo_bpm,
+        tempo_prior_bpm: tempo.bpm,
+        beats_s,
+        beats_per_bar: bpb,
+        downbeat,
+        downbeat_given,
+        bars,
+        onsets: env,
+    })
+}
