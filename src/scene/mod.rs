@@ -269,7 +269,9 @@ pub fn validate(scene: &Scene) -> Result<(), SceneError> {
             pictures(s.render.filmstrip_frames, s.render.gif, s.render.gif_fps)?
         }
         Scene::Fall(s) => pictures(s.render.filmstrip_frames, s.render.gif, s.render.gif_fps)?,
-        Scene::EvolveFall(s) => pictures(s.render.filmstrip_frames, s.render.gif, s.render.gif_fps)?,
+        Scene::EvolveFall(s) => {
+            pictures(s.render.filmstrip_frames, s.render.gif, s.render.gif_fps)?
+        }
     }
     Ok(())
 }

@@ -172,8 +172,7 @@ pub fn run_parallel_from(
 ) -> Vec<Result<FallResult, Arc<SimError>>> {
     let pool = WorldPool::new(configs.len(), 0, |k, world| {
         world.insert_resource(Clock::physics(configs[k].dt_s));
-        let built =
-            super::build_fall_from(&configs[k], start).and_then(|ch| spawn_fall(world, ch));
+        let built = super::build_fall_from(&configs[k], start).and_then(|ch| spawn_fall(world, ch));
         if let Err(e) = built {
             world.insert_resource(NotBuilt(Arc::new(e)));
         }
