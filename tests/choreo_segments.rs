@@ -76,7 +76,7 @@ fn dance_bars_at_120_bpm_give_its_four_bars() {
         .to_model_clip();
     let f = (4.0 / clip.frame_time).round() as usize;
     assert!(db.segments[2].root_rotation[0].angle_between(clip.root_rotation[f]) < 1e-9);
-    // The squat bar moves the most of the four, the arm waves not the least (intensity is data).
+    // The motion intensity of each bar, printed for the report.
     let w: Vec<f64> = db.segments.iter().map(|s| s.intensity).collect();
     eprintln!("dance_bars intensity per bar (m/s, unit weights): {w:?}");
 

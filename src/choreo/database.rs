@@ -21,6 +21,7 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use super::eros::eros_weights;
+pub use super::segments::BuildParams;
 use super::segments::{Beat, Segment, SegmentError, TempoSource, cut_segments, kinematic_beat};
 use crate::humanoid::{ModelClip, humanoid24};
 
@@ -158,26 +159,6 @@ pub fn load_model_clip(path: &Path) -> Result<ModelClip, SegmentError> {
     crate::mapping::retarget(&clip, &mapping, &humanoid24()).map_err(|e| load(e.into()))
 }
 
-/// How a database is built.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct BuildParams {
-    /// Frames every segment is resampled to (one bar).
-    pub bar_frames: usize,
-    /// The weights α_i of the motion intensity, one per drawable point of humanoid24 (joints
-    /// then End Sites); missing weights count 1.
-    pub alpha: Vec<f64>,
-}
-
-impl Default for BuildParams {
-    /// 32 frames per bar, unit weights.
-    fn default() -> BuildParams {
-        BuildParams {
-            bar_frames: 32,
-            alpha: vec![],
-        }
-    }
-}
-
 /// What one source clip gave the database.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Source {
@@ -254,7 +235,7 @@ impl Database {
                     b
                 }
             };
-            let cut = cut_segments(&clip, &name, i, &beat, params.bar_frames, &params.alpha)?;
+            let cut = cut_segments(&clip, &name, i, &beat, params)?;
             let source = Source {
                 file: name,
                 frames: clip.frame_count(),

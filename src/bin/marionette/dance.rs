@@ -1,5 +1,6 @@
 //! `marionette dance db FOLDER|MANIFEST --out DB`: builds the dance-segment database (a line
-//! per clip on stderr as it goes).
+//! per clip on stderr as it goes); `marionette dance info DB`: what a database was built from
+//! and how long it took to load.
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -29,6 +30,20 @@ enum DanceCommand {
         #[arg(long, default_value_t = 32)]
         bar_frames: usize,
     },
+    /// Print what a database was built from (sources, tempo per clip and how it was found,
+    /// segments per clip) and the time it took to load.
+    Info {
+        /// The database file.
+        db: PathBuf,
+    },
+}
+
+/// How a tempo was found, in words.
+fn how(source: TempoSource) -> &'static str {
+    match source {
+        TempoSource::Manifest => "manifest",
+        TempoSource::Kinematic => "kinematic",
+    }
 }
 
 /// Runs `marionette dance`.
@@ -47,10 +62,7 @@ pub fn dance(a: Args) -> Result<()> {
                 ..BuildParams::default()
             };
             let db = Database::build(&manifest, &params, |i, s| {
-                let how = match s.beat.source {
-                    TempoSource::Manifest => "manifest",
-                    TempoSource::Kinematic => "kinematic",
-                };
+                let how = how(s.beat.source);
                 eprintln!(
                     "[{}/{n}] {}: {} frames at {:.1} fps, {:.2} BPM ({how}), first beat {:.3} s, \
                      {} segments",
@@ -71,6 +83,33 @@ pub fn dance(a: Args) -> Result<()> {
                 db.sources.len(),
                 start.elapsed().as_secs_f64()
             );
+            Ok(())
+        }
+        DanceCommand::Info { db } => {
+            let start = Instant::now();
+            let d = Database::load(&db)?;
+            let secs = start.elapsed().as_secs_f64();
+            println!(
+                "{}: {} segments of {} frames on {} from {} clips, loaded in {:.3} s",
+                db.display(),
+                d.segments.len(),
+                d.params.bar_frames,
+                d.model,
+                d.sources.len(),
+                secs
+            );
+            for s in &d.sources {
+                println!(
+                    "  {}: {} frames at {:.1} fps, {:.2} BPM ({}), first beat {:.3} s, {} segments",
+                    s.file,
+                    s.frames,
+                    s.fps,
+                    s.beat.tempo_bpm,
+                    how(s.beat.source),
+                    s.beat.first_beat_s,
+                    s.segments
+                );
+            }
             Ok(())
         }
     }
