@@ -8,7 +8,7 @@ mod common;
 use std::path::{Path, PathBuf};
 
 use marionette::choreo::database::{BuildParams, Database, Manifest, ManifestClip};
-use marionette::choreo::segments::{SegmentError, TempoSource};
+use marionette::choreo::segments::{Beat, SegmentError, TempoSource, cut_segments};
 use marionette::humanoid::{ModelClip, humanoid24};
 
 use glam::{DQuat, DVec3};
@@ -69,6 +69,17 @@ fn dance_bars_at_120_bpm_give_its_four_bars() {
         for d in &s.first_directions {
             assert!((d.length() - 1.0).abs() < 1e-9 || d.length() == 0.0);
         }
+    }
+    // Consecutive bars of one take connect: the last links of a bar point where the next bar's
+    // first links do (one resampled frame, 1/16 s, apart).
+    let mean_dot = |a: &[DVec3], b: &[DVec3]| -> f64 {
+        a.iter().zip(b).map(|(x, y)| x.dot(*y)).sum::<f64>() / a.len() as f64
+    };
+    for k in 0..3 {
+        let (a, b) = (&db.segments[k], &db.segments[k + 1]);
+        let seam = mean_dot(&a.last_directions, &b.first_directions);
+        eprintln!("bar {k}→{}: mean cosine of boundary links {seam:.4}", k + 1);
+        assert!(seam > 0.98, "{seam}");
     }
     // Frame 0 of bar 2 is the clip at 4 s: bar 3's quarter turn starts there (turn 0 at 4 s).
     let clip = marionette::clips::KeyframeClip::load(&dance_bars())
@@ -209,6 +220,40 @@ fn shared_dance_clips_segments_and_tempo() {
         Database::load(&out).unwrap().segments.len(),
         db.segments.len()
     );
+}
+
+#[test]
+fn boundary_links_do_not_depend_on_where_the_dancer_faces() {
+    let clip = marionette::clips::KeyframeClip::load(&dance_bars())
+        .unwrap()
+        .to_model_clip();
+    let yaw = DQuat::from_rotation_y(1.1);
+    let mut turned = clip.clone();
+    for (t, r) in turned
+        .root_translation
+        .iter_mut()
+        .zip(turned.root_rotation.iter_mut())
+    {
+        *t = yaw * *t + DVec3::new(3.0, 0.0, -2.0);
+        *r = yaw * *r;
+    }
+    let beat = Beat {
+        tempo_bpm: 120.0,
+        first_beat_s: 0.0,
+        source: TempoSource::Manifest,
+    };
+    let p = BuildParams::default();
+    let a = cut_segments(&clip, "a", 0, &beat, &p).unwrap();
+    let b = cut_segments(&turned, "b", 0, &beat, &p).unwrap();
+    for (x, y) in a.iter().zip(&b) {
+        for (u, v) in x.first_directions.iter().zip(&y.first_directions) {
+            assert!((*u - *v).length() < 1e-9, "{u} {v}");
+        }
+        for (u, v) in x.last_velocities.iter().zip(&y.last_velocities) {
+            assert!((*u - *v).length() < 1e-9, "{u} {v}");
+        }
+        assert!((x.intensity - y.intensity).abs() < 1e-9);
+    }
 }
 
 #[test]
