@@ -8,7 +8,7 @@ mod common;
 use std::path::{Path, PathBuf};
 
 use marionette::choreo::database::{BuildParams, Database, Manifest, ManifestClip};
-use marionette::choreo::segments::{Beat, SegmentError, TempoSource, cut_segments};
+use marionette::choreo::segments::{Beat, SegmentError, TempoSource, cut_segments, kinematic_beat};
 use marionette::humanoid::{ModelClip, humanoid24};
 
 use glam::{DQuat, DVec3};
@@ -213,6 +213,22 @@ fn shared_dance_clips_segments_and_tempo() {
             s.segments,
             ((dur - s.beat.first_beat_s) / s.beat.bar_s() + 1e-9).floor() as usize
         );
+    }
+    // A consistency check (no music exists for these takes): the kinematic tempo of each half.
+    for c in &m.clips {
+        let clip = marionette::choreo::database::load_model_clip(&c.file).unwrap();
+        let half = clip.frame_count() as f64 * clip.frame_time / 2.0;
+        let name = c.file.file_name().unwrap().to_string_lossy().to_string();
+        let t: Vec<String> = [(0.0, half), (half, 2.0 * half)]
+            .iter()
+            .map(|&(a, b)| {
+                let w = clip.window(a, b).unwrap();
+                kinematic_beat(&w, &name)
+                    .map(|b| format!("{:.2}", b.tempo_bpm))
+                    .unwrap_or_else(|e| e.to_string())
+            })
+            .collect();
+        eprintln!("{name}: kinematic tempo of the first and second half {t:?} BPM");
     }
     let out = scratch("shared").join("db.json");
     db.save(&out).unwrap();

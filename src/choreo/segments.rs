@@ -213,8 +213,9 @@ pub fn kinematic_beat(clip: &ModelClip, name: &str) -> Result<Beat, SegmentError
     let tempo_bpm = kinematic_tempo(&speed, fps).ok_or_else(|| SegmentError::Tempo {
         clip: name.to_string(),
         message: format!(
-            "no kinematic tempo between {MIN_BPM} and {MAX_BPM} BPM: the motion is still or \
-             shorter than two beats at {MIN_BPM} BPM ({} frames); give tempo_bpm and \
+            "no kinematic tempo between {MIN_BPM} and {MAX_BPM} BPM: the speed curve's \
+             autocorrelation has no positive peak there (no regular speed minima), or the motion \
+             is still or shorter than two beats at {MIN_BPM} BPM ({} frames); give tempo_bpm and \
              first_beat_s in a manifest",
             speed.len()
         ),
