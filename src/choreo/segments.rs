@@ -237,7 +237,7 @@ pub struct BuildParams {
     pub alpha: Vec<f64>,
     /// Principal axes kept per segment for Eros (the leading ones; at most the pose rows'
     /// dimension). On the shared dance clips the 16 leading axes of humanoid24's 66 carry 99.9 %
-    /// of the database's Eros weight, and the file is four times smaller.
+    /// of the database's Eros weight, and the file is 2.4 times smaller (3.0 MB, not 7.1 MB).
     pub eros_axes: usize,
 }
 
