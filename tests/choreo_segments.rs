@@ -308,7 +308,9 @@ fn bad_input_gives_one_clear_error_each() {
     )
     .unwrap_err();
     assert!(matches!(e, SegmentError::Load { .. }), "{e}");
-    assert!(e.to_string().contains("broken.bvh"), "{e}");
+    let msg = e.to_string();
+    assert_eq!(msg.matches("broken.bvh").count(), 1, "{msg}");
+    assert!(msg.contains("line 4"), "{msg}");
 
     // A file that does not exist, and a database that is not one.
     let e = Manifest::load(&bad.join("missing.ron")).unwrap_err();

@@ -64,8 +64,9 @@ pub enum SegmentError {
         /// The folder.
         path: String,
     },
-    /// A clip or manifest that could not be read, parsed or mapped onto humanoid24.
-    #[error("{path}: {source}")]
+    /// A clip or manifest that could not be read, parsed or mapped onto humanoid24 (the file
+    /// named once: the reason's own text when it names it already).
+    #[error("{}", name_once(path, source))]
     Load {
         /// The file.
         path: String,
@@ -89,6 +90,16 @@ pub enum SegmentError {
         /// What was wrong (with line and column for JSON errors).
         message: String,
     },
+}
+
+/// `source`'s text, preceded by `path` unless it names it already.
+fn name_once(path: &str, source: &crate::Error) -> String {
+    let s = source.to_string();
+    if s.contains(path) {
+        s
+    } else {
+        format!("{path}: {s}")
+    }
 }
 
 /// How a clip's tempo and first beat were found.
