@@ -47,6 +47,9 @@ pub enum Error {
     /// Decoding or analysing a song.
     #[error(transparent)]
     Music(#[from] crate::choreo::music::MusicError),
+    /// Dance segments and their database.
+    #[error(transparent)]
+    Segment(#[from] crate::choreo::segments::SegmentError),
     /// A data file (RON): reading, syntax, version.
     #[error(transparent)]
     File(#[from] crate::io::FileError),

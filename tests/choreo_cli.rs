@@ -74,3 +74,67 @@ fn music_prints_tempo_beats_bars_as_text_and_json_and_draws_them() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// `marionette dance db` on a manifest of the project's four bars at 120 BPM: a progress line
+/// per clip, a database with four segments that `dance info` reads back; an empty folder is one
+/// clear error and writes nothing.
+#[test]
+fn dance_db_builds_from_a_manifest_and_refuses_an_empty_folder() {
+    let dir = std::env::temp_dir().join(format!("marionette-dance-cli-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(dir.join("empty")).unwrap();
+    let clip = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/clips/dance_bars.ron");
+    let manifest = dir.join("manifest.ron");
+    std::fs::write(
+        &manifest,
+        format!(
+            "(format_version: 1, clips: [(file: {:?}, tempo_bpm: 120.0, first_beat_s: 0.0)])",
+            clip.display().to_string()
+        ),
+    )
+    .unwrap();
+    let db = dir.join("db.json");
+    let out = Command::new(env!("CARGO_BIN_EXE_marionette"))
+        .args(["dance", "db"])
+        .arg(&manifest)
+        .arg("--out")
+        .arg(&db)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        err.contains("[1/1]")
+            && err.contains("120.00 BPM (manifest)")
+            && err.contains("4 segments"),
+        "{err}"
+    );
+    let info = Command::new(env!("CARGO_BIN_EXE_marionette"))
+        .args(["dance", "info"])
+        .arg(&db)
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&info.stdout);
+    assert!(
+        info.status.success(),
+        "{}",
+        String::from_utf8_lossy(&info.stderr)
+    );
+    assert!(
+        text.contains("4 segments of 32 frames") && text.contains("dance_bars.ron"),
+        "{text}"
+    );
+
+    let none = dir.join("none.json");
+    let out = Command::new(env!("CARGO_BIN_EXE_marionette"))
+        .args(["dance", "db"])
+        .arg(dir.join("empty"))
+        .arg("--out")
+        .arg(&none)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(err.contains("no dance clip in the folder"), "{err}");
+    assert!(!none.exists());
+}

@@ -5,8 +5,13 @@
 //!   bar intensity), song decoding behind the `audio` feature, and a drum-track synthesizer with
 //!   exact ground truth;
 //! - [`eros`]: the eigen-analysis (PCA) similarity between motion segments (Eros);
-//! - [`features`]: per-frame motion intensity W(f) and the features of a segment for Eros.
+//! - [`features`]: per-frame motion intensity W(f) and the features of a segment for Eros;
+//! - [`segments`]: dance clips cut into bars of 4 counts (tempo from a manifest or the kinematic
+//!   beat), each resampled, with intensity, Eros features and boundary links;
+//! - [`database`]: the segment database file and what it was built from.
 
+pub mod database;
 pub mod eros;
 pub mod features;
 pub mod music;
+pub mod segments;

@@ -4,6 +4,7 @@
 
 mod body;
 mod common;
+mod dance;
 mod eval;
 mod export;
 mod inspect;
@@ -39,6 +40,8 @@ enum Command {
     /// Analyse a song (WAV, OGG/Vorbis, MP3): tempo, beats, bars of 4 and each bar's intensity;
     /// draw them with --out, print JSON with --json.
     Music(music::Args),
+    /// Dance segments: `dance db FOLDER|MANIFEST --out DB` builds the segment database.
+    Dance(dance::Args),
     /// Run a scene file; outputs go to one folder (default out/<scene name>/) with report.json.
     Run(run::Args),
     /// Evaluate fall genomes for a GA over the JSON-lines protocol (`--stdin`): the worker a
@@ -57,6 +60,7 @@ fn main() -> ExitCode {
         Command::Mapping(a) => mapping::mapping(a),
         Command::Render(a) => render::render(a),
         Command::Music(a) => music::music(a),
+        Command::Dance(a) => dance::dance(a),
         Command::Run(a) => run::run(a),
         Command::Eval(a) => eval::eval(a),
         Command::Body(a) => body::body(a),

@@ -1,0 +1,303 @@
+//! The dance-segment database: every clip of a folder or a manifest mapped onto humanoid24 and
+//! cut into bars ([`super::segments`]), saved as one compact JSON file that says what it was
+//! built from (each source, its tempo and first beat and how they were found, its segment
+//! count).
+//!
+//! A manifest (RON) lists clips, each with an optional tempo and first beat and an optional
+//! time window:
+//!
+//! ```ron
+//! (format_version: 1, clips: [
+//!     (file: "dance_bars.ron", tempo_bpm: 120.0, first_beat_s: 0.0),
+//!     (file: "salsa.bvh", window: (2.0, 30.0)),
+//! ])
+//! ```
+//!
+//! File names are relative to the manifest's folder; a clip without `tempo_bpm` gets the
+//! kinematic beat (with `first_beat_s` kept when given).
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use super::eros::eros_weights;
+pub use super::segments::BuildParams;
+use super::segments::{Beat, Segment, SegmentError, TempoSource, cut_segments, kinematic_beat};
+use crate::humanoid::{ModelClip, humanoid24};
+
+/// Newest manifest format this build reads.
+pub const MANIFEST_VERSION: u32 = 1;
+
+/// Newest database format this build reads and writes.
+pub const DATABASE_VERSION: u32 = 1;
+
+/// One clip of a manifest.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ManifestClip {
+    /// The clip (.bvh, or a keyframed .ron clip), relative to the manifest's folder.
+    pub file: PathBuf,
+    /// Its tempo, BPM, when known.
+    #[serde(default)]
+    pub tempo_bpm: Option<f64>,
+    /// Its first beat from the start of the (windowed) clip, seconds, when known.
+    #[serde(default)]
+    pub first_beat_s: Option<f64>,
+    /// The part of the clip to use, (start, end) seconds.
+    #[serde(default)]
+    pub window: Option<(f64, f64)>,
+}
+
+/// A manifest: the clips a database is built from.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Manifest {
+    /// Format version (1).
+    pub format_version: u32,
+    /// The clips.
+    pub clips: Vec<ManifestClip>,
+}
+
+impl Manifest {
+    /// Reads a manifest; file names in it become relative to its folder.
+    pub fn load(path: &Path) -> Result<Manifest, SegmentError> {
+        let origin = path.display().to_string();
+        let load = |e: crate::Error| SegmentError::Load {
+            path: origin.clone(),
+            source: Box::new(e),
+        };
+        let text = crate::io::read_text(path).map_err(|e| load(e.into()))?;
+        let mut m: Manifest = crate::io::parse_ron(&text, &origin).map_err(|e| load(e.into()))?;
+        crate::io::check_version(&origin, m.format_version, MANIFEST_VERSION)
+            .map_err(|e| load(e.into()))?;
+        if m.clips.is_empty() {
+            return Err(SegmentError::Manifest {
+                path: origin,
+                message: "the manifest lists no clips".into(),
+            });
+        }
+        let dir = path.parent().unwrap_or(Path::new("."));
+        for c in &mut m.clips {
+            c.file = dir.join(&c.file);
+        }
+        Ok(m)
+    }
+
+    /// Every .bvh and keyframed .ron clip of a folder (sorted by name; .ron manifests skipped),
+    /// with no tempo known.
+    pub fn from_folder(dir: &Path) -> Result<Manifest, SegmentError> {
+        let origin = dir.display().to_string();
+        let entries = std::fs::read_dir(dir).map_err(|e| SegmentError::Load {
+            path: origin.clone(),
+            source: Box::new(e.into()),
+        })?;
+        let mut files: Vec<PathBuf> = entries
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| {
+                let ext = p
+                    .extension()
+                    .and_then(|e| e.to_str())
+                    .map(str::to_lowercase);
+                match ext.as_deref() {
+                    Some("bvh") => true,
+                    Some("ron") => !is_manifest(p),
+                    _ => false,
+                }
+            })
+            .collect();
+        files.sort();
+        if files.is_empty() {
+            return Err(SegmentError::EmptyFolder { path: origin });
+        }
+        Ok(Manifest {
+            format_version: MANIFEST_VERSION,
+            clips: files
+                .into_iter()
+                .map(|file| ManifestClip {
+                    file,
+                    tempo_bpm: None,
+                    first_beat_s: None,
+                    window: None,
+                })
+                .collect(),
+        })
+    }
+
+    /// A folder's clips, or a manifest's.
+    pub fn from_path(path: &Path) -> Result<Manifest, SegmentError> {
+        if path.is_dir() {
+            Manifest::from_folder(path)
+        } else {
+            Manifest::load(path)
+        }
+    }
+}
+
+/// Whether a .ron file reads as a manifest.
+fn is_manifest(p: &Path) -> bool {
+    crate::io::read_text(p)
+        .ok()
+        .is_some_and(|t| crate::io::parse_ron::<Manifest>(&t, "").is_ok())
+}
+
+/// A clip on humanoid24: a BVH mapped with the detected mapping and retargeted, or a keyframed
+/// .ron clip.
+pub fn load_model_clip(path: &Path) -> Result<ModelClip, SegmentError> {
+    let load = |e: crate::Error| SegmentError::Load {
+        path: path.display().to_string(),
+        source: Box::new(e),
+    };
+    let is_ron = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("ron"));
+    if is_ron {
+        return crate::clips::KeyframeClip::load(path)
+            .map(|k| k.to_model_clip())
+            .map_err(|e| load(e.into()));
+    }
+    let (bvh, _warnings) = crate::bvh::parse_file(path).map_err(|e| load(e.into()))?;
+    let clip = crate::skeleton::Clip::from_bvh(&bvh, None).map_err(|e| load(e.into()))?;
+    let mapping = crate::mapping::Mapping::detect_clip(&clip).map_err(|e| load(e.into()))?;
+    crate::mapping::retarget(&clip, &mapping, &humanoid24()).map_err(|e| load(e.into()))
+}
+
+/// What one source clip gave the database.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Source {
+    /// The clip file as given.
+    pub file: String,
+    /// Frames used (after the window).
+    pub frames: usize,
+    /// Frames per second.
+    pub fps: f64,
+    /// The window used, (start, end) seconds, if any.
+    pub window: Option<(f64, f64)>,
+    /// Its tempo and first beat and how they were found.
+    pub beat: Beat,
+    /// Segments cut from it.
+    pub segments: usize,
+}
+
+/// The dance-segment database.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Database {
+    /// Format version ([`DATABASE_VERSION`]).
+    pub format_version: u32,
+    /// The model the segments are on ("humanoid24").
+    pub model: String,
+    /// The parameters it was built with.
+    pub params: BuildParams,
+    /// The clips it was built from.
+    pub sources: Vec<Source>,
+    /// Every segment, clip by clip, bar by bar.
+    pub segments: Vec<Segment>,
+    /// Eros weights over all segments ([`eros_weights`]).
+    pub eros_weights: Vec<f64>,
+}
+
+impl Database {
+    /// Builds a database from a manifest's clips; `progress` is called after each clip with its
+    /// index and what it gave.
+    pub fn build(
+        manifest: &Manifest,
+        params: &BuildParams,
+        mut progress: impl FnMut(usize, &Source),
+    ) -> Result<Database, SegmentError> {
+        if params.bar_frames < 2 {
+            return Err(SegmentError::Manifest {
+                path: "build parameters".into(),
+                message: format!("bar_frames must be at least 2, found {}", params.bar_frames),
+            });
+        }
+        let mut sources = vec![];
+        let mut segments = vec![];
+        for (i, c) in manifest.clips.iter().enumerate() {
+            let name = c.file.display().to_string();
+            let mut clip = load_model_clip(&c.file)?;
+            if let Some((a, b)) = c.window {
+                clip = clip.window(a, b).ok_or_else(|| SegmentError::Manifest {
+                    path: name.clone(),
+                    message: format!(
+                        "window {a:.3}..{b:.3} s holds no frame of the clip ({:.3} s)",
+                        clip.frame_count() as f64 * clip.frame_time
+                    ),
+                })?;
+            }
+            let beat = match c.tempo_bpm {
+                Some(tempo_bpm) => Beat {
+                    tempo_bpm,
+                    first_beat_s: c.first_beat_s.unwrap_or(0.0),
+                    source: TempoSource::Manifest,
+                },
+                None => {
+                    let mut b = kinematic_beat(&clip, &name)?;
+                    if let Some(f) = c.first_beat_s {
+                        b.first_beat_s = f;
+                    }
+                    b
+                }
+            };
+            let cut = cut_segments(&clip, &name, i, &beat, params)?;
+            let source = Source {
+                file: name,
+                frames: clip.frame_count(),
+                fps: 1.0 / clip.frame_time,
+                window: c.window,
+                beat,
+                segments: cut.len(),
+            };
+            progress(i, &source);
+            sources.push(source);
+            segments.extend(cut);
+        }
+        let pcas: Vec<_> = segments.iter().map(|s| &s.eros).collect();
+        let eros_weights = eros_weights(&pcas);
+        Ok(Database {
+            format_version: DATABASE_VERSION,
+            model: "humanoid24".into(),
+            params: params.clone(),
+            sources,
+            segments,
+            eros_weights,
+        })
+    }
+
+    /// The database as compact JSON.
+    pub fn to_json(&self) -> Vec<u8> {
+        serde_json::to_vec(self).expect("a database serialises")
+    }
+
+    /// Writes the database (compact JSON) atomically: nothing is left half-written.
+    pub fn save(&self, path: &Path) -> Result<(), SegmentError> {
+        crate::io::write_atomic(path, &self.to_json()).map_err(|e| SegmentError::Load {
+            path: path.display().to_string(),
+            source: Box::new(e.into()),
+        })
+    }
+
+    /// Reads a database written by [`Database::save`].
+    pub fn load(path: &Path) -> Result<Database, SegmentError> {
+        let origin = path.display().to_string();
+        let bytes = std::fs::read(path).map_err(|e| SegmentError::Load {
+            path: origin.clone(),
+            source: Box::new(e.into()),
+        })?;
+        let db: Database = serde_json::from_slice(&bytes).map_err(|e| SegmentError::Database {
+            path: origin.clone(),
+            message: format!("line {} column {}: {e}", e.line(), e.column()),
+        })?;
+        if db.format_version == 0 || db.format_version > DATABASE_VERSION {
+            return Err(SegmentError::Database {
+                path: origin,
+                message: format!(
+                    "format_version {} is not one this build reads (1 to {DATABASE_VERSION})",
+                    db.format_version
+                ),
+            });
+        }
+        Ok(db)
+    }
+
+    /// Segments cut from source clip `clip`.
+    pub fn segments_of(&self, clip: usize) -> impl Iterator<Item = &Segment> {
+        self.segments.iter().filter(move |s| s.clip == clip)
+    }
+}

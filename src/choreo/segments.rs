@@ -1,0 +1,505 @@
+//! Dance segments of the dance-editing paper: a dance clip on humanoid24 cut into bars of 4
+//! counts (one bar of 4/4), each resampled to a common number of frames per bar, with its
+//! motion intensity, its Eros features and its boundary link directions and velocities.
+//!
+//! Dance capture has no music, so when no manifest gives a clip's tempo and first beat they are
+//! found from the motion itself (the kinematic beat): the speed curve v(f) = Σ_i |ẋ_i(f)| over
+//! every joint, its autocorrelation r(ℓ) = Σ_f (v(f) − v̄)(v(f+ℓ) − v̄) / ((n − ℓ) σ²) searched for
+//! the beat period between [`MIN_BPM`] and [`MAX_BPM`] (the highest local peak of r(ℓ) weighted
+//! by the music kernel's log-normal tempo prior, centre [`PRIOR_BPM`], σ one octave, so that the
+//! beat wins over the two-beat period whose r is as high; refined by a parabola through its
+//! neighbours), and the first beat the phase φ ∈ [0, T) whose beats φ + kT fall on
+//! the lowest mean speed (dancers mark the count with the minima of their speed).
+
+use glam::{DQuat, DVec3};
+use serde::{Deserialize, Serialize};
+
+use super::eros::{Pca, pca};
+use super::features::{joint_speeds, mean_motion_intensity, pose_rows};
+use crate::humanoid::ModelClip;
+
+/// Counts (beats) per segment: one bar of 4/4.
+pub const BEATS_PER_BAR: usize = 4;
+
+/// Slowest tempo the kinematic beat looks for, beats per minute.
+pub const MIN_BPM: f64 = 60.0;
+
+/// Fastest tempo the kinematic beat looks for, beats per minute.
+pub const MAX_BPM: f64 = 180.0;
+
+/// Centre of the log-normal tempo prior of the kinematic beat, BPM (σ one octave).
+pub const PRIOR_BPM: f64 = 120.0;
+
+/// Why a clip could not be cut into segments or a database built.
+#[derive(Debug, thiserror::Error)]
+pub enum SegmentError {
+    /// A clip shorter than one bar after its first beat.
+    #[error(
+        "{clip}: the clip lasts {duration_s:.3} s after its first beat at {first_beat_s:.3} s, \
+         shorter than one bar of {BEATS_PER_BAR} counts ({bar_s:.3} s at {tempo_bpm:.2} BPM)"
+    )]
+    TooShort {
+        /// The clip.
+        clip: String,
+        /// Its duration, seconds.
+        duration_s: f64,
+        /// Its first beat, seconds.
+        first_beat_s: f64,
+        /// The bar length, seconds.
+        bar_s: f64,
+        /// The tempo, BPM.
+        tempo_bpm: f64,
+    },
+    /// A tempo or first beat that is not usable (given in a manifest, or not found in the motion).
+    #[error("{clip}: {message}")]
+    Tempo {
+        /// The clip.
+        clip: String,
+        /// What was wrong.
+        message: String,
+    },
+    /// A folder with no clip in it.
+    #[error("{path}: no dance clip in the folder (expected .bvh or keyframed .ron clips)")]
+    EmptyFolder {
+        /// The folder.
+        path: String,
+    },
+    /// A clip or manifest that could not be read, parsed or mapped onto humanoid24 (the file
+    /// named once: the reason's own text when it names it already).
+    #[error("{}", name_once(path, source))]
+    Load {
+        /// The file.
+        path: String,
+        /// Why.
+        #[source]
+        source: Box<crate::Error>,
+    },
+    /// A manifest whose content is inconsistent.
+    #[error("{path}: {message}")]
+    Manifest {
+        /// The manifest.
+        path: String,
+        /// What was wrong.
+        message: String,
+    },
+    /// A database file that could not be read or is not a database.
+    #[error("{path}: not a dance database: {message}")]
+    Database {
+        /// The file.
+        path: String,
+        /// What was wrong (with line and column for JSON errors).
+        message: String,
+    },
+}
+
+/// `source`'s text, preceded by `path` unless it names it already.
+fn name_once(path: &str, source: &crate::Error) -> String {
+    let s = source.to_string();
+    if s.contains(path) {
+        s
+    } else {
+        format!("{path}: {s}")
+    }
+}
+
+/// How a clip's tempo and first beat were found.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum TempoSource {
+    /// Given in the manifest.
+    Manifest,
+    /// Estimated from the motion (the kinematic beat, module docs).
+    Kinematic,
+}
+
+/// A clip's beat: tempo and the time of its first beat.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Beat {
+    /// Tempo, beats per minute.
+    pub tempo_bpm: f64,
+    /// Time of the first beat from the clip's start, seconds.
+    pub first_beat_s: f64,
+    /// How they were found.
+    pub source: TempoSource,
+}
+
+impl Beat {
+    /// The bar length, seconds: [`BEATS_PER_BAR`] × 60 / tempo.
+    pub fn bar_s(&self) -> f64 {
+        BEATS_PER_BAR as f64 * 60.0 / self.tempo_bpm
+    }
+}
+
+/// The speed curve of a motion, v(f) = Σ_i |ẋ_i(f)| over every point (m/s).
+pub fn speed_curve(positions: &[Vec<DVec3>], fps: f64) -> Vec<f64> {
+    joint_speeds(positions, fps)
+        .iter()
+        .map(|s| s.iter().sum())
+        .collect()
+}
+
+/// The kinematic tempo of a speed curve sampled at `fps`: the beat period with the highest
+/// normalised autocorrelation between [`MIN_BPM`] and [`MAX_BPM`] (module docs), in BPM; `None`
+/// when the curve is too short for two periods of the slowest tempo or is constant.
+pub fn kinematic_tempo(speed: &[f64], fps: f64) -> Option<f64> {
+    let n = speed.len();
+    let min_lag = (fps * 60.0 / MAX_BPM).floor().max(1.0) as usize;
+    let max_lag = (fps * 60.0 / MIN_BPM).ceil() as usize;
+    if n < 2 * max_lag + 2 {
+        return None;
+    }
+    let mean = speed.iter().sum::<f64>() / n as f64;
+    let c: Vec<f64> = speed.iter().map(|v| v - mean).collect();
+    let var = c.iter().map(|x| x * x).sum::<f64>() / n as f64;
+    if var <= 1e-12 {
+        return None;
+    }
+    let r = |lag: usize| -> f64 {
+        let s: f64 = (0..n - lag).map(|f| c[f] * c[f + lag]).sum();
+        s / ((n - lag) as f64 * var)
+    };
+    let rs: Vec<f64> = (min_lag - 1..=max_lag + 1).map(r).collect();
+    // The highest local maximum inside the range, weighted by the tempo prior.
+    let prior = |k: usize| -> f64 {
+        let bpm = 60.0 * fps / (min_lag - 1 + k) as f64;
+        (-0.5 * (bpm / PRIOR_BPM).log2().powi(2)).exp()
+    };
+    let mut best: Option<(usize, f64)> = None;
+    for k in 1..rs.len() - 1 {
+        let score = rs[k] * prior(k);
+        if rs[k] > 0.0
+            && rs[k] >= rs[k - 1]
+            && rs[k] >= rs[k + 1]
+            && best.is_none_or(|(_, b)| score > b)
+        {
+            best = Some((k, score));
+        }
+    }
+    let (k, _) = best?;
+    let (a, b, cc) = (rs[k - 1], rs[k], rs[k + 1]);
+    let denom = a - 2.0 * b + cc;
+    let offset = if denom.abs() > 1e-15 {
+        (0.5 * (a - cc) / denom).clamp(-0.5, 0.5)
+    } else {
+        0.0
+    };
+    let lag = (min_lag - 1 + k) as f64 + offset;
+    Some(60.0 * fps / lag)
+}
+
+/// The first beat of a speed curve at a known tempo: the phase φ ∈ [0, T) (T = 60/tempo s)
+/// whose beats φ + kT have the lowest mean speed (linear interpolation between frames), seconds.
+pub fn kinematic_first_beat(speed: &[f64], fps: f64, tempo_bpm: f64) -> f64 {
+    let period = 60.0 / tempo_bpm * fps;
+    let at = |x: f64| -> f64 {
+        let i = x.floor() as usize;
+        let t = x - i as f64;
+        if i + 1 >= speed.len() {
+            speed[speed.len() - 1]
+        } else {
+            speed[i] * (1.0 - t) + speed[i + 1] * t
+        }
+    };
+    let steps = period.ceil().max(1.0) as usize * 4;
+    let mut best = (0.0, f64::INFINITY);
+    for s in 0..steps {
+        let phase = period * s as f64 / steps as f64;
+        let (mut sum, mut count) = (0.0, 0usize);
+        let mut x = phase;
+        while x <= (speed.len() - 1) as f64 {
+            sum += at(x);
+            count += 1;
+            x += period;
+        }
+        if count > 0 && sum / (count as f64) < best.1 {
+            best = (phase, sum / count as f64);
+        }
+    }
+    best.0 / fps
+}
+
+/// The kinematic beat of a motion (tempo by autocorrelation, first beat by speed minima).
+pub fn kinematic_beat(clip: &ModelClip, name: &str) -> Result<Beat, SegmentError> {
+    let fps = 1.0 / clip.frame_time;
+    let speed = speed_curve(&clip.to_clip().point_frames(), fps);
+    let tempo_bpm = kinematic_tempo(&speed, fps).ok_or_else(|| SegmentError::Tempo {
+        clip: name.to_string(),
+        message: format!(
+            "no kinematic tempo between {MIN_BPM} and {MAX_BPM} BPM: the speed curve's \
+             autocorrelation has no positive peak there (no regular speed minima), or the motion \
+             is still or shorter than two beats at {MIN_BPM} BPM ({} frames); give tempo_bpm and \
+             first_beat_s in a manifest",
+            speed.len()
+        ),
+    })?;
+    Ok(Beat {
+        tempo_bpm,
+        first_beat_s: kinematic_first_beat(&speed, fps, tempo_bpm),
+        source: TempoSource::Kinematic,
+    })
+}
+
+/// How a database is built.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct BuildParams {
+    /// Frames every segment is resampled to (one bar).
+    pub bar_frames: usize,
+    /// The weights α_i of the motion intensity, one per drawable point of humanoid24 (joints
+    /// then End Sites); missing weights count 1.
+    pub alpha: Vec<f64>,
+    /// Principal axes kept per segment for Eros (the leading ones; at most the pose rows'
+    /// dimension). On the shared dance clips the 16 leading axes of humanoid24's 66 carry 99.9 %
+    /// of the database's Eros weight, and the file is 2.4 times smaller (3.0 MB, not 7.1 MB).
+    pub eros_axes: usize,
+}
+
+impl Default for BuildParams {
+    /// 32 frames per bar, unit weights, 16 Eros axes.
+    fn default() -> BuildParams {
+        BuildParams {
+            bar_frames: 32,
+            alpha: vec![],
+            eros_axes: 16,
+        }
+    }
+}
+
+/// One bar of dance on humanoid24, resampled to a common number of frames.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Segment {
+    /// Index of the clip it was cut from in the database's sources.
+    pub clip: usize,
+    /// Bar number within the clip (0-based).
+    pub bar: usize,
+    /// Start of the bar in the clip, seconds.
+    pub start_s: f64,
+    /// End of the bar in the clip, seconds.
+    pub end_s: f64,
+    /// Pelvis position per resampled frame, metres.
+    pub root_translation: Vec<DVec3>,
+    /// Pelvis orientation per resampled frame.
+    pub root_rotation: Vec<DQuat>,
+    /// DOF angles, `frames × dofs`, radians.
+    pub angles: Vec<f64>,
+    /// The paper's motion intensity of the bar, the time average of W(f) = Σ_i α_i |ẋ_i| at the
+    /// clip's real timing (m/s with unit weights).
+    pub intensity: f64,
+    /// Eros features: the leading principal axes ([`BuildParams::eros_axes`]) of the pose rows
+    /// (points relative to the pelvis).
+    pub eros: Pca,
+    /// Unit direction of every link (parent point → point, pelvis excluded) at the first frame,
+    /// in the pelvis heading frame (the vertical-axis rotation removed).
+    pub first_directions: Vec<DVec3>,
+    /// The same at the last frame.
+    pub last_directions: Vec<DVec3>,
+    /// Velocity of every point at the first frame relative to the pelvis heading, m/s.
+    pub first_velocities: Vec<DVec3>,
+    /// The same at the last frame.
+    pub last_velocities: Vec<DVec3>,
+}
+
+impl Segment {
+    /// Number of resampled frames.
+    pub fn frame_count(&self) -> usize {
+        self.root_translation.len()
+    }
+}
+
+/// `clip` resampled at the times `times` (seconds): angles and pelvis position interpolated
+/// linearly, pelvis orientation by slerp; times are clamped to the clip.
+pub fn resample(clip: &ModelClip, times: &[f64]) -> ModelClip {
+    let n = clip.frame_count();
+    let d = clip.dof_count();
+    let mut out = ModelClip {
+        model: clip.model.clone(),
+        frame_time: if times.len() > 1 {
+            times[1] - times[0]
+        } else {
+            clip.frame_time
+        },
+        root_translation: Vec::with_capacity(times.len()),
+        root_rotation: Vec::with_capacity(times.len()),
+        angles: Vec::with_capacity(times.len() * d),
+    };
+    for &t in times {
+        let x = (t / clip.frame_time).clamp(0.0, (n - 1) as f64);
+        let i = (x.floor() as usize).min(n.saturating_sub(2));
+        let j = (i + 1).min(n - 1);
+        let a = x - i as f64;
+        out.root_translation
+            .push(clip.root_translation[i].lerp(clip.root_translation[j], a));
+        out.root_rotation
+            .push(clip.root_rotation[i].slerp(clip.root_rotation[j], a));
+        let (p, q) = (clip.frame_angles(i), clip.frame_angles(j));
+        out.angles
+            .extend(p.iter().zip(q).map(|(u, v)| u + (v - u) * a));
+    }
+    out
+}
+
+/// The rotation about the vertical (Y) axis that undoes the pelvis heading `q`.
+fn unheading(q: DQuat) -> DQuat {
+    let f = q * DVec3::Z;
+    let yaw = f.x.atan2(f.z);
+    DQuat::from_rotation_y(-yaw)
+}
+
+/// Boundary link directions and velocities at frame `f` of `points` (frames of every point).
+fn boundary(
+    points: &[Vec<DVec3>],
+    parents: &[Option<usize>],
+    root_rotation: DQuat,
+    f: usize,
+    fps: f64,
+) -> (Vec<DVec3>, Vec<DVec3>) {
+    let h = unheading(root_rotation);
+    let p = &points[f];
+    let dirs = parents
+        .iter()
+        .enumerate()
+        .filter_map(|(i, par)| par.map(|q| h * (p[i] - p[q]).normalize_or_zero()))
+        .collect();
+    let speeds_at = |g: usize| -> Vec<DVec3> {
+        let (a, b) = (g.saturating_sub(1), (g + 1).min(points.len() - 1));
+        let dt = (b - a).max(1) as f64 / fps;
+        (0..p.len())
+            .map(|i| h * ((points[b][i] - points[b][0]) - (points[a][i] - points[a][0])) / dt)
+            .collect()
+    };
+    (dirs, speeds_at(f))
+}
+
+/// Cuts `clip` into bars of [`BEATS_PER_BAR`] counts from `beat`, each resampled to
+/// `params.bar_frames` frames at the times start + k·bar/bar_frames; `params.alpha` weighs each
+/// point in the motion intensity (missing weights count 1). A clip shorter than a bar is an
+/// error.
+pub fn cut_segments(
+    clip: &ModelClip,
+    name: &str,
+    clip_index: usize,
+    beat: &Beat,
+    params: &BuildParams,
+) -> Result<Vec<Segment>, SegmentError> {
+    let (bar_frames, alpha) = (params.bar_frames, &params.alpha);
+    let usable = beat.tempo_bpm.is_finite()
+        && beat.tempo_bpm > 0.0
+        && beat.first_beat_s.is_finite()
+        && beat.first_beat_s >= 0.0;
+    if !usable {
+        return Err(SegmentError::Tempo {
+            clip: name.to_string(),
+            message: format!(
+                "tempo must be a positive number of BPM and the first beat a time ≥ 0 s, found \
+                 {} BPM and {} s",
+                beat.tempo_bpm, beat.first_beat_s
+            ),
+        });
+    }
+    let bar_s = beat.bar_s();
+    // The clip spans frames × frame time (as [`crate::skeleton::Clip::duration`]); the last
+    // resampled frame of a bar lies a bar/bar_frames before its end.
+    let duration = clip.frame_count() as f64 * clip.frame_time;
+    let bars = ((duration - beat.first_beat_s) / bar_s + 1e-9).floor();
+    if bars < 1.0 || clip.frame_count() < 2 {
+        return Err(SegmentError::TooShort {
+            clip: name.to_string(),
+            duration_s: (duration - beat.first_beat_s).max(0.0),
+            first_beat_s: beat.first_beat_s,
+            bar_s,
+            tempo_bpm: beat.tempo_bpm,
+        });
+    }
+    let fps = 1.0 / clip.frame_time;
+    let parents = clip.model.skeleton().point_parents();
+    let mut segments = vec![];
+    for bar in 0..bars as usize {
+        let start_s = beat.first_beat_s + bar as f64 * bar_s;
+        let end_s = start_s + bar_s;
+        // Intensity at the clip's own timing, over the frames of the bar.
+        let first = (start_s * fps).round() as usize;
+        let last = ((end_s * fps).round() as usize).min(clip.frame_count() - 1);
+        let real = clip
+            .window(
+                first as f64 * clip.frame_time,
+                (last + 1) as f64 * clip.frame_time,
+            )
+            .map(|w| w.to_clip().point_frames())
+            .unwrap_or_default();
+        let ones: Vec<f64> = (0..real.first().map_or(0, |p| p.len()))
+            .map(|i| alpha.get(i).copied().unwrap_or(1.0))
+            .collect();
+        let intensity = mean_motion_intensity(&real, fps, &ones);
+
+        let times: Vec<f64> = (0..bar_frames)
+            .map(|k| start_s + bar_s * k as f64 / bar_frames as f64)
+            .collect();
+        let seg = resample(clip, &times);
+        let points = seg.to_clip().point_frames();
+        let seg_fps = bar_frames as f64 / bar_s;
+        let lastf = points.len() - 1;
+        let (first_directions, first_velocities) =
+            boundary(&points, &parents, seg.root_rotation[0], 0, seg_fps);
+        let (last_directions, last_velocities) =
+            boundary(&points, &parents, seg.root_rotation[lastf], lastf, seg_fps);
+        segments.push(Segment {
+            clip: clip_index,
+            bar,
+            start_s,
+            end_s,
+            eros: leading_axes(pca(&pose_rows(&points, 0)), params.eros_axes),
+            intensity,
+            root_translation: seg.root_translation,
+            root_rotation: seg.root_rotation,
+            angles: seg.angles,
+            first_directions,
+            last_directions,
+            first_velocities,
+            last_velocities,
+        });
+    }
+    Ok(segments)
+}
+
+/// The `k` leading principal axes of `p` (all when it has fewer).
+fn leading_axes(mut p: Pca, k: usize) -> Pca {
+    p.values.truncate(k.max(1));
+    p.vectors.truncate(k.max(1));
+    p
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A speed curve with a minimum on every beat at `bpm`, starting at `phase_s`.
+    fn beat_curve(bpm: f64, phase_s: f64, fps: f64, seconds: f64) -> Vec<f64> {
+        let w = 2.0 * std::f64::consts::PI * bpm / 60.0;
+        (0..(seconds * fps) as usize)
+            .map(|f| {
+                let t = f as f64 / fps - phase_s;
+                1.5 - (w * t).cos() + 0.3 * (0.5 * w * t).sin().powi(2)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn autocorrelation_finds_a_non_integer_tempo() {
+        for bpm in [72.5, 97.3, 121.0, 143.7] {
+            let s = beat_curve(bpm, 0.21, 120.0, 20.0);
+            let t = kinematic_tempo(&s, 120.0).unwrap();
+            assert!((t / bpm - 1.0).abs() < 0.01, "{bpm}: {t}");
+        }
+    }
+
+    #[test]
+    fn first_beat_falls_on_the_speed_minimum() {
+        let s = beat_curve(120.0, 0.21, 120.0, 10.0);
+        let f = kinematic_first_beat(&s, 120.0, 120.0);
+        assert!((f - 0.21).abs() < 0.01, "{f}");
+    }
+
+    #[test]
+    fn a_still_motion_has_no_tempo() {
+        assert_eq!(kinematic_tempo(&[1.0; 2000], 120.0), None);
+        assert_eq!(kinematic_tempo(&[1.0, 2.0], 120.0), None);
+    }
+}

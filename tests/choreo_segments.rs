@@ -1,0 +1,330 @@
+//! The dance-segment database: the project's keyframed dance (`scenes/clips/dance_bars.ron`,
+//! four bars at 120 BPM) cut into its four bars, the kinematic tempo of a clip generated with a
+//! known tempo, the shared dance clips (segments and tempo per clip), and one clear error per
+//! bad input.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+
+use marionette::choreo::database::{BuildParams, Database, Manifest, ManifestClip};
+use marionette::choreo::segments::{Beat, SegmentError, TempoSource, cut_segments, kinematic_beat};
+use marionette::humanoid::{ModelClip, humanoid24};
+
+use glam::{DQuat, DVec3};
+
+fn dance_bars() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/clips/dance_bars.ron")
+}
+
+/// A fresh scratch folder for one test.
+fn scratch(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("marionette-segments-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn one_clip(file: PathBuf, tempo_bpm: Option<f64>, window: Option<(f64, f64)>) -> Manifest {
+    Manifest {
+        format_version: 1,
+        clips: vec![ManifestClip {
+            file,
+            tempo_bpm,
+            first_beat_s: tempo_bpm.map(|_| 0.0),
+            window,
+        }],
+    }
+}
+
+#[test]
+fn dance_bars_at_120_bpm_give_its_four_bars() {
+    let dir = scratch("bars");
+    let manifest = dir.join("manifest.ron");
+    std::fs::write(
+        &manifest,
+        format!(
+            "(format_version: 1, clips: [(file: {:?}, tempo_bpm: 120.0, first_beat_s: 0.0)])",
+            dance_bars().display().to_string()
+        ),
+    )
+    .unwrap();
+    let m = Manifest::load(&manifest).unwrap();
+    let db = Database::build(&m, &BuildParams::default(), |_, _| {}).unwrap();
+    assert_eq!(db.segments.len(), 4);
+    assert_eq!(db.sources[0].segments, 4);
+    assert_eq!(db.sources[0].beat.source, TempoSource::Manifest);
+    for (k, s) in db.segments.iter().enumerate() {
+        assert_eq!(s.bar, k);
+        assert!((s.start_s - 2.0 * k as f64).abs() < 1e-12, "{}", s.start_s);
+        assert!(
+            (s.end_s - 2.0 * (k + 1) as f64).abs() < 1e-12,
+            "{}",
+            s.end_s
+        );
+        assert_eq!(s.frame_count(), 32);
+        assert_eq!(s.angles.len(), 32 * humanoid24().dofs.len());
+        assert!(s.intensity > 0.0);
+        assert_eq!(s.first_directions.len(), s.last_directions.len());
+        for d in &s.first_directions {
+            assert!((d.length() - 1.0).abs() < 1e-9 || d.length() == 0.0);
+        }
+    }
+    // Consecutive bars of one take connect: the last links of a bar point where the next bar's
+    // first links do (one resampled frame, 1/16 s, apart).
+    let mean_dot = |a: &[DVec3], b: &[DVec3]| -> f64 {
+        a.iter().zip(b).map(|(x, y)| x.dot(*y)).sum::<f64>() / a.len() as f64
+    };
+    for k in 0..3 {
+        let (a, b) = (&db.segments[k], &db.segments[k + 1]);
+        let seam = mean_dot(&a.last_directions, &b.first_directions);
+        eprintln!("bar {k}→{}: mean cosine of boundary links {seam:.4}", k + 1);
+        assert!(seam > 0.98, "{seam}");
+    }
+    // Frame 0 of bar 2 is the clip at 4 s: bar 3's quarter turn starts there (turn 0 at 4 s).
+    let clip = marionette::clips::KeyframeClip::load(&dance_bars())
+        .unwrap()
+        .to_model_clip();
+    let f = (4.0 / clip.frame_time).round() as usize;
+    assert!(db.segments[2].root_rotation[0].angle_between(clip.root_rotation[f]) < 1e-9);
+    // The motion intensity of each bar, printed for the report.
+    let w: Vec<f64> = db.segments.iter().map(|s| s.intensity).collect();
+    eprintln!("dance_bars intensity per bar (m/s, unit weights): {w:?}");
+
+    // Saved and loaded, the same database.
+    let out = dir.join("db.json");
+    db.save(&out).unwrap();
+    let back = Database::load(&out).unwrap();
+    assert_eq!(back, db);
+
+    // Without the manifest (a folder of that one clip), the kinematic beat.
+    let folder = scratch("bars-folder");
+    std::fs::copy(dance_bars(), folder.join("dance_bars.ron")).unwrap();
+    let k = Database::build(
+        &Manifest::from_folder(&folder).unwrap(),
+        &BuildParams::default(),
+        |_, _| {},
+    )
+    .unwrap();
+    eprintln!(
+        "dance_bars kinematic beat: {:.2} BPM, first beat {:.3} s, {} segments",
+        k.sources[0].beat.tempo_bpm, k.sources[0].beat.first_beat_s, k.sources[0].segments
+    );
+    assert_eq!(k.sources[0].beat.source, TempoSource::Kinematic);
+}
+
+/// A humanoid24 clip whose arms and legs swing from one extreme to the other on every beat
+/// (a smooth step per beat, at rest on the beat) at `bpm`, its first beat at `phase_s`.
+fn generated(bpm: f64, phase_s: f64, fps: f64, seconds: f64) -> ModelClip {
+    let model = humanoid24();
+    let d = model.dofs.len();
+    let period = 60.0 / bpm;
+    let n = (seconds * fps) as usize;
+    let dofs: Vec<(usize, f64)> = [
+        ("left_knee", 40.0),
+        ("right_knee", 40.0),
+        ("left_shoulder_abduction", 60.0),
+        ("right_shoulder_abduction", -30.0),
+        ("left_elbow_flexion", 50.0),
+    ]
+    .iter()
+    .map(|(name, amp)| (model.dof_index(name).unwrap(), f64::to_radians(*amp)))
+    .collect();
+    let mut angles = vec![0.0; n * d];
+    for f in 0..n {
+        let t = f as f64 / fps - phase_s + 10.0 * period;
+        let k = (t / period).floor() as i64;
+        let u = t / period - k as f64;
+        let s = u - (2.0 * std::f64::consts::PI * u).sin() / (2.0 * std::f64::consts::PI);
+        let x = if k % 2 == 0 { s } else { 1.0 - s };
+        for &(i, amp) in &dofs {
+            angles[f * d + i] = amp * x + 0.1;
+        }
+    }
+    ModelClip {
+        model,
+        frame_time: 1.0 / fps,
+        root_translation: vec![DVec3::new(0.0, 0.95, 0.0); n],
+        root_rotation: vec![DQuat::IDENTITY; n],
+        angles,
+    }
+}
+
+#[test]
+fn kinematic_tempo_of_a_generated_clip_is_within_2_percent() {
+    let dir = scratch("kinematic");
+    for (bpm, phase) in [(96.0, 0.15), (113.7, 0.31), (131.4, 0.05)] {
+        let clip = generated(bpm, phase, 120.0, 24.0);
+        // Through the whole path: written as BVH, read, mapped onto humanoid24 again.
+        let file = dir.join(format!("gen_{bpm}.bvh"));
+        marionette::bvh::write_file(&clip.to_clip().to_bvh(), &file).unwrap();
+        let db = Database::build(
+            &one_clip(file, None, None),
+            &BuildParams::default(),
+            |_, _| {},
+        )
+        .unwrap();
+        let beat = db.sources[0].beat;
+        eprintln!(
+            "generated {bpm} BPM, first beat {phase} s: kinematic {:.3} BPM, first beat {:.3} s",
+            beat.tempo_bpm, beat.first_beat_s
+        );
+        assert_eq!(beat.source, TempoSource::Kinematic);
+        assert!((beat.tempo_bpm / bpm - 1.0).abs() < 0.02, "{bpm}: {beat:?}");
+        let p = 60.0 / bpm;
+        let off = (beat.first_beat_s - phase).rem_euclid(p);
+        assert!(off.min(p - off) < 0.03, "{bpm}: first beat {beat:?}");
+        let bars = ((24.0 - beat.first_beat_s) / beat.bar_s()).floor() as usize;
+        assert_eq!(db.segments.len(), bars);
+    }
+}
+
+#[test]
+fn shared_dance_clips_segments_and_tempo() {
+    let Some(dir) = common::data_path("dance") else {
+        return;
+    };
+    let m = Manifest::from_folder(&dir).unwrap();
+    let db = Database::build(&m, &BuildParams::default(), |_, s| {
+        eprintln!(
+            "{}: {} frames at {:.0} fps, {:.2} BPM ({:?}), first beat {:.3} s, {} segments",
+            Path::new(&s.file).file_name().unwrap().to_string_lossy(),
+            s.frames,
+            s.fps,
+            s.beat.tempo_bpm,
+            s.beat.source,
+            s.beat.first_beat_s,
+            s.segments
+        )
+    })
+    .unwrap();
+    eprintln!(
+        "{} segments from {} clips; database {} bytes",
+        db.segments.len(),
+        db.sources.len(),
+        db.to_json().len()
+    );
+    assert_eq!(db.sources.len(), m.clips.len());
+    for s in &db.sources {
+        assert!(s.segments >= 1);
+        assert!((60.0..=180.0).contains(&s.beat.tempo_bpm));
+        let dur = s.frames as f64 / s.fps;
+        assert_eq!(
+            s.segments,
+            ((dur - s.beat.first_beat_s) / s.beat.bar_s() + 1e-9).floor() as usize
+        );
+    }
+    // A consistency check (no music exists for these takes): the kinematic tempo of each half.
+    for c in &m.clips {
+        let clip = marionette::choreo::database::load_model_clip(&c.file).unwrap();
+        let half = clip.frame_count() as f64 * clip.frame_time / 2.0;
+        let name = c.file.file_name().unwrap().to_string_lossy().to_string();
+        let t: Vec<String> = [(0.0, half), (half, 2.0 * half)]
+            .iter()
+            .map(|&(a, b)| {
+                let w = clip.window(a, b).unwrap();
+                kinematic_beat(&w, &name)
+                    .map(|b| format!("{:.2}", b.tempo_bpm))
+                    .unwrap_or_else(|e| e.to_string())
+            })
+            .collect();
+        eprintln!("{name}: kinematic tempo of the first and second half {t:?} BPM");
+    }
+    let out = scratch("shared").join("db.json");
+    db.save(&out).unwrap();
+    assert_eq!(
+        Database::load(&out).unwrap().segments.len(),
+        db.segments.len()
+    );
+}
+
+#[test]
+fn boundary_links_do_not_depend_on_where_the_dancer_faces() {
+    let clip = marionette::clips::KeyframeClip::load(&dance_bars())
+        .unwrap()
+        .to_model_clip();
+    let yaw = DQuat::from_rotation_y(1.1);
+    let mut turned = clip.clone();
+    for (t, r) in turned
+        .root_translation
+        .iter_mut()
+        .zip(turned.root_rotation.iter_mut())
+    {
+        *t = yaw * *t + DVec3::new(3.0, 0.0, -2.0);
+        *r = yaw * *r;
+    }
+    let beat = Beat {
+        tempo_bpm: 120.0,
+        first_beat_s: 0.0,
+        source: TempoSource::Manifest,
+    };
+    let p = BuildParams::default();
+    let a = cut_segments(&clip, "a", 0, &beat, &p).unwrap();
+    let b = cut_segments(&turned, "b", 0, &beat, &p).unwrap();
+    for (x, y) in a.iter().zip(&b) {
+        for (u, v) in x.first_directions.iter().zip(&y.first_directions) {
+            assert!((*u - *v).length() < 1e-9, "{u} {v}");
+        }
+        for (u, v) in x.last_velocities.iter().zip(&y.last_velocities) {
+            assert!((*u - *v).length() < 1e-9, "{u} {v}");
+        }
+        assert!((x.intensity - y.intensity).abs() < 1e-9);
+    }
+}
+
+#[test]
+fn bad_input_gives_one_clear_error_each() {
+    // A clip shorter than a bar: one second of the 120 BPM dance.
+    let e = Database::build(
+        &one_clip(dance_bars(), Some(120.0), Some((0.0, 1.0))),
+        &BuildParams::default(),
+        |_, _| {},
+    )
+    .unwrap_err();
+    assert!(matches!(e, SegmentError::TooShort { .. }), "{e}");
+    let msg = e.to_string();
+    assert!(
+        msg.contains("dance_bars.ron") && msg.contains("shorter than one bar"),
+        "{msg}"
+    );
+
+    // An empty folder.
+    let empty = scratch("empty");
+    let e = Manifest::from_folder(&empty).unwrap_err();
+    assert!(matches!(e, SegmentError::EmptyFolder { .. }), "{e}");
+    assert!(e.to_string().contains("no dance clip"), "{e}");
+
+    // An unreadable file: a BVH that is not one.
+    let bad = scratch("bad");
+    std::fs::write(
+        bad.join("broken.bvh"),
+        "HIERARCHY\nROOT hips\n{ OFFSET 0 0\n",
+    )
+    .unwrap();
+    let e = Database::build(
+        &Manifest::from_folder(&bad).unwrap(),
+        &BuildParams::default(),
+        |_, _| {},
+    )
+    .unwrap_err();
+    assert!(matches!(e, SegmentError::Load { .. }), "{e}");
+    let msg = e.to_string();
+    assert_eq!(msg.matches("broken.bvh").count(), 1, "{msg}");
+    assert!(msg.contains("line 4"), "{msg}");
+
+    // A file that does not exist, and a database that is not one.
+    let e = Manifest::load(&bad.join("missing.ron")).unwrap_err();
+    assert!(e.to_string().contains("missing.ron"), "{e}");
+    std::fs::write(bad.join("db.json"), "{\"format_version\": 1}").unwrap();
+    let e = Database::load(&bad.join("db.json")).unwrap_err();
+    assert!(matches!(e, SegmentError::Database { .. }), "{e}");
+
+    // A manifest tempo that is not a tempo.
+    let e = Database::build(
+        &one_clip(dance_bars(), Some(0.0), None),
+        &BuildParams::default(),
+        |_, _| {},
+    )
+    .unwrap_err();
+    assert!(matches!(e, SegmentError::Tempo { .. }), "{e}");
+}
