@@ -111,6 +111,41 @@ fn a_resumed_evolution_ends_where_an_uninterrupted_one_does() {
         let fin = g["final"]["mean"].as_f64().unwrap();
         assert!(fin <= initial, "best so far rose: {initial} → {fin}");
     }
+    // The best controller replays in the Fall scene: the same damage as the evolution's replay.
+    let replay = tmp("replay");
+    let file = format!(
+        "controller_file=\"{}\"",
+        a.join("best_adult.controller.ron").display()
+    );
+    marionette(&[
+        "run",
+        "scenes/fall.ron",
+        "--out",
+        &s(&replay),
+        "--set",
+        "age_group=adult",
+        "--set",
+        "compare_with=null",
+        "--set",
+        "render.gif=false",
+        "--set",
+        &file,
+    ]);
+    let fall = report(&replay);
+    let evolved = r["best_falls"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|b| b["fall"] == "adult evolved")
+        .unwrap()["honesty"]["damage"]
+        .as_f64()
+        .unwrap();
+    let replayed = fall["damage"].as_f64().unwrap();
+    assert!(
+        (replayed - evolved).abs() <= 1e-9 * evolved,
+        "replayed {replayed} N vs evolved {evolved} N"
+    );
+    std::fs::remove_dir_all(&replay).ok();
     // A resume from another experiment is refused.
     let out = Command::new(env!("CARGO_BIN_EXE_marionette"))
         .args([

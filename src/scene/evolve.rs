@@ -209,7 +209,9 @@ impl Progress {
     }
 }
 
-/// The report of one fall (the figures an evolved fall must not win by an artefact).
+/// The report of one fall (the figures an evolved fall must not win by an artefact): peak
+/// penetration, worst range excursion, the DOFs whose PD torque reached the strength limit (and
+/// for how long), the pelvis impact, and the damage re-simulated at half the step.
 fn honesty(config: &FallConfig, result: &FallResult) -> serde_json::Value {
     let mut half = config.clone();
     half.dt_s *= 0.5;
@@ -228,6 +230,8 @@ fn honesty(config: &FallConfig, result: &FallResult) -> serde_json::Value {
         "half_step_relative_change": half_damage.as_ref().ok().map(|d| (d - result.damage) / result.damage),
         "half_step_within_10_percent": half_damage.as_ref().ok().map(|d| ((d - result.damage) / result.damage).abs() <= 0.1),
         "came_to_rest": result.came_to_rest,
+        "torque_saturation": result.torque_saturation,
+        "pelvis": result.pelvis,
     })
 }
 

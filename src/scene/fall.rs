@@ -102,6 +102,10 @@ pub struct FallScene {
     /// PD control toward a key pose.
     #[serde(default)]
     pub controller: Controller,
+    /// A controller file (RON, a `controller` block such as the `best_<group>.controller.ron`
+    /// an evolution writes), applied before `controller`; relative to the scene file.
+    #[serde(default)]
+    pub controller_file: Option<String>,
     /// Damage weight w_i per link (links not named keep the default; the head is protected most).
     #[serde(default)]
     pub damage_weights: BTreeMap<String, f64>,
@@ -162,16 +166,29 @@ impl FallScene {
         c.mass_kg = self.body.mass_kg;
         c.contact = self.contact;
         let names = fall21().dof_names();
-        override_per_dof(
-            "key_pose_deg",
-            &mut c.key_pose_deg,
-            &names,
-            &self.controller.key_pose_deg,
-        )?;
-        override_per_dof("kp", &mut c.kp, &names, &self.controller.kp)?;
-        override_per_dof("kv", &mut c.kv, &names, &self.controller.kv)?;
-        if let Some(s) = self.controller.start_s {
-            c.control_start_s = s;
+        let from_file = match &self.controller_file {
+            Some(f) => {
+                let path = resolve_path(f, base);
+                let text = crate::io::read_text(&path)?;
+                Some(crate::io::parse_ron::<Controller>(
+                    &text,
+                    &path.display().to_string(),
+                )?)
+            }
+            None => None,
+        };
+        for ctrl in from_file.iter().chain(std::iter::once(&self.controller)) {
+            override_per_dof(
+                "key_pose_deg",
+                &mut c.key_pose_deg,
+                &names,
+                &ctrl.key_pose_deg,
+            )?;
+            override_per_dof("kp", &mut c.kp, &names, &ctrl.kp)?;
+            override_per_dof("kv", &mut c.kv, &names, &ctrl.kv)?;
+            if let Some(s) = ctrl.start_s {
+                c.control_start_s = s;
+            }
         }
         for (link, w) in &self.damage_weights {
             if !c.damage_weights.contains_key(link) {
