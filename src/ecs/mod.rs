@@ -1,4 +1,5 @@
-//! The ECS wiring, the only module that knows `bevy_ecs`. Characters are entities; what they
+//! The ECS wiring every character shares (experiments above it add their own systems).
+//! Characters are entities; what they
 //! carry decides what happens to them:
 //!
 //! - every character: [`Character`], [`SkeletonRef`], [`JointState`] and a [`Recorder`] of its
