@@ -1,6 +1,5 @@
 //! The ECS wiring every character shares (experiments above it add their own systems).
-//! Characters are entities; what they
-//! carry decides what happens to them:
+//! Characters are entities; what they carry decides what happens to them:
 //!
 //! - every character: [`Character`], [`SkeletonRef`], [`JointState`] and a [`Recorder`] of its
 //!   drawable points; forward kinematics and recording treat all alike;
