@@ -6,7 +6,8 @@
 //! The Python side runs with the virtual environment `.ci/run` creates (`.venv/`, with `pin`);
 //! when it is missing the test prints a SKIPPED line, except under CI, where it fails.
 
-use std::io::Write;
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -18,32 +19,6 @@ use marionette::humanoid::ranges::{AgeGroup, RangeTable};
 use marionette::humanoid::strength::torque_limits;
 use rand::{RngExt, SeedableRng};
 use serde_json::json;
-
-fn in_ci() -> bool {
-    std::env::var("CI").is_ok_and(|v| !matches!(v.trim(), "" | "0" | "false" | "FALSE"))
-}
-
-/// The virtual environment's python, or `None` after a SKIPPED line (a panic under CI).
-fn venv_python() -> Option<PathBuf> {
-    let py = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(".venv/bin/python");
-    if py.is_file() {
-        return Some(py);
-    }
-    if in_ci() {
-        panic!(
-            "{} not found and CI is set: .ci/run creates the virtual environment (pip install pin \
-             mujoco) so the cross-checks run in CI",
-            py.display()
-        );
-    }
-    let _ = writeln!(
-        std::io::stderr(),
-        "SKIPPED: body cross-check: needs {} (run .ci/run once, or python3 -m venv .venv && \
-         .venv/bin/pip install pin mujoco)",
-        py.display()
-    );
-    None
-}
 
 /// Runs `tools/<script>` with `args` under `py`, prints its output; returns success and output.
 fn run_tool(py: &Path, script: &str, args: &[&dyn AsRef<std::ffi::OsStr>]) -> (bool, String) {
@@ -67,7 +42,9 @@ fn run_tool(py: &Path, script: &str, args: &[&dyn AsRef<std::ffi::OsStr>]) -> (b
 
 #[test]
 fn pinocchio_agrees_with_the_engines_rnea_and_aba_on_the_urdf() {
-    let Some(py) = venv_python() else { return };
+    let Some(py) = common::python_with(&["pinocchio", "mujoco"]) else {
+        return;
+    };
     let g = 9.81;
     let body = fall21_body(1.70, 65.0, g).unwrap();
     let group = AgeGroup::Elderly;
@@ -142,7 +119,9 @@ fn pinocchio_agrees_with_the_engines_rnea_and_aba_on_the_urdf() {
 fn mujoco_follows_the_pushed_fall_until_first_contact() {
     use marionette::experiments::fall::{FallConfig, simulate_fall};
     use marionette::humanoid::export::to_mjcf;
-    let Some(py) = venv_python() else { return };
+    let Some(py) = common::python_with(&["pinocchio", "mujoco"]) else {
+        return;
+    };
     let cfg = FallConfig::paper(AgeGroup::Elderly);
     let r = simulate_fall(&cfg).unwrap();
     let body = fall21_body(cfg.height_m, cfg.mass_kg, cfg.gravity).unwrap();

@@ -200,14 +200,19 @@ pub fn step_bodies(clock: Res<Clock>, mut q: Query<StepQuery>) {
 
 /// Sets the joint state of every drawn body from its configuration: the pelvis from the
 /// floating base, every other joint from its DOF angles (as a model clip does).
-pub fn publish_body_pose(mut q: Query<(&PhysicsBody, &BodyState, &mut JointState)>) {
+pub fn publish_body_pose(
+    mut scratch: Local<(Vec<f64>, Vec<f64>)>,
+    mut q: Query<(&PhysicsBody, &BodyState, &mut JointState)>,
+) {
+    let (all, angles) = &mut *scratch;
     for (body, state, mut joints) in &mut q {
         let b = &*body.body;
-        let mut all = vec![0.0; b.model.nv];
-        b.model.angles(&state.q, &mut all);
-        let angles: Vec<f64> = b.dof_v.iter().map(|&k| all[k]).collect();
+        all.resize(b.model.nv, 0.0);
+        b.model.angles(&state.q, all);
+        angles.clear();
+        angles.extend(b.dof_v.iter().map(|&k| all[k]));
         let js = &mut *joints;
-        b.figure.local_rotations(&angles, &mut js.rotations);
+        b.figure.local_rotations(angles, &mut js.rotations);
         for (t, j) in js.translations.iter_mut().zip(&b.figure.joints) {
             *t = j.offset;
         }

@@ -40,8 +40,8 @@ pub struct EvolveConfig {
     pub ga: GaConfig,
 }
 
-/// Starts every (problem, seed) run: generation 0 drawn and evaluated, with `evaluator(problem)`
-/// giving the evaluator of each problem.
+/// Starts every (problem, seed) run: generation 0 drawn and evaluated, `evaluators[p]`
+/// evaluating problem `p`.
 pub fn start(
     config: &EvolveConfig,
     evaluators: &mut [Box<dyn Evaluator>],

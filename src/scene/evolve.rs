@@ -12,8 +12,9 @@ use std::time::Instant;
 use serde::{Deserialize, Serialize};
 use serde_json::json;
 
+use super::fall::{Controller, write_falls};
 use super::primitives::PrimitiveRender;
-use super::{SceneError, draw_tracks, write_output};
+use super::{SceneError, write_output};
 use crate::evolve::{Evaluator, FallProblem, GaConfig, InProcess, JsonLines, checkpoint, logbook};
 use crate::experiments::evolve_fall::{
     Checkpointing, EvolutionRun, EvolveConfig, GroupOutcome, advance, best_falls, outcomes,
@@ -22,7 +23,7 @@ use crate::experiments::evolve_fall::{
 use crate::experiments::fall::{FallConfig, FallResult, simulate_fall};
 use crate::humanoid::fall21;
 use crate::humanoid::ranges::AgeGroup;
-use crate::render::{Plot, Series, Track, plot};
+use crate::render::{Plot, Series, plot};
 
 /// Who evaluates the generations.
 #[derive(Clone, Debug, PartialEq, Default, Serialize, Deserialize)]
@@ -235,28 +236,30 @@ fn honesty(config: &FallConfig, result: &FallResult) -> serde_json::Value {
     })
 }
 
-/// The best controller of a run as a `Fall` scene's `controller` block (degrees, N·m/rad).
-fn controller_ron(problem: &FallProblem, genes: &[f64]) -> String {
+/// The best controller of a run as a `Fall` scene's `controller` block (degrees, N·m/rad),
+/// for its `controller_file`.
+fn controller_ron(problem: &FallProblem, genes: &[f64]) -> Result<String, SceneError> {
     let names = fall21().dof_names();
     let n = names.len();
-    let mut s = String::from(
-        "// The evolved key pose and stiffness, for a Fall scene's controller.\n(\n    key_pose_deg: {\n",
-    );
-    for (i, name) in names.iter().enumerate() {
-        s.push_str(&format!(
-            "        \"{name}\": {:?},\n",
-            genes[i].to_degrees()
-        ));
-    }
-    s.push_str("    },\n    kp: {\n");
-    for (i, name) in names.iter().enumerate() {
-        s.push_str(&format!("        \"{name}\": {:?},\n", genes[n + i]));
-    }
-    s.push_str(&format!(
-        "    }},\n    start_s: Some({:?}),\n)\n",
-        problem.fall.control_start_s
-    ));
-    s
+    let controller = Controller {
+        key_pose_deg: names
+            .iter()
+            .zip(&genes[..n])
+            .map(|(d, x)| (d.clone(), x.to_degrees()))
+            .collect(),
+        kp: names
+            .iter()
+            .cloned()
+            .zip(genes[n..].iter().copied())
+            .collect(),
+        kv: Default::default(),
+        start_s: Some(problem.fall.control_start_s),
+    };
+    let text = ron::ser::to_string_pretty(&controller, ron::ser::PrettyConfig::default())
+        .map_err(|e| invalid(format!("controller file: {e}")))?;
+    Ok(format!(
+        "// The evolved key pose and stiffness, for a Fall scene's controller_file.\n{text}\n"
+    ))
 }
 
 /// Runs an [`EvolveFallScene`]; returns the report.
@@ -375,7 +378,6 @@ pub fn run_evolve(
     )?;
     // The best run of each group (lowest final damage): its falls before and after.
     let mut falls: Vec<(String, FallConfig, FallResult)> = Vec::new();
-    let mut best_runs = Vec::new();
     for g in &groups {
         let best = runs
             .iter()
@@ -404,37 +406,18 @@ pub fn run_evolve(
         if let Some((genes, _)) = &best.state.best {
             write_output(
                 &out.join(format!("best_{name}.controller.ron")),
-                controller_ron(&best.problem, genes).as_bytes(),
+                controller_ron(&best.problem, genes)?.as_bytes(),
             )?;
         }
-        best_runs.push(best);
     }
-    let clips: Vec<_> = falls
+    let named: Vec<(String, String, &FallResult)> = falls
         .iter()
-        .map(|(_, _, r)| r.to_model_clip().to_clip())
-        .collect();
-    for ((label, _, _), clip) in falls.iter().zip(&clips) {
-        write_output(
-            &out.join(format!("fall_{}.bvh", label.replace(' ', "_"))),
-            crate::bvh::to_string(&clip.to_bvh()).as_bytes(),
-        )?;
-    }
-    let figures: Vec<_> = clips.iter().map(|c| c.skeleton.figure()).collect();
-    let frames: Vec<_> = clips.iter().map(|c| c.point_frames()).collect();
-    let tracks: Vec<Track> = (0..clips.len())
-        .map(|k| Track {
-            figure: &figures[k],
-            frames: &frames[k],
-            label: format!("{} (damage {:.0} N)", falls[k].0, falls[k].2.damage),
-            frame_time: clips[k].frame_time,
+        .map(|(label, _, r)| {
+            let file = format!("fall_{}", label.replace(' ', "_"));
+            (file, format!("{label} (damage {:.0} N)", r.damage), r)
         })
         .collect();
-    draw_tracks(
-        &tracks,
-        scene.render.filmstrip_frames,
-        scene.render.gif.then_some(scene.render.gif_fps),
-        out,
-    )?;
+    write_falls(&named, &scene.render, out)?;
     // Fig. 3: head height of the best falls before and after.
     plot(
         &Plot {

@@ -256,6 +256,41 @@ pub fn fall_report(r: &FallResult, sim_wall_s: f64) -> serde_json::Value {
     })
 }
 
+/// Writes each fall as `<file>.bvh` (fall21 skeleton) and draws them together as
+/// `filmstrip.png` (and `motion.gif`), one track per fall with its label.
+pub(super) fn write_falls(
+    falls: &[(String, String, &FallResult)],
+    render: &PrimitiveRender,
+    out: &Path,
+) -> Result<(), SceneError> {
+    let clips: Vec<_> = falls
+        .iter()
+        .map(|(_, _, r)| r.to_model_clip().to_clip())
+        .collect();
+    for ((file, _, _), clip) in falls.iter().zip(&clips) {
+        write_output(
+            &out.join(format!("{file}.bvh")),
+            crate::bvh::to_string(&clip.to_bvh()).as_bytes(),
+        )?;
+    }
+    let figures: Vec<_> = clips.iter().map(|c| c.skeleton.figure()).collect();
+    let frames: Vec<_> = clips.iter().map(|c| c.point_frames()).collect();
+    let tracks: Vec<Track> = (0..clips.len())
+        .map(|k| Track {
+            figure: &figures[k],
+            frames: &frames[k],
+            label: falls[k].1.clone(),
+            frame_time: clips[k].frame_time,
+        })
+        .collect();
+    draw_tracks(
+        &tracks,
+        render.filmstrip_frames,
+        render.gif.then_some(render.gif_fps),
+        out,
+    )
+}
+
 /// Runs a [`FallScene`]: writes `fall.bvh` (fall21 skeleton), `filmstrip.png`, `motion.gif`,
 /// `head_height.png` (the paper's Fig. 3) and returns the report. With `compare_with`, the same
 /// fall is also simulated for the other age group in a second World, in parallel, and drawn and
@@ -283,37 +318,20 @@ pub fn run_fall(
         .collect::<Result<_, _>>()?;
     let sim_wall = started.elapsed().as_secs_f64();
 
-    let clips: Vec<_> = results
+    let named: Vec<(String, String, &FallResult)> = results
         .iter()
-        .map(|r| r.to_model_clip().to_clip())
-        .collect();
-    for (k, clip) in clips.iter().enumerate() {
-        let name = if k == 0 {
-            "fall.bvh".to_string()
-        } else {
-            format!("fall_{}.bvh", group_name(groups[k].0))
-        };
-        write_output(
-            &out.join(name),
-            crate::bvh::to_string(&clip.to_bvh()).as_bytes(),
-        )?;
-    }
-    let figures: Vec<_> = clips.iter().map(|c| c.skeleton.figure()).collect();
-    let frames: Vec<_> = clips.iter().map(|c| c.point_frames()).collect();
-    let tracks: Vec<Track> = (0..clips.len())
-        .map(|k| Track {
-            figure: &figures[k],
-            frames: &frames[k],
-            label: format!("{} ({})", scene.name, group_name(groups[k].0)),
-            frame_time: clips[k].frame_time,
+        .zip(&groups)
+        .enumerate()
+        .map(|(k, (r, (g, _)))| {
+            let file = if k == 0 {
+                "fall".to_string()
+            } else {
+                format!("fall_{}", group_name(*g))
+            };
+            (file, format!("{} ({})", scene.name, group_name(*g)), r)
         })
         .collect();
-    draw_tracks(
-        &tracks,
-        scene.render.filmstrip_frames,
-        scene.render.gif.then_some(scene.render.gif_fps),
-        out,
-    )?;
+    write_falls(&named, &scene.render, out)?;
     let push_end = scene.push.start_s + scene.push.duration_s;
     plot(
         &Plot {
