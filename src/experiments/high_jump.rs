@@ -178,6 +178,9 @@ pub struct HighJumpOutcome {
     pub clips: Jumps<ModelClip>,
     /// The low jump time-scaled to T as a clip (`rollouts.low`).
     pub low_time_scaled: ModelClip,
+    /// How far each of `clips` was lifted where a foot of its rollout went below the floor
+    /// ([`ModelClip::lift_above_floor`]), metres: the largest lift.
+    pub floor_lift_m: Jumps<f64>,
     /// What each of `clips` did: apex above standing, flight from foot contact, lowest foot.
     pub figures: Jumps<JumpFigures>,
     /// Left-knee flexion of each jump's crouch, degrees: the peak before take-off (found by
@@ -239,10 +242,13 @@ pub fn learn_primitives(
     let normal = Primitive::learn("normal_jump", &config.normal.to_trajectory(), &config.learn)?;
     let t = normal.primitive.duration;
     // What the demonstrations did, each at its own duration, on the normal jump's floor.
-    let normal_clip = on_model(model, &rollout(&normal.primitive, dt)?)?;
-    let low_clip = on_model(model, &rollout(&low.primitive, dt)?)?;
+    let mut normal_clip = on_model(model, &rollout(&normal.primitive, dt)?)?;
+    let mut low_clip = on_model(model, &rollout(&low.primitive, dt)?)?;
     let floor = floor_of(&normal_clip)
         .ok_or_else(|| PrimitiveExperimentError::NoFlight("the model has no feet".into()))?;
+    // Measured as `run` writes them: with the floor constraint.
+    normal_clip.lift_above_floor(floor);
+    low_clip.lift_above_floor(floor);
     let demo_figures = [
         jump_figures(&low_clip, floor),
         jump_figures(&normal_clip, floor),
@@ -473,12 +479,21 @@ pub fn run(config: &HighJumpConfig) -> Result<HighJumpOutcome, PrimitiveExperime
         normal: rollout(&learned.normal.primitive, dt)?,
         high: rollout(&learned.high.primitive, dt)?,
     };
-    let clips = Jumps {
+    let mut clips = Jumps {
         low: on_model(model, &rollout(&learned.low.primitive, dt)?)?,
         normal: on_model(model, &rollouts.normal)?,
         high: on_model(model, &rollouts.high)?,
     };
     let floor = primitives.floor_y_m;
+    // A rollout reproduces its demonstration to within millimetres, which puts a standing foot
+    // that far through the floor: the floor constraint lifts the root by the depth where it is.
+    let floor_lift_m = Jumps {
+        low: clips.low.lift_above_floor(floor),
+        normal: clips.normal.lift_above_floor(floor),
+        high: clips.high.lift_above_floor(floor),
+    };
+    let mut low_time_scaled = on_model(model, &rollouts.low)?;
+    low_time_scaled.lift_above_floor(floor);
     let figures = Jumps {
         low: jump_figures(&clips.low, floor),
         normal: jump_figures(&clips.normal, floor),
@@ -498,7 +513,8 @@ pub fn run(config: &HighJumpConfig) -> Result<HighJumpOutcome, PrimitiveExperime
     let expected = primitives.prediction.crouch_knee_flexion_deg;
     Ok(HighJumpOutcome {
         duration_s: t,
-        low_time_scaled: on_model(model, &rollouts.low)?,
+        low_time_scaled,
+        floor_lift_m,
         rollouts,
         clips,
         figures,

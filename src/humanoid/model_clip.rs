@@ -186,6 +186,24 @@ impl ModelClip {
         out
     }
 
+    /// Lifts the root wherever a foot point (ankle joints and their End Sites) is below
+    /// `floor_y`, by exactly how far it is below, and nowhere else: the floor constraint on a
+    /// rollout whose reproduction error puts a foot a few millimetres through the floor. The
+    /// lift is continuous (the positive part of a continuous depth). Returns the largest lift,
+    /// metres.
+    pub fn lift_above_floor(&mut self, floor_y: f64) -> f64 {
+        let [left, right] = self.foot_heights();
+        let mut largest: f64 = 0.0;
+        for ((t, l), r) in self.root_translation.iter_mut().zip(&left).zip(&right) {
+            let depth = floor_y - l.min(*r);
+            if depth > 0.0 {
+                t.y += depth;
+                largest = largest.max(depth);
+            }
+        }
+        largest
+    }
+
     /// Keeps the feet on the floor: outside the `airborne` spans (seconds) the root is raised or
     /// lowered so that the lowest foot point (ankle joints and their End Sites) is at
     /// `floor_y`; inside a span the correction is interpolated linearly between its ends, so a

@@ -204,7 +204,20 @@ pub fn apply_overrides(scene: &Scene, assignments: &[String]) -> Result<Scene, S
             };
             cur = next;
         }
-        *cur = new;
+        // A bare number for a one-number enum variant (`gamma=-1` where the scene has
+        // `Constant(-0.5)`) keeps the variant and sets its number.
+        let variant = match (&*cur, &new) {
+            (serde_json::Value::Object(map), serde_json::Value::Number(_)) if map.len() == 1 => map
+                .iter()
+                .next()
+                .filter(|(_, v)| v.is_number())
+                .map(|(k, _)| k.clone()),
+            _ => None,
+        };
+        *cur = match variant {
+            Some(k) => serde_json::json!({ k: new }),
+            None => new,
+        };
     }
     serde_json::from_value(value).map_err(|e| SceneError::Override {
         assignment: assignments.join(" "),

@@ -65,7 +65,9 @@ impl Staging {
             }
         }
         std::fs::create_dir_all(&parent).map_err(|e| io_error(&parent, e))?;
-        // Folders of runs that were interrupted: their process is gone.
+        // Folders of runs that were interrupted: their process is gone. A run killed between
+        // the two renames of `commit` left the previous outputs as `.old-`: they are put back
+        // first, so an interruption at any moment leaves the previous outputs in place.
         if let Ok(entries) = std::fs::read_dir(&parent) {
             let prefix = format!(".{name}");
             for e in entries.flatten() {
@@ -80,7 +82,11 @@ impl Staging {
                 if let Some(pid) = pid
                     && !alive(pid)
                 {
-                    let _ = std::fs::remove_dir_all(e.path());
+                    if rest.starts_with(OLD) && !target.exists() {
+                        std::fs::rename(e.path(), target).map_err(|err| io_error(target, err))?;
+                    } else {
+                        let _ = std::fs::remove_dir_all(e.path());
+                    }
                 }
             }
         }
@@ -198,6 +204,31 @@ mod tests {
         let e = Staging::begin(&foreign).err().unwrap().to_string();
         assert!(e.contains("not a scene's output"), "{e}");
         assert!(foreign.join("notes.txt").exists());
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+
+    #[test]
+    fn a_run_killed_between_the_renames_leaves_the_previous_outputs() {
+        let d = scratch("window");
+        // Killed after `target → .old-` and before `.partial- → target`.
+        let old = d.join(".out.old-4294967295");
+        std::fs::create_dir(&old).unwrap();
+        std::fs::write(old.join("report.json"), "previous").unwrap();
+        let half = d.join(".out.partial-4294967295");
+        std::fs::create_dir(&half).unwrap();
+        std::fs::write(half.join("report.json"), "unfinished").unwrap();
+        let target = d.join("out");
+        let s = Staging::begin(&target).unwrap();
+        assert_eq!(
+            std::fs::read_to_string(target.join("report.json")).unwrap(),
+            "previous"
+        );
+        assert!(!old.exists() && !half.exists());
+        drop(s);
+        assert_eq!(
+            std::fs::read_to_string(target.join("report.json")).unwrap(),
+            "previous"
+        );
         std::fs::remove_dir_all(&d).unwrap();
     }
 }

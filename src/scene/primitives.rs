@@ -268,6 +268,7 @@ pub fn run_high_jump(
         "duration_s": hj.duration_s,
         "high_duration_s": learned.high.primitive.duration,
         "ground_correction_m": hj.primitives.ground_correction_m,
+        "floor_lift_m": { "low": hj.floor_lift_m.low, "normal": hj.floor_lift_m.normal, "high": hj.floor_lift_m.high },
     }))
 }
 
