@@ -31,6 +31,45 @@ pub struct FallProblem {
     pub fall: FallConfig,
     /// Upper bound of k_p per DOF (N·m/rad).
     pub kp_max: Vec<f64>,
+    /// The fall's settled standing start, kept from one generation to the next.
+    #[serde(skip)]
+    pub settled: SettleCache,
+}
+
+/// The settled standing start of a problem's fall ([`SettledStart`]), computed at the first
+/// evaluation and kept for the next ones (settled anew if the fall has changed since). Not part
+/// of the problem: a clone starts empty and equality ignores it.
+#[derive(Default)]
+pub struct SettleCache(std::sync::Mutex<Option<SettledStart>>);
+
+impl SettleCache {
+    /// The settled start of `fall`, from the cache when it fits; `None` if the fall cannot be
+    /// built (each evaluation then reports why).
+    pub fn of(&self, fall: &FallConfig) -> Option<SettledStart> {
+        let mut c = self.0.lock().unwrap_or_else(|e| e.into_inner());
+        if !c.as_ref().is_some_and(|s| s.fits(fall)) {
+            *c = SettledStart::of(fall).ok();
+        }
+        c.clone()
+    }
+}
+
+impl Clone for SettleCache {
+    fn clone(&self) -> Self {
+        Self::default()
+    }
+}
+
+impl PartialEq for SettleCache {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
+}
+
+impl std::fmt::Debug for SettleCache {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("SettleCache")
+    }
 }
 
 /// Why a problem is unusable.
@@ -108,6 +147,7 @@ impl FallProblem {
             age_group: group,
             fall,
             kp_max,
+            settled: SettleCache::default(),
         }
     }
 
@@ -147,10 +187,11 @@ impl FallProblem {
     }
 
     /// The damage of every genome, each fall in its own World, in parallel; the standing body
-    /// is settled once for all (the genes do not change how it stands).
+    /// is settled once for the whole run (the genes do not change how it stands; the same bits
+    /// as settling each fall).
     pub fn evaluate(&self, genomes: &[Genome]) -> Vec<Evaluation> {
         let configs: Vec<FallConfig> = genomes.iter().map(|g| self.config(g)).collect();
-        let start = SettledStart::of(&self.fall).ok();
+        let start = self.settled.of(&self.fall);
         run_parallel_from(&configs, start.as_ref())
             .into_iter()
             .map(|r| {
