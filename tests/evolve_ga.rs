@@ -203,3 +203,34 @@ fn a_run_with_diverging_individuals_completes_and_logs_them() {
         s.failures.len()
     );
 }
+
+#[test]
+fn the_standing_start_kept_across_generations_gives_the_bits_of_settling_each_fall() {
+    let mut p = small_fall_problem();
+    p.fall.duration_s = 0.6;
+    let b = p.bounds().unwrap();
+    let genomes: Vec<Genome> = [0.3, 0.7]
+        .iter()
+        .map(|t| (0..b.len()).map(|i| b.lo[i] + t * b.width(i)).collect())
+        .collect();
+    let first = p.evaluate(&genomes);
+    let again = p.evaluate(&genomes);
+    let settled_each: Vec<Evaluation> = genomes
+        .iter()
+        .map(|g| {
+            marionette::experiments::fall::simulate_fall(&p.config(g))
+                .map(|r| r.damage)
+                .map_err(|e| e.to_string())
+        })
+        .collect();
+    assert!(first.iter().all(|r| r.is_ok()), "{first:?}");
+    assert_eq!(first, again);
+    assert_eq!(first, settled_each);
+    // A changed stance is settled anew, not taken from the cache.
+    let mut q = p.clone();
+    q.fall.stance_pose_deg[0] += 2.0;
+    let moved = q.evaluate(&genomes);
+    assert_ne!(moved, first);
+    p.fall = q.fall.clone();
+    assert_eq!(p.evaluate(&genomes), moved);
+}

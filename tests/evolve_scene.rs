@@ -4,6 +4,9 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+use marionette::evolve::FallProblem;
+use marionette::humanoid::ranges::AgeGroup;
+
 fn marionette(args: &[&str]) -> std::process::Output {
     let out = Command::new(env!("CARGO_BIN_EXE_marionette"))
         .args(args)
@@ -130,6 +133,11 @@ fn a_resumed_evolution_ends_where_an_uninterrupted_one_does() {
         "render.gif=false",
         "--set",
         &file,
+        "--set",
+        &format!(
+            "simulation.dt={}",
+            FallProblem::paper(AgeGroup::Adult).fall.dt_s
+        ),
     ]);
     let fall = report(&replay);
     let evolved = r["best_falls"]

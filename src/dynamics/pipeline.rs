@@ -97,6 +97,9 @@ pub struct StepMonitor {
     pub saturated_s: Vec<f64>,
     /// First step start at which each DOF's PD torque was at its limit (s).
     pub first_saturated_s: Vec<Option<f64>>,
+    /// The PD torque of largest magnitude per DOF so far (N·m, signed, after the strength clamp,
+    /// sampled at step starts).
+    pub peak_torque: Vec<f64>,
 }
 
 impl StepMonitor {
@@ -108,6 +111,7 @@ impl StepMonitor {
             max_excursion: vec![0.0; ndofs],
             saturated_s: vec![0.0; ndofs],
             first_saturated_s: vec![None; ndofs],
+            peak_torque: vec![0.0; ndofs],
         }
     }
 }
@@ -260,6 +264,9 @@ fn limits_stage(
         }
         if let Some(pd) = limited {
             let (tau, _) = pd.torque(d, e.angles[k], state.v[k]);
+            if tau.abs() > monitor.peak_torque[d].abs() {
+                monitor.peak_torque[d] = tau;
+            }
             if pd.saturates(d, tau) {
                 monitor.saturated_s[d] += dt;
                 monitor.first_saturated_s[d].get_or_insert(state.time_s);

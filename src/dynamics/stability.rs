@@ -94,16 +94,9 @@ pub fn stiffest_mode(
             consider(bound, &|| "contact".to_string(), i, omega, zeta);
         }
     }
-    let nv = model.nv;
-    let mut data = Data::new(model);
-    crba(model, &mut data, q);
-    let mut h = data.h.clone();
-    cholesky_factor(&mut h, nv)?;
-    for d in dofs {
-        let mut e = vec![0.0; nv];
-        e[d.v] = 1.0;
-        cholesky_solve(&h, nv, &mut e);
-        let w = e[d.v];
+    let vs: Vec<usize> = dofs.iter().map(|d| d.v).collect();
+    let ws = inverse_joint_inertia(model, q, &vs)?;
+    for (d, &w) in dofs.iter().zip(&ws) {
         let omega = (d.stiffness * w).sqrt();
         let zeta = if omega > 0.0 {
             d.damping * w / (2.0 * omega)
@@ -115,6 +108,31 @@ pub fn stiffest_mode(
     }
     Ok(worst)
 }
+/// The inverse effective inertia `(H⁻¹)_jj` (1/(kg·m²) for a revolute DOF) of each velocity
+/// index `j` of `vs` at configuration `q`, with `H` the joint-space inertia of the free tree
+/// (CRBA): the DOF's `ω² = k (H⁻¹)_jj` under a spring `k`.
+pub fn inverse_joint_inertia(
+    model: &Model,
+    q: &[f64],
+    vs: &[usize],
+) -> Result<Vec<f64>, super::crba::NotPositiveDefinite> {
+    let nv = model.nv;
+    let mut data = Data::new(model);
+    crba(model, &mut data, q);
+    let mut h = data.h.clone();
+    cholesky_factor(&mut h, nv)?;
+    let mut e = vec![0.0; nv];
+    Ok(vs
+        .iter()
+        .map(|&j| {
+            e.fill(0.0);
+            e[j] = 1.0;
+            cholesky_solve(&h, nv, &mut e);
+            e[j]
+        })
+        .collect())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

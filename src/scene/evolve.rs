@@ -72,7 +72,9 @@ pub struct EvolveFallScene {
     #[serde(default = "default_kp_scale")]
     pub kp_max_scale: f64,
     /// The fall every genome is tried on, per field (default: the paper's push of the age
-    /// group; its key pose and k_p are the genes).
+    /// group at the largest stable step, [`crate::evolve::fall_fitness::stable_step_for`]; its
+    /// key pose and k_p are the genes). A fall given here takes the group's ranges and strength
+    /// and keeps its own `dt_s` (0.5 ms unless set).
     #[serde(default)]
     pub fall: Option<FallConfig>,
     /// Generations between checkpoints.
@@ -134,6 +136,7 @@ impl EvolveFallScene {
                 if let Some(f) = &self.fall {
                     p.fall = f.clone();
                     p.fall.ranges = crate::experiments::fall::Ranges::Builtin(g);
+                    p.fall.torque_limits_nm = Some(crate::humanoid::strength::torque_limits(g));
                     p.fall.stop_at_rest = true;
                 }
                 p.kp_max = crate::evolve::fall_fitness::strength_kp_max(g, self.kp_max_scale);
@@ -211,22 +214,30 @@ impl Progress {
 }
 
 /// The report of one fall (the figures an evolved fall must not win by an artefact): peak
-/// penetration, worst range excursion, the DOFs whose PD torque reached the strength limit (and
-/// for how long), the pelvis impact, and the damage re-simulated at half the step.
+/// penetration and its link, worst range excursion and its DOF, each DOF's peak PD torque
+/// against its strength limit, the DOFs whose limit bound (and for how long), the pelvis
+/// impact, and the damage re-simulated at half the step.
 fn honesty(config: &FallConfig, result: &FallResult) -> serde_json::Value {
     let mut half = config.clone();
     half.dt_s *= 0.5;
     half.stop_at_rest = false;
     let half_damage = simulate_fall(&half).map(|r| r.damage);
-    let worst = result
-        .max_limit_excursion_rad
-        .iter()
-        .copied()
-        .fold(0.0, f64::max);
+    let argmax = |xs: &[f64]| {
+        xs.iter()
+            .copied()
+            .enumerate()
+            .fold((0, 0.0), |b, (i, x)| if x > b.1 { (i, x) } else { b })
+    };
+    let (worst_dof, worst) = argmax(&result.max_limit_excursion_rad);
+    let (deepest_link, _) = argmax(&result.max_penetration_by_link_m);
     json!({
+        "dt_s": result.dt_s,
         "damage": result.damage,
         "max_penetration_m": result.max_penetration_m,
+        "max_penetration_link": result.link_names.get(deepest_link),
         "worst_range_excursion_deg": worst.to_degrees(),
+        "worst_range_excursion_dof": result.dof_names.get(worst_dof),
+        "peak_torques": result.peak_torques,
         "damage_at_half_step": half_damage.as_ref().ok(),
         "half_step_relative_change": half_damage.as_ref().ok().map(|d| (d - result.damage) / result.damage),
         "half_step_within_10_percent": half_damage.as_ref().ok().map(|d| ((d - result.damage) / result.damage).abs() <= 0.1),
@@ -258,7 +269,9 @@ fn controller_ron(problem: &FallProblem, genes: &[f64]) -> Result<String, SceneE
     let text = ron::ser::to_string_pretty(&controller, ron::ser::PrettyConfig::default())
         .map_err(|e| invalid(format!("controller file: {e}")))?;
     Ok(format!(
-        "// The evolved key pose and stiffness, for a Fall scene's controller_file.\n{text}\n"
+        "// The evolved key pose and stiffness, for a Fall scene's controller_file. Evolved at \
+         dt = {dt} s: replay with simulation.dt={dt} for the same fall.\n{text}\n",
+        dt = problem.fall.dt_s
     ))
 }
 

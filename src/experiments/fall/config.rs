@@ -81,6 +81,13 @@ pub struct FallConfig {
     pub stop_at_rest: bool,
 }
 
+/// The natural frequency (Hz) every joint's range limit is tuned to in [`FallConfig::paper`],
+/// critically damped: a stop hard enough that the impact of a fall bends a joint at most a few
+/// degrees past its range (a shared 300 N·m/rad spring let the wrist and waist overshoot by
+/// 10–40°), soft enough that even the lightest DOF (the wrist, `(H⁻¹)_jj ≈ 570 /(kg·m²)`) stays
+/// within the step's stability bound (ω h ≈ 0.9 of 2 at 0.9 ms).
+pub const LIMIT_FREQUENCY_HZ: f64 = 150.0;
+
 /// A per-DOF table in fall21 order from a function of the DOF name.
 fn per_dof(names: &[String], f: impl Fn(&str) -> f64) -> Vec<f64> {
     names.iter().map(|n| f(n)).collect()
@@ -97,8 +104,8 @@ impl FallConfig {
     /// t = 0.1 s; the reaction toward the key pose (here the stance itself) starts at 0.25 s;
     /// semi-implicit Euler with implicit damping at 0.5 ms (the stiffest mode, the foot's heel
     /// pad contact, bounds it at 0.92 ms) for 3 s after a settling phase of at most 3 s; PD
-    /// torques capped at the group's strength ([`torque_limits`]); damage weights protect the
-    /// head most (w = 10).
+    /// torques capped at the group's strength ([`torque_limits`]); joint range limits tuned to
+    /// [`LIMIT_FREQUENCY_HZ`] per DOF; damage weights protect the head most (w = 10).
     pub fn paper(group: AgeGroup) -> Self {
         let names = crate::humanoid::fall21().dof_names();
         let stance = per_dof(&names, |n| match strip_side(n) {
@@ -148,7 +155,10 @@ impl FallConfig {
             mass_kg: 65.0,
             gravity: 9.81,
             ranges: Ranges::Builtin(group),
-            limits: JointLimitParams::default(),
+            limits: JointLimitParams {
+                limit_frequency_hz: Some(LIMIT_FREQUENCY_HZ),
+                ..JointLimitParams::default()
+            },
             torque_limits_nm: Some(torque_limits(group)),
             stance_pose_deg: stance.clone(),
             stance_kp: kp.clone(),

@@ -19,7 +19,8 @@ pub use self::config::{FallConfig, Ranges};
 pub use self::controller::FallController;
 pub use self::recorder::FallRecorder;
 pub use self::result::{
-    FallFrame, FallResult, LinkImpact, PelvisImpact, SimError, StandingStart, TorqueSaturation,
+    FallFrame, FallResult, LinkImpact, PeakTorque, PelvisImpact, SimError, StandingStart,
+    TorqueSaturation,
 };
 
 use std::sync::Arc;
@@ -28,11 +29,13 @@ use glam::{DQuat, DVec3};
 
 use crate::dynamics::data::Data;
 use crate::dynamics::forces::contact::ContactModel;
-use crate::dynamics::forces::limits::JointRanges;
+use crate::dynamics::forces::limits::{JointRanges, limit_gains};
 use crate::dynamics::forces::pd::PdTargets;
 use crate::dynamics::kinematics::kinematics;
 use crate::dynamics::pipeline::{self, Forces, StepSettings};
-use crate::dynamics::stability::{DofStiffness, scheme_name, stiffest_mode};
+use crate::dynamics::stability::{
+    DofStiffness, StiffestMode, inverse_joint_inertia, scheme_name, stiffest_mode,
+};
 use crate::ecs::physics::{ExternalForces, FloorContact, JointLimits, PdController, PhysicsBundle};
 use crate::humanoid::body::{HumanBody, fall21_body};
 use crate::humanoid::ranges::RangeTable;
@@ -161,6 +164,16 @@ fn validate(cfg: &FallConfig) -> Result<Resolved, SimError> {
         if !(x.is_finite() && x >= 0.0) {
             return Err(cfg_err(f, format!("must be ≥ 0, found {x}")));
         }
+    }
+    if let Some(hz) = cfg.limits.limit_frequency_hz {
+        positive("limits.limit_frequency_hz", hz)?;
+    }
+    let zeta = cfg.limits.limit_damping_ratio;
+    if !(zeta.is_finite() && zeta >= 0.0) {
+        return Err(cfg_err(
+            "limits.limit_damping_ratio",
+            format!("must be ≥ 0, found {zeta}"),
+        ));
     }
     let push_link = body.link_index(&cfg.push.link).ok_or_else(|| {
         cfg_err(
@@ -297,38 +310,7 @@ fn standing_configuration(
 /// unless the scheme takes it implicitly.
 pub fn check_stability(cfg: &FallConfig, ch: &FallCharacter) -> Result<(), SimError> {
     let body = &*ch.physics.body.body;
-    let implicit = matches!(
-        cfg.integrator,
-        crate::dynamics::integrator::Integrator::SemiImplicitEuler {
-            implicit_damping: true
-        }
-    );
-    let l = &cfg.limits;
-    let dofs: Vec<DofStiffness> = body
-        .dof_v
-        .iter()
-        .enumerate()
-        .map(|(d, &k)| DofStiffness {
-            v: k,
-            body: body.figure.dofs[d].joint,
-            name: body.figure.dofs[d].name.clone(),
-            stiffness: cfg.kp[d].max(cfg.stance_kp[d]) + l.limit_kp,
-            damping: if implicit {
-                0.0
-            } else {
-                cfg.kv[d].max(cfg.stance_kv[d]) + l.limit_kv.max(l.friction_kv)
-            },
-        })
-        .collect();
-    let worst = stiffest_mode(
-        &body.model,
-        &ch.physics.state.q,
-        cfg.integrator,
-        Some(&ch.contact.0),
-        &dofs,
-    )
-    .map_err(|e| cfg_err("body", e.to_string()))?;
-    match worst {
+    match stiffest_mode_of(cfg, ch)? {
         Some(m) if cfg.dt_s > m.bound_s => Err(SimError::Unstable {
             what: m.what,
             body: body.link_names[m.body].clone(),
@@ -340,6 +322,56 @@ pub fn check_stability(cfg: &FallConfig, ch: &FallCharacter) -> Result<(), SimEr
         }),
         _ => Ok(()),
     }
+}
+
+/// The stiffest mode of the fall `cfg` standing at its start (contact per link; per DOF its
+/// larger PD gain plus its limit spring): its bound is the largest stable step (s). `None` when
+/// nothing is stiff.
+pub fn stiffest_mode_of_config(cfg: &FallConfig) -> Result<Option<StiffestMode>, SimError> {
+    let ch = assemble(cfg)?;
+    stiffest_mode_of(cfg, &ch)
+}
+
+/// The stiffest mode of the character `ch` of `cfg` at its current configuration.
+fn stiffest_mode_of(
+    cfg: &FallConfig,
+    ch: &FallCharacter,
+) -> Result<Option<StiffestMode>, SimError> {
+    let body = &*ch.physics.body.body;
+    let implicit = matches!(
+        cfg.integrator,
+        crate::dynamics::integrator::Integrator::SemiImplicitEuler {
+            implicit_damping: true
+        }
+    );
+    let l = &ch.limits.0;
+    let dofs: Vec<DofStiffness> = body
+        .dof_v
+        .iter()
+        .enumerate()
+        .map(|(d, &k)| {
+            let (limit_kp, limit_kv) = l.limit(d);
+            DofStiffness {
+                v: k,
+                body: body.figure.dofs[d].joint,
+                name: body.figure.dofs[d].name.clone(),
+                stiffness: cfg.kp[d].max(cfg.stance_kp[d]) + limit_kp,
+                damping: if implicit {
+                    0.0
+                } else {
+                    cfg.kv[d].max(cfg.stance_kv[d]) + limit_kv.max(l.params.friction_kv)
+                },
+            }
+        })
+        .collect();
+    stiffest_mode(
+        &body.model,
+        &ch.physics.state.q,
+        cfg.integrator,
+        Some(&ch.contact.0),
+        &dofs,
+    )
+    .map_err(|e| cfg_err("body", e.to_string()))
 }
 
 /// Validates `cfg`, builds the body standing on the floor with its controller, push and
@@ -402,6 +434,22 @@ pub fn build_fall_from(
     cfg: &FallConfig,
     start: Option<&SettledStart>,
 ) -> Result<FallCharacter, SimError> {
+    let mut ch = assemble(cfg)?;
+    check_stability(cfg, &ch)?;
+    let settled = match start {
+        Some(s) if s.fits(cfg) => s.state.clone(),
+        _ => settle(cfg, &ch)?,
+    };
+    ch.recorder.settle_s = settled.time_s;
+    let st = &mut ch.physics.state.0;
+    st.q = settled.q;
+    st.anchors = settled.anchors;
+    Ok(ch)
+}
+
+/// The validated character of `cfg` standing on the floor, before the stability check and the
+/// settling phase.
+fn assemble(cfg: &FallConfig) -> Result<FallCharacter, SimError> {
     let Resolved {
         body,
         push_link,
@@ -427,14 +475,23 @@ pub fn build_fall_from(
         .with_torque_limits(strength.clone());
     let key = PdTargets::hold(rad(&cfg.key_pose_deg), cfg.kp.clone(), cfg.kv.clone())
         .with_torque_limits(strength);
+    let limit_gains = match cfg.limits.limit_frequency_hz {
+        Some(hz) => inverse_joint_inertia(&body.model, &q, &body.dof_v)
+            .map_err(|e| cfg_err("body", e.to_string()))?
+            .into_iter()
+            .map(|w| limit_gains(hz, cfg.limits.limit_damping_ratio, w))
+            .collect(),
+        None => Vec::new(),
+    };
     let nv = body.model.nv;
     let body = Arc::new(body);
-    let mut ch = FallCharacter {
+    Ok(FallCharacter {
         physics: PhysicsBundle::new(body, cfg.integrator, q),
         pd: PdController(stance.clone()),
         limits: JointLimits(JointRanges {
             ranges,
             params: cfg.limits,
+            limit_gains,
         }),
         contact: FloorContact(Arc::new(contact)),
         external: ExternalForces(vec![cfg.push.to_force(push_link)]),
@@ -445,17 +502,7 @@ pub fn build_fall_from(
             reacting: false,
         },
         recorder: FallRecorder::new(cfg, weights, nv),
-    };
-    check_stability(cfg, &ch)?;
-    let settled = match start {
-        Some(s) if s.fits(cfg) => s.state.clone(),
-        _ => settle(cfg, &ch)?,
-    };
-    ch.recorder.settle_s = settled.time_s;
-    let st = &mut ch.physics.state.0;
-    st.q = settled.q;
-    st.anchors = settled.anchors;
-    Ok(ch)
+    })
 }
 
 /// Relaxation time of the settling phase's velocity damping (s).

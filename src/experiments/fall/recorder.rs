@@ -5,7 +5,9 @@ use bevy_ecs::prelude::*;
 use glam::{DQuat, DVec3};
 
 use super::config::FallConfig;
-use super::result::{FallFrame, FallResult, LinkImpact, PelvisImpact, TorqueSaturation};
+use super::result::{
+    FallFrame, FallResult, LinkImpact, PeakTorque, PelvisImpact, TorqueSaturation,
+};
 use crate::dynamics::data::Data;
 use crate::dynamics::pipeline::{State, StepMonitor};
 use crate::humanoid::body::HumanBody;
@@ -52,6 +54,8 @@ pub struct FallRecorder {
     /// Highest the pelvis box's lowest corner rose above the floor after the pelvis's first
     /// touchdown (m): the rebound.
     pub pelvis_rebound_m: f64,
+    /// Strength `(τ_min, τ_max)` per DOF (N·m; empty = unbounded), for the peak torques.
+    pub torque_limits: Vec<(f64, f64)>,
     angles: Vec<f64>,
 }
 
@@ -86,6 +90,7 @@ impl FallRecorder {
             rest_since: None,
             rest_after: cfg.push.start_s + cfg.push.duration_s,
             rest_hold: cfg.rest_hold_s,
+            torque_limits: cfg.torque_limits_nm.clone().unwrap_or_default(),
             stop_at_rest: cfg.stop_at_rest,
             weights,
             recorded_step: None,
@@ -236,6 +241,27 @@ impl FallRecorder {
                 })
             })
             .collect();
+        let peak_torques = body
+            .figure
+            .dofs
+            .iter()
+            .enumerate()
+            .map(|(d, dof)| {
+                let peak = monitor.peak_torque[d];
+                let limit = match self.torque_limits.get(d) {
+                    Some(&(lo, _)) if peak < 0.0 => lo,
+                    Some(&(_, hi)) => hi,
+                    None => f64::INFINITY,
+                };
+                PeakTorque {
+                    dof: dof.name.clone(),
+                    peak_nm: peak,
+                    limit_nm: limit,
+                    fraction: if limit == 0.0 { 0.0 } else { peak / limit },
+                    bound: monitor.first_saturated_s[d].is_some(),
+                }
+            })
+            .collect();
         let mut standing = self.before_push;
         standing.settle_s = self.settle_s;
         let end = state.time_s;
@@ -268,6 +294,7 @@ impl FallRecorder {
             },
             standing,
             torque_saturation: strength,
+            peak_torques,
         }
     }
 }

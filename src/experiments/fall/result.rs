@@ -65,6 +65,9 @@ pub struct FallResult {
     pub standing: StandingStart,
     /// Every DOF whose PD torque reached its strength limit: when first, and for how long.
     pub torque_saturation: Vec<TorqueSaturation>,
+    /// Per DOF its peak PD torque against its strength limit.
+    #[serde(default)]
+    pub peak_torques: Vec<PeakTorque>,
 }
 
 /// One link's impact with the floor over a fall.
@@ -109,6 +112,21 @@ pub struct PelvisImpact {
     /// Rebound: the highest the pelvis box's lowest corner rose above the floor after the
     /// pelvis first touched it (m).
     pub rebound_m: f64,
+}
+
+/// A DOF's largest PD torque against its strength limit.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PeakTorque {
+    /// DOF name.
+    pub dof: String,
+    /// The PD torque of largest magnitude (N·m, signed, after the strength clamp).
+    pub peak_nm: f64,
+    /// The strength limit on that side (N·m, signed; infinite when unbounded).
+    pub limit_nm: f64,
+    /// `peak / limit` (1 = the limit bound).
+    pub fraction: f64,
+    /// The limit bound at some step.
+    pub bound: bool,
 }
 
 /// A DOF whose PD torque reached its strength limit.
