@@ -56,6 +56,9 @@ pub enum Error {
     /// An action on a dance edit.
     #[error(transparent)]
     Edit(#[from] crate::choreo::edit::EditError),
+    /// The dance-search experiment (the paper's Fig. 4).
+    #[error(transparent)]
+    DanceFeedback(#[from] crate::experiments::dance_feedback::FeedbackError),
     /// A data file (RON): reading, syntax, version.
     #[error(transparent)]
     File(#[from] crate::io::FileError),

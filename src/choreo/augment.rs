@@ -22,11 +22,17 @@
 //! variants compare on equal terms. Its intensity is the time average of W(f) (eq. 2) recomputed
 //! on those frames and scaled per source bar by the factor that gives the original bar its own
 //! stored intensity (measured at the clip's native frame rate), so an unshifted original keeps
-//! its intensity exactly. The database's Eros weights are recomputed over all segments.
+//! its intensity exactly. The database's Eros weights are recomputed over all segments. (Eros
+//! compares principal axes rank by rank, so it is sensitive to the body: on the shared dance
+//! clips an original's axes on the reference body and on its own can be as far apart as an Eros
+//! of 0.46; keeping the stored features of the originals would make a variant differ from its
+//! own source mostly by the body.) Segments are described in parallel; the result does not
+//! depend on the number of threads.
 
 use rand::SeedableRng;
 use rand::seq::SliceRandom;
 use rand_pcg::Pcg64;
+use rayon::prelude::*;
 
 use super::database::Database;
 use super::eros::{Pca, eros_weights, pca};
@@ -208,7 +214,7 @@ pub fn augment_with_variants(db: &Database, target_segments: usize, seed: u64) -
     // The per-bar factor from the recomputed W to the stored intensity.
     let factors: Vec<f64> = db
         .segments
-        .iter()
+        .par_iter()
         .map(|s| {
             let (w, _) = w_of(&segment_clip(s, &model), alpha);
             let mean = w.iter().sum::<f64>() / w.len().max(1) as f64;
@@ -259,7 +265,7 @@ pub fn augment_with_variants(db: &Database, target_segments: usize, seed: u64) -
         }
     }
     let segments: Vec<Segment> = variants
-        .iter()
+        .par_iter()
         .map(|v| {
             let s = &db.segments[v.source];
             let n = s.frame_count();
