@@ -15,6 +15,7 @@ use marionette::choreo::augment::{augment, augment_with_variants};
 use marionette::choreo::database::{BuildParams, Database, Manifest, load_model_clip};
 use marionette::choreo::edit::Edit;
 use marionette::choreo::eros::eros;
+use marionette::choreo::fill::FillParams;
 use marionette::choreo::search::{SearchIndex, SearchParams};
 use marionette::choreo::segments::{Beat, TempoSource, cut_segments};
 use marionette::experiments::dance_feedback::{FeedbackConfig, FeedbackOutcome, run};
@@ -231,7 +232,13 @@ fn an_edit_on_a_synthesized_song_prefers_intense_segments_for_loud_bars() {
     let music = analyze(&song.samples, song.sample_rate, &MusicParams::default()).unwrap();
     let bars = music.bars.clone();
     assert!(bars.len() >= 8);
-    let mut edit = Edit::new(db.clone(), bars.clone(), SearchParams::default()).unwrap();
+    let mut edit = Edit::new(
+        db.clone(),
+        bars.clone(),
+        SearchParams::default(),
+        FillParams::default(),
+    )
+    .unwrap();
     let q = edit.music_intensity().to_vec();
     let loud = (0..q.len()).max_by(|&a, &b| q[a].total_cmp(&q[b])).unwrap();
     let quiet = (0..q.len()).min_by(|&a, &b| q[a].total_cmp(&q[b])).unwrap();
@@ -260,6 +267,22 @@ fn an_edit_on_a_synthesized_song_prefers_intense_segments_for_loud_bars() {
     assert!(edit.pins().is_empty());
     edit.redo().unwrap();
     assert_eq!(edit.pins().get(&loud), Some(&again[0]));
+    // Generate: every other bar filled, the pin kept; the pins of the state, exactly.
+    edit.set(0, l[2]).unwrap();
+    let fill = edit.generate().unwrap();
+    assert_eq!(fill.segments.len(), bars.len());
+    assert_eq!(fill.segments[loud], again[0]);
+    assert_eq!(fill.segments[0], l[2]);
+    assert_eq!(fill.connections.len(), bars.len() - 1);
+    assert!(
+        fill.segments.windows(2).all(|w| w[0] != w[1]),
+        "adjacent repeat"
+    );
+    assert_eq!(
+        edit.generate().unwrap(),
+        fill,
+        "the same pins, the same dance"
+    );
     let saved = serde_json::to_string(edit.state()).unwrap();
     let back = Edit::from_state(db, serde_json::from_str(&saved).unwrap()).unwrap();
     assert_eq!(back.state(), edit.state());

@@ -1,7 +1,8 @@
 //! The stateful edit of a dance that a server holds (the paper's editing interface, §3.3): a
 //! song's bars, the segment database, the pins (bar → segment the user set), per bar the search
 //! state of eqs. (1)–(4) ([`BarSearch`]: τ_k, S_n, L_l, the candidates shown), and undo/redo of
-//! pin changes.
+//! pin changes; [`Edit::generate`] fills every unpinned bar through the pins by the
+//! minimum-cost path ([`super::fill`], Dijkstra over a transition table built once per edit).
 //!
 //! Everything but the database is an [`EditState`] (serde), so a server can save an edit with
 //! its scene and restore it with [`Edit::from_state`]; every method checks its bar and segment
@@ -10,14 +11,16 @@
 //! one behind a `Mutex` for several tabs.
 
 use std::collections::BTreeMap;
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 use serde::{Deserialize, Serialize};
 
 use super::database::Database;
+use super::fill::{Fill, FillError, FillParams, fill_with_table};
 use super::music::Bar;
 use super::relevance::music_intensity;
 use super::search::{BarSearch, SearchError, SearchIndex, SearchParams};
+use super::transition::{TransitionError, TransitionTable};
 
 /// Why an edit action was refused.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -89,6 +92,12 @@ pub enum EditError {
     /// The search itself (parameters).
     #[error(transparent)]
     Search(#[from] SearchError),
+    /// The database's transition table (link weights, boundary data).
+    #[error(transparent)]
+    Transition(#[from] TransitionError),
+    /// Filling the unpinned bars.
+    #[error(transparent)]
+    Fill(#[from] FillError),
 }
 
 /// One change of a bar's pin (for undo/redo): the segment pinned before and after (`None`:
@@ -112,6 +121,8 @@ pub struct EditState {
     pub bars: Vec<Bar>,
     /// The search parameters.
     pub search: SearchParams,
+    /// The fill parameters of [`Edit::generate`].
+    pub fill: FillParams,
     /// Pins: bar → segment index in the database.
     pub pins: BTreeMap<usize, usize>,
     /// The search state of every bar (one per bar).
@@ -129,17 +140,24 @@ pub struct Edit {
     index: Arc<SearchIndex>,
     music: Vec<f64>,
     state: EditState,
+    table: OnceLock<Arc<TransitionTable>>,
 }
 
 impl Edit {
     /// A fresh edit of the song `bars` over `db`: nothing pinned, no bar searched yet.
-    pub fn new(db: Arc<Database>, bars: Vec<Bar>, search: SearchParams) -> Result<Edit, EditError> {
+    pub fn new(
+        db: Arc<Database>,
+        bars: Vec<Bar>,
+        search: SearchParams,
+        fill: FillParams,
+    ) -> Result<Edit, EditError> {
         let searches = vec![BarSearch::new(); bars.len()];
         Edit::from_state(
             db,
             EditState {
                 bars,
                 search,
+                fill,
                 pins: BTreeMap::new(),
                 searches,
                 undo: vec![],
@@ -233,6 +251,7 @@ impl Edit {
             index,
             music,
             state,
+            table: OnceLock::new(),
         })
     }
 
@@ -370,6 +389,26 @@ impl Edit {
         Ok(c)
     }
 
+    /// The paper's Generate: every unpinned bar filled through the pins by the minimum-cost
+    /// path ([`super::fill::fill`]'s Dijkstra, on the database's transition table, built at the
+    /// first call and kept). The pins are honoured exactly.
+    pub fn generate(&self) -> Result<Fill, EditError> {
+        let table = match self.table.get() {
+            Some(t) => t.clone(),
+            None => {
+                let t = Arc::new(TransitionTable::new(&self.db, &self.state.fill.transition)?);
+                self.table.get_or_init(|| t).clone()
+            }
+        };
+        Ok(fill_with_table(
+            &self.db,
+            &table,
+            self.state.bars.len(),
+            &self.state.pins,
+            &self.state.fill,
+        )?)
+    }
+
     /// Redoes the last undone pin change and returns it.
     pub fn redo(&mut self) -> Result<PinChange, EditError> {
         let c = self.state.redo.pop().ok_or(EditError::NothingToRedo)?;
@@ -399,7 +438,13 @@ mod tests {
     }
 
     fn edit() -> Edit {
-        Edit::new(Arc::new(random_db(40, 9)), bars(8), SearchParams::default()).unwrap()
+        Edit::new(
+            Arc::new(random_db(40, 9)),
+            bars(8),
+            SearchParams::default(),
+            FillParams::default(),
+        )
+        .unwrap()
     }
 
     #[test]
@@ -470,6 +515,8 @@ mod tests {
         );
         assert_eq!(e.unpin(0), Err(EditError::NotPinned { bar: 0 }));
         assert_eq!(e.undo(), Err(EditError::NothingToUndo));
+        // This database has no boundary data: Generate says so.
+        assert!(matches!(e.generate(), Err(EditError::Transition(_))));
         assert!(e.search(8).unwrap_err().to_string().contains("0 to 7"));
         // Searching a bar until nothing is left: 40 segments = 6 × 6 + 4.
         for _ in 0..6 {
@@ -486,17 +533,34 @@ mod tests {
         // Construction and restoring check their input.
         let db = Arc::new(random_db(40, 9));
         assert_eq!(
-            Edit::new(db.clone(), vec![], SearchParams::default()).unwrap_err(),
+            Edit::new(
+                db.clone(),
+                vec![],
+                SearchParams::default(),
+                FillParams::default()
+            )
+            .unwrap_err(),
             EditError::NoBars
         );
         assert_eq!(
-            Edit::new(Arc::new(random_db(0, 1)), bars(2), SearchParams::default()).unwrap_err(),
+            Edit::new(
+                Arc::new(random_db(0, 1)),
+                bars(2),
+                SearchParams::default(),
+                FillParams::default()
+            )
+            .unwrap_err(),
             EditError::EmptyDatabase
         );
         let mut nan = bars(3);
         nan[1].rms_db = f64::NAN;
         assert!(matches!(
-            Edit::new(db.clone(), nan, SearchParams::default()),
+            Edit::new(
+                db.clone(),
+                nan,
+                SearchParams::default(),
+                FillParams::default()
+            ),
             Err(EditError::BarLevel { bar: 1, .. })
         ));
         let mut state = edit().state().clone();
