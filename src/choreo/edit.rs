@@ -133,6 +133,24 @@ pub struct EditState {
     pub redo: Vec<PinChange>,
 }
 
+/// `bar` checked against a song of `bars` bars.
+fn bar_in(bar: usize, bars: usize) -> Result<(), EditError> {
+    if bar < bars {
+        Ok(())
+    } else {
+        Err(EditError::NoSuchBar { bar, bars })
+    }
+}
+
+/// `segment` checked against a database of `segments` segments.
+fn segment_in(segment: usize, segments: usize) -> Result<(), EditError> {
+    if segment < segments {
+        Ok(())
+    } else {
+        Err(EditError::NoSuchSegment { segment, segments })
+    }
+}
+
 /// The edit of one dance (module docs).
 #[derive(Debug, Clone)]
 pub struct Edit {
@@ -216,20 +234,8 @@ impl Edit {
                 ),
             });
         }
-        let check_bar = |bar: usize| {
-            if bar < bars {
-                Ok(())
-            } else {
-                Err(EditError::NoSuchBar { bar, bars })
-            }
-        };
-        let check_segment = |segment: usize| {
-            if segment < segments {
-                Ok(())
-            } else {
-                Err(EditError::NoSuchSegment { segment, segments })
-            }
-        };
+        let check_bar = |bar| bar_in(bar, bars);
+        let check_segment = |segment| segment_in(segment, segments);
         for (&bar, &seg) in &state.pins {
             check_bar(bar)?;
             check_segment(seg)?;
@@ -286,21 +292,11 @@ impl Edit {
     }
 
     fn check_bar(&self, bar: usize) -> Result<(), EditError> {
-        let bars = self.state.bars.len();
-        if bar < bars {
-            Ok(())
-        } else {
-            Err(EditError::NoSuchBar { bar, bars })
-        }
+        bar_in(bar, self.state.bars.len())
     }
 
     fn check_segment(&self, segment: usize) -> Result<(), EditError> {
-        let segments = self.db.segments.len();
-        if segment < segments {
-            Ok(())
-        } else {
-            Err(EditError::NoSuchSegment { segment, segments })
-        }
+        segment_in(segment, self.db.segments.len())
     }
 
     /// The search state of `bar`.
