@@ -50,6 +50,27 @@ pub enum Error {
     /// Dance segments and their database.
     #[error(transparent)]
     Segment(#[from] crate::choreo::segments::SegmentError),
+    /// A relevance-feedback search round.
+    #[error(transparent)]
+    Search(#[from] crate::choreo::search::SearchError),
+    /// An action on a dance edit.
+    #[error(transparent)]
+    Edit(#[from] crate::choreo::edit::EditError),
+    /// The dance-search experiment (the paper's Fig. 4).
+    #[error(transparent)]
+    DanceFeedback(#[from] crate::experiments::dance_feedback::FeedbackError),
+    /// The transition table of a dance database (link weights, boundary data).
+    #[error(transparent)]
+    Transition(#[from] crate::choreo::transition::TransitionError),
+    /// Filling the unpinned bars of a dance.
+    #[error(transparent)]
+    Fill(#[from] crate::choreo::fill::FillError),
+    /// Assembling a dance from segments at a song's bars.
+    #[error(transparent)]
+    Dance(#[from] crate::choreo::dance::DanceError),
+    /// The dance-editing paper's Fig. 5 experiment.
+    #[error(transparent)]
+    DanceFill(#[from] crate::experiments::dance_fill::DanceFillError),
     /// A data file (RON): reading, syntax, version.
     #[error(transparent)]
     File(#[from] crate::io::FileError),
