@@ -11,7 +11,6 @@ use marionette::choreo::database::{BuildParams, Database, Manifest};
 use marionette::choreo::fill::{FillParams, Pins, fill, fill_dp};
 use marionette::choreo::metrics::dance_metrics;
 use marionette::choreo::music::Bar;
-use marionette::choreo::transition::TransitionParams;
 use marionette::experiments::dance_fill::{
     DanceFillConfig, DanceFillOutcome, Strategy, generated_database, run,
 };
