@@ -677,7 +677,7 @@ mod tests {
                 e,
                 DanceError::BarTooShort {
                     frames: 10,
-                    needed: 12,
+                    needed: 18,
                     ..
                 }
             ),
