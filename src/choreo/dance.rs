@@ -7,9 +7,9 @@
 //!   the bars' span (the rate differs from `fps` by less than half a frame over the dance). Bar
 //!   k holds the frames [round(start_k / frame_time), round(end_k / frame_time)) (times from the
 //!   dance start); a frame at phase u ∈ [0, 1) of its bar samples its segment at u × (segment
-//!   frames) (angles and root position linearly, root orientation by slerp, as
-//!   [`super::segments::resample`], a whole frame exactly; the segment's frames lie at phases
-//!   i / frames).
+//!   frames) (the segment's frames lie at phases i / frames): angles and root position on the
+//!   natural cubic spline through the segment's frames (linear interpolation would put a kink,
+//!   a spike of jerk, at every segment frame), root orientation by slerp; a whole frame exactly.
 //! - **Root carried on.** The first segment keeps its root. Every later segment is turned about
 //!   the vertical (Y) axis and shifted horizontally so that its first frame's pelvis stands where
 //!   the previous segment, extrapolated by one of its frames to phase 1, ends, with that heading
@@ -17,14 +17,16 @@
 //!   pelvis height stays the segment's own.
 //! - **Angles unwrapped.** A DOF whose first value in a bar is more than π from the last of the
 //!   bar before is shifted by the multiple of 2π that brings it nearest (the same pose).
-//! - **Seams.** The last `seam_frames` frames before a seam and the first `seam_frames` after it
-//!   are replaced by a cubic Hermite curve between the frames just outside (a = seam − w − 1,
-//!   b = seam + w) with the motion's own velocities there (one-sided differences away from the
-//!   seam, a − 1 → a and b → b + 1): positions and velocities continuous at both ends. Per DOF
-//!   angle and per root coordinate; the root orientation as the same Hermite curve in the tangent
-//!   space of q_a (q = q_a exp(v(t)), v from 0 to log(q_a⁻¹ q_b), end rates log(q_{a−1}⁻¹ q_a) and
-//!   log(q_b⁻¹ q_{b+1}), q_b taken on q_a's hemisphere), continuous with no flip.
-//!   Every bar needs 2w + 2 frames so that the windows and their outside frames do not overlap.
+//! - **Seams.** The last w = `seam_frames` frames before a seam and the first w after it are
+//!   replaced by the natural cubic spline through the [`SEAM_KNOTS`] frames on each side of the
+//!   window (frames s − w − 4 … s − w − 1 and s + w … s + w + 3 for a seam at frame s), per DOF
+//!   angle and per root coordinate: the spline interpolates the frames kept, so the motion enters
+//!   and leaves the window with its own velocity and (nearly) its own acceleration, which a
+//!   Hermite curve between the two frames next to the window would break (a jump of
+//!   acceleration, a spike of jerk, at both ends of every seam). The root orientation takes the
+//!   same spline of the rotation vectors log(q_a⁻¹ q) relative to the frame before the window
+//!   (q = q_a exp(r), each on q_a's hemisphere): continuous, no flip. Every bar needs 2w + 2·4
+//!   frames so that a window's knots are never rewritten by the next seam.
 
 use glam::{DQuat, DVec3};
 use serde::{Deserialize, Serialize};
@@ -267,7 +269,11 @@ pub fn assemble(
         })
         .collect();
     let w = p.seam_frames;
-    let needed = if bars.len() > 1 { 2 * w + 2 } else { 1 };
+    let needed = if bars.len() > 1 && w > 0 {
+        2 * w + 2 * SEAM_KNOTS
+    } else {
+        1
+    };
     for (k, &(a, b)) in bar_frames.iter().enumerate() {
         if b - a < needed.max(1) {
             return Err(DanceError::BarTooShort {
@@ -353,10 +359,25 @@ pub fn assemble(
 }
 
 /// A segment's root positions, orientations and angles at frame positions `xs` (fractional
-/// frames, clamped to [0, frames − 1]): a whole frame exactly, between frames angles and position
-/// linearly and orientation by slerp (as [`super::segments::resample`]).
+/// frames from 0 to below frames): angles and root position by the natural cubic spline through
+/// the segment's frames (C², so that the time-resized motion has no kinks at the frames; past
+/// the last frame its last piece continues), the root orientation by slerp between frames (held
+/// past the last); a whole frame is that frame exactly.
 fn sample(seg: &Segment, dofs: usize, xs: impl Iterator<Item = f64>) -> ModelClip {
     let m = seg.frame_count();
+    let channels = dofs + 3;
+    // Channel-major values and the spline's second derivatives.
+    let value = |c: usize, i: usize| -> f64 {
+        if c < dofs {
+            seg.angles[i * dofs + c]
+        } else {
+            seg.root_translation[i][c - dofs]
+        }
+    };
+    let y: Vec<Vec<f64>> = (0..channels)
+        .map(|c| (0..m).map(|i| value(c, i)).collect())
+        .collect();
+    let second: Vec<Vec<f64>> = y.iter().map(|v| natural_spline(v)).collect();
     let mut out = ModelClip {
         model: humanoid24(),
         frame_time: 1.0,
@@ -364,40 +385,100 @@ fn sample(seg: &Segment, dofs: usize, xs: impl Iterator<Item = f64>) -> ModelCli
         root_rotation: vec![],
         angles: vec![],
     };
+    let mut row = vec![0.0; channels];
     for x in xs {
-        let mut x = x.clamp(0.0, (m - 1) as f64);
+        let mut x = x.clamp(0.0, m as f64);
         if (x - x.round()).abs() < 1e-9 {
             x = x.round();
         }
-        let i = (x.floor() as usize).min(m - 1);
-        let a = x - i as f64;
-        let p = &seg.angles[i * dofs..(i + 1) * dofs];
-        if a == 0.0 {
-            out.root_translation.push(seg.root_translation[i]);
-            out.root_rotation.push(seg.root_rotation[i]);
-            out.angles.extend_from_slice(p);
-        } else {
-            let q = &seg.angles[(i + 1) * dofs..(i + 2) * dofs];
-            out.root_translation
-                .push(seg.root_translation[i].lerp(seg.root_translation[i + 1], a));
-            out.root_rotation
-                .push(seg.root_rotation[i].slerp(seg.root_rotation[i + 1], a));
-            out.angles
-                .extend(p.iter().zip(q).map(|(u, v)| u + (v - u) * a));
+        // The spline piece [i, i + 1] (the last one past the last frame), t from its start.
+        let i = (x.floor() as usize).min(m.saturating_sub(2));
+        let t = x - i as f64;
+        let j = (i + 1).min(m - 1);
+        for (c, r) in row.iter_mut().enumerate() {
+            let (yi, yj, mi, mj) = (y[c][i], y[c][j], second[c][i], second[c][j]);
+            let u = 1.0 - t;
+            *r = u * yi + t * yj + ((u * u * u - u) * mi + (t * t * t - t) * mj) / 6.0;
         }
+        out.angles.extend_from_slice(&row[..dofs]);
+        out.root_translation
+            .push(DVec3::new(row[dofs], row[dofs + 1], row[dofs + 2]));
+        let a = (x - i as f64).min(1.0);
+        out.root_rotation.push(if a == 0.0 {
+            seg.root_rotation[i]
+        } else if a == 1.0 {
+            seg.root_rotation[j]
+        } else {
+            seg.root_rotation[i].slerp(seg.root_rotation[j], a)
+        });
     }
     out
 }
 
-/// The cubic Hermite basis at t ∈ [0, 1]: (h00, h10, h01, h11).
-fn hermite(t: f64) -> (f64, f64, f64, f64) {
-    let (t2, t3) = (t * t, t * t * t);
-    (
-        2.0 * t3 - 3.0 * t2 + 1.0,
-        t3 - 2.0 * t2 + t,
-        -2.0 * t3 + 3.0 * t2,
-        t3 - t2,
-    )
+/// The second derivatives of the natural cubic spline through `y` at unit spacing: M_0 =
+/// M_{n−1} = 0, M_{i−1} + 4 M_i + M_{i+1} = 6 (y_{i+1} − 2 y_i + y_{i−1}) (Thomas algorithm).
+fn natural_spline(y: &[f64]) -> Vec<f64> {
+    let n = y.len();
+    let mut m = vec![0.0; n];
+    if n < 3 {
+        return m;
+    }
+    // Forward sweep over the interior unknowns 1 ..= n − 2.
+    let k = n - 2;
+    let mut c = vec![0.0; k];
+    let mut d = vec![0.0; k];
+    for r in 0..k {
+        let i = r + 1;
+        let rhs = 6.0 * (y[i + 1] - 2.0 * y[i] + y[i - 1]);
+        let (cp, dp) = if r == 0 {
+            (0.0, 0.0)
+        } else {
+            (c[r - 1], d[r - 1])
+        };
+        let denom = 4.0 - cp;
+        c[r] = 1.0 / denom;
+        d[r] = (rhs - dp) / denom;
+    }
+    for r in (0..k).rev() {
+        let next = if r + 1 < k { m[r + 2] } else { 0.0 };
+        m[r + 1] = d[r] - c[r] * next;
+    }
+    m
+}
+
+/// Frames on each side of a seam window the interpolating spline passes through.
+pub const SEAM_KNOTS: usize = 4;
+
+/// The natural cubic spline through the points (`x`, `y`) (x increasing) evaluated at `at`:
+/// second derivatives M with M_0 = M_{n−1} = 0 and h_{i−1} M_{i−1} + 2(h_{i−1} + h_i) M_i +
+/// h_i M_{i+1} = 6((y_{i+1} − y_i)/h_i − (y_i − y_{i−1})/h_{i−1}) (Thomas algorithm).
+fn spline_at(x: &[f64], y: &[f64], at: &[f64]) -> Vec<f64> {
+    let n = x.len();
+    let mut m = vec![0.0; n];
+    if n >= 3 {
+        let (mut c, mut d) = (vec![0.0; n], vec![0.0; n]);
+        for i in 1..n - 1 {
+            let (h0, h1) = (x[i] - x[i - 1], x[i + 1] - x[i]);
+            let rhs = 6.0 * ((y[i + 1] - y[i]) / h1 - (y[i] - y[i - 1]) / h0);
+            let diag = 2.0 * (h0 + h1) - h0 * c[i - 1];
+            c[i] = h1 / diag;
+            d[i] = (rhs - h0 * d[i - 1]) / diag;
+        }
+        for i in (1..n - 1).rev() {
+            m[i] = d[i] - c[i] * m[i + 1];
+        }
+    }
+    at.iter()
+        .map(|&t| {
+            let i = (0..n - 1).rfind(|&i| x[i] <= t).unwrap_or(0);
+            let h = x[i + 1] - x[i];
+            let (l, r) = (x[i + 1] - t, t - x[i]);
+            m[i] * l * l * l / (6.0 * h)
+                + m[i + 1] * r * r * r / (6.0 * h)
+                + (y[i] / h - m[i] * h / 6.0) * l
+                + (y[i + 1] / h - m[i + 1] * h / 6.0) * r
+        })
+        .collect()
 }
 
 /// The rotation vector of `q` on the hemisphere w ≥ 0 (angle ≤ π), radians.
@@ -406,31 +487,41 @@ fn log(q: DQuat) -> DVec3 {
     q.to_scaled_axis()
 }
 
-/// Rewrites frames [s − w, s + w) of `out` by cubic Hermite interpolation between frames a =
-/// s − w − 1 and b = s + w of `src` (module docs).
+/// Rewrites frames [s − w, s + w) of `out` by the natural cubic spline through the
+/// [`SEAM_KNOTS`] frames of `src` on each side of the window (module docs).
 fn rewrite_seam(src: &ModelClip, out: &mut ModelClip, s: usize, w: usize) {
     let d = src.dof_count();
-    let (a, b) = (s - w - 1, s + w);
-    let span = (b - a) as f64;
-    // Angles and root position.
-    let ang = |f: usize, j: usize| src.angles[f * d + j];
-    let tr = |f: usize| src.root_translation[f];
-    let (qa, qb0) = (src.root_rotation[a], src.root_rotation[b]);
-    let qb = if qa.dot(qb0) < 0.0 { -qb0 } else { qb0 };
-    let vb = log(qa.inverse() * qb);
-    let ma = log(src.root_rotation[a - 1].inverse() * qa);
-    let mb = log(qb0.inverse() * src.root_rotation[b + 1]);
-    for f in a + 1..b {
-        let (h00, h10, h01, h11) = hermite((f - a) as f64 / span);
-        for j in 0..d {
-            let (xa, xb) = (ang(a, j), ang(b, j));
-            let (va, vb) = (xa - ang(a - 1, j), ang(b + 1, j) - xb);
-            out.angles[f * d + j] = h00 * xa + h10 * span * va + h01 * xb + h11 * span * vb;
+    let knots: Vec<usize> = (s - w - SEAM_KNOTS..s - w)
+        .chain(s + w..s + w + SEAM_KNOTS)
+        .collect();
+    let x: Vec<f64> = knots.iter().map(|&f| f as f64).collect();
+    let at: Vec<f64> = (s - w..s + w).map(|f| f as f64).collect();
+    let mut y = vec![0.0; knots.len()];
+    let mut channel = |value: &dyn Fn(usize) -> f64| -> Vec<f64> {
+        for (v, &f) in y.iter_mut().zip(&knots) {
+            *v = value(f);
         }
-        let (pa, pb) = (tr(a), tr(b));
-        let (va, vbt) = (pa - tr(a - 1), tr(b + 1) - pb);
-        out.root_translation[f] = h00 * pa + h10 * span * va + h01 * pb + h11 * span * vbt;
-        let v = h10 * span * ma + h01 * vb + h11 * span * mb;
+        spline_at(&x, &y, &at)
+    };
+    for j in 0..d {
+        let v = channel(&|f| src.angles[f * d + j]);
+        for (k, f) in (s - w..s + w).enumerate() {
+            out.angles[f * d + j] = v[k];
+        }
+    }
+    for c in 0..3 {
+        let v = channel(&|f| src.root_translation[f][c]);
+        for (k, f) in (s - w..s + w).enumerate() {
+            out.root_translation[f][c] = v[k];
+        }
+    }
+    // Orientation: the same spline of the rotation vectors relative to the last frame before
+    // the window, q = q_a exp(r).
+    let qa = src.root_rotation[s - w - 1];
+    let rel = |f: usize| log(qa.inverse() * src.root_rotation[f]);
+    let r: Vec<Vec<f64>> = (0..3).map(|c| channel(&|f| rel(f)[c])).collect();
+    for (k, f) in (s - w..s + w).enumerate() {
+        let v = DVec3::new(r[0][k], r[1][k], r[2][k]);
         out.root_rotation[f] = (qa * DQuat::from_scaled_axis(v)).normalize();
     }
 }
@@ -586,11 +677,24 @@ mod tests {
                 e,
                 DanceError::BarTooShort {
                     frames: 10,
-                    needed: 12,
+                    needed: 18,
                     ..
                 }
             ),
             "{e}"
         );
+    }
+}
+
+#[cfg(test)]
+mod spline_tests {
+    #[test]
+    fn the_natural_spline_of_a_line_is_flat_and_of_a_cubic_close() {
+        let m = super::natural_spline(&[1.0, 2.0, 3.0, 4.0, 5.0]);
+        assert!(m.iter().all(|v| v.abs() < 1e-12));
+        // y = x² has y'' = 2 inside (the natural ends pull the ends to 0).
+        let y: Vec<f64> = (0..40).map(|i| (i as f64).powi(2)).collect();
+        let m = super::natural_spline(&y);
+        assert!((m[20] - 2.0).abs() < 1e-6, "{}", m[20]);
     }
 }

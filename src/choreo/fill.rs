@@ -111,6 +111,14 @@ pub enum FillError {
         /// The database's segment count.
         segments: usize,
     },
+    /// A transition table made for another database.
+    #[error("the transition table is for {table} segments, the database has {segments}")]
+    TableMismatch {
+        /// Segments of the table.
+        table: usize,
+        /// Segments of the database.
+        segments: usize,
+    },
     /// The transition table could not be built.
     #[error(transparent)]
     Transition(#[from] TransitionError),
@@ -167,12 +175,7 @@ pub fn fill_with_table(
     pins: &Pins,
     p: &FillParams,
 ) -> Result<Fill, FillError> {
-    check(table.n, bars, pins)?;
-    let g = Graph::new(table, bars, pins, p.no_adjacent_repeat);
-    let path = g
-        .dijkstra()
-        .ok_or(FillError::NoPath { segments: table.n })?;
-    Ok(finish(db, path, &p.transition))
+    solve(db, table, bars, pins, p, |g| g.dijkstra())
 }
 
 /// [`fill_dp`] on a prepared transition table of `db` built with `p.transition`.
@@ -183,9 +186,27 @@ pub fn fill_dp_with_table(
     pins: &Pins,
     p: &FillParams,
 ) -> Result<Fill, FillError> {
-    check(table.n, bars, pins)?;
+    solve(db, table, bars, pins, p, |g| g.dp())
+}
+
+/// Checks, builds the graph, finds the path with `path_of`.
+fn solve(
+    db: &Database,
+    table: &TransitionTable,
+    bars: usize,
+    pins: &Pins,
+    p: &FillParams,
+    path_of: fn(&Graph<'_>) -> Option<Vec<usize>>,
+) -> Result<Fill, FillError> {
+    check(db.segments.len(), bars, pins)?;
+    if table.n != db.segments.len() {
+        return Err(FillError::TableMismatch {
+            table: table.n,
+            segments: db.segments.len(),
+        });
+    }
     let g = Graph::new(table, bars, pins, p.no_adjacent_repeat);
-    let path = g.dp().ok_or(FillError::NoPath { segments: table.n })?;
+    let path = path_of(&g).ok_or(FillError::NoPath { segments: table.n })?;
     Ok(finish(db, path, &p.transition))
 }
 

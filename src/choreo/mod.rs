@@ -19,7 +19,11 @@
 //!   dynamic programme that gives the same path);
 //! - [`dance`]: the chosen segments assembled at the song's bar timing, root carried on, seams
 //!   rewritten by cubic interpolation;
-//! - [`metrics`]: beat alignment score, seam jerk, foot skating, transition cost of a dance.
+//! - [`metrics`]: beat alignment score, seam jerk, foot skating, transition cost of a dance;
+//! - [`augment`]: a larger database from a real one by mirror images and time offsets;
+//! - [`relevance`]: rel(q, m), music intensity against motion intensity, both as percentile ranks;
+//! - [`search`]: the relevance-feedback search of eqs. (1)–(4), six candidates per round;
+//! - [`edit`]: the stateful edit a server holds (pins, per-bar search, undo/redo).
 
 pub mod augment;
 pub mod dance;

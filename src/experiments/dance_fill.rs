@@ -436,8 +436,8 @@ fn blind_fill(
     Ok(out.into_iter().map(|s| s.unwrap_or(0)).collect())
 }
 
-/// One move of a generated dance: per DOF an offset, an amplitude, a phase and a frequency (1
-/// or ½ per beat); a turn rate and a travel speed of the root.
+/// One move of a generated dance: per DOF an offset, an amplitude, a phase and a frequency (½
+/// or ¼ per beat: one or two swings a bar); a turn rate and a travel speed of the root.
 #[derive(Debug, Clone)]
 struct Move {
     swings: Vec<(usize, f64, f64, f64, f64)>,
@@ -547,7 +547,7 @@ pub fn generated_database(
                     let j = model.dof_index(name)?;
                     let amp = rng.random_range(0.2..1.0) * max.to_radians();
                     let off = rng.random_range(-0.5..0.5) * max.to_radians();
-                    let freq = if rng.random_bool(0.3) { 0.5 } else { 1.0 };
+                    let freq = if rng.random_bool(0.5) { 0.25 } else { 0.5 };
                     Some((j, off, amp, rng.random_range(0.0..TAU), freq))
                 })
                 .collect(),

@@ -1,0 +1,68 @@
+//! Filling 64 bars over a database of 2,000 segments (issue 10: under 50 ms). The database is
+//! the shared dance clips (`MARIONETTE_DATA/dance`, kinematic tempo) grown to 2,000 segments by
+//! mirror images and time offsets (`choreo::augment`), or, without the shared data, a database
+//! of generated dance clips grown the same way. Four pins at bars 5, 21, 40 and 58.
+//!
+//! - `transition_table_2000`: every connection C(a → b) of the 2,000 × 2,000 pairs (rayon);
+//! - `fill_64x2000`: [`fill`] as the API gives it, Dijkstra, the table built inside;
+//! - `fill_with_table_64x2000` / `fill_dp_with_table_64x2000`: Dijkstra / the exact DP on a
+//!   prepared table (an editor builds the table once per database).
+
+use std::hint::black_box;
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use marionette::choreo::augment::augment;
+use marionette::choreo::database::{BuildParams, Database, Manifest};
+use marionette::choreo::fill::{FillParams, Pins, fill, fill_dp_with_table, fill_with_table};
+use marionette::choreo::transition::TransitionTable;
+use marionette::experiments::dance_fill::generated_database;
+
+/// The 2,000-segment database (module docs).
+fn database() -> Database {
+    let dir = marionette::io::data_dir().join("dance");
+    let base = Manifest::from_folder(&dir)
+        .and_then(|m| Database::build(&m, &BuildParams::default(), |_, _| {}));
+    let base = match base {
+        Ok(db) => {
+            eprintln!("shared dance clips: {} segments", db.segments.len());
+            db
+        }
+        Err(e) => {
+            eprintln!("no shared dance data ({e}): generated clips instead");
+            generated_database(1, 12, 10).expect("generated clips cut into bars")
+        }
+    };
+    let db = augment(&base, 2000, 1);
+    eprintln!("augmented to {} segments", db.segments.len());
+    db
+}
+
+fn bench(c: &mut Criterion) {
+    let db = database();
+    let p = FillParams::default();
+    let n = db.segments.len();
+    let pins = Pins::from([(5, 17 % n), (21, 901 % n), (40, 1402 % n), (58, 3 % n)]);
+    let table = TransitionTable::new(&db, &p.transition).unwrap();
+    let a = fill_with_table(&db, &table, 64, &pins, &p).unwrap();
+    let b = fill_dp_with_table(&db, &table, 64, &pins, &p).unwrap();
+    assert_eq!(a, b, "Dijkstra and the DP agree");
+    eprintln!("64 bars: total cost {:.4}", a.total_cost);
+    let mut g = c.benchmark_group("choreo_fill");
+    g.sample_size(10);
+    g.bench_function("transition_table_2000", |bch| {
+        bch.iter(|| black_box(TransitionTable::new(&db, &p.transition).unwrap()))
+    });
+    g.bench_function("fill_64x2000", |bch| {
+        bch.iter(|| black_box(fill(&db, 64, &pins, &p).unwrap()))
+    });
+    g.bench_function("fill_with_table_64x2000", |bch| {
+        bch.iter(|| black_box(fill_with_table(&db, &table, 64, &pins, &p).unwrap()))
+    });
+    g.bench_function("fill_dp_with_table_64x2000", |bch| {
+        bch.iter(|| black_box(fill_dp_with_table(&db, &table, 64, &pins, &p).unwrap()))
+    });
+    g.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

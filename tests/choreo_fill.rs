@@ -1,0 +1,139 @@
+//! Connection-aware fill (the dance-editing paper §3.2, Fig. 5): on a database generated in code
+//! and on the shared dance clips, over many random pin sets, the minimum-cost fill has lower
+//! seam jerk and a higher connection score S than connection-blind fills (random, intensity
+//! only); the fill honours every pin and assembles into a dance that lasts exactly its bars
+//! with the pinned frames unchanged outside the seams.
+
+mod common;
+
+use marionette::choreo::dance::{DanceParams, assemble};
+use marionette::choreo::database::{BuildParams, Database, Manifest};
+use marionette::choreo::fill::{FillParams, Pins, fill, fill_dp};
+use marionette::choreo::metrics::dance_metrics;
+use marionette::choreo::music::Bar;
+use marionette::experiments::dance_fill::{
+    DanceFillConfig, DanceFillOutcome, Strategy, generated_database, run,
+};
+
+/// The claims of Fig. 5 on an outcome.
+fn check_fig5(o: &DanceFillOutcome, what: &str) {
+    eprintln!("{what}:\n{}", o.table());
+    let aware = o.row(Strategy::ConnectionAware);
+    for other in [Strategy::Random, Strategy::IntensityOnly] {
+        let r = o.row(other);
+        assert!(
+            aware.seam_jerk_mean.mean < r.seam_jerk_mean.mean,
+            "{what}: seam jerk, aware {} vs {other:?} {}",
+            aware.seam_jerk_mean.mean,
+            r.seam_jerk_mean.mean
+        );
+        assert!(
+            aware.mean_s.mean > r.mean_s.mean,
+            "{what}: S, aware {} vs {other:?} {}",
+            aware.mean_s.mean,
+            r.mean_s.mean
+        );
+        // The minimum-cost path costs no more than any other fill of the same pins.
+        for (a, b) in aware.trials.iter().zip(&r.trials) {
+            assert!(a.total_cost <= b.total_cost + 1e-9, "{what}");
+        }
+    }
+    assert!(o.aware_beats_random_jerk > 0.6, "{what}");
+    assert!(o.aware_beats_intensity_jerk > 0.6, "{what}");
+}
+
+#[test]
+fn fig5_on_a_generated_database() {
+    let db = generated_database(21, 6, 8).unwrap();
+    let cfg = DanceFillConfig {
+        pin_sets: 60,
+        ..DanceFillConfig::default()
+    };
+    let o = run(&db, &cfg).unwrap();
+    check_fig5(&o, "generated database");
+}
+
+/// Bars of `bar_s` seconds from `start_s`.
+fn bars(n: usize, bar_s: f64, start_s: f64) -> Vec<Bar> {
+    (0..n)
+        .map(|k| Bar {
+            start_s: start_s + k as f64 * bar_s,
+            end_s: start_s + (k + 1) as f64 * bar_s,
+            rms: 0.1,
+            rms_db: -20.0,
+        })
+        .collect()
+}
+
+#[test]
+fn a_fill_keeps_its_pins_and_assembles_into_a_dance_as_long_as_its_bars() {
+    let db = generated_database(4, 5, 6).unwrap();
+    let n = db.segments.len();
+    let p = FillParams::default();
+    let pins = Pins::from([(2, 7), (3, 8), (9, n - 1), (13, 0)]);
+    let f = fill(&db, 16, &pins, &p).unwrap();
+    assert_eq!(f, fill_dp(&db, 16, &pins, &p).unwrap());
+    assert_eq!(f.segments.len(), 16);
+    assert_eq!(f.connections.len(), 15);
+    for (&bar, &s) in &pins {
+        assert_eq!(f.segments[bar], s);
+    }
+    for w in f.segments.windows(2) {
+        assert_ne!(w[0], w[1], "no adjacent repeat");
+    }
+    // A song's bars of 1.93 s from 0.71 s, 30 fps: 16 bars last 30.88 s, 926 frames.
+    let b = bars(16, 1.93, 0.71);
+    let d = assemble(&db, &f.segments, &b, &DanceParams::default()).unwrap();
+    let duration = d.clip.frame_count() as f64 * d.clip.frame_time;
+    assert!((duration - 16.0 * 1.93).abs() < 1e-9, "{duration}");
+    assert_eq!(d.clip.frame_count(), 926);
+    assert_eq!(d.bar_frames.last().unwrap().1, 926);
+    let beats: Vec<f64> = (0..64).map(|k| 0.71 + k as f64 * 1.93 / 4.0).collect();
+    let m = dance_metrics(&d, &beats, &f);
+    eprintln!("generated dance metrics: {m:?}");
+    assert!((m.transition_cost - f.total_cost).abs() < 1e-12);
+    assert_eq!(m.music_beats, 64);
+    assert!(m.motion_beats > 0);
+    assert!((0.0..=1.0).contains(&m.beat_alignment_score));
+    assert!(m.seam_jerk.samples > 0 && m.inside_jerk.samples > 0);
+    assert!(m.foot_skating_m_s.is_finite());
+}
+
+#[test]
+fn pins_past_the_end_or_to_missing_segments_are_refused() {
+    let db = generated_database(4, 2, 4).unwrap();
+    let n = db.segments.len();
+    let p = FillParams::default();
+    let e = fill(&db, 8, &Pins::from([(8, 0)]), &p).unwrap_err();
+    assert_eq!(e.to_string(), "pin on bar 8: the song has 8 bars (0 to 7)");
+    let e = fill(&db, 8, &Pins::from([(1, n)]), &p).unwrap_err();
+    assert!(
+        e.to_string()
+            .contains(&format!("segment {n} does not exist")),
+        "{e}"
+    );
+    let empty = Database {
+        segments: vec![],
+        ..db.clone()
+    };
+    assert_eq!(
+        fill(&empty, 8, &Pins::new(), &p).unwrap_err().to_string(),
+        "the dance database has no segments to fill bars with"
+    );
+}
+
+/// The shared dance clips as a database (kinematic tempo per clip).
+fn shared_database() -> Option<Database> {
+    let dir = common::data_path("dance")?;
+    let m = Manifest::from_folder(&dir).unwrap();
+    Some(Database::build(&m, &BuildParams::default(), |_, _| {}).unwrap())
+}
+
+#[test]
+fn fig5_on_the_shared_dance_database() {
+    let Some(db) = shared_database() else {
+        return;
+    };
+    let o = run(&db, &DanceFillConfig::default()).unwrap();
+    check_fig5(&o, "shared dance database");
+}
