@@ -50,6 +50,12 @@ pub enum Error {
     /// Dance segments and their database.
     #[error(transparent)]
     Segment(#[from] crate::choreo::segments::SegmentError),
+    /// A relevance-feedback search round.
+    #[error(transparent)]
+    Search(#[from] crate::choreo::search::SearchError),
+    /// An action on a dance edit.
+    #[error(transparent)]
+    Edit(#[from] crate::choreo::edit::EditError),
     /// A data file (RON): reading, syntax, version.
     #[error(transparent)]
     File(#[from] crate::io::FileError),

@@ -8,10 +8,18 @@
 //! - [`features`]: per-frame motion intensity W(f) and the features of a segment for Eros;
 //! - [`segments`]: dance clips cut into bars of 4 counts (tempo from a manifest or the kinematic
 //!   beat), each resampled, with intensity, Eros features and boundary links;
-//! - [`database`]: the segment database file and what it was built from.
+//! - [`database`]: the segment database file and what it was built from;
+//! - [`augment`]: a larger database from a real one by mirror images and time offsets;
+//! - [`relevance`]: rel(q, m), music intensity against motion intensity, both as percentile ranks;
+//! - [`search`]: the relevance-feedback search of eqs. (1)–(4), six candidates per round;
+//! - [`edit`]: the stateful edit a server holds (pins, per-bar search, undo/redo).
 
+pub mod augment;
 pub mod database;
+pub mod edit;
 pub mod eros;
 pub mod features;
 pub mod music;
+pub mod relevance;
+pub mod search;
 pub mod segments;
