@@ -14,12 +14,24 @@
 //! - [`search`]: the relevance-feedback search of eqs. (1)–(4), six candidates per round;
 //! - [`edit`]: the stateful edit a server holds (pins, per-bar search, undo/redo).
 
+//! - [`transition`]: the connection score S = S_pose + S_move of two segments (eqs. 5–8) and
+//!   the transition cost C = 1/S, one pair or a whole database's table;
+//! - [`fill`]: the unpinned bars filled by the minimum-cost path (Dijkstra, and the exact
+//!   dynamic programme that gives the same path);
+//! - [`dance`]: the chosen segments assembled at the song's bar timing, root carried on, seams
+//!   rewritten by cubic interpolation;
+//! - [`metrics`]: beat alignment score, seam jerk, foot skating, transition cost of a dance.
+
 pub mod augment;
+pub mod dance;
 pub mod database;
 pub mod edit;
 pub mod eros;
 pub mod features;
+pub mod fill;
+pub mod metrics;
 pub mod music;
 pub mod relevance;
 pub mod search;
 pub mod segments;
+pub mod transition;
