@@ -13,7 +13,6 @@
 //! - [`relevance`]: rel(q, m), music intensity against motion intensity, both as percentile ranks;
 //! - [`search`]: the relevance-feedback search of eqs. (1)–(4), six candidates per round;
 //! - [`edit`]: the stateful edit a server holds (pins, per-bar search, undo/redo).
-
 //! - [`transition`]: the connection score S = S_pose + S_move of two segments (eqs. 5–8) and
 //!   the transition cost C = 1/S, one pair or a whole database's table;
 //! - [`fill`]: the unpinned bars filled by the minimum-cost path (Dijkstra, and the exact
