@@ -39,7 +39,10 @@ fn browser() -> Option<PathBuf> {
     if missing.is_empty() {
         return Some(chromium);
     }
-    let test = std::thread::current().name().unwrap_or("this test").to_string();
+    let test = std::thread::current()
+        .name()
+        .unwrap_or("this test")
+        .to_string();
     if common::in_ci() {
         panic!("{test}: missing {missing:?}; .ci/run installs them");
     }
@@ -93,11 +96,17 @@ fn the_page_searches_sets_generates_plays_saves_and_exports_in_chromium() {
         panic!("the browser script failed:\n{stdout}\n{stderr}");
     }
     println!("{stdout}");
-    let seen: serde_json::Value = serde_json::from_str(stdout.trim().lines().last().unwrap()).unwrap();
+    let seen: serde_json::Value =
+        serde_json::from_str(stdout.trim().lines().last().unwrap()).unwrap();
 
     // What the page did, as the server has it.
     let ids = |k: &str| -> Vec<u64> {
-        seen[k].as_array().unwrap().iter().map(|v| v.as_u64().unwrap()).collect()
+        seen[k]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_u64().unwrap())
+            .collect()
     };
     let (first, second, liked) = (ids("first"), ids("second"), ids("liked"));
     assert_eq!((first.len(), second.len()), (6, 6));
@@ -105,7 +114,11 @@ fn the_page_searches_sets_generates_plays_saves_and_exports_in_chromium() {
     let c = get(addr, "/api/candidates?bar=2");
     assert_eq!(c["round"], 2);
     assert_eq!(c["liked"].as_array().unwrap().len(), 2);
-    assert!(liked.iter().all(|s| c["liked"].as_array().unwrap().contains(&(*s).into())));
+    assert!(
+        liked
+            .iter()
+            .all(|s| c["liked"].as_array().unwrap().contains(&(*s).into()))
+    );
     let pinned = seen["pinned"].as_u64().unwrap();
     let state = get(addr, "/api/state");
     assert_eq!(state["pins"], serde_json::json!({ "2": pinned }));
@@ -117,10 +130,14 @@ fn the_page_searches_sets_generates_plays_saves_and_exports_in_chromium() {
 
     // The saved scene has the pin; the exported BVH lasts the 16 bars at 30 fps.
     let back = EditScene::load(&path).unwrap();
-    assert_eq!(back.pins, std::collections::BTreeMap::from([(2, pinned as usize)]));
+    assert_eq!(
+        back.pins,
+        std::collections::BTreeMap::from([(2, pinned as usize)])
+    );
     let bvh = std::fs::read_to_string(seen["bvh"].as_str().unwrap()).unwrap();
     let bars = get(addr, "/api/bars");
-    let span = bars["bars"][15]["end_s"].as_f64().unwrap() - bars["bars"][0]["start_s"].as_f64().unwrap();
+    let span =
+        bars["bars"][15]["end_s"].as_f64().unwrap() - bars["bars"][0]["start_s"].as_f64().unwrap();
     let frames: f64 = bvh
         .lines()
         .find_map(|l| l.strip_prefix("Frames:"))
@@ -128,7 +145,10 @@ fn the_page_searches_sets_generates_plays_saves_and_exports_in_chromium() {
         .trim()
         .parse()
         .unwrap();
-    assert!((frames - span * 30.0).abs() <= 1.0, "{frames} frames for {span} s");
+    assert!(
+        (frames - span * 30.0).abs() <= 1.0,
+        "{frames} frames for {span} s"
+    );
     assert!(bvh.starts_with("HIERARCHY"));
     let _ = child.kill();
     let _ = child.wait();

@@ -134,7 +134,10 @@ mod tests {
         )
         .unwrap_err()
         .to_string();
-        assert!(e.contains("bad.ron") && e.contains("2:") && e.contains("extra"), "{e}");
+        assert!(
+            e.contains("bad.ron") && e.contains("2:") && e.contains("extra"),
+            "{e}"
+        );
         let e = EditScene::parse(
             "EditScene(format_version: 7, song: File(\"a.wav\"), database: \"d\")",
             "v.ron",

@@ -75,10 +75,13 @@ impl Editor {
             addr: want.to_string(),
             message: e.to_string(),
         })?;
-        let addr = server.server_addr().to_ip().ok_or_else(|| EditorError::Bind {
-            addr: want.to_string(),
-            message: "not an IP socket".into(),
-        })?;
+        let addr = server
+            .server_addr()
+            .to_ip()
+            .ok_or_else(|| EditorError::Bind {
+                addr: want.to_string(),
+                message: "not an IP socket".into(),
+            })?;
         let server = Arc::new(server);
         let session = Arc::new(Mutex::new(session));
         let stop = Arc::new(AtomicBool::new(false));
@@ -161,7 +164,10 @@ fn answer(rq: &mut tiny_http::Request, session: &Mutex<Session>) -> Reply {
         .map(|h| h.value.as_str())
         .collect();
     if hosts.len() != 1 || !loopback_host(hosts[0]) {
-        return Reply::error(403, "the editor answers only requests to 127.0.0.1 or localhost");
+        return Reply::error(
+            403,
+            "the editor answers only requests to 127.0.0.1 or localhost",
+        );
     }
     let method = rq.method().as_str().to_string();
     let url = rq.url().to_string();
@@ -212,8 +218,12 @@ fn serve(mut rq: tiny_http::Request, session: &Mutex<Session>) {
             "Content-Security-Policy",
             "default-src 'self'; media-src 'self' blob:; img-src 'self' data: blob:",
         ),
-        r.download
-            .and_then(|f| header("Content-Disposition", &format!("attachment; filename=\"{f}\""))),
+        r.download.and_then(|f| {
+            header(
+                "Content-Disposition",
+                &format!("attachment; filename=\"{f}\""),
+            )
+        }),
     ];
     for h in headers.into_iter().flatten() {
         resp.add_header(h);

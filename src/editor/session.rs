@@ -160,7 +160,11 @@ impl Session {
         let joints = &self.model.joints;
         let neck = self.model.joint_index("neck")?;
         joints[neck].end_site?;
-        let site = joints.len() + joints[..neck].iter().filter(|j| j.end_site.is_some()).count();
+        let site = joints.len()
+            + joints[..neck]
+                .iter()
+                .filter(|j| j.end_site.is_some())
+                .count();
         Some((neck, site))
     }
 

@@ -2,8 +2,6 @@
 // node editor.mjs URL SCREENSHOT_DIR
 // Prints one JSON line of what the page showed; exits non-zero on any failed check.
 import { chromium } from 'playwright-core';
-import { mkdtempSync } from 'node:fs';
-import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 
 const [url, shots] = process.argv.slice(2);
@@ -15,14 +13,14 @@ const browser = await chromium.launch({
   args: [
     '--headless', '--no-sandbox', '--disable-gpu', '--disable-background-networking',
     '--disable-component-update', '--no-first-run', '--autoplay-policy=no-user-gesture-required',
-    `--user-data-dir=${mkdtempSync(join(tmpdir(), 'marionette-chromium-'))}`,
   ],
+  // Playwright gives every launch a fresh temporary profile (the --user-data-dir of STACK.md).
 });
 const errors = [];
 try {
   const page = await browser.newPage({ viewport: { width: 1280, height: 860 } });
   page.on('pageerror', (e) => errors.push(String(e)));
-  page.on('console', (m) => { if (m.type() === 'error') errors.push(m.text()); });
+  page.on('console', (m) => { if (m.type() === 'error') errors.push(m.text() + ' ' + (m.location().url || '')); });
   const t0 = Date.now();
   await page.goto(url);
   await page.waitForSelector('body[data-ready="1"]', { timeout: 15000 });

@@ -125,7 +125,10 @@ fn dechunk(mut b: &[u8]) -> Vec<u8> {
 pub fn request(addr: SocketAddr, method: &str, path: &str, body: Option<&str>) -> Answer {
     let body = body.unwrap_or("");
     let len = if method == "POST" {
-        format!("Content-Length: {}\r\nContent-Type: application/json\r\n", body.len())
+        format!(
+            "Content-Length: {}\r\nContent-Type: application/json\r\n",
+            body.len()
+        )
     } else {
         String::new()
     };

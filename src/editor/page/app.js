@@ -134,7 +134,7 @@ function showCandidates(c) {
     row.className = 'row';
     const label = document.createElement('span');
     label.className = 'label';
-    label.textContent = `#${m.segment} · ${m.source ?? ''} bar ${m.source_bar + 1} · ${m.intensity.toFixed(2)} m/s`;
+    label.textContent = `#${m.segment} · ${m.source ?? ''} bar ${m.source_bar + 1} · W ${m.intensity.toFixed(1)}`;
     label.title = label.textContent;
     const like = document.createElement('button');
     like.className = 'like' + (m.liked ? ' on' : '');
@@ -263,6 +263,7 @@ window.addEventListener('resize', () => timeline.draw());
   const s = await refreshState();
   figure = { parents: s.parents, sides: s.sides, head: s.head };
   danceView = new StickView($('dance'), figure);
+  danceView.dist = 4.6;
   await refreshBars();
   status(`${s.bars} bars · ${s.segments} segments · ${s.tempo_bpm.toFixed(1)} BPM`);
   document.body.dataset.ready = '1';

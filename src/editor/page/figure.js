@@ -68,10 +68,10 @@ export class StickView {
     });
     if (head && s[head[0]] && s[head[1]]) {
       const [a, b] = [s[head[0]], s[head[1]]];
-      const r = Math.hypot(a[0] - b[0], a[1] - b[1]) / 2;
+      const r = Math.hypot(a[0] - b[0], a[1] - b[1]) * 0.3;
       g.fillStyle = '#e6e6e6';
       g.beginPath();
-      g.arc((a[0] + b[0]) / 2, (a[1] + b[1]) / 2, Math.max(3, r), 0, 2 * Math.PI);
+      g.arc(a[0] + 0.65 * (b[0] - a[0]), a[1] + 0.65 * (b[1] - a[1]), Math.max(3, r), 0, 2 * Math.PI);
       g.fill();
     }
   }

@@ -55,7 +55,10 @@ export class Timeline {
       g.font = '11px system-ui';
       g.textAlign = 'center';
       g.fillText(String(k + 1), (x0 + x1) / 2, top - 5);
-      if (b.pin !== null) g.fillText('📌', (x0 + x1) / 2, top + 12);
+      if (b.pin !== null) {
+        g.fillStyle = '#4fc3f7';
+        g.fillText('PIN', (x0 + x1) / 2, top + 12);
+      }
       if (b.filled !== null || b.pin !== null) {
         g.fillStyle = '#9aa0a6';
         g.fillText('#' + (b.pin ?? b.filled), (x0 + x1) / 2, h - 4);
