@@ -8,7 +8,7 @@ mod editor_fixture;
 use std::collections::BTreeSet;
 use std::net::SocketAddr;
 
-use editor_fixture::{get, post, raw, request, scene};
+use editor_fixture::{assert_bvh_lasts_the_bars, get, post, raw, request, scene};
 use marionette::editor::scene::EditScene;
 use marionette::editor::server::{Editor, MAX_BODY};
 use marionette::editor::session::Session;
@@ -117,24 +117,7 @@ fn the_api_flow_search_like_search_set_generate_save_export() {
     let bvh = request(a, "POST", "/api/export-bvh", Some("{}"));
     assert_eq!(bvh.status, 200);
     let text = bvh.text();
-    assert!(
-        text.starts_with("HIERARCHY"),
-        "{}",
-        &text[..40.min(text.len())]
-    );
-    let bar_span: f64 =
-        bars["bars"][11]["end_s"].as_f64().unwrap() - bars["bars"][0]["start_s"].as_f64().unwrap();
-    let frames: usize = text
-        .lines()
-        .find_map(|l| l.strip_prefix("Frames:"))
-        .unwrap()
-        .trim()
-        .parse()
-        .unwrap();
-    assert!(
-        (frames as f64 - bar_span * 30.0).abs() <= 1.0,
-        "{frames} frames for {bar_span} s at 30 fps"
-    );
+    let frames = assert_bvh_lasts_the_bars(a, &text);
 
     let dance = get(a, "/api/dance");
     assert_eq!(dance["frames"].as_array().unwrap().len(), frames);

@@ -152,3 +152,29 @@ pub fn post(addr: SocketAddr, path: &str, body: &str) -> serde_json::Value {
     assert_eq!(a.status, 200, "POST {path} {body}: {}", a.text());
     a.json()
 }
+
+/// Checks that `bvh` is a BVH file lasting the song's bars (from `GET /api/bars`) at 30 fps,
+/// within a frame; returns its frame count.
+pub fn assert_bvh_lasts_the_bars(addr: SocketAddr, bvh: &str) -> usize {
+    assert!(
+        bvh.starts_with("HIERARCHY"),
+        "{}",
+        &bvh[..40.min(bvh.len())]
+    );
+    let bars = get(addr, "/api/bars");
+    let bars = bars["bars"].as_array().unwrap();
+    let span =
+        bars[bars.len() - 1]["end_s"].as_f64().unwrap() - bars[0]["start_s"].as_f64().unwrap();
+    let frames: usize = bvh
+        .lines()
+        .find_map(|l| l.strip_prefix("Frames:"))
+        .expect("a Frames: line")
+        .trim()
+        .parse()
+        .unwrap();
+    assert!(
+        (frames as f64 - span * 30.0).abs() <= 1.0,
+        "{frames} frames for {span} s at 30 fps"
+    );
+    frames
+}
