@@ -71,6 +71,10 @@ pub enum Error {
     /// The dance-editing paper's Fig. 5 experiment.
     #[error(transparent)]
     DanceFill(#[from] crate::experiments::dance_fill::DanceFillError),
+    /// The dance editor (its scene, server and actions).
+    #[cfg(feature = "editor")]
+    #[error(transparent)]
+    Editor(#[from] crate::editor::EditorError),
     /// A data file (RON): reading, syntax, version.
     #[error(transparent)]
     File(#[from] crate::io::FileError),

@@ -14,6 +14,8 @@ pub mod choreo;
 pub mod clips;
 pub mod dynamics;
 pub mod ecs;
+#[cfg(feature = "editor")]
+pub mod editor;
 pub mod error;
 pub mod evolve;
 pub mod experiments;

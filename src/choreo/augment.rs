@@ -116,17 +116,6 @@ pub fn mirror_clip(clip: &ModelClip) -> ModelClip {
     }
 }
 
-/// A segment's motion as a clip on `model` at its real timing (a bar over its frames).
-fn segment_clip(s: &Segment, model: &Model) -> ModelClip {
-    let n = s.frame_count().max(1);
-    ModelClip {
-        model: model.clone(),
-        frame_time: (s.end_s - s.start_s) / n as f64,
-        root_translation: s.root_translation.clone(),
-        root_rotation: s.root_rotation.clone(),
-        angles: s.angles.clone(),
-    }
-}
 
 /// Frames `from..from + n` of `clip`.
 fn frames(clip: &ModelClip, from: usize, n: usize) -> ModelClip {
@@ -216,7 +205,7 @@ pub fn augment_with_variants(db: &Database, target_segments: usize, seed: u64) -
         .segments
         .par_iter()
         .map(|s| {
-            let (w, _) = w_of(&segment_clip(s, &model), alpha);
+            let (w, _) = w_of(&s.clip(&model), alpha);
             let mean = w.iter().sum::<f64>() / w.len().max(1) as f64;
             if mean > 0.0 { s.intensity / mean } else { 1.0 }
         })
@@ -270,10 +259,10 @@ pub fn augment_with_variants(db: &Database, target_segments: usize, seed: u64) -
             let s = &db.segments[v.source];
             let n = s.frame_count();
             let bar_s = s.end_s - s.start_s;
-            let mut clip = segment_clip(s, &model);
+            let mut clip = s.clip(&model);
             let mut scale = vec![factors[v.source]; n];
             if v.shift_frames > 0 {
-                let next = segment_clip(&db.segments[v.source + 1], &model);
+                let next = &db.segments[v.source + 1].clip(&model);
                 clip.root_translation.extend(next.root_translation);
                 clip.root_rotation.extend(next.root_rotation);
                 clip.angles.extend(next.angles);

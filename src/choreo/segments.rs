@@ -302,6 +302,19 @@ impl Segment {
     pub fn frame_count(&self) -> usize {
         self.root_translation.len()
     }
+
+    /// The segment's motion as a clip on `model` (humanoid24) at its real timing: the bar's
+    /// length spread over its resampled frames.
+    pub fn clip(&self, model: &crate::humanoid::Model) -> ModelClip {
+        let n = self.frame_count().max(1);
+        ModelClip {
+            model: model.clone(),
+            frame_time: (self.end_s - self.start_s) / n as f64,
+            root_translation: self.root_translation.clone(),
+            root_rotation: self.root_rotation.clone(),
+            angles: self.angles.clone(),
+        }
+    }
 }
 
 /// `clip` resampled at the times `times` (seconds): angles and pelvis position interpolated

@@ -44,7 +44,7 @@ pub fn data_dir() -> Option<PathBuf> {
 }
 
 /// Whether the tests run under CI: `CI` set to anything but empty, `0` or `false`.
-fn in_ci() -> bool {
+pub fn in_ci() -> bool {
     std::env::var("CI").is_ok_and(|v| !matches!(v.trim(), "" | "0" | "false" | "FALSE"))
 }
 

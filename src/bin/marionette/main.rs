@@ -5,6 +5,7 @@
 mod body;
 mod common;
 mod dance;
+mod edit;
 mod eval;
 mod export;
 mod inspect;
@@ -42,6 +43,9 @@ enum Command {
     Music(music::Args),
     /// Dance segments: `dance db FOLDER|MANIFEST --out DB` builds the segment database.
     Dance(dance::Args),
+    /// Open a dance edit scene (song, database, pins) in the browser editor on 127.0.0.1:
+    /// prints its URL and serves until interrupted.
+    Edit(edit::Args),
     /// Run a scene file; outputs go to one folder (default out/<scene name>/) with report.json.
     Run(run::Args),
     /// Evaluate fall genomes for a GA over the JSON-lines protocol (`--stdin`): the worker a
@@ -61,6 +65,7 @@ fn main() -> ExitCode {
         Command::Render(a) => render::render(a),
         Command::Music(a) => music::music(a),
         Command::Dance(a) => dance::dance(a),
+        Command::Edit(a) => edit::edit(a),
         Command::Run(a) => run::run(a),
         Command::Eval(a) => eval::eval(a),
         Command::Body(a) => body::body(a),

@@ -1,0 +1,321 @@
+//! The editor's JSON API: one route per action, a pure function from (method, path, query,
+//! body) to a [`Reply`] over the [`Session`], so it is tested without a network.
+//!
+//! | route | body / query | answer |
+//! |---|---|---|
+//! | `GET /api/state` | | pins, undo/redo depth, last fill, tempo, song length, figure links |
+//! | `GET /api/bars` | | every bar (span, dB, normalised intensity, pin, filled segment), beats |
+//! | `GET /api/candidates` | `?bar=K` | bar K's round, τ, liked, and its six candidates' frames |
+//! | `GET /api/dance` | | the whole dance of the current pins at 30 fps (generates first) |
+//! | `GET /api/audio.wav` | | the song as 16-bit WAV |
+//! | `POST /api/search` | `{"bar": K}` | the next relevance-feedback round; as `candidates` |
+//! | `POST /api/like` | `{"bar": K, "segment": S}` | S into bar K's liked set L_l |
+//! | `POST /api/unlike` | `{"bar": K, "segment": S}` | S out of L_l |
+//! | `POST /api/set` | `{"bar": K, "segment": S}` | pins S to bar K |
+//! | `POST /api/unpin` | `{"bar": K}` | removes bar K's pin |
+//! | `POST /api/undo`, `POST /api/redo` | `{}` | the pin change undone/redone |
+//! | `POST /api/generate` | `{}` | every unpinned bar filled: segments and total cost |
+//! | `POST /api/save` | `{}` | the scene written back with its pins (atomically) |
+//! | `POST /api/export-bvh` | `{}` | the dance as BVH (a download) |
+//!
+//! Errors are `{"error": "one line"}`: 400 for a malformed request (bad JSON, unknown field,
+//! index out of range), 404 for an unknown route, 405 for a wrong method, 409 for an action the
+//! edit's state refuses (nothing to undo, not shown, no candidate left), 500 for a failure to
+//! write the scene.
+
+use serde::Deserialize;
+use serde::de::DeserializeOwned;
+use serde_json::{Value, json};
+
+use super::EditorError;
+use super::session::Session;
+use crate::choreo::edit::EditError;
+
+/// Frames per second of the whole dance sent to the page.
+pub const DANCE_FPS: f64 = 30.0;
+
+/// An HTTP answer.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Reply {
+    /// Status code.
+    pub status: u16,
+    /// Content type.
+    pub content_type: &'static str,
+    /// Body.
+    pub body: Vec<u8>,
+    /// A file name for a download (`Content-Disposition: attachment`).
+    pub download: Option<&'static str>,
+}
+
+impl Reply {
+    /// A JSON answer.
+    pub fn json(status: u16, v: &Value) -> Reply {
+        Reply {
+            status,
+            content_type: "application/json",
+            body: v.to_string().into_bytes(),
+            download: None,
+        }
+    }
+
+    /// An error answer: `{"error": reason}` with the reason on one line.
+    pub fn error(status: u16, reason: &str) -> Reply {
+        let line: String = reason.split_whitespace().collect::<Vec<_>>().join(" ");
+        Reply::json(status, &json!({ "error": line }))
+    }
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct BarBody {
+    bar: usize,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct BarSegmentBody {
+    bar: usize,
+    segment: usize,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Empty {}
+
+/// Parses a JSON body into `T` or answers 400 with serde's one-line reason.
+fn body<T: DeserializeOwned>(b: &[u8]) -> Result<T, Reply> {
+    let b = if b.iter().all(u8::is_ascii_whitespace) {
+        b"{}".as_slice()
+    } else {
+        b
+    };
+    serde_json::from_slice(b).map_err(|e| Reply::error(400, &format!("request body: {e}")))
+}
+
+/// The status of an editor error.
+fn status_of(e: &EditorError) -> u16 {
+    match e {
+        EditorError::Edit(
+            EditError::NoSuchBar { .. } | EditError::NoSuchSegment { .. } | EditError::Search(_),
+        ) => 400,
+        EditorError::Edit(_) | EditorError::Fill(_) | EditorError::Dance(_) => 409,
+        _ => 500,
+    }
+}
+
+fn fail(e: EditorError) -> Reply {
+    Reply::error(status_of(&e), &e.to_string())
+}
+
+/// The value of `key` in a query string as an index, or a 400.
+fn query_index(query: &str, key: &str) -> Result<usize, Reply> {
+    let v = query
+        .split('&')
+        .find_map(|kv| kv.strip_prefix(key)?.strip_prefix('='))
+        .ok_or_else(|| Reply::error(400, &format!("query: `{key}` is missing")))?;
+    v.parse()
+        .map_err(|_| Reply::error(400, &format!("query: `{key}={v}` is not an index")))
+}
+
+/// Answers one API request (`path` starts with `/api/`, `query` without its `?`).
+pub fn handle(s: &mut Session, method: &str, path: &str, query: &str, b: &[u8]) -> Reply {
+    match route(s, method, path, query, b) {
+        Ok(r) | Err(r) => r,
+    }
+}
+
+const GETS: [&str; 5] = [
+    "/api/state",
+    "/api/bars",
+    "/api/candidates",
+    "/api/dance",
+    "/api/audio.wav",
+];
+const POSTS: [&str; 10] = [
+    "/api/search",
+    "/api/like",
+    "/api/unlike",
+    "/api/set",
+    "/api/unpin",
+    "/api/undo",
+    "/api/redo",
+    "/api/generate",
+    "/api/save",
+    "/api/export-bvh",
+];
+
+fn route(s: &mut Session, method: &str, path: &str, query: &str, b: &[u8]) -> Result<Reply, Reply> {
+    let get = GETS.contains(&path);
+    let post = POSTS.contains(&path);
+    if !get && !post {
+        return Err(Reply::error(404, &format!("no route {path}")));
+    }
+    let expected = if get { "GET" } else { "POST" };
+    if method != expected {
+        return Err(Reply::error(
+            405,
+            &format!("{path} takes {expected}, not {method}"),
+        ));
+    }
+    if get && !b.is_empty() {
+        return Err(Reply::error(400, &format!("GET {path} takes no body")));
+    }
+    let ok = |v: Value| Ok(Reply::json(200, &v));
+    match path {
+        "/api/state" => ok(state(s)),
+        "/api/bars" => ok(bars(s)),
+        "/api/candidates" => {
+            let bar = query_index(query, "bar")?;
+            candidates(s, bar).map(|v| Reply::json(200, &v))
+        }
+        "/api/dance" => {
+            let (frames, start_s) = s.dance_frames(DANCE_FPS).map_err(fail)?;
+            ok(json!({ "fps": DANCE_FPS, "start_s": start_s, "frames": frames }))
+        }
+        "/api/audio.wav" => {
+            let song = s.song();
+            let wav = crate::choreo::music::wav::wav_bytes(&song.samples, 1, song.sample_rate)
+                .ok_or_else(|| Reply::error(500, "the song does not fit a WAV file"))?;
+            Ok(Reply {
+                status: 200,
+                content_type: "audio/wav",
+                body: wav,
+                download: None,
+            })
+        }
+        "/api/search" => {
+            let BarBody { bar } = body(b)?;
+            s.edit_mut().search(bar).map_err(|e| fail(e.into()))?;
+            candidates(s, bar).map(|v| Reply::json(200, &v))
+        }
+        "/api/like" | "/api/unlike" => {
+            let BarSegmentBody { bar, segment } = body(b)?;
+            s.edit_mut()
+                .like(bar, segment, path == "/api/like")
+                .map_err(|e| fail(e.into()))?;
+            let liked = &s.edit().bar_search(bar).map_err(|e| fail(e.into()))?.liked;
+            ok(json!({ "bar": bar, "liked": liked }))
+        }
+        "/api/set" => {
+            let BarSegmentBody { bar, segment } = body(b)?;
+            s.edit_mut().set(bar, segment).map_err(|e| fail(e.into()))?;
+            ok(state(s))
+        }
+        "/api/unpin" => {
+            let BarBody { bar } = body(b)?;
+            s.edit_mut().unpin(bar).map_err(|e| fail(e.into()))?;
+            ok(state(s))
+        }
+        "/api/undo" | "/api/redo" => {
+            let Empty {} = body(b)?;
+            let c = if path == "/api/undo" {
+                s.edit_mut().undo()
+            } else {
+                s.edit_mut().redo()
+            }
+            .map_err(|e| fail(e.into()))?;
+            let mut v = state(s);
+            v["change"] = json!(c);
+            ok(v)
+        }
+        "/api/generate" => {
+            let Empty {} = body(b)?;
+            s.generate().map_err(fail)?;
+            ok(state(s))
+        }
+        "/api/save" => {
+            let Empty {} = body(b)?;
+            let p = s.save().map_err(fail)?;
+            ok(json!({ "saved": p.display().to_string() }))
+        }
+        "/api/export-bvh" => {
+            let Empty {} = body(b)?;
+            let bvh = s.export_bvh().map_err(fail)?;
+            Ok(Reply {
+                status: 200,
+                content_type: "text/plain; charset=utf-8",
+                body: bvh.into_bytes(),
+                download: Some("dance.bvh"),
+            })
+        }
+        _ => Err(Reply::error(404, &format!("no route {path}"))),
+    }
+}
+
+fn state(s: &Session) -> Value {
+    let e = s.edit();
+    let st = e.state();
+    let pins: serde_json::Map<String, Value> = st
+        .pins
+        .iter()
+        .map(|(b, g)| (b.to_string(), json!(g)))
+        .collect();
+    let bars = e.bars();
+    json!({
+        "bars": bars.len(),
+        "segments": e.database().segments.len(),
+        "pins": pins,
+        "undo": st.undo.len(),
+        "redo": st.redo.len(),
+        "fill": s.fill().map(|f| json!({ "segments": f.segments, "total_cost": f.total_cost })),
+        "tempo_bpm": s.song().tempo_bpm,
+        "song_s": s.song().samples.len() as f64 / s.song().sample_rate as f64,
+        "parents": s.point_parents(),
+        "sides": s.point_sides().iter().map(|c| c.to_string()).collect::<Vec<_>>(),
+        "head": s.head_points(),
+        "scene": s.scene_path().display().to_string(),
+    })
+}
+
+fn bars(s: &Session) -> Value {
+    let e = s.edit();
+    let fill = s.fill().map(|f| &f.segments);
+    let list: Vec<Value> = e
+        .bars()
+        .iter()
+        .enumerate()
+        .map(|(k, b)| {
+            json!({
+                "start_s": b.start_s,
+                "end_s": b.end_s,
+                "rms_db": if b.rms_db.is_finite() { json!(b.rms_db) } else { Value::Null },
+                "intensity": e.music_intensity()[k],
+                "pin": e.pins().get(&k),
+                "filled": fill.and_then(|f| f.get(k)),
+                "round": e.state().searches[k].round,
+            })
+        })
+        .collect();
+    json!({ "bars": list, "beats_s": s.song().beats_s })
+}
+
+fn candidates(s: &Session, bar: usize) -> Result<Value, Reply> {
+    let e = s.edit();
+    let search = e.bar_search(bar).map_err(|e| fail(e.into()))?;
+    let b = e.bars()[bar];
+    let db = e.database();
+    let mut list = vec![];
+    for &seg in &search.current {
+        let frames = s.segment_frames(seg).map_err(fail)?;
+        let m = &db.segments[seg];
+        list.push(json!({
+            "segment": seg,
+            "liked": search.liked.contains(&seg),
+            "intensity": m.intensity,
+            "source": db.sources.get(m.clip).map(|c| c.file.as_str()),
+            "source_bar": m.bar,
+            "frames": frames,
+        }));
+    }
+    Ok(json!({
+        "bar": bar,
+        "start_s": b.start_s,
+        "end_s": b.end_s,
+        "round": search.round,
+        "tau": search.tau,
+        "shown": search.shown.len(),
+        "liked": search.liked,
+        "pin": e.pins().get(&bar),
+        "candidates": list,
+    }))
+}

@@ -1,0 +1,316 @@
+//! The dance editor's server over real TCP: the API flow (search, like, search, set, generate,
+//! undo/redo, save, export), and its defences — loopback only, Host check (DNS rebinding),
+//! embedded files only, body limit, one-line 400s — and that it keeps answering correctly, with
+//! the saved edit intact, after thousands of bad and concurrent requests.
+
+mod editor_fixture;
+
+use std::collections::BTreeSet;
+use std::net::SocketAddr;
+
+use editor_fixture::{assert_bvh_lasts_the_bars, get, post, raw, request, scene};
+use marionette::editor::scene::EditScene;
+use marionette::editor::server::{Editor, MAX_BODY};
+use marionette::editor::session::Session;
+
+fn start(name: &str) -> (Editor, std::path::PathBuf) {
+    let path = scene(name, 6, 10, 12);
+    let editor = Editor::start(Session::open(&path).unwrap(), 0).unwrap();
+    (editor, path)
+}
+
+fn segments(v: &serde_json::Value) -> Vec<u64> {
+    v["candidates"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c["segment"].as_u64().unwrap())
+        .collect()
+}
+
+#[test]
+fn the_api_flow_search_like_search_set_generate_save_export() {
+    let (ed, path) = start("flow");
+    let a = ed.addr();
+    let state = get(a, "/api/state");
+    assert_eq!(state["bars"], 12);
+    let n_seg = state["segments"].as_u64().unwrap();
+    assert!(n_seg >= 24, "{n_seg} segments");
+
+    let first = post(a, "/api/search", r#"{"bar": 3}"#);
+    let shown = segments(&first);
+    assert_eq!(shown.len(), 6);
+    // Each candidate carries its frames: bar_frames frames of every stick-figure point.
+    let c0 = &first["candidates"][0];
+    let frames = c0["frames"].as_array().unwrap();
+    assert_eq!(frames.len(), 32);
+    assert_eq!(
+        frames[0].as_array().unwrap().len(),
+        state["parents"].as_array().unwrap().len()
+    );
+    assert_eq!(
+        get(a, "/api/candidates?bar=3")["candidates"],
+        first["candidates"]
+    );
+
+    post(
+        a,
+        "/api/like",
+        &format!(r#"{{"bar": 3, "segment": {}}}"#, shown[0]),
+    );
+    post(
+        a,
+        "/api/like",
+        &format!(r#"{{"bar": 3, "segment": {}}}"#, shown[1]),
+    );
+    let liked = post(
+        a,
+        "/api/unlike",
+        &format!(r#"{{"bar": 3, "segment": {}}}"#, shown[1]),
+    );
+    assert_eq!(liked["liked"], serde_json::json!([shown[0]]));
+    let second = segments(&post(a, "/api/search", r#"{"bar": 3}"#));
+    assert_eq!(second.len(), 6);
+    assert!(
+        second.iter().all(|s| !shown.contains(s)),
+        "{second:?} vs {shown:?}"
+    );
+
+    post(
+        a,
+        "/api/set",
+        &format!(r#"{{"bar": 3, "segment": {}}}"#, second[2]),
+    );
+    post(a, "/api/set", r#"{"bar": 7, "segment": 0}"#);
+    let s = post(a, "/api/unpin", r#"{"bar": 7}"#);
+    assert_eq!(s["undo"], 3);
+    let s = post(a, "/api/undo", "{}");
+    assert_eq!(s["pins"]["7"], 0);
+    let s = post(a, "/api/redo", "");
+    assert!(s["pins"].get("7").is_none());
+
+    let g = post(a, "/api/generate", "{}");
+    let fill = g["fill"]["segments"].as_array().unwrap();
+    assert_eq!(fill.len(), 12);
+    assert_eq!(fill[3], second[2]);
+    for w in fill.windows(2) {
+        assert_ne!(w[0], w[1], "no adjacent repeat");
+    }
+    let bars = get(a, "/api/bars");
+    assert_eq!(bars["bars"][3]["pin"], second[2]);
+    assert!(
+        bars["bars"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .all(|b| !b["filled"].is_null())
+    );
+
+    let saved = post(a, "/api/save", "{}");
+    assert_eq!(saved["saved"], path.display().to_string());
+    let back = EditScene::load(&path).unwrap();
+    assert_eq!(
+        back.pins,
+        std::collections::BTreeMap::from([(3, second[2] as usize)])
+    );
+
+    let bvh = request(a, "POST", "/api/export-bvh", Some("{}"));
+    assert_eq!(bvh.status, 200);
+    let text = bvh.text();
+    let frames = assert_bvh_lasts_the_bars(a, &text);
+
+    let dance = get(a, "/api/dance");
+    assert_eq!(dance["frames"].as_array().unwrap().len(), frames);
+
+    let wav = request(a, "GET", "/api/audio.wav", None);
+    assert_eq!(wav.status, 200);
+    assert_eq!(&wav.body[..4], b"RIFF");
+    let song_s = get(a, "/api/state")["song_s"].as_f64().unwrap();
+    let samples = (wav.body.len() - 44) / 2;
+    assert!((samples as f64 / 22_050.0 - song_s).abs() < 1e-3);
+    ed.stop();
+}
+
+/// The status and the one-line reason of a request.
+fn refused(a: SocketAddr, method: &str, path: &str, body: Option<&str>) -> (u16, String) {
+    let r = request(a, method, path, body);
+    let text = r.text();
+    assert!(!text.contains('\n'), "one line: {text}");
+    (r.status, text)
+}
+
+#[test]
+fn bad_requests_get_clear_refusals_and_the_server_keeps_serving() {
+    let (ed, _) = start("refusals");
+    let a = ed.addr();
+    assert!(a.ip().is_loopback());
+
+    // DNS rebinding: a page of evil.com resolving to 127.0.0.1 sends Host: evil.com.
+    for host in [
+        "evil.com",
+        "127.0.0.1.evil.com",
+        "localhost.evil.com:80",
+        "10.0.0.1",
+    ] {
+        let r = raw(
+            a,
+            format!("GET /api/state HTTP/1.1\r\nHost: {host}\r\nConnection: close\r\n\r\n")
+                .as_bytes(),
+        );
+        assert_eq!(r.status, 403, "{host}");
+    }
+    let no_host = raw(a, b"GET /api/state HTTP/1.0\r\n\r\n");
+    assert_eq!(no_host.status, 403);
+    let localhost = raw(
+        a,
+        format!(
+            "GET / HTTP/1.1\r\nHost: localhost:{}\r\nConnection: close\r\n\r\n",
+            a.port()
+        )
+        .as_bytes(),
+    );
+    assert_eq!(localhost.status, 200);
+    assert!(localhost.text().contains("dance editor"));
+
+    // Only the embedded files: every other path is 404, whatever it spells.
+    for p in [
+        "/../Cargo.toml",
+        "/%2e%2e/Cargo.toml",
+        "/app.js/../../Cargo.toml",
+        "/..%2f..%2fCargo.toml",
+        "/%2fetc%2fpasswd",
+        "//etc/passwd",
+        "/etc/passwd",
+        "/src/editor/page/app.js",
+        "/api/../Cargo.toml",
+        "/api/%2e%2e/state",
+        "/app.js%00",
+        "/index.html",
+    ] {
+        assert_eq!(refused(a, "GET", p, None).0, 404, "{p}");
+    }
+    assert_eq!(request(a, "GET", "/app.js", None).status, 200);
+    assert_eq!(request(a, "GET", "/figure.js", None).status, 200);
+
+    // Bodies over the limit.
+    let big = format!(r#"{{"bar": 1, "pad": "{}"}}"#, "x".repeat(MAX_BODY));
+    assert_eq!(refused(a, "POST", "/api/search", Some(&big)).0, 413);
+    let huge = "POST /api/search HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Length: 999999999\r\nConnection: close\r\n\r\n{}";
+    assert_eq!(raw(a, huge.as_bytes()).status, 413);
+    let mut chunked = b"POST /api/search HTTP/1.1\r\nHost: 127.0.0.1\r\nTransfer-Encoding: chunked\r\nConnection: close\r\n\r\n".to_vec();
+    for _ in 0..40 {
+        chunked.extend(format!("400\r\n{}\r\n", "y".repeat(1024)).as_bytes());
+    }
+    chunked.extend(b"0\r\n\r\n");
+    assert_eq!(raw(a, &chunked).status, 413);
+
+    // Malformed JSON, unknown fields, wrong types: 400 with serde's reason on one line.
+    let cases = [
+        ("/api/search", "{bar: 1", "key must be a string"),
+        ("/api/search", r#"{"bar": 1, "x": 2}"#, "unknown field `x`"),
+        ("/api/search", r#"{"bar": -1}"#, "invalid value"),
+        ("/api/set", r#"{"bar": 1}"#, "missing field `segment`"),
+        ("/api/undo", r#"{"please": true}"#, "unknown field `please`"),
+        (
+            "/api/search",
+            r#"{"bar": 12}"#,
+            "bar 12 is past the song's end",
+        ),
+        (
+            "/api/set",
+            r#"{"bar": 0, "segment": 100000}"#,
+            "not in the database",
+        ),
+    ];
+    for (p, body, why) in cases {
+        let (status, text) = refused(a, "POST", p, Some(body));
+        assert_eq!(status, 400, "{p} {body}: {text}");
+        assert!(text.contains(why), "{p} {body}: {text}");
+    }
+    assert_eq!(refused(a, "GET", "/api/candidates?bar=x", None).0, 400);
+    assert_eq!(refused(a, "GET", "/api/candidates", None).0, 400);
+    assert_eq!(refused(a, "GET", "/api/search", None).0, 405);
+    assert_eq!(refused(a, "POST", "/api/state", Some("{}")).0, 405);
+    assert_eq!(refused(a, "DELETE", "/api/state", None).0, 405);
+    assert_eq!(refused(a, "POST", "/api/nope", Some("{}")).0, 404);
+    // Refused by the edit's state: 409.
+    assert_eq!(refused(a, "POST", "/api/undo", Some("{}")).0, 409);
+    assert_eq!(
+        refused(a, "POST", "/api/unpin", Some(r#"{"bar": 2}"#)).0,
+        409
+    );
+    assert_eq!(
+        refused(a, "POST", "/api/like", Some(r#"{"bar": 2, "segment": 0}"#)).0,
+        409
+    );
+    // Garbage that is not HTTP at all, then a correct answer.
+    let _ = raw(a, b"\x00\xff\xfe garbage\r\n\r\n");
+    let _ = raw(a, b"GET");
+    assert_eq!(get(a, "/api/state")["bars"], 12);
+    ed.stop();
+}
+
+#[test]
+fn thousands_of_bad_and_concurrent_requests_leave_the_edit_intact() {
+    let (ed, path) = start("storm");
+    let a = ed.addr();
+    let bad: Vec<Vec<u8>> = vec![
+        b"GET /../../etc/passwd HTTP/1.1\r\nHost: 127.0.0.1\r\nConnection: close\r\n\r\n".to_vec(),
+        b"GET /api/state HTTP/1.1\r\nHost: evil.com\r\nConnection: close\r\n\r\n".to_vec(),
+        b"POST /api/set HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Length: 4\r\nConnection: close\r\n\r\n{\"ba".to_vec(),
+        b"POST /api/set HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Length: 2\r\nConnection: close\r\n\r\n[]".to_vec(),
+        b"POST /api/search HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Length: 99999999\r\nConnection: close\r\n\r\n".to_vec(),
+        b"\x16\x03\x01\x02\x00\x01\x00\x01\xfc\x03\x03".to_vec(),
+        b"GET /api/candidates?bar=99999999999999999999 HTTP/1.1\r\nHost: 127.0.0.1\r\nConnection: close\r\n\r\n".to_vec(),
+        b"POST /api/like HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Length: 30\r\nConnection: close\r\n\r\n{\"bar\":1e400,\"segment\":0}     ".to_vec(),
+    ];
+    // Four threads of bad requests; four "tabs", each pinning and unpinning its own bar.
+    std::thread::scope(|sc| {
+        for t in 0..4 {
+            let bad = &bad;
+            sc.spawn(move || {
+                for k in 0..500 {
+                    let r = raw(a, &bad[(k + t) % bad.len()]);
+                    assert!(
+                        r.status == 0 || (400..=413).contains(&r.status),
+                        "{}: {}",
+                        r.status,
+                        r.text()
+                    );
+                }
+            });
+        }
+        for tab in 0..4usize {
+            sc.spawn(move || {
+                for k in 0..25 {
+                    post(
+                        a,
+                        "/api/set",
+                        &format!(r#"{{"bar": {tab}, "segment": {}}}"#, k % 5),
+                    );
+                    if k % 2 == 1 {
+                        post(a, "/api/unpin", &format!(r#"{{"bar": {tab}}}"#));
+                    }
+                }
+            });
+        }
+    });
+    // Each tab made 25 sets (k % 5 differs from the pin before, or there was none) and 12
+    // unpins; its bar ends pinned to 24 % 5 = 4.
+    let s = get(a, "/api/state");
+    assert_eq!(s["undo"], 4 * (25 + 12));
+    let pins: BTreeSet<(String, u64)> = s["pins"]
+        .as_object()
+        .unwrap()
+        .iter()
+        .map(|(k, v)| (k.clone(), v.as_u64().unwrap()))
+        .collect();
+    let want: BTreeSet<(String, u64)> = (0..4).map(|t| (t.to_string(), 4)).collect();
+    assert_eq!(pins, want);
+    post(a, "/api/save", "{}");
+    let back = EditScene::load(&path).unwrap();
+    assert_eq!(back.pins.len(), 4);
+    assert!(back.pins.values().all(|&s| s == 4));
+    assert_eq!(segments(&post(a, "/api/search", r#"{"bar": 5}"#)).len(), 6);
+    ed.stop();
+}
