@@ -7,6 +7,7 @@
 //! - [`high_jump`]: the motor-primitive paper's high jump by extrapolation (§4.1);
 //! - [`knee_kick`]: its jumping knee kick, blended and connected (§4.2).
 
+pub mod active;
 pub mod evolve_fall;
 pub mod fall;
 pub mod high_jump;
