@@ -396,21 +396,27 @@ pub struct Feedforward {
     data: Option<Data>,
 }
 
+/// What [`pd_targets_from_pose`] reads and writes.
+type TargetQuery<'a> = (
+    &'a PhysicsBody,
+    &'a ModelBinding,
+    &'a DofPose,
+    &'a mut PdController,
+    Option<&'a mut Feedforward>,
+);
+
+/// What [`react_to_pushes`] reads and writes.
+type ReactionQuery<'a> = (
+    &'a BodyState,
+    &'a ExternalForces,
+    &'a mut Reaction,
+    Option<&'a mut RootAssist>,
+    Option<&'a mut PdController>,
+);
+
 /// Copies every tracking character's DOF pose into its PD targets (θ_d and θ̇_d per DOF) and,
 /// with a [`Feedforward`], the inverse dynamics of the animated motion into its feedforward.
-pub fn pd_targets_from_pose(
-    clock: Res<Clock>,
-    mut q: Query<
-        (
-            &PhysicsBody,
-            &ModelBinding,
-            &DofPose,
-            &mut PdController,
-            Option<&mut Feedforward>,
-        ),
-        With<TrackPose>,
-    >,
-) {
+pub fn pd_targets_from_pose(clock: Res<Clock>, mut q: Query<TargetQuery, With<TrackPose>>) {
     for (body, binding, pose, mut pd, ff) in &mut q {
         let pd = &mut pd.0;
         for (d, &c) in binding.dof_columns().iter().enumerate() {
@@ -438,15 +444,7 @@ pub fn pd_targets_from_pose(
 
 /// Notes the first push of every reacting character and, `release_delay_s` after it, releases
 /// its assistance and (if given) switches its PD to the key pose.
-pub fn react_to_pushes(
-    mut q: Query<(
-        &BodyState,
-        &ExternalForces,
-        &mut Reaction,
-        Option<&mut RootAssist>,
-        Option<&mut PdController>,
-    )>,
-) {
+pub fn react_to_pushes(mut q: Query<ReactionQuery>) {
     for (state, forces, mut reaction, assist, pd) in &mut q {
         let t = state.time_s;
         if reaction.pushed_at_s.is_none() {

@@ -217,7 +217,7 @@ pub fn run_active(
         if let Some(err) = world.get::<PhysicsStatus>(e).and_then(|s| s.error.clone()) {
             return Err(ActiveError::Step((*err).clone()));
         }
-        if tick as usize % every == 0 {
+        if (tick as usize).is_multiple_of(every) {
             let q = &world.get::<BodyState>(e).expect("spawned with a state").q;
             configurations.push(q.clone());
         }
