@@ -581,12 +581,18 @@ pub fn add_character_systems(schedule: &mut Schedule) {
 /// recording), primitive players, the character systems and physics.
 pub fn character_schedule() -> Schedule {
     let mut s = Schedule::default();
-    super::add_core_systems(&mut s);
-    super::add_motion_systems(&mut s);
-    super::primitive::add_primitive_systems(&mut s);
-    add_character_systems(&mut s);
-    super::physics::add_physics_systems(&mut s);
+    add_all_character_systems(&mut s);
     s
+}
+
+/// Adds everything [`character_schedule`] holds to `schedule` (e.g. a game's fixed-timestep
+/// schedule): core sets and clock, motion, primitive, character and physics systems.
+pub fn add_all_character_systems(schedule: &mut Schedule) {
+    super::add_core_systems(schedule);
+    super::add_motion_systems(schedule);
+    super::primitive::add_primitive_systems(schedule);
+    add_character_systems(schedule);
+    super::physics::add_physics_systems(schedule);
 }
 
 /// True while the character's body steps.
