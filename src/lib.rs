@@ -9,6 +9,8 @@
 //! plots); Y is up, a character faces +Z and its left is +X (right-handed).
 
 pub mod analysis;
+#[cfg(feature = "bevy")]
+pub mod bevy;
 pub mod bvh;
 pub mod choreo;
 pub mod clips;

@@ -1,5 +1,6 @@
 //! The articulated-body algorithm held against the recursive Newton–Euler algorithm and against
-//! CRBA + Cholesky on random trees mixing every joint type (pin, universal, ball, free root).
+//! CRBA + Cholesky on random trees mixing every joint type (pin, universal, ball, fixed, free
+//! root), and on the human bodies built from the engine's models (fall21 and humanoid24).
 
 use glam::{DMat3, DQuat, DVec3};
 use marionette::dynamics::crba::forward_dynamics_crba;
@@ -28,8 +29,9 @@ fn random_rotation(rng: &mut Pcg64) -> DMat3 {
 }
 
 fn random_joint(rng: &mut Pcg64) -> JointType {
-    match rng.random_range(0..3) {
+    match rng.random_range(0..4) {
         0 => JointType::Pin { axis: unit(rng) },
+        3 => JointType::Fixed,
         1 => JointType::Universal {
             axis1: unit(rng),
             axis2: unit(rng),
@@ -108,6 +110,27 @@ fn random_state(rng: &mut Pcg64, m: &Model) -> (Vec<f64>, Vec<f64>, Vec<f64>, Ve
     (q, v, tau, f_ext)
 }
 
+/// ABA, RNEA(ABA) and CRBA + Cholesky at random states of `m`; the worst relative
+/// disagreements `(RNEA(ABA) vs τ, ABA vs CRBA)`.
+fn worst_disagreement(m: &Model, rng: &mut Pcg64, states: usize) -> (f64, f64) {
+    let mut data = Data::new(m);
+    let (mut worst_rnea, mut worst_crba) = (0.0f64, 0.0f64);
+    for _ in 0..states {
+        let (q, v, tau, f_ext) = random_state(rng, m);
+        let qdd = aba(m, &mut data, &q, &v, &tau, &f_ext).to_vec();
+        assert!(qdd.iter().all(|x| x.is_finite()));
+        let tau2 = rnea(m, &mut data, &q, &v, &qdd, &f_ext).to_vec();
+        let scale = 1.0 + tau.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+        worst_rnea = worst_rnea.max(max_abs_diff(&tau, &tau2) / scale);
+        let qdd2 = forward_dynamics_crba(m, &mut data, &q, &v, &tau, &f_ext)
+            .unwrap()
+            .to_vec();
+        let qscale = 1.0 + qdd.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+        worst_crba = worst_crba.max(max_abs_diff(&qdd, &qdd2) / qscale);
+    }
+    (worst_rnea, worst_crba)
+}
+
 fn max_abs_diff(a: &[f64], b: &[f64]) -> f64 {
     a.iter()
         .zip(b)
@@ -166,5 +189,19 @@ fn crba_matrix_is_symmetric_positive_definite_and_matches_rnea_columns() {
             assert!((col[r] - h[r * nv + k]).abs() < 1e-10);
             assert!((h[r * nv + k] - h[k * nv + r]).abs() < 1e-12);
         }
+    }
+}
+
+#[test]
+fn aba_agrees_with_rnea_and_crba_on_the_human_bodies() {
+    use marionette::humanoid::body::{fall21_body, humanoid24_body};
+    let mut rng = Pcg64::seed_from_u64(24);
+    for (name, body) in [
+        ("fall21", fall21_body(1.70, 65.0, 9.81).unwrap()),
+        ("humanoid24", humanoid24_body(1.70, 65.0, 9.81).unwrap()),
+    ] {
+        let (e1, e2) = worst_disagreement(&body.model, &mut rng, 50);
+        println!("{name}: RNEA(ABA) vs τ {e1:e}, ABA vs CRBA {e2:e} (relative, 50 random states)");
+        assert!(e1 < 1e-9 && e2 < 1e-9, "{name}: {e1:e} {e2:e}");
     }
 }

@@ -57,6 +57,7 @@ fn gameplay(
                 body: torso,
                 point: DVec3::new(0.0, 0.2, 0.0),
                 force: DVec3::new(400.0, 0.0, 0.0),
+                torque: DVec3::ZERO,
                 start_s: state.time_s,
                 duration_s: 0.1,
             });

@@ -262,7 +262,7 @@ pub fn augment_with_variants(db: &Database, target_segments: usize, seed: u64) -
             let mut clip = s.clip(&model);
             let mut scale = vec![factors[v.source]; n];
             if v.shift_frames > 0 {
-                let next = &db.segments[v.source + 1].clip(&model);
+                let next = db.segments[v.source + 1].clip(&model);
                 clip.root_translation.extend(next.root_translation);
                 clip.root_rotation.extend(next.root_rotation);
                 clip.angles.extend(next.angles);

@@ -111,6 +111,15 @@ pub fn aba_passes(
                     data.pa[p] += x.inv_apply_force(pa_a);
                 }
             }
+            JointType::Fixed => {
+                // No DOF: the whole articulated inertia and bias force reach the parent.
+                if let Some(p) = body.parent {
+                    let pa_a = pa + ia.apply(data.c[i]);
+                    let x = data.xup[i];
+                    data.ia[p] += ia.transform_to_parent(&x);
+                    data.pa[p] += x.inv_apply_force(pa_a);
+                }
+            }
             JointType::Free => {}
         }
     }
@@ -145,6 +154,7 @@ pub fn aba_passes(
                 }
                 data.a[i] = a;
             }
+            JointType::Fixed => data.a[i] = a_prime,
             JointType::Free => {
                 let f = ForceVec::new(
                     DVec3::new(tau[iv], tau[iv + 1], tau[iv + 2]),

@@ -36,6 +36,9 @@ pub enum JointType {
     },
     /// Floating base: position and unit quaternion. nq = 7, nv = 6. Root only.
     Free,
+    /// Rigid attachment (a welded joint): `R = 1`, `S` empty. nq = nv = 0; the body moves with
+    /// its parent and its inertia reaches the parent's articulated inertia whole.
+    Fixed,
 }
 
 /// Exact inverse of the right-trivialised exponential differential on SO(3):
@@ -91,6 +94,7 @@ impl JointType {
             JointType::Universal { .. } => 2,
             JointType::Ball { .. } => 4,
             JointType::Free => 7,
+            JointType::Fixed => 0,
         }
     }
 
@@ -102,6 +106,7 @@ impl JointType {
             JointType::Universal { .. } => 2,
             JointType::Ball { .. } => 3,
             JointType::Free => 6,
+            JointType::Fixed => 0,
         }
     }
 
@@ -118,7 +123,7 @@ impl JointType {
                     .iter()
                     .all(|e| e.abs() < 1e-9)
             }
-            JointType::Free => true,
+            JointType::Free | JointType::Fixed => true,
         }
     }
 
@@ -142,6 +147,7 @@ impl JointType {
             }
             JointType::Ball { .. } => DMat3::from_quat(quat_at(q)),
             JointType::Free => DMat3::from_quat(quat_at(&q[3..7])),
+            JointType::Fixed => DMat3::IDENTITY,
         }
     }
 
@@ -198,6 +204,7 @@ impl JointType {
                 );
                 (x, vj, MotionVec::ZERO)
             }
+            JointType::Fixed => (SpatialTransform::IDENTITY, MotionVec::ZERO, MotionVec::ZERO),
         }
     }
 
@@ -233,6 +240,7 @@ impl JointType {
                     &mut out[3..7],
                 );
             }
+            JointType::Fixed => {}
         }
     }
 
@@ -261,6 +269,7 @@ impl JointType {
                 zdot[..3].copy_from_slice(&r.to_array());
                 zdot[3..6].copy_from_slice(&pd.to_array());
             }
+            JointType::Fixed => {}
         }
     }
 
@@ -279,6 +288,7 @@ impl JointType {
                 out[..3].copy_from_slice(&a.to_array());
             }
             JointType::Free => out[..6].fill(0.0),
+            JointType::Fixed => {}
         }
     }
 
@@ -295,7 +305,7 @@ impl JointType {
                 let u = *axes * DVec3::new(angles[0], angles[1], angles[2]);
                 put_quat(DQuat::from_scaled_axis(u), q);
             }
-            JointType::Free => {}
+            JointType::Free | JointType::Fixed => {}
         }
     }
 }

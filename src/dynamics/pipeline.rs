@@ -542,6 +542,7 @@ mod tests {
             body: 0,
             point: DVec3::ZERO,
             force: DVec3::new(0.0, 2.0 * 9.81, 0.0),
+            torque: DVec3::ZERO,
             start_s: 0.0,
             duration_s: f64::INFINITY,
         }];
@@ -562,6 +563,7 @@ mod tests {
             kp: vec![100.0],
             kv: vec![10.0],
             torque_limits: Vec::new(),
+            feedforward: Vec::new(),
         };
         let (tau, d) = pd.torque(0, 0.3, 0.5);
         assert!((tau - 15.0).abs() < 1e-12);

@@ -8,6 +8,7 @@ use bevy_ecs::prelude::*;
 use glam::{DQuat, DVec3};
 
 use super::motion::{Character, JointState, Recorder, SkeletonRef};
+use super::physics::PhysicsBody;
 use super::primitive::{DofPose, PrimitivePlayer};
 use crate::humanoid::{Model, ROOT_CHANNELS};
 use crate::primitive::{Primitive, PrimitiveError};
@@ -49,11 +50,25 @@ impl ModelBinding {
             root_cols,
         })
     }
+
+    /// For each model DOF (model order), its entry in the pose.
+    pub fn dof_columns(&self) -> &[usize] {
+        &self.dof_cols
+    }
+
+    /// The pose entries of the six root channels (`root_tx … root_rz`).
+    pub fn root_columns(&self) -> [usize; 6] {
+        self.root_cols
+    }
 }
 
-/// Sets every bound character's joint state from its DOF pose: the root from the root
-/// channels, every other joint's rotation from its DOF angles (see [`Model::local_rotations`]).
-pub fn pose_from_dofs(mut q: Query<(&ModelBinding, &DofPose, &mut JointState)>) {
+/// Sets every bound kinematic character's joint state from its DOF pose: the root from the
+/// root channels, every other joint's rotation from its DOF angles (see
+/// [`Model::local_rotations`]). A simulated character's joint state comes from its body instead
+/// ([`publish_body_pose`](super::physics::publish_body_pose)); its DOF pose is the PD target.
+pub fn pose_from_dofs(
+    mut q: Query<(&ModelBinding, &DofPose, &mut JointState), Without<PhysicsBody>>,
+) {
     for (b, pose, mut state) in &mut q {
         let angles: Vec<f64> = b.dof_cols.iter().map(|&c| pose.theta[c]).collect();
         let st = &mut *state;

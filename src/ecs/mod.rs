@@ -8,7 +8,10 @@
 //!   [`primitive::DofPose`] that a [`ModelBinding`] turns into the joint state;
 //! - physics: a [`physics::PhysicsBundle`] and the force components the step reads
 //!   ([`physics::PdController`], [`physics::JointLimits`], [`physics::FloorContact`],
-//!   [`physics::ExternalForces`]); its pose reaches the same joint state.
+//!   [`physics::ExternalForces`]); its pose reaches the same joint state;
+//! - physical characters (active ragdolls, [`character`]): both at once, a primitive player
+//!   whose pose is the PD target of the simulated body, with root assistance and reactions to
+//!   pushes.
 //!
 //! One [`Clock`] per World (a tick per schedule run, physics substeps inside it) and one
 //! hierarchy of sets, [`MotionSet`], that a user orders their own systems against. Each domain
@@ -17,6 +20,7 @@
 //! [`physics::add_physics_systems`]. A World holds one experiment and is `Send`; a
 //! [`WorldPool`] runs many in parallel, each with its own seeded generator.
 
+pub mod character;
 mod clock;
 mod dof_pose;
 mod motion;

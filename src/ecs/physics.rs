@@ -15,6 +15,7 @@ use std::sync::Arc;
 use bevy_ecs::prelude::*;
 use glam::{DQuat, DVec3};
 
+use super::character::RootAssist;
 use super::clock::Clock;
 use super::motion::{Character, JointState, Recorder, SkeletonRef};
 use super::sets::{MotionSet, configure_motion_sets};
@@ -160,23 +161,38 @@ type StepQuery<'a> = (
     &'a mut PhysicsWorkspace,
     &'a mut PhysicsMonitor,
     &'a mut PhysicsStatus,
+    Option<&'a RootAssist>,
 );
 
 /// Steps every running body by the clock's substeps of `tick / substeps` seconds; an error
 /// stops that body (recorded in its [`PhysicsStatus`]) and no other.
-pub fn step_bodies(clock: Res<Clock>, mut q: Query<StepQuery>) {
+///
+/// A character's [`RootAssist`] joins its external forces for the tick.
+pub fn step_bodies(
+    clock: Res<Clock>,
+    mut scratch: Local<Vec<ExternalForce>>,
+    mut q: Query<StepQuery>,
+) {
     let dt = clock.physics_dt();
-    for (body, mut state, pd, limits, contact, external, mut ws, mut monitor, mut status) in &mut q
+    for (body, mut state, pd, limits, contact, external, mut ws, mut monitor, mut status, assist) in
+        &mut q
     {
         if !status.running() {
             continue;
+        }
+        let mut external = external.map_or(&[][..], |e| &e.0[..]);
+        if let Some(f) = assist.and_then(RootAssist::external) {
+            scratch.clear();
+            scratch.extend_from_slice(external);
+            scratch.push(f);
+            external = &scratch[..];
         }
         let forces = Forces {
             dofs: &body.body.dof_v,
             pd: pd.map(|p| &p.0),
             limits: limits.map(|l| &l.0),
             contact: contact.map(|c| &*c.0),
-            external: external.map_or(&[], |e| &e.0[..]),
+            external,
         };
         let settings = StepSettings {
             integrator: body.integrator,

@@ -7,8 +7,12 @@
 //! [`MotionSet::Kinematics`] (global transforms) → [`MotionSet::Record`] → [`MotionSet::Clock`].
 //!
 //! A user's own systems go in or between them (`.after(MotionSet::Animate)
-//! .before(MotionSet::Control)`), and sub-sets such as
-//! [`PrimitiveSet`](super::primitive::PrimitiveSet) order systems inside one of them.
+//! .before(MotionSet::Control)`), and sub-sets order systems inside one of them:
+//! [`PrimitiveSet`](super::primitive::PrimitiveSet) (players → blends) inside `Animate`,
+//! [`ControlSet`](super::character::ControlSet) (PD targets from the primitives → reactions to
+//! pushes → root assistance) inside `Control`. Joint limits, floor contact and the dynamics are
+//! the stages of one physics step ([`crate::dynamics::pipeline`]), evaluated at every
+//! integrator stage, so they run inside `Physics` as one system.
 
 use bevy_ecs::prelude::*;
 

@@ -1,6 +1,6 @@
 //! What the editor's server holds: the [`Edit`] (pins, per-bar search, undo/redo), the song
-//! (samples, beats, bars), the database's transition table (built once, so that Generate is a
-//! path search only), the last fill, and the scene file it saves to.
+//! (samples, beats, bars), the last fill, and the scene file it saves to. The edit keeps the
+//! database's transition table from the first Generate on, so later ones are a path search only.
 //!
 //! Every method answers bad input with an [`EditorError`], never a panic; the server keeps one
 //! `Session` behind a `Mutex`.
@@ -15,10 +15,8 @@ use super::scene::{EditScene, SongSource, resolve};
 use crate::choreo::dance::{DanceParams, assemble};
 use crate::choreo::database::Database;
 use crate::choreo::edit::Edit;
-use crate::choreo::fill::{Fill, fill_dp_with_table};
+use crate::choreo::fill::Fill;
 use crate::choreo::music::{MusicParams, analyze, synth::synthesize};
-use crate::choreo::segments::Segment;
-use crate::choreo::transition::TransitionTable;
 use crate::humanoid::{Model, ModelClip, humanoid24};
 
 /// The song the edit dances to.
@@ -37,7 +35,6 @@ pub struct Song {
 /// The editor's state (module docs).
 pub struct Session {
     edit: Edit,
-    table: TransitionTable,
     scene: EditScene,
     scene_path: PathBuf,
     song: Song,
@@ -80,8 +77,7 @@ impl Session {
         scene: EditScene,
         scene_path: PathBuf,
     ) -> Result<Session, EditorError> {
-        let table = TransitionTable::new(&db, &scene.fill.transition)?;
-        let mut edit = Edit::new(db, bars, scene.search.clone())?;
+        let mut edit = Edit::new(db, bars, scene.search.clone(), scene.fill.clone())?;
         for (&bar, &seg) in &scene.pins {
             edit.set(bar, seg)?;
         }
@@ -91,7 +87,6 @@ impl Session {
         let edit = Edit::with_index(edit.database().clone(), edit.index().clone(), state)?;
         Ok(Session {
             edit,
-            table,
             scene,
             scene_path,
             song,
@@ -169,16 +164,10 @@ impl Session {
     }
 
     /// Generate: every unpinned bar filled by the minimum-cost path through the pins
-    /// ([`crate::choreo::fill::fill_dp`], the exact DP, on the prepared transition table).
+    /// ([`Edit::generate`]: the exact DP on the edit's transition table, built at the first
+    /// Generate and kept).
     pub fn generate(&mut self) -> Result<&Fill, EditorError> {
-        let bars = self.edit.bars().len();
-        let f = fill_dp_with_table(
-            self.edit.database(),
-            &self.table,
-            bars,
-            self.edit.pins(),
-            &self.scene.fill,
-        )?;
+        let f = self.edit.generate()?;
         Ok(self.fill.insert(f))
     }
 

@@ -2,6 +2,8 @@
 //! typed outcome out, no files and no pictures (a scene file is only the front door that reads a
 //! configuration, calls one of these and writes its outputs).
 //!
+//! - [`active`]: a physical character that plays primitives under PD control with root
+//!   assistance, is pushed and falls (issue 13);
 //! - [`fall`]: the falling paper's pushed figure (SPEC §3), one fall or many in parallel Worlds;
 //! - [`evolve_fall`]: the falling paper's GA over both age groups and several seeds (§5–6);
 //! - [`high_jump`]: the motor-primitive paper's high jump by extrapolation (§4.1);
@@ -11,6 +13,7 @@
 //! - [`dance_fill`]: the dance-editing paper's Fig. 5, connection-aware against connection-blind
 //!   fill over random pin sets.
 
+pub mod active;
 pub mod dance_feedback;
 pub mod dance_fill;
 pub mod evolve_fall;

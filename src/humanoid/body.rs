@@ -1,19 +1,27 @@
-//! The fall21 human as an articulated body: the joint tree, DOF names, axes and offsets of
-//! [`crate::humanoid::fall21`] (scaled to the subject's height), with segment masses, centres of mass
-//! and inertias from **de Leva (1996)**, *Adjustments to Zatsiorsky–Seluyanov's segment inertia
-//! parameters*, J. Biomech. 29(9):1223–1230, Table 4 (males: stature 1741 mm, 73.0 kg), scaled
-//! to the subject's mass `M` (`m_i = μ_i M`). Segment lengths `ℓ_i` come from the figure's own joint
-//! positions (the waist → hip line for the lower trunk, neck → waist for the upper and middle
-//! trunk in de Leva's proportions, joint to joint along the limbs, the head's end site for
+//! A humanoid model as an articulated body: the joint tree, DOF names, axes and offsets of a
+//! [`figure::Model`] ([`crate::humanoid::fall21`], [`crate::humanoid::humanoid24`], or any model
+//! with the same link names), scaled to the subject's height, with segment masses, centres of
+//! mass and inertias from **de Leva (1996)**, *Adjustments to Zatsiorsky–Seluyanov's segment
+//! inertia parameters*, J. Biomech. 29(9):1223–1230, Table 4 (males: stature 1741 mm, 73.0 kg),
+//! scaled to the subject's mass `M` (`m_i = μ_i M`). Segment lengths `ℓ_i` come from the figure's
+//! own joint positions (the waist → hip line for the lower trunk, neck → waist for the upper and
+//! middle trunk in de Leva's proportions, joint to joint along the limbs, the head's end site for
 //! head + neck), so neighbouring segments meet at their joints and never overlap; only hand and
 //! foot, whose end points are not joints, keep de Leva's lengths scaled by `H / 1.741`. Centres
 //! of mass sit at the table's fraction of `ℓ_i`, inertias are `I = m (r ℓ)²` with the table's radii
 //! of gyration about the sagittal, transverse and longitudinal axes (see [`segment`] for how
 //! they map onto link axes).
 //!
-//! The 15 links: pelvis (de Leva's lower trunk), torso (upper + middle trunk), head (head + neck),
-//! and per side upper arm, forearm, hand, thigh, shank, foot. Each link also carries a box for
-//! floor contact (SPEC §3: "a box on each link").
+//! Links by name (a `left_`/`right_` prefix is ignored): `pelvis` (de Leva's lower trunk),
+//! `torso` or `chest` (upper + middle trunk), `head` (head + neck), `clavicle` (the shoulder
+//! girdle, which de Leva counts in the upper trunk: see [`CLAVICLE_SHARE`]), and per side
+//! `upper_arm`, `forearm`, `hand`, `thigh`, `shin`, `foot`. Joint types follow the model's
+//! joints: free (the pelvis), ball, universal, pin, and fixed (humanoid24's neck, wrists and
+//! ankles: the link is welded to its parent). Each link also carries a box for floor contact
+//! (SPEC §3: "a box on each link").
+//!
+//! fall21 (15 links, 21 DOF) is the falling paper's body ([`fall21_body`]); humanoid24 (17
+//! links, 24 DOF, the motor-primitive model) gets a body the same way ([`humanoid24_body`]).
 
 use crate::dynamics::forces::contact::LinkBox;
 use crate::dynamics::joint::JointType;
@@ -23,16 +31,17 @@ use crate::humanoid::anthropometry::*;
 use crate::humanoid::{self as figure, JointKind};
 use glam::{DMat3, DVec3};
 
-/// The fall21 human ready to simulate.
+/// A human ready to simulate.
 #[derive(Clone, Debug)]
 pub struct HumanBody {
-    /// The articulated body (bodies = fall21 joints/links in the same order; body 0 = pelvis).
+    /// The articulated body (bodies = the figure's joints/links in the same order; body 0 =
+    /// pelvis).
     pub model: Model,
     /// The figure model it was built from, scaled to the subject's height.
     pub figure: figure::Model,
     /// Contact box of each link.
     pub boxes: Vec<LinkBox>,
-    /// For each fall21 DOF (model order), its index in the velocity vector `v`.
+    /// For each figure DOF (model order), its index in the velocity vector `v`.
     pub dof_v: Vec<usize>,
     /// Link names in body order.
     pub link_names: Vec<String>,
@@ -53,12 +62,15 @@ pub enum HumanError {
         /// Upper bound.
         hi: f64,
     },
-    /// The figure model has a joint kind the dynamics does not support here.
-    #[error("joint '{0}' is Fixed; the fall21 dynamics expects movable joints only")]
-    FixedJoint(String),
     /// The figure model has a link this body has no anthropometric row for.
-    #[error("link '{0}' is not a fall21 link (no anthropometric data)")]
+    #[error(
+        "link '{0}' has no anthropometric data (expected pelvis, torso, chest, head, clavicle, \
+         upper_arm, forearm, hand, thigh, shin or foot)"
+    )]
     UnknownLink(String),
+    /// The figure model is not a floating-base tree rooted at the pelvis.
+    #[error("the figure's root joint '{0}' must be a free joint (the pelvis as floating base)")]
+    Root(String),
     /// The assembled tree is invalid.
     #[error(transparent)]
     Model(#[from] ModelError),
@@ -119,9 +131,45 @@ fn combine(a: Inertia, b: Inertia) -> Inertia {
     Inertia::new(m, c, shift(&a) + shift(&b))
 }
 
+/// Share of de Leva's upper trunk carried by each clavicle link (the shoulder girdle: clavicle,
+/// scapula and the muscles between them and the trunk), 5 %: a modelling choice, since de Leva's
+/// table has no girdle segment. The chest keeps the rest, so the masses still sum to `M`.
+pub const CLAVICLE_SHARE: f64 = 0.05;
+
+/// Inertia of a slender cylinder of mass `m` (kg), length `len` (m) and radius `r` (m) from `p0`
+/// along the unit `dir`: `I = m(ℓ²/12 + r²/4)(1 − d dᵀ) + (m r²/2) d dᵀ` about its centre.
+fn rod(m: f64, len: f64, r: f64, p0: DVec3, dir: DVec3) -> Inertia {
+    let dd = crate::dynamics::spatial::outer(dir, dir);
+    let perp = m * (len * len / 12.0 + r * r / 4.0);
+    let axial = 0.5 * m * r * r;
+    Inertia::new(
+        m,
+        p0 + dir * (0.5 * len),
+        (DMat3::IDENTITY - dd) * perp + dd * axial,
+    )
+}
+
 /// Builds the fall21 human of standing height `height` (m) and mass `mass` (kg) under gravity
 /// `(0, −g, 0)`.
 pub fn fall21_body(height: f64, mass: f64, g: f64) -> Result<HumanBody, HumanError> {
+    human_body(&figure::fall21(), height, mass, g)
+}
+
+/// Builds the humanoid24 human (the motor-primitive model) of standing height `height` (m) and
+/// mass `mass` (kg) under gravity `(0, −g, 0)`.
+pub fn humanoid24_body(height: f64, mass: f64, g: f64) -> Result<HumanBody, HumanError> {
+    human_body(&figure::humanoid24(), height, mass, g)
+}
+
+/// Builds the articulated body of `model` (a figure whose root is a free pelvis and whose links
+/// are named as in the module doc) for a subject of standing height `height` (m) and mass `mass`
+/// (kg) under gravity `(0, −g, 0)`.
+pub fn human_body(
+    model: &figure::Model,
+    height: f64,
+    mass: f64,
+    g: f64,
+) -> Result<HumanBody, HumanError> {
     if !(1.0..=2.3).contains(&height) {
         return Err(HumanError::Subject {
             what: "height_m",
@@ -138,7 +186,18 @@ pub fn fall21_body(height: f64, mass: f64, g: f64) -> Result<HumanBody, HumanErr
             hi: 200.0,
         });
     }
-    let fig = figure::fall21().scaled_to_height(height);
+    if let Some(root) = model.joints.first()
+        && root.kind != JointKind::Free
+    {
+        return Err(HumanError::Root(root.name.clone()));
+    }
+    let fig = model.scaled_to_height(height);
+    // The girdle's mass comes out of the upper trunk (see [`CLAVICLE_SHARE`]).
+    let clavicles = fig
+        .joints
+        .iter()
+        .filter(|j| j.link.ends_with("clavicle"))
+        .count() as f64;
     let h = height;
     let down = -DVec3::Y;
     let mut bodies = Vec::with_capacity(fig.joints.len());
@@ -170,7 +229,7 @@ pub fn fall21_body(height: f64, mass: f64, g: f64) -> Result<HumanBody, HumanErr
                     },
                 )
             }
-            "torso" => {
+            "torso" | "chest" => {
                 // Upper trunk (cervicale → xiphion) over middle trunk (xiphion → omphalion),
                 // filling the waist → neck span in de Leva's proportions.
                 let neck = child_offset("neck").unwrap_or(DVec3::new(0.0, 0.23 * h, 0.0));
@@ -179,7 +238,11 @@ pub fn fall21_body(height: f64, mass: f64, g: f64) -> Result<HumanBody, HumanErr
                     table_length(&DE_LEVA_MIDDLE_TRUNK, h),
                 );
                 let scale = neck.y / (lu + lm);
-                let upt = segment(&DE_LEVA_UPPER_TRUNK, mass, lu * scale, neck, down, 1);
+                let mut upt = segment(&DE_LEVA_UPPER_TRUNK, mass, lu * scale, neck, down, 1);
+                if clavicles > 0.0 {
+                    let keep = 1.0 - CLAVICLE_SHARE * clavicles;
+                    upt = Inertia::new(upt.mass * keep, upt.com, upt.inertia_com * keep);
+                }
                 let mpt = segment(
                     &DE_LEVA_MIDDLE_TRUNK,
                     mass,
@@ -206,6 +269,20 @@ pub fn fall21_body(height: f64, mass: f64, g: f64) -> Result<HumanBody, HumanErr
                     LinkBox {
                         center: DVec3::new(0.0, top.y * 0.5, 0.01 * h),
                         half: DVec3::new(0.045 * h, top.y * 0.5, 0.055 * h),
+                    },
+                )
+            }
+            "clavicle" => {
+                // A slender rod from the sterno-clavicular joint to the shoulder, as thick as
+                // the upper arm's box.
+                let end = child_offset("shoulder").unwrap_or(DVec3::new(0.11 * h, 0.0, 0.0));
+                let len = end.length();
+                let m = CLAVICLE_SHARE * DE_LEVA_UPPER_TRUNK.mass_pct / 100.0 * mass;
+                (
+                    rod(m, len, 0.025 * h, DVec3::ZERO, end / len),
+                    LinkBox {
+                        center: end * 0.5,
+                        half: DVec3::new(end.x.abs() * 0.5, 0.025 * h, 0.025 * h),
                     },
                 )
             }
@@ -272,7 +349,7 @@ pub fn fall21_body(height: f64, mass: f64, g: f64) -> Result<HumanBody, HumanErr
                 axis2: axes[1],
             },
             JointKind::Pin => JointType::Pin { axis: axes[0] },
-            JointKind::Fixed => return Err(HumanError::FixedJoint(j.name.clone())),
+            JointKind::Fixed => JointType::Fixed,
         };
         let x_tree = if j.parent.is_some() {
             SpatialTransform::translation(j.offset)
@@ -467,5 +544,85 @@ mod tests {
         let mut seen = b.dof_v.clone();
         seen.sort();
         assert_eq!(seen, (6..27).collect::<Vec<_>>());
+    }
+
+    #[test]
+    fn humanoid24_gets_a_body_like_fall21() {
+        let b = humanoid24_body(1.70, 65.0, 9.81).unwrap();
+        // 17 links: the fixed neck, wrists and ankles weld head, hands and feet to their parents.
+        assert_eq!(b.model.nbodies(), 17);
+        assert_eq!(b.model.nv, 6 + 24);
+        assert_eq!(b.dof_v.len(), 24);
+        assert!(
+            (b.model.total_mass() - 65.0).abs() < 1e-9,
+            "{}",
+            b.model.total_mass()
+        );
+        for link in ["head", "left_hand", "right_foot"] {
+            let i = b.link_index(link).unwrap();
+            assert_eq!(b.model.bodies[i].joint, JointType::Fixed, "{link}");
+        }
+        // Every velocity DOF past the root is one humanoid24 DOF, exactly once.
+        let mut seen = b.dof_v.clone();
+        seen.sort();
+        assert_eq!(seen, (6..30).collect::<Vec<_>>());
+        // The limbs are de Leva's, as on fall21: the same segment masses and inertias.
+        let f = fall21_body(1.70, 65.0, 9.81).unwrap();
+        for link in [
+            "pelvis",
+            "head",
+            "right_thigh",
+            "left_shin",
+            "right_foot",
+            "left_hand",
+        ] {
+            let (x, y) = (
+                &b.model.bodies[b.link_index(link).unwrap()].inertia,
+                &f.model.bodies[f.link_index(link).unwrap()].inertia,
+            );
+            assert!((x.mass - y.mass).abs() < 1e-12, "{link}");
+            assert!(
+                (x.inertia_com - y.inertia_com).abs_diff_eq(DMat3::ZERO, 1e-12),
+                "{link}"
+            );
+        }
+        // The chest gives the girdle its share: chest + 2 clavicles = fall21's torso.
+        let chest = b.model.bodies[b.link_index("chest").unwrap()].inertia.mass;
+        let clav = b.model.bodies[b.link_index("left_clavicle").unwrap()]
+            .inertia
+            .mass;
+        let torso = f.model.bodies[f.link_index("torso").unwrap()].inertia.mass;
+        assert!((chest + 2.0 * clav - torso).abs() < 1e-9);
+        assert!(clav > 0.0 && clav < 0.02 * 65.0);
+    }
+
+    #[test]
+    fn humanoid24_inertia_axes_follow_de_leva() {
+        // Same axis assignment as fall21: the chest (trunk) has more inertia about Z (its
+        // sagittal radius) than about X; the thigh's longitudinal moment (Y) is the smallest.
+        let b = humanoid24_body(1.70, 65.0, 9.81).unwrap();
+        let d = |link: &str| {
+            let ic = b.model.bodies[b.link_index(link).unwrap()]
+                .inertia
+                .inertia_com;
+            [ic.x_axis.x, ic.y_axis.y, ic.z_axis.z]
+        };
+        let chest = d("chest");
+        assert!(chest[2] > chest[0], "{chest:?}");
+        let thigh = d("right_thigh");
+        assert!(thigh[1] < thigh[0] && thigh[1] < thigh[2], "{thigh:?}");
+        // The clavicle rod lies along X: least inertia about its own axis.
+        let c = d("right_clavicle");
+        assert!(c[0] < c[1] && c[0] < c[2], "{c:?}");
+    }
+
+    #[test]
+    fn a_figure_without_a_free_root_is_refused() {
+        let mut m = figure::humanoid24();
+        m.joints[0].kind = JointKind::Fixed;
+        assert!(matches!(
+            human_body(&m, 1.7, 65.0, 9.81),
+            Err(HumanError::Root(_))
+        ));
     }
 }

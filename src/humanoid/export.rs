@@ -40,7 +40,7 @@ fn revolutes(body: &HumanBody, b: usize) -> Vec<(String, DVec3)> {
         JointType::Pin { axis } => vec![axis],
         JointType::Universal { axis1, axis2 } => vec![axis1, axis2],
         JointType::Ball { axes } => vec![axes.x_axis, axes.y_axis, axes.z_axis],
-        JointType::Free => vec![],
+        JointType::Free | JointType::Fixed => vec![],
     };
     j.dofs
         .iter()
@@ -84,6 +84,16 @@ pub fn to_urdf(body: &HumanBody, ranges: &[(f64, f64)], strength: &[(f64, f64)])
         let offset = body.figure.joints[b].offset;
         let revs = revolutes(body, b);
         let mut from = body.model.bodies[parent].name.clone();
+        if matches!(mb.joint, JointType::Fixed) {
+            let _ = writeln!(
+                s,
+                "  <joint name=\"{}\" type=\"fixed\"><parent link=\"{from}\"/><child link=\"{}\"/>\
+                 <origin xyz=\"{}\" rpy=\"0 0 0\"/></joint>",
+                mb.joint_name,
+                mb.name,
+                v3(offset)
+            );
+        }
         for (k, (dof, axis)) in revs.iter().enumerate() {
             let last = k + 1 == revs.len();
             let to = if last {

@@ -1,4 +1,4 @@
-//! Strength: the maximal voluntary joint torque per fall21 DOF and age group, the bound on what
+//! Strength: the maximal voluntary joint torque per DOF (fall21's and humanoid24's) and age group, the bound on what
 //! PD control can ask of a joint (the dynamics clamps the PD torque to it, see
 //! [`crate::dynamics::forces::pd`]; a genetic algorithm reads it to bound its gains).
 //!
@@ -12,7 +12,10 @@
 //! paper's regression tables: check them against it before relying on a single value. Trunk and
 //! neck are not in that study; their values (trunk flexion/extension about 150/200 N·m, neck
 //! 25/40 N·m in young men) are this project's rounded reading of the dynamometry literature, with
-//! the same age decline.
+//! the same age decline. The DOFs only humanoid24 has (waist lateral bend, the clavicle's
+//! elevation and protraction, shoulder abduction and rotation about the long axis, forearm
+//! pronation, hip rotation) are likewise the project's rounded reading of that literature (adult
+//! young men; elderly about 30 % less), orders of magnitude to bound a PD controller, not data.
 //!
 //! Signs follow the DOFs' anatomical convention (positive = flexion, abduction, external
 //! rotation, dorsiflexion, lateral bend to the right, turn to the left): a DOF's range is
@@ -46,7 +49,7 @@ const fn s(dof: &'static str, an: f64, ap: f64, en: f64, ep: f64) -> Strength {
 }
 
 /// The table: per side-less fall21 DOF, (adult −, adult +, elderly −, elderly +) in N·m.
-pub const TABLE: [Strength; 13] = [
+pub const TABLE: [Strength; 20] = [
     s("waist_flexion", 200.0, 150.0, 130.0, 100.0), // extension / flexion
     s("waist_rotation", 60.0, 60.0, 40.0, 40.0),
     s("neck_flexion", 40.0, 25.0, 28.0, 18.0), // extension / flexion
@@ -60,6 +63,14 @@ pub const TABLE: [Strength; 13] = [
     s("hip_abduction", 110.0, 120.0, 75.0, 80.0), // adduction / abduction
     s("knee", 240.0, 120.0, 150.0, 75.0),         // extension / flexion
     s("ankle", 150.0, 40.0, 95.0, 28.0),          // plantar flexion / dorsiflexion
+    // humanoid24 only
+    s("waist_lateral", 120.0, 120.0, 80.0, 80.0),
+    s("clavicle_elevation", 60.0, 60.0, 42.0, 42.0), // depression / elevation
+    s("clavicle_protraction", 50.0, 50.0, 35.0, 35.0), // retraction / protraction
+    s("shoulder_abduction", 70.0, 55.0, 52.0, 41.0), // adduction / abduction
+    s("elbow_flexion", 50.0, 70.0, 38.0, 52.0),      // extension / flexion (fall21's elbow)
+    s("elbow_pronation", 8.0, 8.0, 6.0, 6.0),        // supination / pronation
+    s("hip_rotation", 50.0, 50.0, 33.0, 33.0),       // internal / external
 ];
 
 /// The strength row of a fall21 DOF (full or side-less name).
@@ -69,6 +80,29 @@ pub fn strength(dof: &str) -> Option<&'static Strength> {
         .or_else(|| dof.strip_prefix("right_"))
         .unwrap_or(dof);
     TABLE.iter().find(|r| r.dof == d)
+}
+
+/// A DOF of a model without a row in [`TABLE`].
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("DOF '{0}' has no strength row (see humanoid::strength::TABLE)")]
+pub struct NoStrength(pub String);
+
+/// The torque range `(τ_min, τ_max)` (N·m) of every DOF of `model` in model order for `group`.
+pub fn torque_limits_for(
+    model: &crate::humanoid::Model,
+    group: AgeGroup,
+) -> Result<Vec<(f64, f64)>, NoStrength> {
+    model
+        .dofs
+        .iter()
+        .map(|d| {
+            let r = strength(&d.name).ok_or_else(|| NoStrength(d.name.clone()))?;
+            Ok(match group {
+                AgeGroup::Adult => (-r.adult_negative, r.adult_positive),
+                AgeGroup::Elderly => (-r.elderly_negative, r.elderly_positive),
+            })
+        })
+        .collect()
 }
 
 /// The torque range `(τ_min, τ_max)` (N·m) of every fall21 DOF in model order for `group`.
@@ -102,5 +136,24 @@ mod tests {
         // Knee extension (negative) is the strongest lower-limb action.
         let k = crate::humanoid::fall21().dof_index("left_knee").unwrap();
         assert_eq!(a[k], (-240.0, 120.0));
+    }
+
+    #[test]
+    fn every_humanoid24_dof_has_a_limit_and_fall21_keeps_its_own() {
+        let m = crate::humanoid::humanoid24();
+        let a = torque_limits_for(&m, AgeGroup::Adult).unwrap();
+        let e = torque_limits_for(&m, AgeGroup::Elderly).unwrap();
+        assert_eq!(a.len(), 24);
+        for (x, y) in a.iter().zip(&e) {
+            assert!(x.0 < 0.0 && x.1 > 0.0 && y.0 > x.0 && y.1 < x.1);
+        }
+        let f = crate::humanoid::fall21();
+        assert_eq!(
+            torque_limits_for(&f, AgeGroup::Elderly).unwrap(),
+            torque_limits(AgeGroup::Elderly)
+        );
+        let mut bad = m.clone();
+        bad.dofs[0].name = "tail".into();
+        assert!(torque_limits_for(&bad, AgeGroup::Adult).is_err());
     }
 }

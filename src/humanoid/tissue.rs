@@ -90,7 +90,7 @@ pub fn region(link: &str) -> Option<Region> {
         .unwrap_or(link);
     Some(match l {
         "pelvis" => PELVIS,
-        "torso" => TORSO,
+        "torso" | "chest" | "clavicle" => TORSO,
         "head" => HEAD,
         "upper_arm" | "forearm" | "hand" | "thigh" | "shin" => LIMB,
         "foot" => FOOT,

@@ -6,6 +6,7 @@
 //! from the command line (`--set clip.end_s=2.5`) so a parameter can be swept without editing
 //! files.
 
+mod active;
 mod evolve;
 mod fall;
 mod output;
@@ -13,6 +14,7 @@ mod primitives;
 mod show;
 mod source;
 
+pub use active::{ActiveCharacter, ActiveKneeKickScene, run_active_knee_kick};
 pub use evolve::{EvaluatorChoice, EvolveFallScene, run_evolve};
 pub use fall::{Body, Controller, FallScene, Simulation, fall_report, run_fall};
 pub use primitives::{
@@ -40,6 +42,8 @@ pub enum Scene {
     JumpingKneeKick(Box<JumpingKneeKickScene>),
     /// The falling paper's pushed figure.
     Fall(Box<FallScene>),
+    /// The jumping knee kick played by a physical character, pushed and falling.
+    ActiveKneeKick(Box<ActiveKneeKickScene>),
     /// The falling paper's GA for both age groups over several seeds.
     EvolveFall(Box<EvolveFallScene>),
 }
@@ -120,6 +124,7 @@ impl Scene {
             Scene::HighJump(s) => &s.name,
             Scene::JumpingKneeKick(s) => &s.name,
             Scene::Fall(s) => &s.name,
+            Scene::ActiveKneeKick(s) => &s.name,
             Scene::EvolveFall(s) => &s.name,
         }
     }
@@ -130,6 +135,7 @@ impl Scene {
             Scene::HighJump(s) => s.format_version,
             Scene::JumpingKneeKick(s) => s.format_version,
             Scene::Fall(s) => s.format_version,
+            Scene::ActiveKneeKick(s) => s.format_version,
             Scene::EvolveFall(s) => s.format_version,
         }
     }
@@ -282,6 +288,54 @@ pub fn validate(scene: &Scene) -> Result<(), SceneError> {
             pictures(s.render.filmstrip_frames, s.render.gif, s.render.gif_fps)?
         }
         Scene::Fall(s) => pictures(s.render.filmstrip_frames, s.render.gif, s.render.gif_fps)?,
+        Scene::ActiveKneeKick(s) => {
+            pictures(s.render.filmstrip_frames, s.render.gif, s.render.gif_fps)?;
+            let positive = |field: &str, x: f64| {
+                if x.is_finite() && x > 0.0 {
+                    Ok(())
+                } else {
+                    Err(SceneError::Invalid(format!(
+                        "{field} is {x}, expected a positive number"
+                    )))
+                }
+            };
+            positive("dt_s", s.dt_s)?;
+            positive("duration_s", s.duration_s)?;
+            positive("character.joint_omega", s.character.joint_omega)?;
+            positive("character.assist_omega", s.character.assist_omega)?;
+            if !(0.0..=1.0).contains(&s.character.assist) {
+                return Err(SceneError::Invalid(format!(
+                    "character.assist is {}, expected 0 (none) to 1 (full)",
+                    s.character.assist
+                )));
+            }
+            if let Some(d) = s.release_delay_s
+                && !(d.is_finite() && d >= 0.0)
+            {
+                return Err(SceneError::Invalid(format!(
+                    "release_delay_s is {d}, expected ≥ 0 or None"
+                )));
+            }
+            if !(s.push.start_s.is_finite()
+                && s.push.start_s >= 0.0
+                && s.push.start_s < s.duration_s)
+            {
+                return Err(SceneError::Invalid(format!(
+                    "push.start_s is {}, expected inside the run [0, {})",
+                    s.push.start_s, s.duration_s
+                )));
+            }
+            let links = crate::humanoid::body::humanoid24_body(1.70, 65.0, 9.81)
+                .map_err(|e| SceneError::Invalid(e.to_string()))?
+                .link_names;
+            if !links.contains(&s.push.link) {
+                return Err(SceneError::Invalid(format!(
+                    "push.link '{}' is not a humanoid24 link; links: {}",
+                    s.push.link,
+                    links.join(", ")
+                )));
+            }
+        }
         Scene::EvolveFall(s) => {
             pictures(s.render.filmstrip_frames, s.render.gif, s.render.gif_fps)?
         }
@@ -307,6 +361,7 @@ pub fn run(scene: &Scene, base: &Path, out_dir: &Path) -> Result<serde_json::Val
         Scene::HighJump(s) => run_high_jump(s, base, tmp)?,
         Scene::JumpingKneeKick(s) => run_jumping_knee_kick(s, base, tmp)?,
         Scene::Fall(s) => run_fall(s, base, tmp)?,
+        Scene::ActiveKneeKick(s) => run_active_knee_kick(s, base, tmp)?,
         Scene::EvolveFall(s) => run_evolve(s, base, tmp)?,
     };
     if let Some(o) = report.as_object_mut() {

@@ -131,7 +131,7 @@ fn fit_json(l: &Learned) -> serde_json::Value {
 }
 
 /// Draws tracks of model clips: filmstrip, GIF.
-fn draw(
+pub(super) fn draw(
     tracks: &[(&str, &ModelClip)],
     render: &PrimitiveRender,
     out: &Path,
@@ -273,7 +273,7 @@ pub fn run_high_jump(
 }
 
 /// Writes a clip on the model as BVH.
-fn write_bvh(path: &Path, clip: &ModelClip) -> Result<(), SceneError> {
+pub(super) fn write_bvh(path: &Path, clip: &ModelClip) -> Result<(), SceneError> {
     write_output(
         path,
         crate::bvh::to_string(&clip.to_clip().to_bvh()).as_bytes(),
@@ -317,6 +317,22 @@ fn events_json(e: &JumpEvents) -> serde_json::Value {
     json!({ "start": e.start, "bend": e.bend, "take_off": e.take_off, "leap": e.leap, "land": e.land })
 }
 
+/// The jumping knee kick's configuration: the scene's clips loaded onto humanoid24, γs checked.
+pub(super) fn knee_kick_config(
+    scene: &JumpingKneeKickScene,
+    base: &Path,
+) -> Result<KneeKickConfig, SceneError> {
+    scene.gamma.validate()?;
+    scene.jump.gamma.validate()?;
+    let model = Model::by_name("humanoid24")?;
+    Ok(KneeKickConfig {
+        jump: high_jump_config(&scene.jump, base, &model)?,
+        kick: demo(&scene.kick, base, &model)?,
+        gamma: scene.gamma.clone(),
+        events: scene.events,
+    })
+}
+
 /// Runs the jumping-knee-kick scene ([`knee_kick::run`] on the scene's clips, then the connected
 /// sequence played in an ECS world and compared with the kernel): writes
 /// `jumping_knee_kick.bvh`, the two primitives, `filmstrip.png`, `motion.gif`, `left_knee.png`,
@@ -326,15 +342,8 @@ pub fn run_jumping_knee_kick(
     base: &Path,
     out: &Path,
 ) -> Result<serde_json::Value, SceneError> {
-    scene.gamma.validate()?;
-    scene.jump.gamma.validate()?;
     let model = Model::by_name("humanoid24")?;
-    let config = KneeKickConfig {
-        jump: high_jump_config(&scene.jump, base, &model)?,
-        kick: demo(&scene.kick, base, &model)?,
-        gamma: scene.gamma.clone(),
-        events: scene.events,
-    };
+    let config = knee_kick_config(scene, base)?;
     let kk = knee_kick::run(&config).map_err(SceneError::from)?;
     let ecs_gap = play_in_world(&model, &kk.sequence(), &kk.result_clip)?;
     let ev = &kk.events;

@@ -1,4 +1,5 @@
-//! External forces: a world-frame force applied at a point of a body during
+//! External forces: a world-frame force applied at a point of a body (and a world-frame torque)
+//! during
 //! `[start, start + duration)` ([`ExternalForce`], what the step reads), and the scene-level
 //! description of a push by link name ([`Push`]; the paper: 1000 N on the torso from the front
 //! for 0.1 s).
@@ -48,14 +49,15 @@ impl Push {
             body,
             point: self.point,
             force: self.direction.normalize_or_zero() * self.force_n,
+            torque: DVec3::ZERO,
             start_s: self.start_s,
             duration_s: self.duration_s,
         }
     }
 }
 
-/// A force `F` (world frame, N) applied at `point` (body frame, m) of body `body` while
-/// `start_s ≤ t < start_s + duration_s`.
+/// A force `F` (world frame, N) applied at `point` (body frame, m) of body `body`, plus a pure
+/// torque `T` (world frame, N·m), while `start_s ≤ t < start_s + duration_s`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ExternalForce {
     /// Body index in the model.
@@ -64,6 +66,8 @@ pub struct ExternalForce {
     pub point: DVec3,
     /// Force in world coordinates (N).
     pub force: DVec3,
+    /// Pure torque in world coordinates (N·m); zero for a push.
+    pub torque: DVec3,
     /// Start time (s).
     pub start_s: f64,
     /// Duration (s); `f64::INFINITY` for a force that stays.
@@ -77,10 +81,15 @@ impl ExternalForce {
         t >= self.start_s && t < self.start_s + self.duration_s
     }
 
-    /// The spatial force in body coordinates after kinematics: `f = Rᵀ F`, `n = p × f`.
+    /// The spatial force in body coordinates after kinematics: `f = Rᵀ F`, `n = p × f + Rᵀ T`.
     #[inline]
     pub fn body_force(&self, data: &Data) -> ForceVec {
-        ForceVec::at_point(data.rot[self.body].transpose() * self.force, self.point)
+        let rt = data.rot[self.body].transpose();
+        let mut f = ForceVec::at_point(rt * self.force, self.point);
+        if self.torque != DVec3::ZERO {
+            f.ang += rt * self.torque;
+        }
+        f
     }
 }
 

@@ -1,5 +1,6 @@
 //! PD control toward a key pose (the paper's eq. 4.1): `τ = k_p(θ_d − θ) + k_v(θ̇_d − θ̇)` per DOF,
-//! saturated at the DOF's strength: `τ ← clamp(τ, τ_min, τ_max)` (a muscle cannot give more than
+//! plus an optional feedforward torque `τ_ff` (computed-torque control: the inverse dynamics of
+//! the desired motion), saturated at the DOF's strength: `τ ← clamp(τ, τ_min, τ_max)` (a muscle cannot give more than
 //! its maximal voluntary torque; see [`crate::humanoid::strength`]). A saturated torque no
 //! longer depends on θ̇, so its velocity coefficient is 0.
 
@@ -18,6 +19,8 @@ pub struct PdTargets {
     /// Strength per DOF: the torque range `(τ_min, τ_max)` (N·m, `τ_min ≤ 0 ≤ τ_max`) the PD
     /// torque is clamped to; empty = unbounded.
     pub torque_limits: Vec<(f64, f64)>,
+    /// Feedforward torque `τ_ff` per DOF (N·m) added before the clamp; empty = none.
+    pub feedforward: Vec<f64>,
 }
 
 impl PdTargets {
@@ -30,6 +33,7 @@ impl PdTargets {
             kp,
             kv,
             torque_limits: Vec::new(),
+            feedforward: Vec::new(),
         }
     }
 
@@ -50,7 +54,7 @@ impl PdTargets {
     /// The torque (N·m) and velocity coefficient on DOF `d` at angle `theta`, rate `theta_dot`.
     #[inline]
     pub fn torque(&self, d: usize, theta: f64, theta_dot: f64) -> (f64, f64) {
-        let (tau, kv) = pd_torque(
+        let (mut tau, kv) = pd_torque(
             self.kp[d],
             self.kv[d],
             self.target[d],
@@ -58,6 +62,9 @@ impl PdTargets {
             theta,
             theta_dot,
         );
+        if let Some(ff) = self.feedforward.get(d) {
+            tau += ff;
+        }
         match self.torque_limits.get(d) {
             Some(&(_, hi)) if tau > hi => (hi, 0.0),
             Some(&(lo, _)) if tau < lo => (lo, 0.0),

@@ -1,0 +1,601 @@
+//! Physical characters (active ragdolls): one entity that both plays motor primitives and lives
+//! under physics. Its primitive player writes the [`DofPose`] (θ, θ̇ per DOF and the root
+//! channels) as for a kinematic character; in [`MotionSet::Control`] the pose becomes the PD
+//! targets of the simulated joints ([`ControlSet::Targets`]), pushes release the assistance or
+//! switch to a key pose ([`ControlSet::Reactions`]), and a root assistance ("hand of god") pulls
+//! the pelvis toward the animated root ([`ControlSet::Assist`]); the body steps in
+//! [`MotionSet::Physics`] through the one pipeline (limits, contact and dynamics are its stages,
+//! evaluated at every integrator stage, so they are not separate systems); its pose reaches the
+//! joint state in [`MotionSet::Pose`] and the [`CharacterLog`] in [`MotionSet::Record`].
+//!
+//! Root assistance, a PD on the pelvis's pose with strength `s ∈ [0, 1]` (1 = fully assisted,
+//! 0 = not at all): `F = s M (ω_a² (p_d − p) + 2ζ_a ω_a (ṗ_d − ṗ))` at the pelvis origin and
+//! `T = s I (ω_a² log(R_d Rᵀ) + 2ζ_a ω_a (ω_d − ω))`, world frame, with `M` the body's mass and
+//! `I` the mean of its composite rotational inertia about the pelvis (CRBA's root block at the
+//! start pose). `ω_d` is taken as the rate of the animated rotation vector (exact about a fixed
+//! axis, a first-order approximation otherwise).
+//!
+//! Joint torques are PD plus the computed-torque feedforward of the animated motion
+//! ([`Feedforward`]). Joint PD gains come from the body itself: `k_p = ω_j² H_kk`, `k_v = 2ζ_j ω_j H_kk` with `H_kk`
+//! the joint-space inertia (CRBA diagonal) of DOF `k` at the start pose, so every DOF tracks
+//! with the same bandwidth `ω_j`; the torques are clamped to the DOF's strength
+//! ([`crate::humanoid::strength`]).
+
+use std::sync::Arc;
+
+use bevy_ecs::prelude::*;
+use glam::{DMat3, DQuat, DVec3};
+
+use super::clock::Clock;
+use super::dof_pose::ModelBinding;
+use super::physics::{
+    BodyState, ExternalForces, FloorContact, PdController, PhysicsBody, PhysicsBundle,
+    PhysicsMonitor, PhysicsStatus, drawn_body,
+};
+use super::primitive::{DofPose, PrimitivePlayer};
+use super::sets::{MotionSet, configure_motion_sets};
+use crate::dynamics::data::Data;
+use crate::dynamics::forces::contact::{ContactModel, ContactParams};
+use crate::dynamics::forces::external::{ExternalForce, Push};
+use crate::dynamics::forces::pd::PdTargets;
+use crate::dynamics::integrator::Integrator;
+use crate::dynamics::joint::quat_log;
+use crate::dynamics::kinematics::kinematics;
+use crate::humanoid::body::HumanBody;
+use crate::humanoid::ranges::AgeGroup;
+use crate::humanoid::strength::{NoStrength, torque_limits_for};
+use crate::humanoid::tissue;
+use crate::primitive::{Primitive, PrimitiveError};
+
+/// The order of the control systems inside [`MotionSet::Control`].
+#[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum ControlSet {
+    /// DOF poses become PD targets ([`pd_targets_from_pose`]).
+    Targets,
+    /// Pushes release the assistance or switch the controller ([`react_to_pushes`]).
+    Reactions,
+    /// The root assistance's force and torque for this tick ([`root_assist`]).
+    Assist,
+}
+
+/// Marks a character whose PD targets follow its [`DofPose`] (θ_d, θ̇_d per DOF).
+#[derive(Component, Clone, Copy, Debug, Default)]
+pub struct TrackPose;
+
+/// The root assistance ("hand of god"): a PD pulling the pelvis toward the animated root pose.
+#[derive(Component, Clone, Debug, PartialEq)]
+pub struct RootAssist {
+    /// Strength `s` (1 fully assisted, 0 not at all; values in between partly).
+    pub strength: f64,
+    /// Natural frequency `ω_a` (rad/s).
+    pub omega: f64,
+    /// Damping ratio `ζ_a`.
+    pub zeta: f64,
+    /// Body mass `M` (kg).
+    pub mass_kg: f64,
+    /// Rotational inertia scale `I` (kg·m²).
+    pub inertia_kg_m2: f64,
+    /// True once released: the force is zero from then on.
+    pub released: bool,
+    /// The force (N, world) at the pelvis origin for this tick.
+    pub force: DVec3,
+    /// The torque (N·m, world) for this tick.
+    pub torque: DVec3,
+}
+
+impl RootAssist {
+    /// The assistance as the external force the step applies (none when zero).
+    pub fn external(&self) -> Option<ExternalForce> {
+        (self.force != DVec3::ZERO || self.torque != DVec3::ZERO).then_some(ExternalForce {
+            body: 0,
+            point: DVec3::ZERO,
+            force: self.force,
+            torque: self.torque,
+            start_s: 0.0,
+            duration_s: f64::INFINITY,
+        })
+    }
+}
+
+/// What a push does to the character.
+#[derive(Component, Clone, Debug, PartialEq, Default)]
+pub struct Reaction {
+    /// Seconds after the first push starts at which the assistance is released; `None` keeps
+    /// it on.
+    pub release_delay_s: Option<f64>,
+    /// A key pose (the falling paper's controller) the PD switches to at the release; `None`
+    /// keeps following the primitives.
+    pub key_pose: Option<PdTargets>,
+    /// Start of the first push (s), once one has started.
+    pub pushed_at_s: Option<f64>,
+    /// Time the assistance was released (s).
+    pub released_at_s: Option<f64>,
+}
+
+/// One tick of a character's log.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LogSample {
+    /// Time at the end of the tick (s).
+    pub time_s: f64,
+    /// Height of the pelvis origin (m).
+    pub pelvis_height_m: f64,
+    /// Animated (target) pelvis height (m).
+    pub target_pelvis_height_m: f64,
+    /// Mean over DOFs of `(θ − θ_d)²` (rad²).
+    pub mean_sq_error: f64,
+}
+
+/// Records a physical character: per tick the tracking error and pelvis heights, per DOF the
+/// peak PD torque (sampled at the end of each tick), per link the peak floor force after the
+/// first push.
+#[derive(Component, Clone, Debug, Default, PartialEq)]
+pub struct CharacterLog {
+    /// One sample per tick.
+    pub samples: Vec<LogSample>,
+    /// Per DOF the sum of `(θ − θ_d)²` over the ticks before the first push (rad²).
+    pub dof_sq_error: Vec<f64>,
+    /// Ticks summed in `dof_sq_error`.
+    pub tracked_ticks: usize,
+    /// Per DOF the largest |PD torque| (N·m).
+    pub peak_torque_nm: Vec<f64>,
+    /// Per link the largest normal floor force after the first push (N).
+    pub peak_force_after_push_n: Vec<f64>,
+    angles: Vec<f64>,
+}
+
+/// Settings of a physical character.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PhysicalSettings {
+    /// Joint PD bandwidth `ω_j` (rad/s).
+    pub joint_omega: f64,
+    /// Joint PD damping ratio `ζ_j`.
+    pub joint_zeta: f64,
+    /// Root assistance strength (1 full, 0 none).
+    pub assist: f64,
+    /// Root assistance bandwidth `ω_a` (rad/s).
+    pub assist_omega: f64,
+    /// Root assistance damping ratio.
+    pub assist_zeta: f64,
+    /// Whose strength bounds the joint torques; `None` leaves them unbounded.
+    pub strength: Option<AgeGroup>,
+    /// Integration scheme.
+    pub integrator: Integrator,
+    /// Floor contact parameters (the floor height is set from the start pose).
+    pub contact: ContactParams,
+    /// Add the computed-torque feedforward ([`Feedforward`]) to the PD.
+    pub feedforward: bool,
+    /// How far the floor lies below the start pose's lowest contact corner (m, ≥ 0; 0 = the
+    /// feet start on it).
+    pub floor_clearance_m: f64,
+}
+
+impl Default for PhysicalSettings {
+    fn default() -> Self {
+        Self {
+            joint_omega: 40.0,
+            joint_zeta: 1.0,
+            assist: 1.0,
+            assist_omega: 20.0,
+            assist_zeta: 1.0,
+            strength: Some(AgeGroup::Adult),
+            integrator: Integrator::SemiImplicitEuler {
+                implicit_damping: true,
+            },
+            contact: ContactParams::default(),
+            feedforward: true,
+            floor_clearance_m: 0.0,
+        }
+    }
+}
+
+/// Why a physical character could not be made.
+#[derive(Debug, thiserror::Error)]
+pub enum CharacterError {
+    /// The primitives do not fit the body's model.
+    #[error(transparent)]
+    Primitive(#[from] PrimitiveError),
+    /// A DOF has no strength row.
+    #[error(transparent)]
+    Strength(#[from] NoStrength),
+    /// A link has no tissue region for its contact gains.
+    #[error("link '{0}' has no tissue region (contact gains)")]
+    Tissue(String),
+    /// A setting out of range.
+    #[error("{field}: {message}")]
+    Setting {
+        /// The field.
+        field: &'static str,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+/// The body configuration and velocity of a DOF pose: the pelvis at the root channels, every
+/// joint at its DOF angles.
+pub fn pose_configuration(
+    body: &HumanBody,
+    binding: &ModelBinding,
+    pose: &DofPose,
+) -> (Vec<f64>, Vec<f64>) {
+    let angles: Vec<f64> = binding
+        .dof_columns()
+        .iter()
+        .map(|&c| pose.theta[c])
+        .collect();
+    let r = binding.root_columns();
+    let at = |k: usize| pose.theta[r[k]];
+    let rot = DQuat::from_scaled_axis(DVec3::new(at(3), at(4), at(5)));
+    let q = body.configuration(&angles, DVec3::new(at(0), at(1), at(2)), rot);
+    let mut v = vec![0.0; body.model.nv];
+    for (d, &c) in binding.dof_columns().iter().enumerate() {
+        v[body.dof_v[d]] = pose.theta_dot[c];
+    }
+    let rate = |k: usize| pose.theta_dot[r[k]];
+    let rt = DMat3::from_quat(rot).transpose();
+    let w = rt * DVec3::new(rate(3), rate(4), rate(5));
+    let lin = rt * DVec3::new(rate(0), rate(1), rate(2));
+    v[0..3].copy_from_slice(&w.to_array());
+    v[3..6].copy_from_slice(&lin.to_array());
+    (q, v)
+}
+
+/// Spawns a physical character named `name`: `body` playing `sequence` (connected) under PD
+/// control with root assistance, standing on a floor at the height of its lowest contact corner
+/// in the first pose (less the feet's static sink under half the weight each).
+pub fn spawn_physical_character(
+    world: &mut World,
+    name: &str,
+    body: Arc<HumanBody>,
+    sequence: Vec<Arc<Primitive>>,
+    settings: &PhysicalSettings,
+    reaction: Reaction,
+) -> Result<Entity, CharacterError> {
+    for (field, x) in [
+        ("joint_omega", settings.joint_omega),
+        ("assist_omega", settings.assist_omega),
+    ] {
+        if !(x.is_finite() && x > 0.0) {
+            return Err(CharacterError::Setting {
+                field,
+                message: format!("must be a positive number, found {x}"),
+            });
+        }
+    }
+    if !(settings.floor_clearance_m.is_finite() && settings.floor_clearance_m >= 0.0) {
+        return Err(CharacterError::Setting {
+            field: "floor_clearance_m",
+            message: format!("must be ≥ 0, found {}", settings.floor_clearance_m),
+        });
+    }
+    if !(0.0..=1.0).contains(&settings.assist) {
+        return Err(CharacterError::Setting {
+            field: "assist",
+            message: format!("must lie in [0, 1], found {}", settings.assist),
+        });
+    }
+    let player = PrimitivePlayer::new(sequence)?;
+    let pose = player.pose();
+    let binding = ModelBinding::new(Arc::new(body.figure.clone()), &pose.names)?;
+    let model = &body.model;
+    let masses: Vec<f64> = model.bodies.iter().map(|b| b.inertia.mass).collect();
+    let gains = body
+        .link_names
+        .iter()
+        .map(|n| {
+            tissue::region(n)
+                .map(|r| r.gains())
+                .ok_or_else(|| CharacterError::Tissue(n.clone()))
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let (q, v) = pose_configuration(&body, &binding, &pose);
+    // The floor under the lowest corner of the start pose.
+    let mut data = Data::new(model);
+    kinematics(model, &mut data, &q, &v);
+    let mut params = settings.contact;
+    let probe = ContactModel::new(&body.boxes, &masses, &gains, params);
+    let lowest = probe
+        .corners
+        .iter()
+        .enumerate()
+        .flat_map(|(i, cs)| cs.iter().map(move |&c| (i, c)))
+        .map(|(i, c)| params.floor_normal.dot(data.pos[i] + data.rot[i] * c))
+        .fold(f64::INFINITY, f64::min);
+    let weight = model.total_mass() * model.gravity.length();
+    let foot = body
+        .link_names
+        .iter()
+        .position(|n| n.ends_with("foot"))
+        .unwrap_or(0);
+    params.floor_height =
+        lowest + probe.static_sink(foot, 0.5 * weight) - settings.floor_clearance_m;
+    let contact = ContactModel::new(&body.boxes, &masses, &gains, params);
+    // Gains from the joint-space inertia at the start pose.
+    let h = crate::dynamics::crba(model, &mut data, &q).to_vec();
+    let nv = model.nv;
+    let hkk: Vec<f64> = body.dof_v.iter().map(|&k| h[k * nv + k]).collect();
+    let (w, z) = (settings.joint_omega, settings.joint_zeta);
+    let kp: Vec<f64> = hkk.iter().map(|i| w * w * i).collect();
+    let kv: Vec<f64> = hkk.iter().map(|i| 2.0 * z * w * i).collect();
+    let limits = match settings.strength {
+        Some(g) => torque_limits_for(&body.figure, g)?,
+        None => Vec::new(),
+    };
+    let targets: Vec<f64> = binding
+        .dof_columns()
+        .iter()
+        .map(|&c| pose.theta[c])
+        .collect();
+    let pd = PdTargets::hold(targets, kp, kv).with_torque_limits(limits);
+    let assist = RootAssist {
+        strength: settings.assist,
+        omega: settings.assist_omega,
+        zeta: settings.assist_zeta,
+        mass_kg: model.total_mass(),
+        inertia_kg_m2: (h[0] + h[nv + 1] + h[2 * nv + 2]) / 3.0,
+        released: false,
+        force: DVec3::ZERO,
+        torque: DVec3::ZERO,
+    };
+    let ndofs = body.dof_v.len();
+    let nlinks = model.nbodies();
+    let mut physics = PhysicsBundle::new(body.clone(), settings.integrator, q);
+    physics.state.v = v;
+    let log = CharacterLog {
+        dof_sq_error: vec![0.0; ndofs],
+        peak_torque_nm: vec![0.0; ndofs],
+        peak_force_after_push_n: vec![0.0; nlinks],
+        ..CharacterLog::default()
+    };
+    let mut entity = world.spawn((
+        drawn_body(name, &body),
+        physics,
+        (pose, player, binding, TrackPose),
+        (
+            PdController(pd),
+            FloorContact(Arc::new(contact)),
+            ExternalForces::default(),
+            assist,
+            reaction,
+            log,
+        ),
+    ));
+    if settings.feedforward {
+        entity.insert(Feedforward::default());
+    }
+    Ok(entity.id())
+}
+
+/// Pushes `entity` with `push` starting now (the body's time), e.g. from a game's input; the
+/// push's own `start_s` is replaced. Returns false when the entity is not a simulated body.
+pub fn push_now(world: &mut World, entity: Entity, push: &Push) -> bool {
+    let Some(body) = world.get::<PhysicsBody>(entity).map(|b| b.body.clone()) else {
+        return false;
+    };
+    let Some(link) = body.link_index(&push.link) else {
+        return false;
+    };
+    let Some(t) = world.get::<BodyState>(entity).map(|s| s.time_s) else {
+        return false;
+    };
+    let Some(mut forces) = world.get_mut::<ExternalForces>(entity) else {
+        return false;
+    };
+    let mut f = push.to_force(link);
+    f.start_s = t;
+    forces.push(f);
+    true
+}
+
+/// Computed-torque feedforward of a tracking character: `τ_ff = RNEA(q_d, q̇_d, q̈_d)` on the
+/// animated motion (no contact; the root's share is left to the assistance), `q̈_d` the
+/// backward difference of `q̇_d` over one tick.
+#[derive(Component, Clone, Debug, Default)]
+pub struct Feedforward {
+    previous_velocity: Option<Vec<f64>>,
+    acceleration: Vec<f64>,
+    data: Option<Data>,
+}
+
+/// What [`pd_targets_from_pose`] reads and writes.
+type TargetQuery<'a> = (
+    &'a PhysicsBody,
+    &'a ModelBinding,
+    &'a DofPose,
+    &'a mut PdController,
+    Option<&'a mut Feedforward>,
+);
+
+/// What [`react_to_pushes`] reads and writes.
+type ReactionQuery<'a> = (
+    &'a BodyState,
+    &'a ExternalForces,
+    &'a mut Reaction,
+    Option<&'a mut RootAssist>,
+    Option<&'a mut PdController>,
+);
+
+/// Copies every tracking character's DOF pose into its PD targets (θ_d and θ̇_d per DOF) and,
+/// with a [`Feedforward`], the inverse dynamics of the animated motion into its feedforward.
+pub fn pd_targets_from_pose(clock: Res<Clock>, mut q: Query<TargetQuery, With<TrackPose>>) {
+    for (body, binding, pose, mut pd, ff) in &mut q {
+        let pd = &mut pd.0;
+        for (d, &c) in binding.dof_columns().iter().enumerate() {
+            pd.target[d] = pose.theta[c];
+            pd.target_velocity[d] = pose.theta_dot[c];
+        }
+        let Some(mut ff) = ff else { continue };
+        let b = &*body.body;
+        let (q_d, v_d) = pose_configuration(b, binding, pose);
+        let ff = &mut *ff;
+        ff.acceleration.resize(v_d.len(), 0.0);
+        if let Some(prev) = &ff.previous_velocity {
+            for ((a, v), p) in ff.acceleration.iter_mut().zip(&v_d).zip(prev) {
+                *a = (v - p) / clock.tick_s;
+            }
+        }
+        let data = ff.data.get_or_insert_with(|| Data::new(&b.model));
+        let f_ext = vec![crate::dynamics::spatial::ForceVec::ZERO; b.model.nbodies()];
+        let tau = crate::dynamics::rnea(&b.model, data, &q_d, &v_d, &ff.acceleration, &f_ext);
+        pd.feedforward.clear();
+        pd.feedforward.extend(b.dof_v.iter().map(|&k| tau[k]));
+        ff.previous_velocity = Some(v_d);
+    }
+}
+
+/// Notes the first push of every reacting character and, `release_delay_s` after it, releases
+/// its assistance and (if given) switches its PD to the key pose.
+pub fn react_to_pushes(mut q: Query<ReactionQuery>) {
+    for (state, forces, mut reaction, assist, pd) in &mut q {
+        let t = state.time_s;
+        if reaction.pushed_at_s.is_none() {
+            reaction.pushed_at_s = forces
+                .iter()
+                .filter(|f| f.start_s <= t)
+                .map(|f| f.start_s)
+                .reduce(f64::min);
+        }
+        let (Some(p), Some(delay)) = (reaction.pushed_at_s, reaction.release_delay_s) else {
+            continue;
+        };
+        if t + 1e-12 >= p + delay {
+            if reaction.released_at_s.is_none() {
+                reaction.released_at_s = Some(t);
+            }
+            if let Some(mut a) = assist {
+                a.released = true;
+            }
+            if let (Some(key), Some(mut pd)) = (&reaction.key_pose, pd) {
+                pd.0.clone_from(key);
+            }
+        }
+    }
+}
+
+/// The root assistance's force and torque for this tick from the body's pelvis at the tick
+/// start and the animated root (see the module doc).
+pub fn root_assist(mut q: Query<(&BodyState, &ModelBinding, &DofPose, &mut RootAssist)>) {
+    for (state, binding, pose, mut a) in &mut q {
+        if a.released || a.strength == 0.0 {
+            a.force = DVec3::ZERO;
+            a.torque = DVec3::ZERO;
+            continue;
+        }
+        let r = binding.root_columns();
+        let th = |k: usize| pose.theta[r[k]];
+        let rate = |k: usize| pose.theta_dot[r[k]];
+        let qs = &state.q;
+        let p = DVec3::new(qs[0], qs[1], qs[2]);
+        let rot = DQuat::from_xyzw(qs[3], qs[4], qs[5], qs[6]);
+        let v = &state.v;
+        let w_world = rot * DVec3::new(v[0], v[1], v[2]);
+        let v_world = rot * DVec3::new(v[3], v[4], v[5]);
+        let (om, z, s) = (a.omega, a.zeta, a.strength);
+        let (kp, kd) = (om * om, 2.0 * z * om);
+        let p_d = DVec3::new(th(0), th(1), th(2));
+        let v_d = DVec3::new(rate(0), rate(1), rate(2));
+        a.force = s * a.mass_kg * (kp * (p_d - p) + kd * (v_d - v_world));
+        let rot_d = DQuat::from_scaled_axis(DVec3::new(th(3), th(4), th(5)));
+        let e = quat_log(rot_d * rot.inverse());
+        let w_d = DVec3::new(rate(3), rate(4), rate(5));
+        a.torque = s * a.inertia_kg_m2 * (kp * e + kd * (w_d - w_world));
+    }
+}
+
+/// Logs every physical character after its step (see [`CharacterLog`]).
+#[allow(clippy::type_complexity)]
+pub fn log_characters(
+    mut q: Query<(
+        &PhysicsBody,
+        &BodyState,
+        &PhysicsMonitor,
+        &PdController,
+        &ModelBinding,
+        &DofPose,
+        &Reaction,
+        &mut CharacterLog,
+    )>,
+) {
+    for (body, state, monitor, pd, binding, pose, reaction, mut log) in &mut q {
+        let b = &*body.body;
+        let log = &mut *log;
+        log.angles.resize(b.model.nv, 0.0);
+        b.model.angles(&state.q, &mut log.angles);
+        let before_push = reaction.pushed_at_s.is_none_or(|p| state.time_s <= p);
+        let mut sum = 0.0;
+        for (d, &c) in binding.dof_columns().iter().enumerate() {
+            let k = b.dof_v[d];
+            let e = log.angles[k] - pose.theta[c];
+            sum += e * e;
+            if before_push {
+                log.dof_sq_error[d] += e * e;
+            }
+            let (tau, _) = pd.torque(d, log.angles[k], state.v[k]);
+            log.peak_torque_nm[d] = log.peak_torque_nm[d].max(tau.abs());
+        }
+        if before_push {
+            log.tracked_ticks += 1;
+        }
+        if reaction.pushed_at_s.is_some() && !before_push {
+            for (peak, f) in log
+                .peak_force_after_push_n
+                .iter_mut()
+                .zip(&monitor.sample.normal)
+            {
+                *peak = peak.max(*f);
+            }
+        }
+        let n = binding.dof_columns().len().max(1) as f64;
+        log.samples.push(LogSample {
+            time_s: state.time_s,
+            pelvis_height_m: state.q[1],
+            target_pelvis_height_m: pose.theta[binding.root_columns()[1]],
+            mean_sq_error: sum / n,
+        });
+    }
+}
+
+/// Adds the physical-character systems to `schedule`: [`ControlSet::Targets`] →
+/// [`ControlSet::Reactions`] → [`ControlSet::Assist`] inside [`MotionSet::Control`], and
+/// [`log_characters`] in [`MotionSet::Record`]. The primitive and physics systems come from
+/// their own helpers.
+pub fn add_character_systems(schedule: &mut Schedule) {
+    configure_motion_sets(schedule);
+    schedule.configure_sets(
+        (
+            ControlSet::Targets,
+            ControlSet::Reactions,
+            ControlSet::Assist,
+        )
+            .chain()
+            .in_set(MotionSet::Control),
+    );
+    schedule.add_systems((
+        pd_targets_from_pose.in_set(ControlSet::Targets),
+        react_to_pushes.in_set(ControlSet::Reactions),
+        root_assist.in_set(ControlSet::Assist),
+        log_characters.in_set(MotionSet::Record),
+    ));
+}
+
+/// The schedule of physical characters: core sets and clock, motion (forward kinematics,
+/// recording), primitive players, the character systems and physics.
+pub fn character_schedule() -> Schedule {
+    let mut s = Schedule::default();
+    add_all_character_systems(&mut s);
+    s
+}
+
+/// Adds everything [`character_schedule`] holds to `schedule` (e.g. a game's fixed-timestep
+/// schedule): core sets and clock, motion, primitive, character and physics systems.
+pub fn add_all_character_systems(schedule: &mut Schedule) {
+    super::add_core_systems(schedule);
+    super::add_motion_systems(schedule);
+    super::primitive::add_primitive_systems(schedule);
+    add_character_systems(schedule);
+    super::physics::add_physics_systems(schedule);
+}
+
+/// True while the character's body steps.
+pub fn running(world: &World, e: Entity) -> bool {
+    world.get::<PhysicsStatus>(e).is_some_and(|s| s.running())
+}

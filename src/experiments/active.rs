@@ -1,0 +1,342 @@
+//! An active character: a humanoid24 body plays a sequence of motor primitives under physics
+//! (PD toward the primitives' θ_d, θ̇_d with the strength limits, root assistance of a given
+//! strength), may be pushed, and falls once its assistance is released. Plain data in and out:
+//! [`run_active`] takes an [`ActiveConfig`] and the primitives and returns an
+//! [`ActiveOutcome`] (tracking error, push, release and fall times, peak torques against the
+//! limits, the damage as in the fall experiment: `D = Σ w_i f_i` over the peak floor force of
+//! each link after the push).
+
+use std::collections::BTreeMap;
+use std::sync::Arc;
+
+use glam::DVec3;
+
+use crate::dynamics::forces::external::Push;
+use crate::ecs::character::{
+    CharacterError, CharacterLog, PhysicalSettings, Reaction, character_schedule,
+    spawn_physical_character,
+};
+use crate::ecs::physics::{BodyState, ExternalForces, PdController, PhysicsBody, PhysicsStatus};
+use crate::ecs::{Clock, Recorder};
+use crate::humanoid::ModelClip;
+use crate::humanoid::body::{HumanBody, HumanError, humanoid24_body};
+use crate::primitive::Primitive;
+
+/// The pelvis counts as fallen once its height is below this fraction of its start height.
+pub const FALLEN_FRACTION: f64 = 0.5;
+
+/// The most ticks one run may take.
+pub const MAX_TICKS: f64 = 2.0e6;
+
+/// The inputs of an active character run.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ActiveConfig {
+    /// Standing height (m).
+    pub height_m: f64,
+    /// Body mass (kg).
+    pub mass_kg: f64,
+    /// Gravity (m/s²).
+    pub gravity: f64,
+    /// PD, assistance, strength, integrator and floor.
+    pub settings: PhysicalSettings,
+    /// Physics step = tick (s).
+    pub dt_s: f64,
+    /// Simulated time (s).
+    pub duration_s: f64,
+    /// A push, if any (its `start_s` is on the motion's time line).
+    pub push: Option<Push>,
+    /// Seconds after the push at which the assistance is released; `None` keeps it.
+    pub release_delay_s: Option<f64>,
+    /// Damage weight per link (links not named weigh 1).
+    pub damage_weights: BTreeMap<String, f64>,
+    /// Frames kept per second in the outcome.
+    pub record_hz: f64,
+}
+
+impl Default for ActiveConfig {
+    fn default() -> Self {
+        Self {
+            height_m: 1.70,
+            mass_kg: 65.0,
+            gravity: 9.81,
+            settings: PhysicalSettings::default(),
+            dt_s: 5e-4,
+            duration_s: 2.0,
+            push: None,
+            release_delay_s: None,
+            damage_weights: BTreeMap::new(),
+            record_hz: 60.0,
+        }
+    }
+}
+
+/// A DOF's peak PD torque against its strength.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct TorquePeak {
+    /// DOF name.
+    pub dof: String,
+    /// Largest |τ| (N·m), sampled at the end of every tick.
+    pub peak_nm: f64,
+    /// The strength limit in that direction's larger magnitude (N·m).
+    pub limit_nm: f64,
+}
+
+/// A link's peak floor force after the push and its share of the damage.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct LinkDamage {
+    /// Link name.
+    pub link: String,
+    /// Peak normal force after the push (N).
+    pub peak_force_n: f64,
+    /// Damage weight.
+    pub weight: f64,
+}
+
+/// What an active character did.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ActiveOutcome {
+    /// Drawable points of the body (joints, then End Sites) at `record_hz`.
+    pub frames: Vec<Vec<DVec3>>,
+    /// The body's motion as a clip on its model (DOF angles and pelvis), at `record_hz`.
+    pub motion: ModelClip,
+    /// Seconds between frames.
+    pub frame_time_s: f64,
+    /// Joint-angle RMS error against the primitives over all DOFs and ticks before the push
+    /// (or the whole run without one), degrees.
+    pub tracking_rms_deg: f64,
+    /// The same per DOF, degrees.
+    pub dof_rms_deg: Vec<(String, f64)>,
+    /// Start of the push (s).
+    pub push_s: Option<f64>,
+    /// Release of the assistance (s).
+    pub release_s: Option<f64>,
+    /// First time the pelvis was below [`FALLEN_FRACTION`] of its start height (s).
+    pub fall_s: Option<f64>,
+    /// Pelvis height at the start and at the end (m).
+    pub pelvis_height_m: (f64, f64),
+    /// Largest gap between the body's and the animated pelvis height before the push (m).
+    pub max_pelvis_gap_m: f64,
+    /// Peak torques per DOF.
+    pub torques: Vec<TorquePeak>,
+    /// Peak floor force per link after the push.
+    pub links: Vec<LinkDamage>,
+    /// `D = Σ w_i f_i` (N).
+    pub damage: f64,
+    /// Pelvis height and animated pelvis height per tick, with the time (s, m, m).
+    pub pelvis_track: Vec<(f64, f64, f64)>,
+}
+
+/// Why an active run failed.
+#[derive(Debug, thiserror::Error)]
+pub enum ActiveError {
+    /// The body.
+    #[error(transparent)]
+    Body(#[from] HumanError),
+    /// The character.
+    #[error(transparent)]
+    Character(#[from] CharacterError),
+    /// A setting out of range.
+    #[error("{field}: {message}")]
+    Config {
+        /// The field.
+        field: &'static str,
+        /// What is wrong.
+        message: String,
+    },
+    /// The simulation diverged.
+    #[error(transparent)]
+    Step(#[from] crate::dynamics::pipeline::StepError),
+}
+
+fn positive(field: &'static str, x: f64) -> Result<(), ActiveError> {
+    if x.is_finite() && x > 0.0 {
+        Ok(())
+    } else {
+        Err(ActiveError::Config {
+            field,
+            message: format!("must be a positive number, found {x}"),
+        })
+    }
+}
+
+/// Runs `sequence` (connected) on a physical humanoid24 character for `config.duration_s`.
+pub fn run_active(
+    config: &ActiveConfig,
+    sequence: &[Primitive],
+) -> Result<ActiveOutcome, ActiveError> {
+    positive("dt_s", config.dt_s)?;
+    positive("duration_s", config.duration_s)?;
+    positive("record_hz", config.record_hz)?;
+    let ticks = (config.duration_s / config.dt_s).round();
+    if ticks > MAX_TICKS {
+        return Err(ActiveError::Config {
+            field: "duration_s",
+            message: format!("{ticks} ticks; at most {MAX_TICKS} are allowed"),
+        });
+    }
+    let body = Arc::new(humanoid24_body(
+        config.height_m,
+        config.mass_kg,
+        config.gravity,
+    )?);
+    let push_link = match &config.push {
+        Some(p) => Some(
+            body.link_index(&p.link)
+                .ok_or_else(|| ActiveError::Config {
+                    field: "push.link",
+                    message: format!("'{}' is not a link ({:?})", p.link, body.link_names),
+                })?,
+        ),
+        None => None,
+    };
+    let mut world = crate::ecs::new_world(Clock::physics(config.dt_s));
+    let reaction = Reaction {
+        release_delay_s: config.release_delay_s,
+        ..Reaction::default()
+    };
+    let seq = sequence.iter().cloned().map(Arc::new).collect();
+    let e = spawn_physical_character(
+        &mut world,
+        "active",
+        body.clone(),
+        seq,
+        &config.settings,
+        reaction,
+    )?;
+    if let (Some(p), Some(link)) = (&config.push, push_link) {
+        world
+            .get_mut::<ExternalForces>(e)
+            .expect("spawned with external forces")
+            .push(p.to_force(link));
+    }
+    let mut schedule = character_schedule();
+    let every = frame_stride(config);
+    let mut configurations = Vec::new();
+    for tick in 0..ticks as u64 {
+        schedule.run(&mut world);
+        if let Some(err) = world.get::<PhysicsStatus>(e).and_then(|s| s.error.clone()) {
+            return Err(ActiveError::Step((*err).clone()));
+        }
+        if (tick as usize).is_multiple_of(every) {
+            let q = &world.get::<BodyState>(e).expect("spawned with a state").q;
+            configurations.push(q.clone());
+        }
+    }
+    let log = world.get::<CharacterLog>(e).expect("log").clone();
+    let reaction = world.get::<Reaction>(e).expect("reaction").clone();
+    let rec = world.get::<Recorder>(e).expect("recorder");
+    let pd = &world.get::<PdController>(e).expect("pd").0;
+    let b = &world.get::<PhysicsBody>(e).expect("body").body;
+    let motion = body_clip(b, &configurations, every as f64 * config.dt_s);
+    Ok(outcome(config, b, pd, &log, &reaction, &rec.frames, motion))
+}
+
+/// Ticks between kept frames.
+fn frame_stride(config: &ActiveConfig) -> usize {
+    ((1.0 / config.record_hz) / config.dt_s).round().max(1.0) as usize
+}
+
+/// The body's configurations as a clip on its figure model.
+fn body_clip(body: &HumanBody, configurations: &[Vec<f64>], frame_time: f64) -> ModelClip {
+    let mut all = vec![0.0; body.model.nv];
+    let mut angles = Vec::with_capacity(configurations.len() * body.dof_v.len());
+    let mut root_translation = Vec::with_capacity(configurations.len());
+    let mut root_rotation = Vec::with_capacity(configurations.len());
+    for q in configurations {
+        body.model.angles(q, &mut all);
+        angles.extend(body.dof_v.iter().map(|&k| all[k]));
+        root_translation.push(DVec3::new(q[0], q[1], q[2]));
+        root_rotation.push(glam::DQuat::from_xyzw(q[3], q[4], q[5], q[6]));
+    }
+    ModelClip {
+        model: body.figure.clone(),
+        frame_time,
+        root_translation,
+        root_rotation,
+        angles,
+    }
+}
+
+fn outcome(
+    config: &ActiveConfig,
+    body: &HumanBody,
+    pd: &crate::dynamics::forces::pd::PdTargets,
+    log: &CharacterLog,
+    reaction: &Reaction,
+    all_frames: &[Vec<DVec3>],
+    motion: ModelClip,
+) -> ActiveOutcome {
+    let n = log.tracked_ticks.max(1) as f64;
+    let dof_rms_deg: Vec<(String, f64)> = body
+        .figure
+        .dofs
+        .iter()
+        .zip(&log.dof_sq_error)
+        .map(|(d, s)| (d.name.clone(), (s / n).sqrt().to_degrees()))
+        .collect();
+    let total: f64 = log.dof_sq_error.iter().sum();
+    let tracking_rms_deg = (total / (n * log.dof_sq_error.len().max(1) as f64))
+        .sqrt()
+        .to_degrees();
+    let start_h = log.samples.first().map_or(0.0, |s| s.pelvis_height_m);
+    let end_h = log.samples.last().map_or(0.0, |s| s.pelvis_height_m);
+    let fall_s = log
+        .samples
+        .iter()
+        .find(|s| s.pelvis_height_m < FALLEN_FRACTION * start_h)
+        .map(|s| s.time_s);
+    let before = |t: f64| reaction.pushed_at_s.is_none_or(|p| t <= p);
+    let max_pelvis_gap_m = log
+        .samples
+        .iter()
+        .filter(|s| before(s.time_s))
+        .map(|s| (s.pelvis_height_m - s.target_pelvis_height_m).abs())
+        .fold(0.0, f64::max);
+    let torques = body
+        .figure
+        .dofs
+        .iter()
+        .enumerate()
+        .map(|(d, dof)| {
+            let (lo, hi) = pd.torque_limits.get(d).copied().unwrap_or((0.0, 0.0));
+            TorquePeak {
+                dof: dof.name.clone(),
+                peak_nm: log.peak_torque_nm[d],
+                limit_nm: lo.abs().max(hi.abs()),
+            }
+        })
+        .collect();
+    let links: Vec<LinkDamage> = body
+        .link_names
+        .iter()
+        .zip(&log.peak_force_after_push_n)
+        .map(|(l, f)| LinkDamage {
+            link: l.clone(),
+            peak_force_n: *f,
+            weight: config.damage_weights.get(l).copied().unwrap_or(1.0),
+        })
+        .collect();
+    let damage = links.iter().map(|l| l.weight * l.peak_force_n).sum();
+    let every = frame_stride(config);
+    let frames = all_frames.iter().step_by(every).cloned().collect();
+    ActiveOutcome {
+        frames,
+        motion,
+        frame_time_s: every as f64 * config.dt_s,
+        tracking_rms_deg,
+        dof_rms_deg,
+        push_s: reaction.pushed_at_s,
+        release_s: reaction.released_at_s,
+        fall_s,
+        pelvis_height_m: (start_h, end_h),
+        max_pelvis_gap_m,
+        torques,
+        links,
+        damage,
+        pelvis_track: log
+            .samples
+            .iter()
+            .map(|s| (s.time_s, s.pelvis_height_m, s.target_pelvis_height_m))
+            .collect(),
+    }
+}
