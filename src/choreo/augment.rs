@@ -116,7 +116,6 @@ pub fn mirror_clip(clip: &ModelClip) -> ModelClip {
     }
 }
 
-
 /// Frames `from..from + n` of `clip`.
 fn frames(clip: &ModelClip, from: usize, n: usize) -> ModelClip {
     let d = clip.dof_count();

@@ -236,7 +236,6 @@ fn decode(path: &Path) -> Result<(Vec<f32>, u32), EditorError> {
     })
 }
 
-
 /// Every frame's drawable points of `clip`, less `origin`, in single precision.
 fn points(clip: &ModelClip, origin: DVec3) -> Frames {
     clip.to_clip()
