@@ -8,8 +8,10 @@
 //! - [`features`]: per-frame motion intensity W(f) and the features of a segment for Eros;
 //! - [`segments`]: dance clips cut into bars of 4 counts (tempo from a manifest or the kinematic
 //!   beat), each resampled, with intensity, Eros features and boundary links;
-//! - [`database`]: the segment database file and what it was built from.
+//! - [`database`]: the segment database file and what it was built from;
+//! - [`authored`]: the project's own dance, generated in code at a known tempo.
 
+pub mod authored;
 pub mod database;
 pub mod eros;
 pub mod features;
