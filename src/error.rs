@@ -50,6 +50,18 @@ pub enum Error {
     /// Dance segments and their database.
     #[error(transparent)]
     Segment(#[from] crate::choreo::segments::SegmentError),
+    /// The transition table of a dance database (link weights, boundary data).
+    #[error(transparent)]
+    Transition(#[from] crate::choreo::transition::TransitionError),
+    /// Filling the unpinned bars of a dance.
+    #[error(transparent)]
+    Fill(#[from] crate::choreo::fill::FillError),
+    /// Assembling a dance from segments at a song's bars.
+    #[error(transparent)]
+    Dance(#[from] crate::choreo::dance::DanceError),
+    /// The dance-editing paper's Fig. 5 experiment.
+    #[error(transparent)]
+    DanceFill(#[from] crate::experiments::dance_fill::DanceFillError),
     /// A data file (RON): reading, syntax, version.
     #[error(transparent)]
     File(#[from] crate::io::FileError),

@@ -9,11 +9,22 @@
 //! - [`segments`]: dance clips cut into bars of 4 counts (tempo from a manifest or the kinematic
 //!   beat), each resampled, with intensity, Eros features and boundary links;
 //! - [`database`]: the segment database file and what it was built from;
+//! - [`transition`]: the connection score S = S_pose + S_move of two segments (eqs. 5–8) and
+//!   the transition cost C = 1/S, one pair or a whole database's table;
+//! - [`fill`]: the unpinned bars filled by the minimum-cost path (Dijkstra, and the exact
+//!   dynamic programme that gives the same path);
+//! - [`dance`]: the chosen segments assembled at the song's bar timing, root carried on, seams
+//!   rewritten by cubic interpolation;
+//! - [`metrics`]: beat alignment score, seam jerk, foot skating, transition cost of a dance;
 //! - [`authored`]: the project's own dance, generated in code at a known tempo.
 
 pub mod authored;
+pub mod dance;
 pub mod database;
 pub mod eros;
 pub mod features;
+pub mod fill;
+pub mod metrics;
 pub mod music;
 pub mod segments;
+pub mod transition;

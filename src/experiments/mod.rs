@@ -5,8 +5,11 @@
 //! - [`fall`]: the falling paper's pushed figure (SPEC §3), one fall or many in parallel Worlds;
 //! - [`evolve_fall`]: the falling paper's GA over both age groups and several seeds (§5–6);
 //! - [`high_jump`]: the motor-primitive paper's high jump by extrapolation (§4.1);
-//! - [`knee_kick`]: its jumping knee kick, blended and connected (§4.2).
+//! - [`knee_kick`]: its jumping knee kick, blended and connected (§4.2);
+//! - [`dance_fill`]: the dance-editing paper's Fig. 5, connection-aware against connection-blind
+//!   fill over random pin sets.
 
+pub mod dance_fill;
 pub mod evolve_fall;
 pub mod fall;
 pub mod high_jump;

@@ -1,0 +1,612 @@
+//! Filling the bars the user did not pin (paper §3.2.1): the sequence of segments, one per bar,
+//! of minimum summed transition cost Σ C (eqs. 5–8, [`super::transition`]) through every pinned
+//! (bar, segment), before, between and after the pins.
+//!
+//! The graph is layered: layer k holds bar k's choices (every segment of the database, or only
+//! its pin), an edge joins each choice of bar k to each of bar k+1 with weight C(a → b) from the
+//! [`TransitionTable`]; with [`FillParams::no_adjacent_repeat`] the edge a → a is left out
+//! unless both bars are pinned (a repeat the user chose is kept). A source joins every choice
+//! of bar 0 and every choice of the last bar joins the sink, both with weight 0.
+//!
+//! [`fill`] runs Dijkstra's algorithm on it (a binary heap, lazy deletion) with the consistent
+//! potential h(k) = Σ_{j ≥ k} m_j, m_j the smallest weight between layers j and j+1, so that
+//! nodes are settled in the order of d + h (Dijkstra on the reduced weights w − m_j ≥ 0, A*);
+//! [`fill_dp`] is the exact dynamic programme D_{k+1}(b) = min_a D_k(a) + C(a → b), which sweeps
+//! the rows a in ascending D_k(a) and stops for a column b once D_k(a) + min_a' C(a' → b)
+//! exceeds the best D_{k+1}(b) found. Both break ties the same way (at every node the
+//! predecessor of smallest index among those of equal sum, and the end of smallest index among
+//! equal totals), so they return the same path.
+
+use std::cmp::Ordering;
+use std::collections::{BTreeMap, BinaryHeap};
+
+use serde::{Deserialize, Serialize};
+
+use super::database::Database;
+use super::transition::{
+    Connection, TransitionError, TransitionParams, TransitionTable, connection,
+};
+
+/// Pins: bar index → segment index in the database.
+pub type Pins = BTreeMap<usize, usize>;
+
+/// Largest number of bars filled (graph nodes are bars × segments).
+pub const MAX_BARS: usize = 100_000;
+
+/// How bars are filled.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FillParams {
+    /// The link weights of the connection score.
+    #[serde(default)]
+    pub transition: TransitionParams,
+    /// No filled bar takes the segment of the bar before or after it (default true).
+    #[serde(default = "yes")]
+    pub no_adjacent_repeat: bool,
+}
+
+fn yes() -> bool {
+    true
+}
+
+impl Default for FillParams {
+    /// Unit link weights, no adjacent repeat.
+    fn default() -> FillParams {
+        FillParams {
+            transition: TransitionParams::default(),
+            no_adjacent_repeat: true,
+        }
+    }
+}
+
+/// A filled dance: one segment per bar.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Fill {
+    /// The segment of every bar (pins included).
+    pub segments: Vec<usize>,
+    /// The connection of every seam, bar k → k+1 (bars − 1 of them).
+    pub connections: Vec<Connection>,
+    /// Σ C over the seams.
+    pub total_cost: f64,
+}
+
+/// Why bars could not be filled.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum FillError {
+    /// A database without segments.
+    #[error("the dance database has no segments to fill bars with")]
+    EmptyDatabase,
+    /// No bars to fill.
+    #[error("no bars to fill: the song has no bar")]
+    NoBars,
+    /// More bars than [`MAX_BARS`].
+    #[error("{bars} bars are more than the {MAX_BARS} a fill takes")]
+    TooManyBars {
+        /// The bars asked for.
+        bars: usize,
+    },
+    /// A pin on a bar past the song's end.
+    #[error("pin on bar {bar}: the song has {bars} bars (0 to {})", bars.saturating_sub(1))]
+    PinPastEnd {
+        /// The pinned bar.
+        bar: usize,
+        /// The song's bar count.
+        bars: usize,
+    },
+    /// A pin to a segment that is not in the database.
+    #[error("pin on bar {bar}: segment {segment} does not exist (the database has {segments}, 0 to {})", segments.saturating_sub(1))]
+    NoSuchSegment {
+        /// The pinned bar.
+        bar: usize,
+        /// The segment asked for.
+        segment: usize,
+        /// The database's segment count.
+        segments: usize,
+    },
+    /// No sequence satisfies the pins without an adjacent repeat.
+    #[error(
+        "no sequence of segments fills the bars: with no adjacent repeat, a filled bar needs a \
+         segment other than its neighbours' ({segments} segments in the database)"
+    )]
+    NoPath {
+        /// The database's segment count.
+        segments: usize,
+    },
+    /// The transition table could not be built.
+    #[error(transparent)]
+    Transition(#[from] TransitionError),
+}
+
+/// Checks the sizes and pins against a database of `segments` segments.
+pub fn check(segments: usize, bars: usize, pins: &Pins) -> Result<(), FillError> {
+    if segments == 0 {
+        return Err(FillError::EmptyDatabase);
+    }
+    if bars == 0 {
+        return Err(FillError::NoBars);
+    }
+    if bars > MAX_BARS {
+        return Err(FillError::TooManyBars { bars });
+    }
+    for (&bar, &segment) in pins {
+        if bar >= bars {
+            return Err(FillError::PinPastEnd { bar, bars });
+        }
+        if segment >= segments {
+            return Err(FillError::NoSuchSegment {
+                bar,
+                segment,
+                segments,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Fills `bars` bars through `pins` by Dijkstra's algorithm (module docs), building the
+/// transition table of `db` first.
+pub fn fill(db: &Database, bars: usize, pins: &Pins, p: &FillParams) -> Result<Fill, FillError> {
+    check(db.segments.len(), bars, pins)?;
+    let table = TransitionTable::new(db, &p.transition)?;
+    fill_with_table(db, &table, bars, pins, p)
+}
+
+/// Fills `bars` bars through `pins` by the exact dynamic programme (module docs), building the
+/// transition table of `db` first.
+pub fn fill_dp(db: &Database, bars: usize, pins: &Pins, p: &FillParams) -> Result<Fill, FillError> {
+    check(db.segments.len(), bars, pins)?;
+    let table = TransitionTable::new(db, &p.transition)?;
+    fill_dp_with_table(db, &table, bars, pins, p)
+}
+
+/// [`fill`] (Dijkstra) on a prepared transition table of `db` built with `p.transition`: the
+/// table depends only on the database and the weights, so an editor builds it once.
+pub fn fill_with_table(
+    db: &Database,
+    table: &TransitionTable,
+    bars: usize,
+    pins: &Pins,
+    p: &FillParams,
+) -> Result<Fill, FillError> {
+    check(table.n, bars, pins)?;
+    let g = Graph::new(table, bars, pins, p.no_adjacent_repeat);
+    let path = g
+        .dijkstra()
+        .ok_or(FillError::NoPath { segments: table.n })?;
+    Ok(finish(db, path, &p.transition))
+}
+
+/// [`fill_dp`] on a prepared transition table of `db` built with `p.transition`.
+pub fn fill_dp_with_table(
+    db: &Database,
+    table: &TransitionTable,
+    bars: usize,
+    pins: &Pins,
+    p: &FillParams,
+) -> Result<Fill, FillError> {
+    check(table.n, bars, pins)?;
+    let g = Graph::new(table, bars, pins, p.no_adjacent_repeat);
+    let path = g.dp().ok_or(FillError::NoPath { segments: table.n })?;
+    Ok(finish(db, path, &p.transition))
+}
+
+/// The fill of a path: its connections and their summed cost.
+fn finish(db: &Database, segments: Vec<usize>, p: &TransitionParams) -> Fill {
+    let connections: Vec<Connection> = segments
+        .windows(2)
+        .map(|w| connection(&db.segments[w[0]], &db.segments[w[1]], p))
+        .collect();
+    let total_cost = connections.iter().fold(0.0, |s, c| s + c.cost);
+    Fill {
+        segments,
+        connections,
+        total_cost,
+    }
+}
+
+/// The layered graph of a fill.
+struct Graph<'a> {
+    table: &'a TransitionTable,
+    bars: usize,
+    /// The pin of every bar.
+    pin: Vec<Option<usize>>,
+    no_repeat: bool,
+}
+
+impl<'a> Graph<'a> {
+    fn new(table: &'a TransitionTable, bars: usize, pins: &Pins, no_repeat: bool) -> Graph<'a> {
+        let mut pin = vec![None; bars];
+        for (&b, &s) in pins {
+            pin[b] = Some(s);
+        }
+        Graph {
+            table,
+            bars,
+            pin,
+            no_repeat,
+        }
+    }
+
+    /// Whether the edge a (bar k) → b (bar k+1) exists.
+    #[inline]
+    fn edge(&self, k: usize, a: usize, b: usize) -> bool {
+        !(self.no_repeat && a == b && (self.pin[k].is_none() || self.pin[k + 1].is_none()))
+    }
+
+    /// Whether segment s is a choice of bar k.
+    #[inline]
+    fn allowed(&self, k: usize, s: usize) -> bool {
+        self.pin[k].is_none_or(|p| p == s)
+    }
+
+    /// The smallest weight between layers k and k+1.
+    fn min_weight(&self, k: usize) -> f64 {
+        let t = self.table;
+        let n = t.n;
+        match (self.pin[k], self.pin[k + 1]) {
+            (Some(a), Some(b)) => t.cost(a, b),
+            (Some(a), None) => (0..n)
+                .filter(|&b| self.edge(k, a, b))
+                .map(|b| t.cost(a, b))
+                .fold(f64::INFINITY, f64::min),
+            (None, Some(b)) => (0..n)
+                .filter(|&a| self.edge(k, a, b))
+                .map(|a| t.cost(a, b))
+                .fold(f64::INFINITY, f64::min),
+            (None, None) if self.no_repeat => t.min_cost_off_diagonal,
+            (None, None) => t.min_cost,
+        }
+    }
+
+    /// The potential h(k) = Σ_{j ≥ k} m_j of every layer (0 at the last; +∞ once a layer pair
+    /// has no edge).
+    fn potential(&self) -> Vec<f64> {
+        let mut h = vec![0.0; self.bars];
+        for k in (0..self.bars.saturating_sub(1)).rev() {
+            h[k] = h[k + 1] + self.min_weight(k);
+        }
+        h
+    }
+
+    /// Dijkstra's algorithm with the potential (module docs); `None` without a path.
+    fn dijkstra(&self) -> Option<Vec<usize>> {
+        let (n, bars) = (self.table.n, self.bars);
+        let h = self.potential();
+        if !h[0].is_finite() {
+            return None;
+        }
+        let mut dist = vec![f64::INFINITY; n * bars];
+        let mut pred = vec![u32::MAX; n * bars];
+        let mut done = vec![false; n * bars];
+        let mut heap = BinaryHeap::new();
+        for s in (0..n).filter(|&s| self.allowed(0, s)) {
+            dist[s] = 0.0;
+            heap.push(Node {
+                f: h[0],
+                k: 0,
+                s: s as u32,
+            });
+        }
+        while let Some(Node { k, s, .. }) = heap.pop() {
+            let (k, s) = (k as usize, s as usize);
+            let u = k * n + s;
+            if done[u] {
+                continue;
+            }
+            done[u] = true;
+            if k + 1 == bars {
+                let mut path = vec![s; bars];
+                let mut v = u;
+                for kk in (1..bars).rev() {
+                    let a = pred[v] as usize;
+                    path[kk - 1] = a;
+                    v = (kk - 1) * n + a;
+                }
+                return Some(path);
+            }
+            let d = dist[u];
+            let row = self.table.row(s);
+            let next = (k + 1) * n;
+            let mut relax = |t: usize| {
+                if !self.edge(k, s, t) || done[next + t] {
+                    return;
+                }
+                let nd = d + row[t];
+                let v = next + t;
+                if nd < dist[v] {
+                    dist[v] = nd;
+                    pred[v] = s as u32;
+                    heap.push(Node {
+                        f: nd + h[k + 1],
+                        k: (k + 1) as u32,
+                        s: t as u32,
+                    });
+                } else if nd == dist[v] && (s as u32) < pred[v] {
+                    pred[v] = s as u32;
+                }
+            };
+            match self.pin[k + 1] {
+                Some(t) => relax(t),
+                None => (0..n).for_each(relax),
+            }
+        }
+        None
+    }
+
+    /// The exact dynamic programme (module docs); `None` without a path.
+    fn dp(&self) -> Option<Vec<usize>> {
+        let (n, bars) = (self.table.n, self.bars);
+        let t = self.table;
+        // Column minima of the table (with and without the diagonal), for the sweep's bound.
+        let mut colmin = vec![f64::INFINITY; n];
+        for a in 0..n {
+            for (b, (m, &c)) in colmin.iter_mut().zip(t.row(a)).enumerate() {
+                if (a != b || !self.no_repeat) && c < *m {
+                    *m = c;
+                }
+            }
+        }
+        let mut d: Vec<f64> = (0..n)
+            .map(|s| {
+                if self.allowed(0, s) {
+                    0.0
+                } else {
+                    f64::INFINITY
+                }
+            })
+            .collect();
+        let mut next = vec![f64::INFINITY; n];
+        let mut back = vec![u32::MAX; n * bars];
+        let mut order: Vec<u32> = Vec::with_capacity(n);
+        let mut open: Vec<u32> = Vec::with_capacity(n);
+        for k in 0..bars - 1 {
+            next.fill(f64::INFINITY);
+            let bk = &mut back[(k + 1) * n..(k + 2) * n];
+            match (self.pin[k], self.pin[k + 1]) {
+                (_, Some(b)) => {
+                    for (a, &da) in d.iter().enumerate() {
+                        if da.is_finite() && self.edge(k, a, b) {
+                            let c = da + t.cost(a, b);
+                            if c < next[b] {
+                                next[b] = c;
+                                bk[b] = a as u32;
+                            }
+                        }
+                    }
+                }
+                (Some(a), None) => {
+                    let row = t.row(a);
+                    for b in 0..n {
+                        if self.edge(k, a, b) {
+                            next[b] = d[a] + row[b];
+                            bk[b] = a as u32;
+                        }
+                    }
+                }
+                (None, None) => {
+                    // Rows in ascending D_k (ties by index), each column closed once no later
+                    // row can reach it: D_k(a) + colmin(b) > best(b) (a margin of 1e-12
+                    // relative covers rounding).
+                    order.clear();
+                    order.extend((0..n as u32).filter(|&a| d[a as usize].is_finite()));
+                    order.sort_by(|&x, &y| d[x as usize].total_cmp(&d[y as usize]).then(x.cmp(&y)));
+                    open.clear();
+                    open.extend(0..n as u32);
+                    for (i, &a) in order.iter().enumerate() {
+                        let a = a as usize;
+                        let da = d[a];
+                        if i % 8 == 0 {
+                            open.retain(|&b| {
+                                let b = b as usize;
+                                let bound = da + colmin[b];
+                                bound <= next[b] + 1e-12 * next[b].abs()
+                            });
+                            if open.is_empty() {
+                                break;
+                            }
+                        }
+                        let row = t.row(a);
+                        for &b in &open {
+                            let b = b as usize;
+                            if self.no_repeat && a == b {
+                                continue;
+                            }
+                            let c = da + row[b];
+                            if c < next[b] || (c == next[b] && (a as u32) < bk[b]) {
+                                next[b] = c;
+                                bk[b] = a as u32;
+                            }
+                        }
+                    }
+                }
+            }
+            std::mem::swap(&mut d, &mut next);
+        }
+        // The end of smallest total (smallest index among equal totals).
+        let mut end = None;
+        for (s, &v) in d.iter().enumerate() {
+            if v.is_finite() && end.is_none_or(|(_, b)| v < b) {
+                end = Some((s, v));
+            }
+        }
+        let (mut s, _) = end?;
+        let mut path = vec![s; bars];
+        for k in (1..bars).rev() {
+            s = back[k * n + s] as usize;
+            path[k - 1] = s;
+        }
+        Some(path)
+    }
+}
+
+/// A heap entry of Dijkstra: d + h, then the layer, then the segment, smallest first.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Node {
+    f: f64,
+    k: u32,
+    s: u32,
+}
+
+impl Eq for Node {}
+
+impl Ord for Node {
+    fn cmp(&self, o: &Node) -> Ordering {
+        // BinaryHeap is a max-heap: the smallest key is the greatest.
+        o.f.total_cmp(&self.f)
+            .then(o.k.cmp(&self.k))
+            .then(o.s.cmp(&self.s))
+    }
+}
+
+impl PartialOrd for Node {
+    fn partial_cmp(&self, o: &Node) -> Option<Ordering> {
+        Some(self.cmp(o))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::choreo::transition::TransitionTable;
+    use rand::{RngExt, SeedableRng};
+
+    /// A table of random costs (no database needed for the graph algorithms).
+    fn random_table(n: usize, seed: u64, levels: Option<u32>) -> TransitionTable {
+        let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
+        let cost: Vec<f64> = (0..n * n)
+            .map(|_| match levels {
+                // Few distinct values: many exact ties.
+                Some(l) => 1.0 + rng.random_range(0..l) as f64,
+                None => rng.random_range(0.05..2.0),
+            })
+            .collect();
+        let min_cost = cost.iter().copied().fold(f64::INFINITY, f64::min);
+        let min_cost_off_diagonal = (0..n * n)
+            .filter(|i| i / n != i % n)
+            .map(|i| cost[i])
+            .fold(f64::INFINITY, f64::min);
+        TransitionTable {
+            n,
+            beta_sum: 1.0,
+            cost,
+            min_cost,
+            min_cost_off_diagonal,
+        }
+    }
+
+    /// Every path by brute force: the cheapest total, and the paths reaching it.
+    fn brute(g: &Graph) -> Option<f64> {
+        let (n, bars) = (g.table.n, g.bars);
+        let mut best: Option<f64> = None;
+        let mut path = vec![0usize; bars];
+        loop {
+            let ok = (0..bars).all(|k| g.allowed(k, path[k]))
+                && (0..bars - 1).all(|k| g.edge(k, path[k], path[k + 1]));
+            if ok {
+                let c = (0..bars - 1).fold(0.0, |s, k| s + g.table.cost(path[k], path[k + 1]));
+                best = Some(best.map_or(c, |b: f64| b.min(c)));
+            }
+            let mut i = 0;
+            loop {
+                if i == bars {
+                    return best;
+                }
+                path[i] += 1;
+                if path[i] < n {
+                    break;
+                }
+                path[i] = 0;
+                i += 1;
+            }
+        }
+    }
+
+    fn cost_of(g: &Graph, p: &[usize]) -> f64 {
+        p.windows(2).fold(0.0, |s, w| s + g.table.cost(w[0], w[1]))
+    }
+
+    #[test]
+    fn dijkstra_and_dp_give_the_same_path_and_the_brute_force_optimum() {
+        let mut rng = rand_pcg::Pcg64::seed_from_u64(7);
+        for case in 0..300 {
+            let n = rng.random_range(1..6);
+            let bars = rng.random_range(1..6);
+            let levels = if case % 2 == 0 { Some(3) } else { None };
+            let table = random_table(n, case, levels);
+            let mut pins = Pins::new();
+            for _ in 0..rng.random_range(0..3) {
+                pins.insert(rng.random_range(0..bars), rng.random_range(0..n));
+            }
+            let no_repeat = case % 3 != 0;
+            let g = Graph::new(&table, bars, &pins, no_repeat);
+            let (a, b) = (g.dijkstra(), g.dp());
+            assert_eq!(a, b, "case {case}: n {n}, bars {bars}, pins {pins:?}");
+            match (a, brute(&g)) {
+                (Some(p), Some(best)) => {
+                    assert!((cost_of(&g, &p) - best).abs() < 1e-12, "case {case}");
+                    for (&bar, &s) in &pins {
+                        assert_eq!(p[bar], s, "pin kept");
+                    }
+                    if no_repeat {
+                        for k in 0..bars - 1 {
+                            let both = pins.contains_key(&k) && pins.contains_key(&(k + 1));
+                            assert!(both || p[k] != p[k + 1], "case {case}: {p:?}");
+                        }
+                    }
+                }
+                (None, None) => {}
+                (p, best) => panic!("case {case}: {p:?} vs brute force {best:?}"),
+            }
+        }
+    }
+
+    #[test]
+    fn large_random_instances_agree() {
+        for seed in 0..6 {
+            let n = 150;
+            let table = random_table(n, 100 + seed, if seed % 2 == 0 { Some(4) } else { None });
+            let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
+            let bars = 24;
+            let mut pins = Pins::new();
+            for _ in 0..4 {
+                pins.insert(rng.random_range(0..bars), rng.random_range(0..n));
+            }
+            let g = Graph::new(&table, bars, &pins, true);
+            let (a, b) = (g.dijkstra().unwrap(), g.dp().unwrap());
+            assert_eq!(a, b, "seed {seed}");
+        }
+    }
+
+    #[test]
+    fn a_lone_segment_cannot_fill_two_bars_without_a_repeat() {
+        let table = random_table(1, 1, None);
+        let g = Graph::new(&table, 2, &Pins::new(), true);
+        assert_eq!(g.dijkstra(), None);
+        assert_eq!(g.dp(), None);
+        let g = Graph::new(&table, 2, &Pins::new(), false);
+        assert_eq!(g.dijkstra(), Some(vec![0, 0]));
+        // Two pinned bars may repeat: the user chose it.
+        let pins = Pins::from([(0, 0), (1, 0)]);
+        let g = Graph::new(&table, 2, &pins, true);
+        assert_eq!(g.dp(), Some(vec![0, 0]));
+    }
+
+    #[test]
+    fn bad_pins_are_named() {
+        assert_eq!(check(0, 4, &Pins::new()), Err(FillError::EmptyDatabase));
+        assert_eq!(check(3, 0, &Pins::new()), Err(FillError::NoBars));
+        assert_eq!(
+            check(3, 4, &Pins::from([(4, 0)])),
+            Err(FillError::PinPastEnd { bar: 4, bars: 4 })
+        );
+        assert_eq!(
+            check(3, 4, &Pins::from([(1, 3)])),
+            Err(FillError::NoSuchSegment {
+                bar: 1,
+                segment: 3,
+                segments: 3
+            })
+        );
+        let e = check(3, 4, &Pins::from([(1, 3)])).unwrap_err().to_string();
+        assert!(e.contains("segment 3 does not exist"), "{e}");
+    }
+}

@@ -1,0 +1,286 @@
+//! The metrics every dance reports, as the literature defines them.
+//!
+//! - **Beat alignment score** (AIST++ / FACT, Li et al. 2021, as its `calculate_beat_scores` and
+//!   Bailando's evaluation compute it): the mean over the *motion* beats t_x of
+//!   exp(−min_y (t_x − t_y)² / (2σ²)) against the music beats t_y, σ = 3 frames at their 60 fps
+//!   ([`BAS_SIGMA_S`] = 0.05 s). Motion beats are the local minima of the kinematic speed
+//!   v(f) = Σ_i |ẋ_i(f)| ([`super::segments::speed_curve`]) that are lower than every other
+//!   frame within ±10 frames at 60 fps (scipy `argrelextrema(order=10)`; ±[`BEAT_ORDER_S`] at the
+//!   dance's rate). 1 when every motion beat falls on a music beat, 0 without motion beats.
+//! - **Seam jerk**: the angular jerk of the DOF angles, j(f) = (x_{f+2} − 3x_{f+1} + 3x_f −
+//!   x_{f−1}) / dt³ per DOF (rad/s³, centred at f + ½), its magnitude the Euclidean norm over
+//!   the DOFs; peak and mean over the samples whose stencil touches a seam window (the
+//!   rewritten frames and the frame on each side), and the same over every other sample for
+//!   scale ("inside").
+//! - **Foot skating**: the mean horizontal speed (m/s) of the heels (ankle joints) and toes (their
+//!   End Sites) over the frames they are in contact, a point being in contact when it is within
+//!   [`CONTACT_HEIGHT_M`] of the floor (the lowest any of them gets in the dance) and its vertical
+//!   speed is under [`CONTACT_VERTICAL_SPEED_M_S`] (not lifting or landing).
+//! - **Transition cost**: Σ C over the seams of the fill, and the mean S.
+
+use glam::DVec3;
+use serde::{Deserialize, Serialize};
+
+use super::dance::Dance;
+use super::fill::Fill;
+use super::segments::speed_curve;
+use crate::humanoid::ModelClip;
+
+/// σ of the beat alignment score: 3 frames at 60 fps, seconds.
+pub const BAS_SIGMA_S: f64 = 3.0 / 60.0;
+
+/// Half-width of the neighbourhood a motion beat is the minimum of: 10 frames at 60 fps, seconds.
+pub const BEAT_ORDER_S: f64 = 10.0 / 60.0;
+
+/// A foot point is in contact within this height of the floor, metres.
+pub const CONTACT_HEIGHT_M: f64 = 0.05;
+
+/// A foot point is in contact while its vertical speed is under this, m/s.
+pub const CONTACT_VERTICAL_SPEED_M_S: f64 = 0.3;
+
+/// Peak and mean of the angular jerk over a set of samples.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct Jerk {
+    /// The largest jerk magnitude, rad/s³.
+    pub peak_rad_s3: f64,
+    /// The mean jerk magnitude, rad/s³.
+    pub mean_rad_s3: f64,
+    /// The samples it is taken over.
+    pub samples: usize,
+}
+
+impl Jerk {
+    /// Peak and mean of `values` (zeros for none).
+    pub fn of(values: impl IntoIterator<Item = f64>) -> Jerk {
+        let (mut peak, mut sum, mut n) = (0.0f64, 0.0, 0usize);
+        for v in values {
+            peak = peak.max(v);
+            sum += v;
+            n += 1;
+        }
+        Jerk {
+            peak_rad_s3: peak,
+            mean_rad_s3: if n > 0 { sum / n as f64 } else { 0.0 },
+            samples: n,
+        }
+    }
+}
+
+/// The metrics of a dance.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct DanceMetrics {
+    /// Beat alignment score (AIST++), in [0, 1].
+    pub beat_alignment_score: f64,
+    /// Motion beats found (kinematic speed minima).
+    pub motion_beats: usize,
+    /// Music beats within the dance.
+    pub music_beats: usize,
+    /// Angular jerk around the seams.
+    pub seam_jerk: Jerk,
+    /// Angular jerk inside the segments, away from the seams.
+    pub inside_jerk: Jerk,
+    /// Mean horizontal foot speed while in contact, m/s.
+    pub foot_skating_m_s: f64,
+    /// Fraction of foot-point samples in contact.
+    pub foot_contact_fraction: f64,
+    /// Σ C over the seams.
+    pub transition_cost: f64,
+    /// Mean connection score S over the seams (0 without seams).
+    pub mean_connection_s: f64,
+}
+
+/// The motion beats of a clip (module docs), seconds from its first frame.
+pub fn motion_beats(clip: &ModelClip) -> Vec<f64> {
+    let fps = 1.0 / clip.frame_time;
+    let v = speed_curve(&clip.to_clip().point_frames(), fps);
+    let order = ((BEAT_ORDER_S * fps).round() as usize).max(1);
+    (0..v.len())
+        .filter(|&f| {
+            let lo = f.saturating_sub(order);
+            let hi = (f + order).min(v.len() - 1);
+            f >= order && f + order < v.len() && (lo..=hi).all(|g| g == f || v[f] < v[g])
+        })
+        .map(|f| f as f64 * clip.frame_time)
+        .collect()
+}
+
+/// The beat alignment score of AIST++: mean over `motion_s` of exp(−min (t − t_music)² / 2σ²)
+/// (module docs); 0 without motion or music beats.
+pub fn beat_alignment_score(motion_s: &[f64], music_s: &[f64], sigma_s: f64) -> f64 {
+    if motion_s.is_empty() || music_s.is_empty() {
+        return 0.0;
+    }
+    let sum: f64 = motion_s
+        .iter()
+        .map(|t| {
+            let d = music_s
+                .iter()
+                .map(|m| (t - m).abs())
+                .fold(f64::INFINITY, f64::min);
+            (-d * d / (2.0 * sigma_s * sigma_s)).exp()
+        })
+        .sum();
+    sum / motion_s.len() as f64
+}
+
+/// The angular jerk magnitude of every sample f = 1 .. frames − 2 (index f − 1), rad/s³.
+pub fn angular_jerk(clip: &ModelClip) -> Vec<f64> {
+    let n = clip.frame_count();
+    let dt3 = clip.frame_time.powi(3);
+    if n < 4 {
+        return vec![];
+    }
+    (1..n - 2)
+        .map(|f| {
+            let (a, b, c, d) = (
+                clip.frame_angles(f - 1),
+                clip.frame_angles(f),
+                clip.frame_angles(f + 1),
+                clip.frame_angles(f + 2),
+            );
+            let s: f64 = (0..a.len())
+                .map(|j| {
+                    let x = (d[j] - 3.0 * c[j] + 3.0 * b[j] - a[j]) / dt3;
+                    x * x
+                })
+                .sum();
+            s.sqrt()
+        })
+        .collect()
+}
+
+/// Seam and inside jerk of a dance (module docs).
+pub fn seam_jerk(dance: &Dance) -> (Jerk, Jerk) {
+    let j = angular_jerk(&dance.clip);
+    let w = dance.seam_frames;
+    // Frames touched by a seam: the window [s − w, s + w) and the frame on each side.
+    let near = |f: usize| -> bool {
+        dance
+            .seam_frame_indices()
+            .iter()
+            .any(|&s| f + w + 1 >= s && f <= s + w)
+    };
+    let (mut seam, mut inside) = (vec![], vec![]);
+    for (i, &v) in j.iter().enumerate() {
+        let f = i + 1; // stencil f − 1 ..= f + 2
+        if (f - 1..=f + 2).any(near) {
+            seam.push(v);
+        } else {
+            inside.push(v);
+        }
+    }
+    (Jerk::of(seam), Jerk::of(inside))
+}
+
+/// Foot skating of a clip: (mean horizontal speed in contact m/s, contact fraction) (module
+/// docs).
+pub fn foot_skating(clip: &ModelClip) -> (f64, f64) {
+    let c = clip.to_clip();
+    let names = c.skeleton.point_names();
+    let feet: Vec<usize> = [
+        "left_ankle",
+        "right_ankle",
+        "left_ankle_end",
+        "right_ankle_end",
+    ]
+    .iter()
+    .filter_map(|n| names.iter().position(|m| m == n))
+    .collect();
+    let pts = c.point_frames();
+    let n = pts.len();
+    if feet.is_empty() || n < 2 {
+        return (0.0, 0.0);
+    }
+    let floor = pts
+        .iter()
+        .flat_map(|p| feet.iter().map(move |&i| p[i].y))
+        .fold(f64::INFINITY, f64::min);
+    let fps = 1.0 / clip.frame_time;
+    let (mut sum, mut contact, mut total) = (0.0, 0usize, 0usize);
+    for f in 0..n {
+        let (a, b) = (f.saturating_sub(1), (f + 1).min(n - 1));
+        let dt = (b - a) as f64 / fps;
+        for &i in &feet {
+            let v: DVec3 = (pts[b][i] - pts[a][i]) / dt;
+            total += 1;
+            if pts[f][i].y - floor < CONTACT_HEIGHT_M && v.y.abs() < CONTACT_VERTICAL_SPEED_M_S {
+                contact += 1;
+                sum += DVec3::new(v.x, 0.0, v.z).length();
+            }
+        }
+    }
+    let skating = if contact > 0 {
+        sum / contact as f64
+    } else {
+        0.0
+    };
+    (skating, contact as f64 / total as f64)
+}
+
+/// Every metric of a dance against the song's beats `beats_s` (song time, seconds) and the fill
+/// it was assembled from.
+pub fn dance_metrics(dance: &Dance, beats_s: &[f64], fill: &Fill) -> DanceMetrics {
+    let duration = dance.clip.frame_count() as f64 * dance.clip.frame_time;
+    let music: Vec<f64> = beats_s
+        .iter()
+        .map(|t| t - dance.start_s)
+        .filter(|t| (0.0..=duration).contains(t))
+        .collect();
+    let motion = motion_beats(&dance.clip);
+    let (seam, inside) = seam_jerk(dance);
+    let (skating, contact) = foot_skating(&dance.clip);
+    let seams = fill.connections.len();
+    DanceMetrics {
+        beat_alignment_score: beat_alignment_score(&motion, &music, BAS_SIGMA_S),
+        motion_beats: motion.len(),
+        music_beats: music.len(),
+        seam_jerk: seam,
+        inside_jerk: inside,
+        foot_skating_m_s: skating,
+        foot_contact_fraction: contact,
+        transition_cost: fill.total_cost,
+        mean_connection_s: if seams > 0 {
+            fill.connections.iter().map(|c| c.s).sum::<f64>() / seams as f64
+        } else {
+            0.0
+        },
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn beats_on_the_music_score_one_and_off_beat_less() {
+        let music: Vec<f64> = (0..16).map(|k| 0.5 * k as f64).collect();
+        assert!((beat_alignment_score(&music, &music, BAS_SIGMA_S) - 1.0).abs() < 1e-12);
+        let late: Vec<f64> = music.iter().map(|t| t + 0.05).collect();
+        let s = beat_alignment_score(&late, &music, BAS_SIGMA_S);
+        assert!((s - (-0.5f64).exp()).abs() < 1e-9, "{s}");
+        assert_eq!(beat_alignment_score(&[], &music, BAS_SIGMA_S), 0.0);
+    }
+
+    #[test]
+    fn jerk_of_a_cubic_is_its_third_derivative() {
+        let model = crate::humanoid::humanoid24();
+        let d = model.dofs.len();
+        let fps = 100.0;
+        let n = 50;
+        let mut angles = vec![0.0; n * d];
+        for f in 0..n {
+            let t = f as f64 / fps;
+            angles[f * d] = 2.0 * t * t * t; // x''' = 12
+        }
+        let clip = ModelClip {
+            model,
+            frame_time: 1.0 / fps,
+            root_translation: vec![DVec3::ZERO; n],
+            root_rotation: vec![glam::DQuat::IDENTITY; n],
+            angles,
+        };
+        for j in angular_jerk(&clip) {
+            assert!((j - 12.0).abs() < 1e-6, "{j}");
+        }
+    }
+}

@@ -1,0 +1,590 @@
+//! The dance-editing paper's Fig. 5 in numbers: for the same pins, connection-aware fill (the
+//! minimum-cost path of [`crate::choreo::fill`]) against connection-blind fills — random
+//! segments, and segments chosen by intensity only — over many random pin sets: the mean and
+//! spread of the seam jerk of the assembled dances and of the connection score S at their
+//! seams.
+//!
+//! The intensity-only fill gives every unpinned bar the segment whose motion-intensity
+//! percentile (its rank among the database's segments) is nearest the bar's music-intensity
+//! percentile; the experiment has no song, so each pin set draws a music-intensity profile, a
+//! seeded random walk of percentiles clamped to [0, 1]. Random and intensity-only fills keep
+//! the no-adjacent-repeat rule when the fill does.
+//!
+//! [`generated_database`] builds a database from dance clips generated in code (moves of
+//! sinusoidal DOF swings at a beat, changing bar by bar with smooth blends, the root bouncing,
+//! turning and travelling), so that the experiment also runs without the shared data.
+
+use std::f64::consts::TAU;
+
+use glam::{DQuat, DVec3};
+use rand::{Rng, RngExt, SeedableRng};
+use serde::{Deserialize, Serialize};
+
+use crate::choreo::dance::{DanceError, DanceParams, assemble};
+use crate::choreo::database::{BuildParams, DATABASE_VERSION, Database, Source};
+use crate::choreo::eros::eros_weights;
+use crate::choreo::fill::{Fill, FillError, FillParams, Pins, check, fill_with_table};
+use crate::choreo::metrics::seam_jerk;
+use crate::choreo::music::Bar;
+use crate::choreo::segments::{Beat, SegmentError, TempoSource, cut_segments};
+use crate::choreo::transition::{TransitionTable, connection};
+use crate::humanoid::{ModelClip, humanoid24};
+
+/// How a fill is chosen.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Strategy {
+    /// The minimum-cost path (Dijkstra over C = 1/S).
+    ConnectionAware,
+    /// Uniformly random segments.
+    Random,
+    /// The segment nearest the bar's music intensity (percentiles).
+    IntensityOnly,
+}
+
+/// The strategies compared, in table order.
+pub const STRATEGIES: [Strategy; 3] = [
+    Strategy::ConnectionAware,
+    Strategy::Random,
+    Strategy::IntensityOnly,
+];
+
+/// The experiment's inputs.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct DanceFillConfig {
+    /// Bars per dance.
+    pub bars: usize,
+    /// Random pin sets.
+    pub pin_sets: usize,
+    /// Pins per set (distinct bars).
+    pub pins_per_set: usize,
+    /// Bar length of the dances, seconds.
+    pub bar_s: f64,
+    /// The fill (link weights, no adjacent repeat).
+    pub fill: FillParams,
+    /// The assembly (fps, seam frames).
+    pub dance: DanceParams,
+    /// Seed of the pins, music profiles and random fills.
+    pub seed: u64,
+}
+
+impl Default for DanceFillConfig {
+    /// 16 bars of 2 s, 40 pin sets of 3 pins, 30 fps, 5 seam frames, seed 1.
+    fn default() -> DanceFillConfig {
+        DanceFillConfig {
+            bars: 16,
+            pin_sets: 40,
+            pins_per_set: 3,
+            bar_s: 2.0,
+            fill: FillParams::default(),
+            dance: DanceParams::default(),
+            seed: 1,
+        }
+    }
+}
+
+/// Mean and spread of a quantity over the pin sets.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct Spread {
+    /// Mean.
+    pub mean: f64,
+    /// Standard deviation (population).
+    pub sd: f64,
+    /// Smallest value.
+    pub min: f64,
+    /// Largest value.
+    pub max: f64,
+}
+
+impl Spread {
+    /// The spread of `v` (zeros for none).
+    pub fn of(v: &[f64]) -> Spread {
+        if v.is_empty() {
+            return Spread::default();
+        }
+        let n = v.len() as f64;
+        let mean = v.iter().sum::<f64>() / n;
+        let var = v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / n;
+        Spread {
+            mean,
+            sd: var.sqrt(),
+            min: v.iter().copied().fold(f64::INFINITY, f64::min),
+            max: v.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+        }
+    }
+}
+
+/// One pin set's dance under one strategy.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Trial {
+    /// The segment of every bar.
+    pub segments: Vec<usize>,
+    /// Mean angular jerk around the seams, rad/s³.
+    pub seam_jerk_mean: f64,
+    /// Peak angular jerk around the seams, rad/s³.
+    pub seam_jerk_peak: f64,
+    /// Mean angular jerk inside the segments, rad/s³.
+    pub inside_jerk_mean: f64,
+    /// Mean S over the seams.
+    pub mean_s: f64,
+    /// Σ C over the seams.
+    pub total_cost: f64,
+}
+
+/// One strategy over every pin set.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct StrategyRow {
+    /// The strategy.
+    pub strategy: Strategy,
+    /// Mean seam jerk per dance, over the pin sets, rad/s³.
+    pub seam_jerk_mean: Spread,
+    /// Peak seam jerk per dance, rad/s³.
+    pub seam_jerk_peak: Spread,
+    /// Mean jerk inside the segments per dance (the scale), rad/s³.
+    pub inside_jerk_mean: Spread,
+    /// Mean S per dance.
+    pub mean_s: Spread,
+    /// Σ C per dance.
+    pub total_cost: Spread,
+    /// Every trial, pin set by pin set.
+    pub trials: Vec<Trial>,
+}
+
+/// The outcome: one row per strategy, and how often connection-aware fill wins.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct DanceFillOutcome {
+    /// Segments in the database.
+    pub segments: usize,
+    /// The pins of every set.
+    pub pins: Vec<Pins>,
+    /// One row per strategy ([`STRATEGIES`] order).
+    pub rows: Vec<StrategyRow>,
+    /// Fraction of pin sets where connection-aware fill has a lower mean seam jerk than random
+    /// fill.
+    pub aware_beats_random_jerk: f64,
+    /// The same against intensity-only fill.
+    pub aware_beats_intensity_jerk: f64,
+}
+
+impl DanceFillOutcome {
+    /// The row of `s`.
+    pub fn row(&self, s: Strategy) -> &StrategyRow {
+        self.rows
+            .iter()
+            .find(|r| r.strategy == s)
+            .expect("every strategy has a row")
+    }
+
+    /// The table as text: one line per strategy, mean ± sd.
+    pub fn table(&self) -> String {
+        let mut out = format!(
+            "{} pin sets over {} segments: mean ± sd over the pin sets\n{:<17} {:>24} {:>24} {:>24} {:>16} {:>16}\n",
+            self.pins.len(),
+            self.segments,
+            "fill",
+            "seam jerk mean rad/s³",
+            "seam jerk peak rad/s³",
+            "inside jerk rad/s³",
+            "mean S",
+            "Σ C"
+        );
+        for r in &self.rows {
+            let f = |s: &Spread| format!("{:.0} ± {:.0}", s.mean, s.sd);
+            out.push_str(&format!(
+                "{:<17} {:>24} {:>24} {:>24} {:>16} {:>16}\n",
+                format!("{:?}", r.strategy),
+                f(&r.seam_jerk_mean),
+                f(&r.seam_jerk_peak),
+                f(&r.inside_jerk_mean),
+                format!("{:.2} ± {:.2}", r.mean_s.mean, r.mean_s.sd),
+                format!("{:.3} ± {:.3}", r.total_cost.mean, r.total_cost.sd),
+            ));
+        }
+        out.push_str(&format!(
+            "connection-aware seam jerk lower than random in {:.0} % of pin sets, than \
+             intensity-only in {:.0} %\n",
+            100.0 * self.aware_beats_random_jerk,
+            100.0 * self.aware_beats_intensity_jerk
+        ));
+        out
+    }
+}
+
+/// Why the experiment could not run.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum DanceFillError {
+    /// Filling failed.
+    #[error(transparent)]
+    Fill(#[from] FillError),
+    /// Assembling failed.
+    #[error(transparent)]
+    Dance(#[from] DanceError),
+    /// A configuration that cannot run.
+    #[error("dance-fill experiment: {0}")]
+    Config(String),
+}
+
+/// Runs the experiment on `db` (module docs).
+pub fn run(db: &Database, cfg: &DanceFillConfig) -> Result<DanceFillOutcome, DanceFillError> {
+    let n = db.segments.len();
+    check(n, cfg.bars, &Pins::new())?;
+    if cfg.pins_per_set > cfg.bars {
+        return Err(DanceFillError::Config(format!(
+            "{} pins per set on {} bars",
+            cfg.pins_per_set, cfg.bars
+        )));
+    }
+    if !(cfg.bar_s.is_finite() && cfg.bar_s > 0.0) {
+        return Err(DanceFillError::Config(format!(
+            "bar length {} s must be positive",
+            cfg.bar_s
+        )));
+    }
+    let table = TransitionTable::new(db, &cfg.fill.transition).map_err(FillError::from)?;
+    let bars: Vec<Bar> = (0..cfg.bars)
+        .map(|k| Bar {
+            start_s: k as f64 * cfg.bar_s,
+            end_s: (k + 1) as f64 * cfg.bar_s,
+            rms: 0.0,
+            rms_db: f64::NEG_INFINITY,
+        })
+        .collect();
+    let percentile = intensity_percentiles(db);
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(cfg.seed);
+    let mut all_pins = vec![];
+    let mut trials: Vec<Vec<Trial>> = vec![vec![]; STRATEGIES.len()];
+    for _ in 0..cfg.pin_sets {
+        let pins = random_pins(&mut rng, cfg.bars, cfg.pins_per_set, n);
+        let music = music_profile(&mut rng, cfg.bars);
+        for (i, s) in STRATEGIES.iter().enumerate() {
+            let segments = match s {
+                Strategy::ConnectionAware => {
+                    fill_with_table(db, &table, cfg.bars, &pins, &cfg.fill)?.segments
+                }
+                Strategy::Random => {
+                    blind_fill(cfg.bars, &pins, n, cfg.fill.no_adjacent_repeat, |_, _| {
+                        rng.random_range(0..n)
+                    })?
+                }
+                Strategy::IntensityOnly => blind_fill(
+                    cfg.bars,
+                    &pins,
+                    n,
+                    cfg.fill.no_adjacent_repeat,
+                    |bar, skip| nearest_percentile(&percentile, music[bar], skip),
+                )?,
+            };
+            trials[i].push(trial(db, &segments, &bars, cfg)?);
+        }
+        all_pins.push(pins);
+    }
+    let wins = |other: usize| -> f64 {
+        let w = trials[0]
+            .iter()
+            .zip(&trials[other])
+            .filter(|(a, b)| a.seam_jerk_mean < b.seam_jerk_mean)
+            .count();
+        w as f64 / cfg.pin_sets.max(1) as f64
+    };
+    let (aware_beats_random_jerk, aware_beats_intensity_jerk) = (wins(1), wins(2));
+    let rows = STRATEGIES
+        .iter()
+        .zip(trials)
+        .map(|(&strategy, t)| {
+            let col = |f: fn(&Trial) -> f64| Spread::of(&t.iter().map(f).collect::<Vec<_>>());
+            StrategyRow {
+                strategy,
+                seam_jerk_mean: col(|t| t.seam_jerk_mean),
+                seam_jerk_peak: col(|t| t.seam_jerk_peak),
+                inside_jerk_mean: col(|t| t.inside_jerk_mean),
+                mean_s: col(|t| t.mean_s),
+                total_cost: col(|t| t.total_cost),
+                trials: t,
+            }
+        })
+        .collect();
+    Ok(DanceFillOutcome {
+        segments: n,
+        pins: all_pins,
+        rows,
+        aware_beats_random_jerk,
+        aware_beats_intensity_jerk,
+    })
+}
+
+/// The dance of `segments` and its seam numbers.
+fn trial(
+    db: &Database,
+    segments: &[usize],
+    bars: &[Bar],
+    cfg: &DanceFillConfig,
+) -> Result<Trial, DanceFillError> {
+    let dance = assemble(db, segments, bars, &cfg.dance)?;
+    let (seam, inside) = seam_jerk(&dance);
+    let connections: Vec<_> = segments
+        .windows(2)
+        .map(|w| connection(&db.segments[w[0]], &db.segments[w[1]], &cfg.fill.transition))
+        .collect();
+    let fill = Fill {
+        segments: segments.to_vec(),
+        total_cost: connections.iter().map(|c| c.cost).sum(),
+        connections,
+    };
+    let seams = fill.connections.len().max(1) as f64;
+    Ok(Trial {
+        segments: fill.segments.clone(),
+        seam_jerk_mean: seam.mean_rad_s3,
+        seam_jerk_peak: seam.peak_rad_s3,
+        inside_jerk_mean: inside.mean_rad_s3,
+        mean_s: fill.connections.iter().map(|c| c.s).sum::<f64>() / seams,
+        total_cost: fill.total_cost,
+    })
+}
+
+/// `count` pins on distinct random bars, each to a random segment.
+fn random_pins(rng: &mut impl Rng, bars: usize, count: usize, n: usize) -> Pins {
+    let mut pins = Pins::new();
+    while pins.len() < count {
+        pins.insert(rng.random_range(0..bars), rng.random_range(0..n));
+    }
+    pins
+}
+
+/// A music-intensity profile in percentiles: a random walk from a random start, steps of up to
+/// ±0.25, clamped to [0, 1].
+fn music_profile(rng: &mut impl Rng, bars: usize) -> Vec<f64> {
+    let mut x: f64 = rng.random_range(0.0..1.0);
+    (0..bars)
+        .map(|_| {
+            let v = x;
+            x = (x + rng.random_range(-0.25..0.25)).clamp(0.0, 1.0);
+            v
+        })
+        .collect()
+}
+
+/// Every segment's motion-intensity percentile: its rank over n − 1 (0 the calmest, 1 the most
+/// intense; ties by index).
+pub fn intensity_percentiles(db: &Database) -> Vec<f64> {
+    let n = db.segments.len();
+    let mut order: Vec<usize> = (0..n).collect();
+    order.sort_by(|&a, &b| {
+        db.segments[a]
+            .intensity
+            .total_cmp(&db.segments[b].intensity)
+            .then(a.cmp(&b))
+    });
+    let mut p = vec![0.0; n];
+    for (rank, &s) in order.iter().enumerate() {
+        p[s] = if n > 1 {
+            rank as f64 / (n - 1) as f64
+        } else {
+            0.5
+        };
+    }
+    p
+}
+
+/// The segment whose percentile is nearest `target`, other than those in `skip` (ties by index).
+fn nearest_percentile(p: &[f64], target: f64, skip: &[usize]) -> usize {
+    (0..p.len())
+        .filter(|s| !skip.contains(s))
+        .min_by(|&a, &b| {
+            (p[a] - target)
+                .abs()
+                .total_cmp(&(p[b] - target).abs())
+                .then(a.cmp(&b))
+        })
+        .unwrap_or(0)
+}
+
+/// A connection-blind fill: pins kept, every other bar from `choose(bar, segments to avoid)`,
+/// drawn again (up to 64 times) while it repeats a neighbour under `no_repeat`.
+fn blind_fill(
+    bars: usize,
+    pins: &Pins,
+    n: usize,
+    no_repeat: bool,
+    mut choose: impl FnMut(usize, &[usize]) -> usize,
+) -> Result<Vec<usize>, FillError> {
+    let mut out: Vec<Option<usize>> = (0..bars).map(|b| pins.get(&b).copied()).collect();
+    for b in 0..bars {
+        if out[b].is_some() {
+            continue;
+        }
+        let skip: Vec<usize> = if no_repeat {
+            [
+                b.checked_sub(1).and_then(|p| out[p]),
+                out.get(b + 1).copied().flatten(),
+            ]
+            .into_iter()
+            .flatten()
+            .collect()
+        } else {
+            vec![]
+        };
+        let mut s = choose(b, &skip);
+        let mut tries = 0;
+        while skip.contains(&s) {
+            tries += 1;
+            if tries > 64 || skip.len() >= n {
+                return Err(FillError::NoPath { segments: n });
+            }
+            s = choose(b, &skip);
+        }
+        out[b] = Some(s);
+    }
+    Ok(out.into_iter().map(|s| s.unwrap_or(0)).collect())
+}
+
+/// One move of a generated dance: per DOF an offset, an amplitude, a phase and a frequency (1
+/// or ½ per beat); a turn rate and a travel speed of the root.
+#[derive(Debug, Clone)]
+struct Move {
+    swings: Vec<(usize, f64, f64, f64, f64)>,
+    turn_rad_s: f64,
+    travel_m_s: f64,
+}
+
+/// The DOFs a generated move swings, with the largest amplitude of each, degrees.
+const SWING_DOFS: [(&str, f64); 12] = [
+    ("left_knee", 35.0),
+    ("right_knee", 35.0),
+    ("left_hip_flexion", 30.0),
+    ("right_hip_flexion", 30.0),
+    ("left_shoulder_abduction", 70.0),
+    ("right_shoulder_abduction", 70.0),
+    ("left_shoulder_flexion", 60.0),
+    ("right_shoulder_flexion", 60.0),
+    ("left_elbow_flexion", 60.0),
+    ("right_elbow_flexion", 60.0),
+    ("waist_flexion", 15.0),
+    ("waist_lateral", 15.0),
+];
+
+/// A generated dance clip on humanoid24 at `fps`: `bars` bars of 4 beats at `bpm`, each a move
+/// drawn from `moves` (blended over ±0.1 bar at the bar lines, so the clip is smooth).
+fn generated_clip(
+    rng: &mut impl Rng,
+    moves: &[Move],
+    bpm: f64,
+    bars: usize,
+    fps: f64,
+) -> ModelClip {
+    let model = humanoid24();
+    let d = model.dofs.len();
+    let beat = 60.0 / bpm;
+    let bar = 4.0 * beat;
+    let order: Vec<usize> = (0..bars + 1)
+        .map(|_| rng.random_range(0..moves.len()))
+        .collect();
+    let frames = (bars as f64 * bar * fps).round() as usize;
+    let pose = |m: &Move, t: f64, out: &mut [f64]| {
+        for &(j, off, amp, ph, freq) in &m.swings {
+            out[j] += off + amp * (TAU * freq * t / beat + ph).sin();
+        }
+    };
+    let mut clip = ModelClip {
+        model,
+        frame_time: 1.0 / fps,
+        root_translation: Vec::with_capacity(frames),
+        root_rotation: Vec::with_capacity(frames),
+        angles: vec![0.0; frames * d],
+    };
+    let (mut yaw, mut pos) = (rng.random_range(0.0..TAU), DVec3::ZERO);
+    for f in 0..frames {
+        let t = f as f64 / fps;
+        let k = ((t / bar) as usize).min(bars - 1);
+        let u = t / bar - k as f64;
+        // Blend weights of this bar's move and its neighbours' near the bar lines.
+        let smooth = |x: f64| {
+            let x = x.clamp(0.0, 1.0);
+            x * x * (3.0 - 2.0 * x)
+        };
+        let mut parts = vec![(order[k], 1.0)];
+        if u > 0.9 {
+            let w = 0.5 * smooth((u - 0.9) / 0.1);
+            parts = vec![(order[k], 1.0 - w), (order[k + 1], w)];
+        } else if u < 0.1 && k > 0 {
+            let w = 0.5 * smooth((0.1 - u) / 0.1);
+            parts = vec![(order[k], 1.0 - w), (order[k - 1], w)];
+        }
+        let row = &mut clip.angles[f * d..(f + 1) * d];
+        let mut tmp = vec![0.0; d];
+        let (mut turn, mut travel) = (0.0, 0.0);
+        for &(m, w) in &parts {
+            tmp.fill(0.0);
+            pose(&moves[m], t, &mut tmp);
+            for (r, x) in row.iter_mut().zip(&tmp) {
+                *r += w * x;
+            }
+            turn += w * moves[m].turn_rad_s;
+            travel += w * moves[m].travel_m_s;
+        }
+        yaw += turn / fps;
+        pos += DQuat::from_rotation_y(yaw) * DVec3::Z * travel / fps;
+        let bounce = 0.03 * (TAU * t / beat).cos();
+        clip.root_translation
+            .push(DVec3::new(pos.x, 0.93 + bounce, pos.z));
+        clip.root_rotation.push(DQuat::from_rotation_y(yaw));
+    }
+    clip
+}
+
+/// A database of `clips` generated dance clips of `bars_per_clip` bars each (module docs),
+/// tempo 96–128 BPM, from a vocabulary of 8 moves; seeded.
+pub fn generated_database(
+    seed: u64,
+    clips: usize,
+    bars_per_clip: usize,
+) -> Result<Database, SegmentError> {
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
+    let model = humanoid24();
+    let moves: Vec<Move> = (0..8)
+        .map(|_| Move {
+            swings: SWING_DOFS
+                .iter()
+                .filter_map(|&(name, max)| {
+                    let j = model.dof_index(name)?;
+                    let amp = rng.random_range(0.2..1.0) * max.to_radians();
+                    let off = rng.random_range(-0.5..0.5) * max.to_radians();
+                    let freq = if rng.random_bool(0.3) { 0.5 } else { 1.0 };
+                    Some((j, off, amp, rng.random_range(0.0..TAU), freq))
+                })
+                .collect(),
+            turn_rad_s: rng.random_range(-0.6..0.6),
+            travel_m_s: rng.random_range(0.0..0.4),
+        })
+        .collect();
+    let params = BuildParams::default();
+    let (mut sources, mut segments) = (vec![], vec![]);
+    for c in 0..clips {
+        let bpm = rng.random_range(96.0..128.0);
+        let clip = generated_clip(&mut rng, &moves, bpm, bars_per_clip, 60.0);
+        let beat = Beat {
+            tempo_bpm: bpm,
+            first_beat_s: 0.0,
+            source: TempoSource::Manifest,
+        };
+        let name = format!("generated_{c}");
+        let cut = cut_segments(&clip, &name, c, &beat, &params)?;
+        sources.push(Source {
+            file: name,
+            frames: clip.frame_count(),
+            fps: 60.0,
+            window: None,
+            beat,
+            segments: cut.len(),
+        });
+        segments.extend(cut);
+    }
+    let pcas: Vec<_> = segments.iter().map(|s| &s.eros).collect();
+    let eros_weights = eros_weights(&pcas);
+    Ok(Database {
+        format_version: DATABASE_VERSION,
+        model: "humanoid24".into(),
+        params,
+        sources,
+        segments,
+        eros_weights,
+    })
+}
