@@ -62,6 +62,12 @@ pub enum Error {
     /// The dance-editing paper's Fig. 5 experiment.
     #[error(transparent)]
     DanceFill(#[from] crate::experiments::dance_fill::DanceFillError),
+    /// A relevance-feedback search round.
+    #[error(transparent)]
+    Search(#[from] crate::choreo::search::SearchError),
+    /// An action on a dance edit.
+    #[error(transparent)]
+    Edit(#[from] crate::choreo::edit::EditError),
     /// A data file (RON): reading, syntax, version.
     #[error(transparent)]
     File(#[from] crate::io::FileError),

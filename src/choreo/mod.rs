@@ -16,15 +16,23 @@
 //! - [`dance`]: the chosen segments assembled at the song's bar timing, root carried on, seams
 //!   rewritten by cubic interpolation;
 //! - [`metrics`]: beat alignment score, seam jerk, foot skating, transition cost of a dance;
+//! - [`augment`]: a larger database from a real one by mirror images and time offsets;
+//! - [`relevance`]: rel(q, m), music intensity against motion intensity, both as percentile ranks;
+//! - [`search`]: the relevance-feedback search of eqs. (1)–(4), six candidates per round;
+//! - [`edit`]: the stateful edit a server holds (pins, per-bar search, undo/redo);
 //! - [`authored`]: the project's own dance, generated in code at a known tempo.
 
+pub mod augment;
 pub mod authored;
 pub mod dance;
 pub mod database;
+pub mod edit;
 pub mod eros;
 pub mod features;
 pub mod fill;
 pub mod metrics;
 pub mod music;
+pub mod relevance;
+pub mod search;
 pub mod segments;
 pub mod transition;

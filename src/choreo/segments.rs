@@ -343,8 +343,10 @@ fn unheading(q: DQuat) -> DQuat {
     DQuat::from_rotation_y(-yaw)
 }
 
-/// Boundary link directions and velocities at frame `f` of `points` (frames of every point).
-fn boundary(
+/// Boundary link directions and velocities at frame `f` of `points` (frames of every point):
+/// the unit direction of every link (parent point → point) and the velocity of every point
+/// relative to the pelvis, both in the pelvis heading frame (the fields of [`Segment`]).
+pub fn boundary(
     points: &[Vec<DVec3>],
     parents: &[Option<usize>],
     root_rotation: DQuat,
@@ -459,8 +461,8 @@ pub fn cut_segments(
     Ok(segments)
 }
 
-/// The `k` leading principal axes of `p` (all when it has fewer).
-fn leading_axes(mut p: Pca, k: usize) -> Pca {
+/// The `k` leading principal axes of `p` (all when it has fewer; at least one).
+pub fn leading_axes(mut p: Pca, k: usize) -> Pca {
     p.values.truncate(k.max(1));
     p.vectors.truncate(k.max(1));
     p
