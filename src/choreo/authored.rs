@@ -212,7 +212,9 @@ impl Move {
     fn describe(&self) -> String {
         let side = |s: f64| if s > 0.0 { "left" } else { "right" };
         match *self {
-            Move::StepTouch { side: s, pattern, .. } => format!(
+            Move::StepTouch {
+                side: s, pattern, ..
+            } => format!(
                 "step-touch {}, {}",
                 side(s),
                 ["arm swings", "claps", "pumps"][pattern as usize % 3]
@@ -232,13 +234,9 @@ impl Move {
                 side(angle),
                 if high { "high" } else { "open" }
             ),
-            Move::Kick {
-                side: s, front, ..
-            } => format!(
-                "{} kick, {}",
-                side(s),
-                if front { "front" } else { "side" }
-            ),
+            Move::Kick { side: s, front, .. } => {
+                format!("{} kick, {}", side(s), if front { "front" } else { "side" })
+            }
             Move::KneeDrop { pattern, .. } => format!(
                 "knee drops, arms {}",
                 ["pushing down", "up"][pattern as usize % 2]
@@ -333,7 +331,11 @@ fn move_poses(m: Move, p0: &Pose, at: Place, amp: f64, end: Arms) -> [Pose; 4] {
             p[3].toes = p[2].toes;
             p[3].toes[trail] = floor(x3 - side * 2.0 * STANCE, 0.0);
             p[3].weight = 0.5;
-            let out = if high { arm(Arms::High) } else { arm(Arms::Open) };
+            let out = if high {
+                arm(Arms::High)
+            } else {
+                arm(Arms::Open)
+            };
             p[0].arms = [out; 2];
             p[1].arms = [arm(Arms::Front); 2];
             p[2].arms = [out; 2];
@@ -717,10 +719,7 @@ fn generate_clip(p: &AuthoredDance, c: usize) -> AuthoredClip {
     let plan = choreography(c, p.bars_per_clip);
     // Every count's pose: the first stands square at the origin.
     let neutral = Pose {
-        toes: [
-            DVec3::new(STANCE, 0.0, 0.0),
-            DVec3::new(-STANCE, 0.0, 0.0),
-        ],
+        toes: [DVec3::new(STANCE, 0.0, 0.0), DVec3::new(-STANCE, 0.0, 0.0)],
         heading: [0.0; 2],
         weight: 0.5,
         yaw: 0.0,
@@ -791,7 +790,9 @@ fn generate_clip(p: &AuthoredDance, c: usize) -> AuthoredClip {
             let hip = pelvis + rot * leg.hip;
             let flat = DVec2::new(hip.x - pose.toes[i].x, hip.z - pose.toes[i].z).length();
             let reach = full_reach(leg) - SLACK - pose.drop;
-            pelvis.y = pelvis.y.min(pose.toes[i].y + (reach * reach - flat * flat).max(0.0).sqrt());
+            pelvis.y = pelvis
+                .y
+                .min(pose.toes[i].y + (reach * reach - flat * flat).max(0.0).sqrt());
         }
         if !pelvis.y.is_finite() {
             pelvis.y = stand - pose.drop;
@@ -799,14 +800,7 @@ fn generate_clip(p: &AuthoredDance, c: usize) -> AuthoredClip {
         let mut angles = vec![0.0; dofs];
         for (i, leg) in legs.iter().enumerate() {
             let square = pose.toes[i].y < SQUARE_BELOW;
-            let (h, knee) = leg_ik(
-                leg,
-                pelvis,
-                rot,
-                pose.toes[i],
-                pose.heading[i],
-                square,
-            );
+            let (h, knee) = leg_ik(leg, pelvis, rot, pose.toes[i], pose.heading[i], square);
             for j in 0..3 {
                 angles[leg_dofs[i][j]] = h[j];
             }
@@ -878,7 +872,11 @@ mod tests {
                 .position(|n| n == &format!("{side}_ankle"))
                 .unwrap();
             let pts = &c.to_clip().point_frames()[0];
-            assert!((pts[toe] - target).length() < 1e-3, "{side}: {:?}", pts[toe]);
+            assert!(
+                (pts[toe] - target).length() < 1e-3,
+                "{side}: {:?}",
+                pts[toe]
+            );
             let f = pts[toe] - pts[ankle];
             let yaw = f.x.atan2(f.z);
             if square {
@@ -890,10 +888,15 @@ mod tests {
     /// Heights and horizontal speeds of both toes and ankles, per frame.
     fn feet(c: &ModelClip) -> Vec<[DVec3; 4]> {
         let names = c.model.skeleton().point_names();
-        let idx: Vec<usize> = ["left_ankle", "left_ankle_end", "right_ankle", "right_ankle_end"]
-            .iter()
-            .map(|n| names.iter().position(|m| m == n).unwrap())
-            .collect();
+        let idx: Vec<usize> = [
+            "left_ankle",
+            "left_ankle_end",
+            "right_ankle",
+            "right_ankle_end",
+        ]
+        .iter()
+        .map(|n| names.iter().position(|m| m == n).unwrap())
+        .collect();
         c.to_clip()
             .point_frames()
             .iter()
@@ -901,8 +904,14 @@ mod tests {
             .collect()
     }
 
-    trait Lowest { fn into_lowest(self) -> (usize, usize); }
-    impl Lowest for (usize, usize, f64) { fn into_lowest(self) -> (usize, usize) { (self.0, self.1) } }
+    trait Lowest {
+        fn into_lowest(self) -> (usize, usize);
+    }
+    impl Lowest for (usize, usize, f64) {
+        fn into_lowest(self) -> (usize, usize) {
+            (self.0, self.1)
+        }
+    }
 
     #[test]
     fn the_kinematic_beat_finds_the_tempo_and_feet_stay_on_the_floor() {
@@ -913,19 +922,45 @@ mod tests {
             };
             for clip in generate(&p).unwrap() {
                 let b = crate::choreo::segments::kinematic_beat(&clip.motion, &clip.name).unwrap();
-                eprintln!("{bpm} {}: {:.2} BPM, first beat {:.3} s", clip.name, b.tempo_bpm, b.first_beat_s);
-                assert!((b.tempo_bpm / bpm - 1.0).abs() < 0.01, "{}: {}", clip.name, b.tempo_bpm);
+                eprintln!(
+                    "{bpm} {}: {:.2} BPM, first beat {:.3} s",
+                    clip.name, b.tempo_bpm, b.first_beat_s
+                );
+                assert!(
+                    (b.tempo_bpm / bpm - 1.0).abs() < 0.01,
+                    "{}: {}",
+                    clip.name,
+                    b.tempo_bpm
+                );
                 let fs = feet(&clip.motion);
-                let lowest = fs.iter().flatten().map(|p| p.y).fold(f64::INFINITY, f64::min);
-                let (fi, pi) = fs.iter().enumerate().flat_map(|(f, p)| p.iter().enumerate().map(move |(i, q)| (f, i, q.y))).fold((0, 0, f64::INFINITY), |m, (f, i, y)| if y < m.2 { (f, i, y) } else { m }).into_lowest();
-                assert!(lowest > -1e-4, "{}: a foot at {lowest} m, frame {fi} point {pi}", clip.name);
+                let lowest = fs
+                    .iter()
+                    .flatten()
+                    .map(|p| p.y)
+                    .fold(f64::INFINITY, f64::min);
+                let (fi, pi) = fs
+                    .iter()
+                    .enumerate()
+                    .flat_map(|(f, p)| p.iter().enumerate().map(move |(i, q)| (f, i, q.y)))
+                    .fold(
+                        (0, 0, f64::INFINITY),
+                        |m, (f, i, y)| if y < m.2 { (f, i, y) } else { m },
+                    )
+                    .into_lowest();
+                assert!(
+                    lowest > -1e-4,
+                    "{}: a foot at {lowest} m, frame {fi} point {pi}",
+                    clip.name
+                );
                 // A toe on the floor does not slide: its horizontal speed while within 1 mm of it.
                 let dt = clip.motion.frame_time;
                 let mut worst: f64 = 0.0;
                 for w in fs.windows(2) {
                     for k in [1, 3] {
                         if w[0][k].y < 1e-3 && w[1][k].y < 1e-3 {
-                            let v = DVec2::new(w[1][k].x - w[0][k].x, w[1][k].z - w[0][k].z).length() / dt;
+                            let v = DVec2::new(w[1][k].x - w[0][k].x, w[1][k].z - w[0][k].z)
+                                .length()
+                                / dt;
                             worst = worst.max(v);
                         }
                     }
@@ -940,13 +975,19 @@ mod tests {
     fn write_demo() {
         let clips = generate(&AuthoredDance::default()).unwrap();
         write_bvh_folder(&clips, std::path::Path::new("/tmp/authored_demo")).unwrap();
-        for c in &clips { eprintln!("{}: {:?}", c.name, c.moves); }
+        for c in &clips {
+            eprintln!("{}: {:?}", c.name, c.moves);
+        }
         let m = &clips[0].motion;
         for f in [0usize, 30, 60] {
             let names = m.model.dof_names();
             let a = m.frame_angles(f);
             eprintln!("frame {f} root {:?}", m.root_translation[f]);
-            for (n, v) in names.iter().zip(a) { if v.abs() > 1e-6 { eprint!("{n}={:.1} ", v.to_degrees()); } }
+            for (n, v) in names.iter().zip(a) {
+                if v.abs() > 1e-6 {
+                    eprint!("{n}={:.1} ", v.to_degrees());
+                }
+            }
             eprintln!();
         }
     }

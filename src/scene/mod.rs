@@ -6,6 +6,7 @@
 //! from the command line (`--set clip.end_s=2.5`) so a parameter can be swept without editing
 //! files.
 
+mod dance;
 mod evolve;
 mod fall;
 mod output;
@@ -13,6 +14,9 @@ mod primitives;
 mod show;
 mod source;
 
+pub use dance::{
+    DanceRender, DanceScene, DatabaseSource, Pin, SongSource, run_dance, validate_dance,
+};
 pub use evolve::{EvaluatorChoice, EvolveFallScene, run_evolve};
 pub use fall::{Body, Controller, FallScene, Simulation, fall_report, run_fall};
 pub use primitives::{
@@ -42,6 +46,8 @@ pub enum Scene {
     Fall(Box<FallScene>),
     /// The falling paper's GA for both age groups over several seeds.
     EvolveFall(Box<EvolveFallScene>),
+    /// The dance-editing paper: a song, a segment database, pins, the rest filled.
+    Dance(Box<DanceScene>),
 }
 
 /// Why a scene could not be read or run. Module errors keep their own type (and message), so a
@@ -110,6 +116,21 @@ pub enum SceneError {
     /// Drawing.
     #[error(transparent)]
     Render(#[from] crate::render::RenderError),
+    /// A song: decoding, synthesis or analysis.
+    #[error(transparent)]
+    Music(#[from] crate::choreo::music::MusicError),
+    /// Dance clips and their segment database.
+    #[error(transparent)]
+    Segment(#[from] crate::choreo::segments::SegmentError),
+    /// The project's own dance.
+    #[error(transparent)]
+    Authored(#[from] crate::choreo::authored::AuthoredError),
+    /// Filling the unpinned bars.
+    #[error(transparent)]
+    Fill(#[from] crate::choreo::fill::FillError),
+    /// Assembling the dance.
+    #[error(transparent)]
+    Dance(#[from] crate::choreo::dance::DanceError),
 }
 
 impl Scene {
@@ -121,6 +142,7 @@ impl Scene {
             Scene::JumpingKneeKick(s) => &s.name,
             Scene::Fall(s) => &s.name,
             Scene::EvolveFall(s) => &s.name,
+            Scene::Dance(s) => &s.name,
         }
     }
 
@@ -131,6 +153,7 @@ impl Scene {
             Scene::JumpingKneeKick(s) => s.format_version,
             Scene::Fall(s) => s.format_version,
             Scene::EvolveFall(s) => s.format_version,
+            Scene::Dance(s) => s.format_version,
         }
     }
 
@@ -272,6 +295,7 @@ pub fn validate(scene: &Scene) -> Result<(), SceneError> {
         Scene::EvolveFall(s) => {
             pictures(s.render.filmstrip_frames, s.render.gif, s.render.gif_fps)?
         }
+        Scene::Dance(s) => validate_dance(s)?,
     }
     Ok(())
 }
@@ -295,6 +319,7 @@ pub fn run(scene: &Scene, base: &Path, out_dir: &Path) -> Result<serde_json::Val
         Scene::JumpingKneeKick(s) => run_jumping_knee_kick(s, base, tmp)?,
         Scene::Fall(s) => run_fall(s, base, tmp)?,
         Scene::EvolveFall(s) => run_evolve(s, base, tmp)?,
+        Scene::Dance(s) => run_dance(s, base, tmp)?,
     };
     if let Some(o) = report.as_object_mut() {
         o.insert("scene".into(), scene.name().into());
