@@ -503,16 +503,16 @@ fn choreography(c: usize, bars: usize) -> Vec<(Move, Arms)> {
                 2 => Move::Grapevine {
                     side,
                     step: [0.18, 0.24][k % 2],
-                    high: k % 2 == 0,
+                    high: k.is_multiple_of(2),
                 },
                 3 => Move::Kick {
                     side,
-                    front: k % 2 == 0,
+                    front: k.is_multiple_of(2),
                     height: [0.45, 0.6][(k / 2) % 2],
                 },
                 4 => Move::Turn {
                     angle: side * [90.0, 180.0][k % 2] * deg,
-                    high: k % 3 == 0,
+                    high: k.is_multiple_of(3),
                 },
                 _ => Move::KneeDrop {
                     depth: [0.15, 0.26][k % 2],
@@ -904,15 +904,6 @@ mod tests {
             .collect()
     }
 
-    trait Lowest {
-        fn into_lowest(self) -> (usize, usize);
-    }
-    impl Lowest for (usize, usize, f64) {
-        fn into_lowest(self) -> (usize, usize) {
-            (self.0, self.1)
-        }
-    }
-
     #[test]
     fn the_kinematic_beat_finds_the_tempo_and_feet_stay_on_the_floor() {
         for bpm in [96.0, 118.0, 137.5] {
@@ -938,20 +929,7 @@ mod tests {
                     .flatten()
                     .map(|p| p.y)
                     .fold(f64::INFINITY, f64::min);
-                let (fi, pi) = fs
-                    .iter()
-                    .enumerate()
-                    .flat_map(|(f, p)| p.iter().enumerate().map(move |(i, q)| (f, i, q.y)))
-                    .fold(
-                        (0, 0, f64::INFINITY),
-                        |m, (f, i, y)| if y < m.2 { (f, i, y) } else { m },
-                    )
-                    .into_lowest();
-                assert!(
-                    lowest > -1e-4,
-                    "{}: a foot at {lowest} m, frame {fi} point {pi}",
-                    clip.name
-                );
+                assert!(lowest > -1e-4, "{}: a foot at {lowest} m", clip.name);
                 // A toe on the floor does not slide: its horizontal speed while within 1 mm of it.
                 let dt = clip.motion.frame_time;
                 let mut worst: f64 = 0.0;
@@ -966,30 +944,83 @@ mod tests {
                     }
                 }
                 eprintln!("  lowest {lowest:.4} m, planted toe speed {worst:.4} m/s");
+                assert!(
+                    worst < 0.05,
+                    "{}: a planted toe slides at {worst} m/s",
+                    clip.name
+                );
             }
         }
     }
 
     #[test]
-    #[ignore]
-    fn write_demo() {
-        let clips = generate(&AuthoredDance::default()).unwrap();
-        write_bvh_folder(&clips, std::path::Path::new("/tmp/authored_demo")).unwrap();
-        for c in &clips {
-            eprintln!("{}: {:?}", c.name, c.moves);
+    fn written_as_bvh_the_database_finds_the_tempo() {
+        let p = AuthoredDance {
+            bpm: 107.0,
+            clips: 2,
+            ..AuthoredDance::default()
+        };
+        let clips = generate(&p).unwrap();
+        let dir = std::env::temp_dir().join(format!("marionette-authored-{}", std::process::id()));
+        let files = write_bvh_folder(&clips, &dir).unwrap();
+        assert_eq!(files.len(), 2);
+        let manifest = crate::choreo::database::Manifest::from_folder(&dir).unwrap();
+        let db = crate::choreo::database::Database::build(
+            &manifest,
+            &crate::choreo::database::BuildParams::default(),
+            |_, _| {},
+        )
+        .unwrap();
+        for s in &db.sources {
+            eprintln!("{}: {:.2} BPM", s.file, s.beat.tempo_bpm);
+            assert!(
+                (s.beat.tempo_bpm / 107.0 - 1.0).abs() < 0.01,
+                "{}",
+                s.beat.tempo_bpm
+            );
         }
-        let m = &clips[0].motion;
-        for f in [0usize, 30, 60] {
-            let names = m.model.dof_names();
-            let a = m.frame_angles(f);
-            eprintln!("frame {f} root {:?}", m.root_translation[f]);
-            for (n, v) in names.iter().zip(a) {
-                if v.abs() > 1e-6 {
-                    eprint!("{n}={:.1} ", v.to_degrees());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn moves_are_distinct_by_eros() {
+        use crate::choreo::database::{BuildParams, Database};
+        use crate::choreo::eros::eros;
+        let p = AuthoredDance::default();
+        let clips = generate(&p).unwrap();
+        let beat = crate::choreo::segments::Beat {
+            tempo_bpm: p.bpm,
+            first_beat_s: 0.0,
+            source: crate::choreo::segments::TempoSource::Manifest,
+        };
+        let named: Vec<_> = clips
+            .iter()
+            .map(|c| (c.name.clone(), c.motion.clone(), Some(beat)))
+            .collect();
+        let db = Database::from_clips(&named, &BuildParams::default()).unwrap();
+        assert_eq!(db.segments.len(), p.clips * p.bars_per_clip);
+        let family = |i: usize| {
+            let s = &db.segments[i];
+            clips[s.clip].families[s.bar]
+        };
+        let sim =
+            |i: usize, j: usize| eros(&db.segments[i].eros, &db.segments[j].eros, &db.eros_weights);
+        // No two segments are as alike as a segment with itself (Eros 1): the database holds
+        // real choices; segments of different move families are less alike still.
+        let n = db.segments.len();
+        let (mut any, mut across) = (0.0f64, 0.0f64);
+        for i in 0..n {
+            assert!((sim(i, i) - 1.0).abs() < 1e-9);
+            for j in (0..n).filter(|&j| j != i) {
+                any = any.max(sim(i, j));
+                if family(j) != family(i) {
+                    across = across.max(sim(i, j));
                 }
             }
-            eprintln!();
         }
+        eprintln!("most alike: any two segments {any:.4}, of different moves {across:.4}");
+        assert!(any < 0.99, "{any}");
+        assert!(across < 0.95, "{across}");
     }
 
     #[test]
