@@ -248,16 +248,54 @@ impl Database {
             sources.push(source);
             segments.extend(cut);
         }
+        Ok(Database::of_segments(params, sources, segments))
+    }
+
+    /// A database from clips already on humanoid24 (e.g. the project's own dance, built in
+    /// memory), each with its name and its beat when known (else the kinematic beat).
+    pub fn from_clips(
+        clips: &[(String, ModelClip, Option<Beat>)],
+        params: &BuildParams,
+    ) -> Result<Database, SegmentError> {
+        if clips.is_empty() {
+            return Err(SegmentError::Manifest {
+                path: "clips".into(),
+                message: "no clip to build a dance database from".into(),
+            });
+        }
+        let mut sources = vec![];
+        let mut segments = vec![];
+        for (i, (name, clip, beat)) in clips.iter().enumerate() {
+            let beat = match beat {
+                Some(b) => *b,
+                None => kinematic_beat(clip, name)?,
+            };
+            let cut = cut_segments(clip, name, i, &beat, params)?;
+            sources.push(Source {
+                file: name.clone(),
+                frames: clip.frame_count(),
+                fps: 1.0 / clip.frame_time,
+                window: None,
+                beat,
+                segments: cut.len(),
+            });
+            segments.extend(cut);
+        }
+        Ok(Database::of_segments(params, sources, segments))
+    }
+
+    /// The database of `segments` cut from `sources`, with their Eros weights.
+    fn of_segments(params: &BuildParams, sources: Vec<Source>, segments: Vec<Segment>) -> Database {
         let pcas: Vec<_> = segments.iter().map(|s| &s.eros).collect();
         let eros_weights = eros_weights(&pcas);
-        Ok(Database {
+        Database {
             format_version: DATABASE_VERSION,
             model: "humanoid24".into(),
             params: params.clone(),
             sources,
             segments,
             eros_weights,
-        })
+        }
     }
 
     /// The database as compact JSON.

@@ -9,10 +9,6 @@
 //! - [`segments`]: dance clips cut into bars of 4 counts (tempo from a manifest or the kinematic
 //!   beat), each resampled, with intensity, Eros features and boundary links;
 //! - [`database`]: the segment database file and what it was built from;
-//! - [`augment`]: a larger database from a real one by mirror images and time offsets;
-//! - [`relevance`]: rel(q, m), music intensity against motion intensity, both as percentile ranks;
-//! - [`search`]: the relevance-feedback search of eqs. (1)–(4), six candidates per round;
-//! - [`edit`]: the stateful edit a server holds (pins, per-bar search, undo/redo, generate);
 //! - [`transition`]: the connection score S = S_pose + S_move of two segments (eqs. 5–8) and
 //!   the transition cost C = 1/S, one pair or a whole database's table;
 //! - [`fill`]: the unpinned bars filled by the minimum-cost path (Dijkstra, and the exact
@@ -23,9 +19,11 @@
 //! - [`augment`]: a larger database from a real one by mirror images and time offsets;
 //! - [`relevance`]: rel(q, m), music intensity against motion intensity, both as percentile ranks;
 //! - [`search`]: the relevance-feedback search of eqs. (1)–(4), six candidates per round;
-//! - [`edit`]: the stateful edit a server holds (pins, per-bar search, undo/redo).
+//! - [`edit`]: the stateful edit a server holds (pins, per-bar search, undo/redo, generate);
+//! - [`authored`]: the project's own dance, generated in code at a known tempo.
 
 pub mod augment;
+pub mod authored;
 pub mod dance;
 pub mod database;
 pub mod edit;

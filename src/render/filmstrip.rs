@@ -150,7 +150,6 @@ pub fn filmstrip_view_png(
     let turned = super::facing::turned_frames(tracks);
     let turned_tracks = super::facing::with_frames(tracks, &turned);
     let tracks = &turned_tracks[..];
-    let font = font()?;
     let (mpp, pad) = scale_for(tracks, CELL_HEIGHT);
     let limits = PanelLimits {
         height: CELL_HEIGHT,
@@ -160,6 +159,56 @@ pub fn filmstrip_view_png(
     let cam = Camera::fit(tracks, view, mpp, pad, limits);
     let style = Style::for_height(CELL_HEIGHT.max(cam.height));
     let times = column_times(tracks, n);
+    let labels: Vec<String> = times.iter().map(|t| format!("t = {t:.2} s")).collect();
+    draw_columns(tracks, &times, &labels, &cam, style, mpp, path)
+}
+
+/// Draws `tracks` at the given instants (seconds), each column headed by its label, in `view`,
+/// each figure turned to face +Z; otherwise as [`filmstrip_view_png`] (one scale and framing
+/// for every cell, 1 m scale bar and colour key below). Used where the instants mean something
+/// (a bar of a dance per column).
+pub fn filmstrip_at_png(
+    tracks: &[Track],
+    times: &[f64],
+    labels: &[String],
+    view: View,
+    path: &Path,
+) -> Result<(), RenderError> {
+    require_extension(path, "png")?;
+    validate_tracks(tracks)?;
+    if times.is_empty() || times.len() != labels.len() {
+        return Err(RenderError::InvalidArgument(format!(
+            "a filmstrip needs at least one column and a label per column ({} times, {} labels)",
+            times.len(),
+            labels.len()
+        )));
+    }
+    let turned = super::facing::turned_frames(tracks);
+    let turned_tracks = super::facing::with_frames(tracks, &turned);
+    let tracks = &turned_tracks[..];
+    let (mpp, pad) = scale_for(tracks, CELL_HEIGHT);
+    let limits = PanelLimits {
+        height: CELL_HEIGHT,
+        min_width: CELL_HEIGHT * 9 / 20,
+        max_width: CELL_HEIGHT * 9 / 10,
+    };
+    let cam = Camera::fit(tracks, view, mpp, pad, limits);
+    let style = Style::for_height(CELL_HEIGHT.max(cam.height));
+    draw_columns(tracks, times, labels, &cam, style, mpp, path)
+}
+
+/// The sheet of a filmstrip: a column per instant with its label above, a row per track.
+fn draw_columns(
+    tracks: &[Track],
+    times: &[f64],
+    labels: &[String],
+    cam: &Camera,
+    style: Style,
+    mpp: f64,
+    path: &Path,
+) -> Result<(), RenderError> {
+    let font = font()?;
+    let n = times.len();
 
     let time_row = (style.small * 1.8) as u32;
     let label_row = (style.text * 1.7) as u32;
@@ -179,13 +228,12 @@ pub fn filmstrip_view_png(
     let x0 = MARGIN;
     let mut y = MARGIN;
     let time_base = y as f32 + ascent(font, style.small);
-    for (j, t) in times.iter().enumerate() {
+    for (j, s) in labels.iter().enumerate() {
         let cx = (x0 + j as u32 * (cam.width + GAP)) as f32 + cam.width as f32 * 0.5;
-        let s = format!("t = {t:.2} s");
         draw_text(
             &mut sheet,
             font,
-            &s,
+            s,
             (cx, time_base),
             Pen {
                 size: style.small,
@@ -196,8 +244,8 @@ pub fn filmstrip_view_png(
     }
     y += time_row;
     // The view's name only in each row's first cell.
-    let first = panel_background(&cam, font, style, true)?;
-    let rest = panel_background(&cam, font, style, false)?;
+    let first = panel_background(cam, font, style, true)?;
+    let rest = panel_background(cam, font, style, false)?;
     for track in tracks {
         let base = y as f32 + ascent(font, style.text);
         draw_text(
@@ -215,7 +263,7 @@ pub fn filmstrip_view_png(
         let sides = track.figure.sides();
         for (j, &t) in times.iter().enumerate() {
             let mut cell = if j == 0 { first.clone() } else { rest.clone() };
-            draw_figure(&mut cell, &cam, track, &sides, track.frame_at(t), style);
+            draw_figure(&mut cell, cam, track, &sides, track.frame_at(t), style);
             blit(&mut sheet, &cell, x0 + j as u32 * (cam.width + GAP), y);
         }
         y += cam.height + ROW_GAP;

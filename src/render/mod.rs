@@ -36,7 +36,7 @@ use std::path::{Path, PathBuf};
 pub use animation::{MAX_GIF_FPS, MAX_GIF_FRAMES, animation_gif};
 pub use camera::View;
 pub use figure::{Figure, Side, Track, side_from_name};
-pub use filmstrip::{filmstrip_png, filmstrip_view_png};
+pub use filmstrip::{filmstrip_at_png, filmstrip_png, filmstrip_view_png};
 pub use plot::{Plot, Series, plot};
 pub use pose::pose_png;
 pub use text::FONT_TTF;

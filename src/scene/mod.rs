@@ -7,6 +7,7 @@
 //! files.
 
 mod active;
+mod dance;
 mod evolve;
 mod fall;
 mod output;
@@ -15,6 +16,9 @@ mod show;
 mod source;
 
 pub use active::{ActiveCharacter, ActiveKneeKickScene, run_active_knee_kick};
+pub use dance::{
+    DanceRender, DanceScene, DatabaseSource, Pin, SongSource, run_dance, validate_dance,
+};
 pub use evolve::{EvaluatorChoice, EvolveFallScene, run_evolve};
 pub use fall::{Body, Controller, FallScene, Simulation, fall_report, run_fall};
 pub use primitives::{
@@ -46,6 +50,8 @@ pub enum Scene {
     ActiveKneeKick(Box<ActiveKneeKickScene>),
     /// The falling paper's GA for both age groups over several seeds.
     EvolveFall(Box<EvolveFallScene>),
+    /// The dance-editing paper: a song, a segment database, pins, the rest filled.
+    Dance(Box<DanceScene>),
 }
 
 /// Why a scene could not be read or run. Module errors keep their own type (and message), so a
@@ -114,6 +120,21 @@ pub enum SceneError {
     /// Drawing.
     #[error(transparent)]
     Render(#[from] crate::render::RenderError),
+    /// A song: decoding, synthesis or analysis.
+    #[error(transparent)]
+    Music(#[from] crate::choreo::music::MusicError),
+    /// Dance clips and their segment database.
+    #[error(transparent)]
+    Segment(#[from] crate::choreo::segments::SegmentError),
+    /// The project's own dance.
+    #[error(transparent)]
+    Authored(#[from] crate::choreo::authored::AuthoredError),
+    /// Filling the unpinned bars.
+    #[error(transparent)]
+    Fill(#[from] crate::choreo::fill::FillError),
+    /// Assembling the dance.
+    #[error(transparent)]
+    Dance(#[from] crate::choreo::dance::DanceError),
 }
 
 impl Scene {
@@ -126,6 +147,7 @@ impl Scene {
             Scene::Fall(s) => &s.name,
             Scene::ActiveKneeKick(s) => &s.name,
             Scene::EvolveFall(s) => &s.name,
+            Scene::Dance(s) => &s.name,
         }
     }
 
@@ -137,6 +159,7 @@ impl Scene {
             Scene::Fall(s) => s.format_version,
             Scene::ActiveKneeKick(s) => s.format_version,
             Scene::EvolveFall(s) => s.format_version,
+            Scene::Dance(s) => s.format_version,
         }
     }
 
@@ -339,6 +362,7 @@ pub fn validate(scene: &Scene) -> Result<(), SceneError> {
         Scene::EvolveFall(s) => {
             pictures(s.render.filmstrip_frames, s.render.gif, s.render.gif_fps)?
         }
+        Scene::Dance(s) => validate_dance(s)?,
     }
     Ok(())
 }
@@ -363,6 +387,7 @@ pub fn run(scene: &Scene, base: &Path, out_dir: &Path) -> Result<serde_json::Val
         Scene::Fall(s) => run_fall(s, base, tmp)?,
         Scene::ActiveKneeKick(s) => run_active_knee_kick(s, base, tmp)?,
         Scene::EvolveFall(s) => run_evolve(s, base, tmp)?,
+        Scene::Dance(s) => run_dance(s, base, tmp)?,
     };
     if let Some(o) = report.as_object_mut() {
         o.insert("scene".into(), scene.name().into());

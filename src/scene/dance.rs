@@ -1,0 +1,486 @@
+//! The `Dance` scene (SPEC §2, the dance-editing paper): a song, a segment database and pins
+//! (bar → segment); the unpinned bars are filled by the minimum-cost path ([`fill::fill`]), the
+//! segments assembled at the song's bar timing ([`dance::assemble`]) and the dance measured
+//! ([`metrics::dance_metrics`]).
+//!
+//! Outputs: `motion.bvh` (the dance on humanoid24; frame 0 is the song's t = 0, the first frame
+//! held until the first bar), `song.wav` beside it when the song is synthesized, `filmstrip.png`
+//! (one tile per bar at its middle, bar numbers above, pinned bars marked), `motion.gif`,
+//! `intensity.png` (music against motion intensity per bar, both as the search normalises them:
+//! percentile ranks, [`relevance`]) and `report.json`.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+use serde_json::json;
+
+use super::source::resolve_path;
+use super::{SceneError, write_output};
+use crate::choreo::authored::{AuthoredDance, generate};
+use crate::choreo::dance::{self, DanceParams};
+use crate::choreo::database::{BuildParams, Database, Manifest};
+use crate::choreo::fill::{self, FillParams, Pins};
+use crate::choreo::metrics;
+use crate::choreo::music::synth::{SynthSong, synthesize};
+use crate::choreo::music::{MusicParams, analyze};
+use crate::choreo::relevance;
+use crate::choreo::segments::{Beat, TempoSource};
+use crate::render::{Plot, Series, Track, View, animation_gif, filmstrip_at_png, plot};
+
+/// Where the song comes from.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum SongSource {
+    /// A drum track synthesized at a known tempo with a loudness per bar.
+    Synth(SynthSong),
+    /// A song file (WAV, OGG/Vorbis, MP3), relative to the scene, `${MARIONETTE_DATA}` allowed.
+    File(String),
+}
+
+/// Where the segment database comes from.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum DatabaseSource {
+    /// The project's own dance ([`crate::choreo::authored`]), built in memory; each clip's tempo
+    /// and first beat are the generator's (known, not estimated).
+    Authored(AuthoredDance),
+    /// Every clip of a folder, or a manifest's clips (path relative to the scene).
+    Clips(String),
+    /// A database file written by `marionette dance db`.
+    File(String),
+}
+
+/// A pin: a bar of the song and the segment it takes, by index in the database or by the clip
+/// (file name without extension) and the bar within it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Pin {
+    /// The song's bar (0-based).
+    pub bar: usize,
+    /// The segment's index in the database.
+    #[serde(default)]
+    pub segment: Option<usize>,
+    /// The clip the segment is cut from (its file name without extension).
+    #[serde(default)]
+    pub clip: Option<String>,
+    /// The bar within that clip (0-based).
+    #[serde(default)]
+    pub clip_bar: Option<usize>,
+}
+
+/// What the scene draws.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct DanceRender {
+    /// Write the animated GIF.
+    pub gif: bool,
+    /// Its frame rate.
+    pub gif_fps: f64,
+}
+
+impl Default for DanceRender {
+    fn default() -> Self {
+        DanceRender {
+            gif: true,
+            gif_fps: 15.0,
+        }
+    }
+}
+
+/// A dance to a song: pins given, the rest filled.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DanceScene {
+    /// Scene format version.
+    pub format_version: u32,
+    /// Scene name.
+    pub name: String,
+    /// The song.
+    pub song: SongSource,
+    /// Music analysis parameters.
+    #[serde(default)]
+    pub music: MusicParams,
+    /// Bars to dance, from the song's first bar (all the song's bars when absent).
+    #[serde(default)]
+    pub bars: Option<usize>,
+    /// The segment database.
+    pub database: DatabaseSource,
+    /// How a database is built from clips (not used for a database file).
+    #[serde(default)]
+    pub build: BuildParams,
+    /// The pins.
+    #[serde(default)]
+    pub pins: Vec<Pin>,
+    /// How the other bars are filled.
+    #[serde(default)]
+    pub fill: FillParams,
+    /// How the dance is assembled.
+    #[serde(default)]
+    pub dance: DanceParams,
+    /// Pictures.
+    #[serde(default)]
+    pub render: DanceRender,
+}
+
+/// Checks what can be checked before any work: each pin names its segment one way (an index,
+/// or a clip and its bar), no bar is pinned twice, and the picture settings are in range.
+pub fn validate_dance(s: &DanceScene) -> Result<(), SceneError> {
+    let mut seen = BTreeMap::new();
+    for (k, p) in s.pins.iter().enumerate() {
+        let by_index = p.segment.is_some();
+        let by_clip = p.clip.is_some() || p.clip_bar.is_some();
+        if by_index == by_clip || (by_clip && (p.clip.is_none() || p.clip_bar.is_none())) {
+            return Err(SceneError::Invalid(format!(
+                "pins[{k}] (bar {}): give either segment: N, or clip: \"name\" with clip_bar: N",
+                p.bar
+            )));
+        }
+        if let Some(j) = seen.insert(p.bar, k) {
+            return Err(SceneError::Invalid(format!(
+                "pins[{k}]: bar {} is pinned already by pins[{j}]",
+                p.bar
+            )));
+        }
+    }
+    if s.bars == Some(0) {
+        return Err(SceneError::Invalid(
+            "bars is 0: expected at least one bar to dance (or leave it out for the whole song)"
+                .into(),
+        ));
+    }
+    let fps = s.render.gif_fps;
+    if s.render.gif && !(fps.is_finite() && fps > 0.0 && fps <= crate::render::MAX_GIF_FPS) {
+        return Err(SceneError::Invalid(format!(
+            "render.gif_fps is {fps}, expected more than 0 and at most {}",
+            crate::render::MAX_GIF_FPS
+        )));
+    }
+    Ok(())
+}
+
+/// The song: mono samples, rate, and the synthesized track's ground truth when there is one.
+struct Song {
+    samples: Vec<f32>,
+    sample_rate: u32,
+    known_bpm: Option<f64>,
+    origin: String,
+}
+
+fn load_song(src: &SongSource, base: &Path) -> Result<Song, SceneError> {
+    match src {
+        SongSource::Synth(s) => {
+            let t = synthesize(s)?;
+            Ok(Song {
+                samples: t.samples,
+                sample_rate: t.sample_rate,
+                known_bpm: Some(s.bpm),
+                origin: format!("synthesized at {} BPM", s.bpm),
+            })
+        }
+        SongSource::File(f) => {
+            let path = resolve_path(f, base);
+            #[cfg(feature = "audio")]
+            {
+                let a = crate::choreo::music::decode::decode_file(&path)?;
+                Ok(Song {
+                    samples: a.samples,
+                    sample_rate: a.sample_rate,
+                    known_bpm: None,
+                    origin: path.display().to_string(),
+                })
+            }
+            #[cfg(not(feature = "audio"))]
+            Err(SceneError::Invalid(format!(
+                "{}: decoding songs needs the `audio` feature",
+                path.display()
+            )))
+        }
+    }
+}
+
+/// The database and, for the project's own dance, each clip's moves.
+fn load_database(
+    s: &DanceScene,
+    base: &Path,
+) -> Result<(Database, Vec<Vec<String>>, String), SceneError> {
+    match &s.database {
+        DatabaseSource::Authored(a) => {
+            let clips = generate(a)?;
+            let beat = Beat {
+                tempo_bpm: a.bpm,
+                first_beat_s: 0.0,
+                source: TempoSource::Manifest,
+            };
+            let named: Vec<_> = clips
+                .iter()
+                .map(|c| (c.name.clone(), c.motion.clone(), Some(beat)))
+                .collect();
+            let db = Database::from_clips(&named, &s.build)?;
+            let moves = clips.iter().map(|c| c.moves.clone()).collect();
+            Ok((
+                db,
+                moves,
+                format!(
+                    "the project's own dance: {} clips of {} bars at {} BPM, built in memory",
+                    a.clips, a.bars_per_clip, a.bpm
+                ),
+            ))
+        }
+        DatabaseSource::Clips(p) => {
+            let path = resolve_path(p, base);
+            let manifest = Manifest::from_path(&path)?;
+            let db = Database::build(&manifest, &s.build, |_, _| {})?;
+            Ok((db, vec![], path.display().to_string()))
+        }
+        DatabaseSource::File(p) => {
+            let path = resolve_path(p, base);
+            Ok((Database::load(&path)?, vec![], path.display().to_string()))
+        }
+    }
+}
+
+/// A source clip's name: its file name without extension.
+fn clip_name(file: &str) -> String {
+    Path::new(file)
+        .file_stem()
+        .map_or_else(|| file.to_string(), |s| s.to_string_lossy().to_string())
+}
+
+/// The pins as bar → segment index.
+fn resolve_pins(pins: &[Pin], db: &Database) -> Result<Pins, SceneError> {
+    let mut out = Pins::new();
+    for (k, p) in pins.iter().enumerate() {
+        let seg = match (p.segment, &p.clip, p.clip_bar) {
+            (Some(i), _, _) => i,
+            (None, Some(clip), Some(bar)) => {
+                let names: Vec<String> = db.sources.iter().map(|s| clip_name(&s.file)).collect();
+                let c = names.iter().position(|n| n == clip).ok_or_else(|| {
+                    SceneError::Invalid(format!(
+                        "pins[{k}] (bar {}): no clip '{clip}' in the database; its clips: {}",
+                        p.bar,
+                        names.join(", ")
+                    ))
+                })?;
+                db.segments
+                    .iter()
+                    .position(|s| s.clip == c && s.bar == bar)
+                    .ok_or_else(|| {
+                        SceneError::Invalid(format!(
+                            "pins[{k}] (bar {}): clip '{clip}' has {} bars (0 to {}), not bar {bar}",
+                            p.bar,
+                            db.sources[c].segments,
+                            db.sources[c].segments.saturating_sub(1)
+                        ))
+                    })?
+            }
+            _ => unreachable!("validate_dance checks each pin names its segment"),
+        };
+        out.insert(p.bar, seg);
+    }
+    Ok(out)
+}
+
+/// Runs a [`DanceScene`] (module docs). Returns the report.
+pub fn run_dance(
+    scene: &DanceScene,
+    base: &Path,
+    out: &Path,
+) -> Result<serde_json::Value, SceneError> {
+    let song = load_song(&scene.song, base)?;
+    let analysis = analyze(&song.samples, song.sample_rate, &scene.music)?;
+    analysis.require_bars(1)?;
+    let bars_n = match scene.bars {
+        Some(n) => {
+            analysis.require_bars(n)?;
+            n
+        }
+        None => analysis.bars.len(),
+    };
+    let bars = &analysis.bars[..bars_n];
+    let (db, moves, db_origin) = load_database(scene, base)?;
+    let pins = resolve_pins(&scene.pins, &db)?;
+    let filled = fill::fill(&db, bars_n, &pins, &scene.fill)?;
+    let d = dance::assemble(&db, &filled.segments, bars, &scene.dance)?;
+    let m = metrics::dance_metrics(&d, &analysis.beats_s, &filled);
+
+    // motion.bvh at the song's timing: the first frame held from t = 0 to the first bar.
+    let lead = (d.start_s / d.clip.frame_time).round() as usize;
+    let mut synced = d.clip.clone();
+    let dofs = synced.dof_count();
+    for _ in 0..lead {
+        synced
+            .root_translation
+            .insert(0, d.clip.root_translation[0]);
+        synced.root_rotation.insert(0, d.clip.root_rotation[0]);
+        let first: Vec<f64> = d.clip.frame_angles(0).to_vec();
+        synced.angles.splice(0..0, first);
+    }
+    debug_assert_eq!(synced.angles.len(), synced.frame_count() * dofs);
+    let clip = synced.to_clip();
+    write_output(
+        &out.join("motion.bvh"),
+        crate::bvh::to_string(&clip.to_bvh()).as_bytes(),
+    )?;
+    if matches!(scene.song, SongSource::Synth(_)) {
+        let wav = crate::choreo::music::wav::wav_bytes(&song.samples, 1, song.sample_rate)
+            .ok_or_else(|| SceneError::Invalid("the song is too long for a WAV file".into()))?;
+        write_output(&out.join("song.wav"), &wav)?;
+    }
+
+    // Pictures of the dance itself (frame 0 at the first bar).
+    let dclip = d.clip.to_clip();
+    let frames = dclip.point_frames();
+    let figure = dclip.skeleton.figure();
+    let track = Track {
+        figure: &figure,
+        frames: &frames,
+        label: format!("{}: {} bars on humanoid24", scene.name, bars_n),
+        frame_time: dclip.frame_time,
+    };
+    let mid: Vec<f64> = d
+        .bar_frames
+        .iter()
+        .map(|&(a, b)| 0.5 * (a + b) as f64 * dclip.frame_time)
+        .collect();
+    let labels: Vec<String> = (0..bars_n)
+        .map(|b| {
+            if pins.contains_key(&b) {
+                format!("bar {b} (pinned)")
+            } else {
+                format!("bar {b}")
+            }
+        })
+        .collect();
+    filmstrip_at_png(
+        std::slice::from_ref(&track),
+        &mid,
+        &labels,
+        View::Front,
+        &out.join("filmstrip.png"),
+    )?;
+    if scene.render.gif {
+        animation_gif(
+            std::slice::from_ref(&track),
+            scene.render.gif_fps,
+            &out.join("motion.gif"),
+        )?;
+    }
+    let music_rank = relevance::music_intensity(bars);
+    let motion_rank_db = relevance::motion_intensity(&db);
+    let motion_rank: Vec<f64> = filled.segments.iter().map(|&s| motion_rank_db[s]).collect();
+    plot(
+        &Plot {
+            title: format!("{}: music and motion intensity per bar", scene.name),
+            x_label: "bar".into(),
+            y_label: "percentile rank (RMS in song, W in database)".into(),
+            series: vec![
+                Series {
+                    name: "music (bar RMS)".into(),
+                    points: music_rank
+                        .iter()
+                        .enumerate()
+                        .map(|(b, v)| (b as f64, *v))
+                        .collect(),
+                },
+                Series {
+                    name: "motion (chosen segment's W)".into(),
+                    points: motion_rank
+                        .iter()
+                        .enumerate()
+                        .map(|(b, v)| (b as f64, *v))
+                        .collect(),
+                },
+            ],
+            markers: pins
+                .keys()
+                .map(|&b| (b as f64, "pin".to_string()))
+                .collect(),
+        },
+        &out.join("intensity.png"),
+    )?;
+
+    let per_bar: Vec<serde_json::Value> = (0..bars_n)
+        .map(|b| {
+            let seg = filled.segments[b];
+            let s = &db.segments[seg];
+            let mut v = json!({
+                "bar": b,
+                "start_s": bars[b].start_s,
+                "end_s": bars[b].end_s,
+                "segment": seg,
+                "clip": clip_name(&db.sources[s.clip].file),
+                "clip_bar": s.bar,
+                "pinned": pins.contains_key(&b),
+                "music_rms_db": bars[b].rms_db,
+                "music_intensity_rank": music_rank[b],
+                "motion_intensity_m_s": s.intensity,
+                "motion_intensity_rank": motion_rank[b],
+            });
+            if let Some(mv) = moves.get(s.clip).and_then(|m| m.get(s.bar)) {
+                v["move"] = json!(mv);
+            }
+            v
+        })
+        .collect();
+    let seams: Vec<serde_json::Value> = filled
+        .connections
+        .iter()
+        .enumerate()
+        .map(|(k, c)| {
+            json!({
+                "from_bar": k, "to_bar": k + 1, "time_s": bars[k + 1].start_s,
+                "s_pose": c.s_pose, "s_move": c.s_move, "s": c.s, "cost": c.cost,
+            })
+        })
+        .collect();
+    let dance_s = d.clip.frame_count() as f64 * d.clip.frame_time;
+    let bars_s = bars[bars_n - 1].end_s - bars[0].start_s;
+    Ok(json!({
+        "song": song.origin,
+        "song_known_tempo_bpm": song.known_bpm,
+        "tempo_bpm": analysis.tempo_bpm,
+        "song_duration_s": analysis.duration_s,
+        "song_bars": analysis.bars.len(),
+        "bars": bars_n,
+        "database": db_origin,
+        "database_segments": db.segments.len(),
+        "database_sources": db.sources.iter().map(|s| json!({
+            "clip": clip_name(&s.file), "segments": s.segments,
+            "tempo_bpm": s.beat.tempo_bpm, "first_beat_s": s.beat.first_beat_s,
+            "tempo_from": format!("{:?}", s.beat.source),
+        })).collect::<Vec<_>>(),
+        "pins": pins.iter().map(|(b, s)| json!({"bar": b, "segment": s})).collect::<Vec<_>>(),
+        "no_adjacent_repeat": scene.fill.no_adjacent_repeat,
+        "per_bar": per_bar,
+        "seams": seams,
+        "metrics": {
+            "beat_alignment_score": m.beat_alignment_score,
+            "motion_beats": m.motion_beats,
+            "music_beats": m.music_beats,
+            "seam_jerk_peak_rad_s3": m.seam_jerk.peak_rad_s3,
+            "seam_jerk_mean_rad_s3": m.seam_jerk.mean_rad_s3,
+            "inside_jerk_peak_rad_s3": m.inside_jerk.peak_rad_s3,
+            "inside_jerk_mean_rad_s3": m.inside_jerk.mean_rad_s3,
+            "foot_skating_m_s": m.foot_skating_m_s,
+            "foot_contact_fraction": m.foot_contact_fraction,
+            "transition_cost": m.transition_cost,
+            "mean_connection_s": m.mean_connection_s,
+        },
+        "dance_start_s": d.start_s,
+        "duration_s": dance_s,
+        "bars_duration_s": bars_s,
+        "fps": 1.0 / d.clip.frame_time,
+        "frames": d.clip.frame_count(),
+        "motion_bvh": format!(
+            "humanoid24, {} frames; frame 0 is the song's t = 0 (the dance's first frame held \
+             for {lead} frames until the first bar at {:.3} s)",
+            clip.frame_count(),
+            d.start_s
+        ),
+        "intensity_normalisation": "percentile rank: a bar's RMS (dB) among the song's bars \
+            danced; a segment's mean W(f) among the database's segments",
+        "source_skeleton": "not written: the mapping retargets onto humanoid24 only (no inverse \
+            retarget onto a source skeleton exists)",
+    }))
+}
