@@ -9,7 +9,14 @@
 //! representative isometric maxima of men of about 70–75 kg: `Adult` for ages 20–40, `Elderly`
 //! for ages 60–80, where the lower-limb extensors have lost the most (about 35–40 %), the upper
 //! limb less (about 25 %). They were transcribed as orders of magnitude, not row by row from the
-//! paper's regression tables: check them against it before relying on a single value. Trunk and
+//! paper's regression tables: check them against it before relying on a single value. The knee
+//! row was checked against the meta-analysis of Šarabon, Kozinc & Perman (2021), *Establishing
+//! reference values for isometric knee extension and flexion strength*, Front. Physiol.
+//! 12:767941 (411 studies): at mid-range knee angles its pooled 95 % intervals for men are
+//! 2.92–3.45 N·m/kg (extension) and 1.15–1.62 N·m/kg (flexion) in adults, 1.74–2.16 and
+//! 0.69–0.89 N·m/kg in older adults, i.e. 210–248, 83–117, 125–156 and 50–64 N·m at 72 kg: the
+//! extension values below lie inside, adult flexion (120) just above and elderly flexion (75)
+//! above its interval (see the unit test). Trunk and
 //! neck are not in that study; their values (trunk flexion/extension about 150/200 N·m, neck
 //! 25/40 N·m in young men) are this project's rounded reading of the dynamometry literature, with
 //! the same age decline. The DOFs only humanoid24 has (waist lateral bend, the clavicle's
@@ -136,6 +143,20 @@ mod tests {
         // Knee extension (negative) is the strongest lower-limb action.
         let k = crate::humanoid::fall21().dof_index("left_knee").unwrap();
         assert_eq!(a[k], (-240.0, 120.0));
+    }
+
+    /// The knee row against Šarabon, Kozinc & Perman (2021) at 72 kg (module docs): extension
+    /// inside the pooled 95 % intervals; flexion, which the table puts higher, within 20 % of
+    /// the intervals' upper ends.
+    #[test]
+    fn the_knee_row_agrees_with_the_meta_analysis() {
+        let knee = strength("left_knee").unwrap();
+        let at = |lo: f64, hi: f64| (lo * 72.0, hi * 72.0);
+        let inside = |v: f64, (lo, hi): (f64, f64)| (lo..=hi).contains(&v);
+        assert!(inside(knee.adult_negative, at(2.92, 3.45)), "{knee:?}");
+        assert!(inside(knee.elderly_negative, at(1.74, 2.16)), "{knee:?}");
+        assert!(knee.adult_positive <= 1.2 * at(1.15, 1.62).1, "{knee:?}");
+        assert!(knee.elderly_positive <= 1.2 * at(0.69, 0.89).1, "{knee:?}");
     }
 
     #[test]
