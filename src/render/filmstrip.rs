@@ -147,20 +147,11 @@ pub fn filmstrip_view_png(
             "a filmstrip needs at least one column".into(),
         ));
     }
-    let turned = super::facing::turned_frames(tracks);
-    let turned_tracks = super::facing::with_frames(tracks, &turned);
-    let tracks = &turned_tracks[..];
-    let (mpp, pad) = scale_for(tracks, CELL_HEIGHT);
-    let limits = PanelLimits {
-        height: CELL_HEIGHT,
-        min_width: CELL_HEIGHT * 9 / 20,
-        max_width: CELL_HEIGHT * 9 / 10,
-    };
-    let cam = Camera::fit(tracks, view, mpp, pad, limits);
-    let style = Style::for_height(CELL_HEIGHT.max(cam.height));
-    let times = column_times(tracks, n);
-    let labels: Vec<String> = times.iter().map(|t| format!("t = {t:.2} s")).collect();
-    draw_columns(tracks, &times, &labels, &cam, style, mpp, path)
+    draw_facing(tracks, view, path, |tracks| {
+        let times = column_times(tracks, n);
+        let labels = times.iter().map(|t| format!("t = {t:.2} s")).collect();
+        (times, labels)
+    })
 }
 
 /// Draws `tracks` at the given instants (seconds), each column headed by its label, in `view`,
@@ -183,6 +174,17 @@ pub fn filmstrip_at_png(
             labels.len()
         )));
     }
+    draw_facing(tracks, view, path, |_| (times.to_vec(), labels.to_vec()))
+}
+
+/// Turns every figure to face +Z, frames them all at one scale in `view` and draws the columns
+/// that `columns` chooses (instants in seconds and their labels) from the turned tracks.
+fn draw_facing(
+    tracks: &[Track],
+    view: View,
+    path: &Path,
+    columns: impl FnOnce(&[Track]) -> (Vec<f64>, Vec<String>),
+) -> Result<(), RenderError> {
     let turned = super::facing::turned_frames(tracks);
     let turned_tracks = super::facing::with_frames(tracks, &turned);
     let tracks = &turned_tracks[..];
@@ -194,7 +196,8 @@ pub fn filmstrip_at_png(
     };
     let cam = Camera::fit(tracks, view, mpp, pad, limits);
     let style = Style::for_height(CELL_HEIGHT.max(cam.height));
-    draw_columns(tracks, times, labels, &cam, style, mpp, path)
+    let (times, labels) = columns(tracks);
+    draw_columns(tracks, &times, &labels, &cam, style, mpp, path)
 }
 
 /// The sheet of a filmstrip: a column per instant with its label above, a row per track.
