@@ -11,9 +11,10 @@
 //! [`fill`] runs Dijkstra's algorithm on it (a binary heap, lazy deletion) with the consistent
 //! potential h(k) = Σ_{j ≥ k} m_j, m_j the smallest weight between layers j and j+1, so that
 //! nodes are settled in the order of d + h (Dijkstra on the reduced weights w − m_j ≥ 0, A*);
-//! [`fill_dp`] is the exact dynamic programme D_{k+1}(b) = min_a D_k(a) + C(a → b), which sweeps
-//! the rows a in ascending D_k(a) and stops for a column b once D_k(a) + min_a' C(a' → b)
-//! exceeds the best D_{k+1}(b) found. Both break ties the same way (at every node the
+//! [`fill_dp`] is the exact dynamic programme D_{k+1}(b) = min_a D_k(a) + C(a → b): column by
+//! column (in parallel with rayon) it takes the rows a in ascending C(a → b), from the table's
+//! sorted column prefixes, and stops once min_a' D_k(a') + C(a → b) exceeds the best sum found;
+//! the predecessors are recovered afterwards from the stored D_k. Both break ties the same way (at every node the
 //! predecessor of smallest index among those of equal sum, and the end of smallest index among
 //! equal totals), so they return the same path.
 
@@ -331,7 +332,7 @@ impl<'a> Graph<'a> {
                 if !self.edge(k, s, t) || done[next + t] {
                     return;
                 }
-                let nd = d + row[t];
+                let nd = d + f64::from(row[t]);
                 let v = next + t;
                 if nd < dist[v] {
                     dist[v] = nd;
@@ -357,94 +358,64 @@ impl<'a> Graph<'a> {
     fn dp(&self) -> Option<Vec<usize>> {
         let (n, bars) = (self.table.n, self.bars);
         let t = self.table;
-        // Column minima of the table (with and without the diagonal), for the sweep's bound.
+        // Column minima of the table (without the diagonal under no-repeat), for the bound.
         let mut colmin = vec![f64::INFINITY; n];
         for a in 0..n {
             for (b, (m, &c)) in colmin.iter_mut().zip(t.row(a)).enumerate() {
+                let c = f64::from(c);
                 if (a != b || !self.no_repeat) && c < *m {
                     *m = c;
                 }
             }
         }
-        let mut d: Vec<f64> = (0..n)
-            .map(|s| {
-                if self.allowed(0, s) {
-                    0.0
-                } else {
-                    f64::INFINITY
-                }
-            })
-            .collect();
-        let mut next = vec![f64::INFINITY; n];
-        let mut back = vec![u32::MAX; n * bars];
-        let mut order: Vec<u32> = Vec::with_capacity(n);
-        let mut open: Vec<u32> = Vec::with_capacity(n);
+        // D_k(s) of every layer, row-major: the backtrack recovers the predecessors.
+        let mut dist = vec![f64::INFINITY; n * bars];
+        for (s, d) in dist[..n].iter_mut().enumerate() {
+            if self.allowed(0, s) {
+                *d = 0.0;
+            }
+        }
+        let mut order: Vec<usize> = Vec::with_capacity(n);
         for k in 0..bars - 1 {
-            next.fill(f64::INFINITY);
-            let bk = &mut back[(k + 1) * n..(k + 2) * n];
+            let (done, rest) = dist.split_at_mut((k + 1) * n);
+            let d = &done[k * n..];
+            let next = &mut rest[..n];
             match (self.pin[k], self.pin[k + 1]) {
                 (_, Some(b)) => {
                     for (a, &da) in d.iter().enumerate() {
-                        if da.is_finite() && self.edge(k, a, b) {
-                            let c = da + t.cost(a, b);
-                            if c < next[b] {
-                                next[b] = c;
-                                bk[b] = a as u32;
-                            }
+                        let c = da + t.cost(a, b);
+                        if c < next[b] && self.edge(k, a, b) {
+                            next[b] = c;
                         }
                     }
                 }
                 (Some(a), None) => {
                     let row = t.row(a);
-                    for b in 0..n {
+                    for (b, nb) in next.iter_mut().enumerate() {
                         if self.edge(k, a, b) {
-                            next[b] = d[a] + row[b];
-                            bk[b] = a as u32;
+                            *nb = d[a] + f64::from(row[b]);
                         }
                     }
                 }
                 (None, None) => {
-                    // Rows in ascending D_k (ties by index), each column closed once no later
-                    // row can reach it: D_k(a) + colmin(b) > best(b) (a margin of 1e-12
-                    // relative covers rounding).
                     order.clear();
-                    order.extend((0..n as u32).filter(|&a| d[a as usize].is_finite()));
-                    order.sort_by(|&x, &y| d[x as usize].total_cmp(&d[y as usize]).then(x.cmp(&y)));
-                    open.clear();
-                    open.extend(0..n as u32);
-                    for (i, &a) in order.iter().enumerate() {
-                        let a = a as usize;
-                        let da = d[a];
-                        if i % 8 == 0 {
-                            open.retain(|&b| {
-                                let b = b as usize;
-                                let bound = da + colmin[b];
-                                bound <= next[b] + 1e-12 * next[b].abs()
-                            });
-                            if open.is_empty() {
-                                break;
-                            }
-                        }
-                        let row = t.row(a);
-                        for &b in &open {
-                            let b = b as usize;
-                            if self.no_repeat && a == b {
-                                continue;
-                            }
-                            let c = da + row[b];
-                            if c < next[b] || (c == next[b] && (a as u32) < bk[b]) {
-                                next[b] = c;
-                                bk[b] = a as u32;
-                            }
-                        }
-                    }
+                    order.extend((0..n).filter(|&a| d[a].is_finite()));
+                    order.sort_by(|&x, &y| d[x].total_cmp(&d[y]).then(x.cmp(&y)));
+                    use rayon::prelude::*;
+                    next.par_chunks_mut(SWEEP_COLUMNS)
+                        .zip(colmin.par_chunks(SWEEP_COLUMNS))
+                        .enumerate()
+                        .for_each(|(c, (out, cm))| {
+                            self.sweep(d, &order, c * SWEEP_COLUMNS, out, cm)
+                        });
                 }
             }
-            std::mem::swap(&mut d, &mut next);
         }
-        // The end of smallest total (smallest index among equal totals).
+        // The end of smallest total (smallest index among equal totals), then back layer by
+        // layer: the predecessor of smallest index whose sum gives the node's D exactly.
+        let last = &dist[(bars - 1) * n..];
         let mut end = None;
-        for (s, &v) in d.iter().enumerate() {
+        for (s, &v) in last.iter().enumerate() {
             if v.is_finite() && end.is_none_or(|(_, b)| v < b) {
                 end = Some((s, v));
             }
@@ -452,10 +423,71 @@ impl<'a> Graph<'a> {
         let (mut s, _) = end?;
         let mut path = vec![s; bars];
         for k in (1..bars).rev() {
-            s = back[k * n + s] as usize;
+            let target = dist[k * n + s];
+            let d = &dist[(k - 1) * n..k * n];
+            s = (0..n)
+                .find(|&a| {
+                    d[a].is_finite() && self.edge(k - 1, a, s) && d[a] + t.cost(a, s) == target
+                })
+                .expect("a finite D has a predecessor that gives it");
             path[k - 1] = s;
         }
         Some(path)
+    }
+
+    /// One unpinned layer's columns `lo .. lo + out.len()`: out(b) = min_a D(a) + C(a → b) over
+    /// the rows a in ascending D, stopping once D(a) + colmin(b) > out(b) for every column of
+    /// the block (rounding is monotone, so no later row can lower any of them).
+    fn sweep(&self, d: &[f64], order: &[usize], lo: usize, out: &mut [f64], colmin: &[f64]) {
+        let hi = lo + out.len();
+        for (i, &a) in order.iter().enumerate() {
+            let da = d[a];
+            if i % 8 == 0 && !out.iter().zip(colmin).any(|(&o, &m)| da + m <= o) {
+                break;
+            }
+            let row = &self.table.row(a)[lo..hi];
+            if self.no_repeat && (lo..hi).contains(&a) {
+                let j = a - lo;
+                relax(&mut out[..j], &row[..j], da);
+                relax(&mut out[j + 1..], &row[j + 1..], da);
+            } else {
+                relax(out, row, da);
+            }
+        }
+    }
+}
+
+/// Columns per block of the DP's sweep (one rayon task; 1 KiB of each row).
+const SWEEP_COLUMNS: usize = 256;
+
+/// out(b) = min(out(b), da + row(b)) for every b, with AVX2 where the processor has it (the
+/// same IEEE additions and comparisons at any vector width, so the same bits).
+#[inline]
+fn relax(out: &mut [f64], row: &[f32], da: f64) {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the processor supports AVX2 (checked just above).
+        unsafe { relax_avx2(out, row, da) };
+        return;
+    }
+    relax_plain(out, row, da);
+}
+
+/// [`relax`] compiled for AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn relax_avx2(out: &mut [f64], row: &[f32], da: f64) {
+    relax_plain(out, row, da);
+}
+
+/// [`relax`] as a plain loop the compiler vectorises.
+#[inline(always)]
+fn relax_plain(out: &mut [f64], row: &[f32], da: f64) {
+    for (o, &c) in out.iter_mut().zip(row) {
+        let v = da + f64::from(c);
+        // A minimum, not a conditional store (masked stores are slow on some processors);
+        // no NaN reaches here (D and C are finite or +∞).
+        *o = o.min(v);
     }
 }
 
@@ -493,17 +525,18 @@ mod tests {
     /// A table of random costs (no database needed for the graph algorithms).
     fn random_table(n: usize, seed: u64, levels: Option<u32>) -> TransitionTable {
         let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
-        let cost: Vec<f64> = (0..n * n)
+        let cost: Vec<f32> = (0..n * n)
             .map(|_| match levels {
                 // Few distinct values: many exact ties.
-                Some(l) => 1.0 + rng.random_range(0..l) as f64,
+                Some(l) => 1.0 + rng.random_range(0..l) as f32,
                 None => rng.random_range(0.05..2.0),
             })
             .collect();
-        let min_cost = cost.iter().copied().fold(f64::INFINITY, f64::min);
+        let wide = |i: usize| f64::from(cost[i]);
+        let min_cost = (0..n * n).map(wide).fold(f64::INFINITY, f64::min);
         let min_cost_off_diagonal = (0..n * n)
             .filter(|i| i / n != i % n)
-            .map(|i| cost[i])
+            .map(wide)
             .fold(f64::INFINITY, f64::min);
         TransitionTable {
             n,
@@ -594,6 +627,21 @@ mod tests {
             let g = Graph::new(&table, bars, &pins, true);
             let (a, b) = (g.dijkstra().unwrap(), g.dp().unwrap());
             assert_eq!(a, b, "seed {seed}");
+        }
+    }
+
+    #[test]
+    fn several_column_blocks_agree() {
+        // Three blocks of the DP's sweep, the last one partial, with ties and without.
+        let n = 2 * SWEEP_COLUMNS + 44;
+        for (seed, levels) in [(1, Some(2)), (2, None), (3, Some(1))] {
+            let table = random_table(n, seed, levels);
+            let pins = Pins::from([(3, 7), (4, 7), (9, n - 1)]);
+            for no_repeat in [true, false] {
+                let g = Graph::new(&table, 12, &pins, no_repeat);
+                let (a, b) = (g.dijkstra().unwrap(), g.dp().unwrap());
+                assert_eq!(a, b, "seed {seed}, no repeat {no_repeat}");
+            }
         }
     }
 
