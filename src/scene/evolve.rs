@@ -265,12 +265,13 @@ fn controller_ron(problem: &FallProblem, genes: &[f64]) -> Result<String, SceneE
             .collect(),
         kv: Default::default(),
         start_s: Some(problem.fall.control_start_s),
+        dt_s: Some(problem.fall.dt_s),
     };
     let text = ron::ser::to_string_pretty(&controller, ron::ser::PrettyConfig::default())
         .map_err(|e| invalid(format!("controller file: {e}")))?;
     Ok(format!(
         "// The evolved key pose and stiffness, for a Fall scene's controller_file. Evolved at \
-         dt = {dt} s: replay with simulation.dt={dt} for the same fall.\n{text}\n",
+         dt = {dt} s (dt_s), the step a Fall scene replays it at.\n{text}\n",
         dt = problem.fall.dt_s
     ))
 }
