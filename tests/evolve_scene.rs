@@ -164,7 +164,10 @@ fn a_resumed_evolution_ends_where_an_uninterrupted_one_does() {
     assert!(!out.status.success());
     let err = String::from_utf8_lossy(&out.stderr);
     let evolved_at = format!("dt_s = {} s", FallProblem::paper(AgeGroup::Adult).fall.dt_s);
-    assert!(err.contains("controller.dt_s") && err.contains(&evolved_at), "{err}");
+    assert!(
+        err.contains("controller.dt_s") && err.contains(&evolved_at),
+        "{err}"
+    );
     std::fs::remove_dir_all(&replay).ok();
     // A resume from another experiment is refused.
     let out = Command::new(env!("CARGO_BIN_EXE_marionette"))

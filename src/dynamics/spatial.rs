@@ -426,9 +426,8 @@ impl ArticulatedInertia {
         // `A R` columns `a_y r_z − a_z r_y, a_z r_x − a_x r_z, a_x r_y − a_y r_x`, the same
         // bits as multiplying by `skew(r)` (its zero entries add nothing) at a third of the work.
         let r = x.trans;
-        let cross_cols = |a: DMat3| {
-            DMat3::from_cols(r.cross(a.x_axis), r.cross(a.y_axis), r.cross(a.z_axis))
-        };
+        let cross_cols =
+            |a: DMat3| DMat3::from_cols(r.cross(a.x_axis), r.cross(a.y_axis), r.cross(a.z_axis));
         let rl = cross_cols(l1);
         let rh = cross_cols(h1.transpose());
         let rlr = DMat3::from_cols(
