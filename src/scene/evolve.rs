@@ -72,7 +72,7 @@ pub struct EvolveFallScene {
     #[serde(default = "default_kp_scale")]
     pub kp_max_scale: f64,
     /// The fall every genome is tried on, per field (default: the paper's push of the age
-    /// group at the largest stable step, [`crate::evolve::fall_fitness::stable_step_for`]; its
+    /// group at the GA's step, [`crate::evolve::fall_fitness::stable_step_for`]; its
     /// key pose and k_p are the genes). A fall given here takes the group's ranges and strength
     /// and keeps its own `dt_s` (0.5 ms unless set).
     #[serde(default)]
