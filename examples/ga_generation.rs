@@ -3,14 +3,28 @@
 //! damage, steps, rest time, worst range excursion and penetration so a change can be checked
 //! for identical bits. Deterministic instruction counts:
 //! `RAYON_NUM_THREADS=1 valgrind --tool=callgrind target/release/examples/ga_generation 8`.
-//! Optional environment: `GROUP=adult`, `DT=<s>` (time step).
+//! Optional environment: `GROUP=adult`, `DT=<s>` (time step), `SEED=<k>` (the GA seed), and
+//! to find what makes the age groups' first generations differ, the other group's joint
+//! ranges (`RANGES=adult|elderly`: θ_d bounds and the simulated ranges) or strength
+//! (`STRENGTH=adult|elderly`: torque limits and k_p bounds, the step re-derived from them).
 
+use marionette::evolve::fall_fitness::{stable_step_for, strength_kp_max};
 use marionette::evolve::{FallProblem, GaConfig, GaState, InProcess};
+use marionette::experiments::fall::Ranges;
 use marionette::experiments::fall::{SettledStart, ecs::run_parallel_from};
 use marionette::humanoid::ranges::AgeGroup;
 
 fn env(name: &str) -> Option<f64> {
     std::env::var(name).ok().map(|v| v.parse().expect(name))
+}
+
+fn group_env(name: &str) -> Option<AgeGroup> {
+    match std::env::var(name).as_deref() {
+        Ok("adult") => Some(AgeGroup::Adult),
+        Ok("elderly") => Some(AgeGroup::Elderly),
+        Ok(other) => panic!("{name}={other}: adult or elderly"),
+        Err(_) => None,
+    }
 }
 
 fn main() {
@@ -22,6 +36,14 @@ fn main() {
         _ => AgeGroup::Elderly,
     };
     let mut problem = FallProblem::paper(group);
+    if let Some(g) = group_env("RANGES") {
+        problem.fall.ranges = Ranges::Builtin(g);
+    }
+    if let Some(g) = group_env("STRENGTH") {
+        problem.fall.torque_limits_nm = Some(marionette::humanoid::strength::torque_limits(g));
+        problem.kp_max = strength_kp_max(g, 1.0);
+        problem.fall.dt_s = stable_step_for(&problem.fall, &problem.kp_max).expect("step");
+    }
     if let Some(dt) = env("DT") {
         problem.fall.dt_s = dt;
     }
@@ -45,7 +67,7 @@ fn main() {
     let cfg = GaConfig {
         population: n.max(2),
         generations: 1,
-        seed: 1,
+        seed: env("SEED").map_or(1, |s| s as u64),
         ..GaConfig::default()
     };
     let mut free = InProcess {
@@ -72,10 +94,12 @@ fn main() {
     let results = run_parallel_from(&configs, start.as_ref());
     let wall = t0.elapsed().as_secs_f64();
     let mut steps = 0;
+    let mut best = f64::INFINITY;
     for (i, r) in results.iter().enumerate() {
         match r {
             Ok(f) => {
                 steps += f.steps;
+                best = best.min(f.damage);
                 let (d, ex) = f
                     .max_limit_excursion_rad
                     .iter()
@@ -98,4 +122,5 @@ fn main() {
         "{n} falls, {steps} steps, {wall:.3} s wall, {:.1} falls/s",
         n as f64 / wall
     );
+    println!("best damage {best}");
 }

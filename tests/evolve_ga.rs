@@ -1,7 +1,7 @@
 //! The genetic algorithm: it optimises, elitism never loses the best, the same seed gives the
 //! same logbook on 1 and 2 threads, a resumed run continues to the same bits, the JSON-lines
 //! worker gives the same fitness as in-process evaluation, and a run with diverging individuals
-//! completes with them logged.
+//! (refused before they run, or blowing up mid-fall) completes with them logged.
 
 use std::process::Command;
 
@@ -198,6 +198,106 @@ fn a_run_with_diverging_individuals_completes_and_logs_them() {
         why.contains("stability") || why.contains("exploding") || why.contains("non-finite"),
         "generation {g}, individual {i}: {why}"
     );
+    assert_eq!(
+        s.logbook.iter().map(|l| l.failures).sum::<usize>(),
+        s.failures.len()
+    );
+}
+
+#[test]
+fn a_run_whose_individual_blows_up_mid_fall_completes_with_it_worst_and_logged() {
+    // The paper's controller with elbows and knees folding to 140° and the hips flexing to 90°,
+    // held by 0.5–2·10⁵ N·m/rad with no strength cap (the only genes that differ): every genome
+    // passes the stability check at the GA's step (standing, the contact is the stiffest mode),
+    // but the stiffest hips drive the folded legs past the step's bound during the fall and the
+    // state runs away (a head 100 m away, or non-finite), while softer ones fall normally. The
+    // run goes on; a runaway gets the worst fitness and is logged.
+    let mut p = small_fall_problem();
+    // A step near the contact's stability bound (0.92 ms) that the stiff hips pass standing.
+    p.fall.dt_s = 0.0009;
+    p.fall.duration_s = 1.5;
+    p.fall.stop_at_rest = false;
+    p.fall.torque_limits_nm = None;
+    let names = marionette::humanoid::fall21().dof_names();
+    let dof = |n: &str| names.iter().position(|x| x == n).unwrap();
+    let n = names.len();
+    let mut genes: Vec<f64> = p.fall.key_pose_deg.iter().map(|x| x.to_radians()).collect();
+    genes.extend(p.fall.kp.iter().copied());
+    let mut bounds = Bounds::new(genes.clone(), genes).unwrap();
+    for side in ["left_", "right_"] {
+        for joint in ["knee", "elbow"] {
+            let d = dof(&format!("{side}{joint}"));
+            bounds.lo[d] = 140f64.to_radians();
+            bounds.hi[d] = bounds.lo[d];
+        }
+        let hip = dof(&format!("{side}hip_flexion"));
+        p.kp_max[hip] = 2.0e5;
+        bounds.lo[hip] = 90f64.to_radians();
+        bounds.hi[hip] = bounds.lo[hip];
+        bounds.lo[n + hip] = 0.5e5;
+        bounds.hi[n + hip] = 2.0e5;
+    }
+    // Before anything runs, the strongest genome is within the step's bound.
+    let strongest = p.config(&bounds.hi);
+    let ok_up_front = marionette::experiments::fall::stiffest_mode_of_config(&strongest)
+        .unwrap()
+        .is_none_or(|m| m.bound_s >= p.fall.dt_s);
+    assert!(ok_up_front, "the genomes must pass the up-front check");
+    let mut e = fall_eval(&p);
+    let cfg = GaConfig {
+        population: 10,
+        generations: 1,
+        seed: 4,
+        ..GaConfig::default()
+    };
+    let s = run_to_end(GaState::initial(cfg, bounds, &mut e).unwrap(), &mut e);
+    assert_eq!(s.generation, 1);
+    let blown: Vec<&(u64, usize, String)> = s
+        .failures
+        .iter()
+        .filter(|(_, _, why)| why.contains("exploding") || why.contains("non-finite"))
+        .collect();
+    assert!(
+        !blown.is_empty(),
+        "no individual blew up: {:?} {:?}",
+        s.failures,
+        s.fitness
+    );
+    assert!(
+        s.failures
+            .iter()
+            .all(|(_, _, why)| !why.contains("stability")),
+        "refused up front: {:?}",
+        s.failures
+    );
+    // Mid-fall: after the push and the reaction began.
+    for (_, _, why) in &blown {
+        let t: f64 = why
+            .split("t = ")
+            .nth(1)
+            .unwrap()
+            .split(' ')
+            .next()
+            .unwrap()
+            .parse()
+            .unwrap();
+        assert!(t > p.fall.control_start_s, "{why}");
+    }
+    // The last generation's runaways rank below every fall that completed.
+    let last: Vec<usize> = s
+        .failures
+        .iter()
+        .filter(|(g, _, _)| *g == s.generation)
+        .map(|(_, i, _)| *i)
+        .collect();
+    let ranking = s.ranking();
+    let completed = s.fitness.iter().filter(|f| f.is_some()).count();
+    assert!(completed > 0, "no fall completed");
+    for i in &last {
+        assert_eq!(s.fitness[*i], None);
+        assert!(ranking.iter().position(|r| r == i).unwrap() >= completed);
+    }
+    assert!(s.best.is_some());
     assert_eq!(
         s.logbook.iter().map(|l| l.failures).sum::<usize>(),
         s.failures.len()

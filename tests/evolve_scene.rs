@@ -133,13 +133,13 @@ fn a_resumed_evolution_ends_where_an_uninterrupted_one_does() {
         "render.gif=false",
         "--set",
         &file,
-        "--set",
-        &format!(
-            "simulation.dt={}",
-            FallProblem::paper(AgeGroup::Adult).fall.dt_s
-        ),
     ]);
+    // The file carries the step it was evolved at; the Fall scene takes it.
     let fall = report(&replay);
+    assert_eq!(
+        fall["dt_s"].as_f64(),
+        Some(FallProblem::paper(AgeGroup::Adult).fall.dt_s)
+    );
     let evolved = r["best_falls"]
         .as_array()
         .unwrap()
@@ -152,6 +152,21 @@ fn a_resumed_evolution_ends_where_an_uninterrupted_one_does() {
     assert!(
         (replayed - evolved).abs() <= 1e-9 * evolved,
         "replayed {replayed} N vs evolved {evolved} N"
+    );
+    std::fs::remove_dir_all(&replay).ok();
+    // A scene step that contradicts the controller's is refused, naming the way out.
+    let out = Command::new(env!("CARGO_BIN_EXE_marionette"))
+        .args(["run", "scenes/fall.ron", "--out", &s(&replay)])
+        .args(["--set", &file, "--set", "simulation.dt=0.0005"])
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    let evolved_at = format!("dt_s = {} s", FallProblem::paper(AgeGroup::Adult).fall.dt_s);
+    assert!(
+        err.contains("controller.dt_s") && err.contains(&evolved_at),
+        "{err}"
     );
     std::fs::remove_dir_all(&replay).ok();
     // A resume from another experiment is refused.

@@ -119,6 +119,10 @@ fn impossible_runs_are_refused_up_front() {
         (vec!["simulation.duration=1e9"], "duration_s"),
         (vec!["simulation.dt=1e-9"], "duration_s"),
         (vec!["push.start_s=5"], "push.start_s"),
+        (
+            vec!["controller.dt_s=0.0009", "simulation.dt=0.0005"],
+            "evolved at, dt_s = 0.0009 s",
+        ),
     ] {
         let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
         let s = apply_overrides(&scene, &sets).unwrap();

@@ -52,7 +52,10 @@ pub fn aba_passes(
     for i in (0..n).rev() {
         let body = &model.bodies[i];
         let iv = model.v_idx[i];
-        let ia = data.ia[i];
+        // Parents come before their children: the parent's entries lie below `i`, and the
+        // body's own articulated inertia is updated in place to `I^a` (no copies).
+        let (ia_head, ia_tail) = data.ia.split_at_mut(i);
+        let ia = &mut ia_tail[0];
         let pa = data.pa[i];
         let arm = |k: usize| armature.map_or(0.0, |a| a[iv + k]);
         match body.joint {
@@ -67,11 +70,10 @@ pub fn aba_passes(
                 data.dinv[i].x_axis.x = dinv;
                 data.uu[i].x = uu;
                 if let Some(p) = body.parent {
-                    let mut ia_a = ia;
-                    ia_a.sub_outer(u, dinv);
-                    let pa_a = pa + ia_a.apply(data.c[i]) + u * (dinv * uu);
-                    let x = data.xup[i];
-                    data.ia[p] += ia_a.transform_to_parent(&x);
+                    ia.sub_outer(u, dinv);
+                    let pa_a = pa + ia.apply(data.c[i]) + u * (dinv * uu);
+                    let x = &data.xup[i];
+                    ia_head[p] += ia.transform_to_parent(x);
                     data.pa[p] += x.inv_apply_force(pa_a);
                 }
             }
@@ -99,15 +101,14 @@ pub fn aba_passes(
                 data.dinv[i] = dinv;
                 data.uu[i] = uu;
                 if let Some(p) = body.parent {
-                    let mut ia_a = ia;
-                    ia_a.sub_u_dinv_ut(&u[..nv], &dinv);
+                    ia.sub_u_dinv_ut(&u[..nv], &dinv);
                     let w = dinv * uu;
-                    let mut pa_a = pa + ia_a.apply(data.c[i]);
+                    let mut pa_a = pa + ia.apply(data.c[i]);
                     for k in 0..nv {
                         pa_a += u[k] * w[k];
                     }
-                    let x = data.xup[i];
-                    data.ia[p] += ia_a.transform_to_parent(&x);
+                    let x = &data.xup[i];
+                    ia_head[p] += ia.transform_to_parent(x);
                     data.pa[p] += x.inv_apply_force(pa_a);
                 }
             }
@@ -115,8 +116,8 @@ pub fn aba_passes(
                 // No DOF: the whole articulated inertia and bias force reach the parent.
                 if let Some(p) = body.parent {
                     let pa_a = pa + ia.apply(data.c[i]);
-                    let x = data.xup[i];
-                    data.ia[p] += ia.transform_to_parent(&x);
+                    let x = &data.xup[i];
+                    ia_head[p] += ia.transform_to_parent(x);
                     data.pa[p] += x.inv_apply_force(pa_a);
                 }
             }

@@ -19,7 +19,8 @@ pub struct Data {
     pub c: Vec<MotionVec>,
     /// Body spatial acceleration (including the fictitious `−g` base acceleration), body coordinates.
     pub a: Vec<MotionVec>,
-    /// Articulated-body inertia `I^A`.
+    /// Articulated-body inertia `I^A`; after the ABA's second pass, for a body with a parent,
+    /// the inertia `I^a = I^A − U D⁻¹ Uᵀ` it passed on (updated in place).
     pub ia: Vec<ArticulatedInertia>,
     /// Articulated bias force `p^A`.
     pub pa: Vec<ForceVec>,

@@ -142,6 +142,13 @@ pub struct EvalScratch {
     pub angles: Vec<f64>,
     /// Per-link normal forces (scratch).
     pub normal: Vec<f64>,
+    /// PD torque and velocity coefficient per actuated DOF at the step start (N·m, N·m·s/rad),
+    /// when the limits stage computed them (`step_start_pd`).
+    pub pd_start: Vec<(f64, f64)>,
+    /// `angles` hold the step-start angles (the limits stage computed them).
+    pub step_start_angles: bool,
+    /// `pd_start` holds the step-start PD torques.
+    pub step_start_pd: bool,
     /// `data` holds the kinematics of the state after this many steps.
     pub kinematics_at_step: Option<u64>,
     /// `data` and `f_ext` hold the step-start kinematics and contact forces, so the
@@ -162,6 +169,9 @@ impl StepWorkspace {
                 armature: vec![0.0; nv],
                 angles: vec![0.0; nv],
                 normal: vec![0.0; nb],
+                pd_start: Vec::new(),
+                step_start_angles: false,
+                step_start_pd: false,
                 kinematics_at_step: None,
                 step_start_ready: false,
             },
@@ -252,18 +262,28 @@ fn limits_stage(
     dt: f64,
 ) {
     let limited = forces.pd.filter(|pd| !pd.torque_limits.is_empty());
+    let e = &mut ws.eval;
+    e.step_start_angles = false;
+    e.step_start_pd = false;
     if forces.limits.is_none() && limited.is_none() {
         return;
     }
-    let e = &mut ws.eval;
     model.angles(&state.q, &mut e.angles);
+    // The integrator's first evaluation is at this same state: it reuses the angles and the
+    // PD torques computed here (the same bits, computed once).
+    e.step_start_angles = true;
+    if limited.is_some() {
+        e.pd_start.resize(forces.dofs.len(), (0.0, 0.0));
+        e.step_start_pd = true;
+    }
     for (d, &k) in forces.dofs.iter().enumerate() {
         if let Some(l) = forces.limits {
             let ex = l.excursion(d, e.angles[k]);
             monitor.max_excursion[d] = monitor.max_excursion[d].max(ex);
         }
         if let Some(pd) = limited {
-            let (tau, _) = pd.torque(d, e.angles[k], state.v[k]);
+            let (tau, damp) = pd.torque(d, e.angles[k], state.v[k]);
+            e.pd_start[d] = (tau, damp);
             if tau.abs() > monitor.peak_torque[d].abs() {
                 monitor.peak_torque[d] = tau;
             }
@@ -398,9 +418,16 @@ impl Dynamics for Evaluation<'_> {
         let model = self.model;
         let forces = self.forces;
         let ws = &mut *self.ws;
-        if ws.step_start_ready {
+        let at_start = ws.step_start_ready;
+        let (start_angles, start_pd) = (
+            at_start && ws.step_start_angles,
+            at_start && ws.step_start_pd,
+        );
+        ws.step_start_angles = false;
+        ws.step_start_pd = false;
+        if at_start {
             // First evaluation of the step: the contact stage computed kinematics and contact
-            // forces at exactly this state.
+            // forces at exactly this state (and the limits stage its angles and PD torques).
             ws.step_start_ready = false;
         } else {
             kinematics(model, &mut ws.data, q, v);
@@ -410,13 +437,15 @@ impl Dynamics for Evaluation<'_> {
             }
         }
         apply_external(&ws.data, forces.external, t, &mut ws.f_ext);
-        if forces.pd.is_some() || forces.limits.is_some() {
+        if (forces.pd.is_some() || forces.limits.is_some()) && !start_angles {
             model.angles(q, &mut ws.angles);
         }
         for (d, &k) in forces.dofs.iter().enumerate() {
             let (th, thd) = (ws.angles[k], v[k]);
             let (mut tau, mut damp) = (0.0, 0.0);
-            if let Some(pd) = forces.pd {
+            if start_pd {
+                (tau, damp) = ws.pd_start[d];
+            } else if let Some(pd) = forces.pd {
                 (tau, damp) = pd.torque(d, th, thd);
             }
             if let Some(l) = forces.limits {

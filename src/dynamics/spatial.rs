@@ -422,11 +422,21 @@ impl ArticulatedInertia {
         let m1 = et * self.m * e;
         let h1 = et * self.h * e;
         let l1 = et * self.l * e;
-        let rx = skew(x.trans);
-        let rl = rx * l1;
-        let rh = rx * h1.transpose();
+        // The products with R = [r]× as cross products: `R A` has columns `r × a_j` and
+        // `A R` columns `a_y r_z − a_z r_y, a_z r_x − a_x r_z, a_x r_y − a_y r_x`, the same
+        // bits as multiplying by `skew(r)` (its zero entries add nothing) at a third of the work.
+        let r = x.trans;
+        let cross_cols =
+            |a: DMat3| DMat3::from_cols(r.cross(a.x_axis), r.cross(a.y_axis), r.cross(a.z_axis));
+        let rl = cross_cols(l1);
+        let rh = cross_cols(h1.transpose());
+        let rlr = DMat3::from_cols(
+            rl.y_axis * r.z - rl.z_axis * r.y,
+            rl.z_axis * r.x - rl.x_axis * r.z,
+            rl.x_axis * r.y - rl.y_axis * r.x,
+        );
         Self {
-            m: m1 + rh + rh.transpose() - rl * rx,
+            m: m1 + rh + rh.transpose() - rlr,
             h: h1 + rl,
             l: l1,
         }

@@ -72,7 +72,7 @@ pub struct EvolveFallScene {
     #[serde(default = "default_kp_scale")]
     pub kp_max_scale: f64,
     /// The fall every genome is tried on, per field (default: the paper's push of the age
-    /// group at the largest stable step, [`crate::evolve::fall_fitness::stable_step_for`]; its
+    /// group at the GA's step, [`crate::evolve::fall_fitness::stable_step_for`]; its
     /// key pose and k_p are the genes). A fall given here takes the group's ranges and strength
     /// and keeps its own `dt_s` (0.5 ms unless set).
     #[serde(default)]
@@ -265,12 +265,13 @@ fn controller_ron(problem: &FallProblem, genes: &[f64]) -> Result<String, SceneE
             .collect(),
         kv: Default::default(),
         start_s: Some(problem.fall.control_start_s),
+        dt_s: Some(problem.fall.dt_s),
     };
     let text = ron::ser::to_string_pretty(&controller, ron::ser::PrettyConfig::default())
         .map_err(|e| invalid(format!("controller file: {e}")))?;
     Ok(format!(
         "// The evolved key pose and stiffness, for a Fall scene's controller_file. Evolved at \
-         dt = {dt} s: replay with simulation.dt={dt} for the same fall.\n{text}\n",
+         dt = {dt} s (dt_s), the step a Fall scene replays it at.\n{text}\n",
         dt = problem.fall.dt_s
     ))
 }

@@ -23,8 +23,10 @@ use crate::render::{Plot, Series, Track, plot};
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct Simulation {
-    /// Step, seconds.
-    pub dt: f64,
+    /// Step, seconds. Left out: the step the controller was evolved at (its `dt_s`, e.g. from
+    /// a `controller_file`), else the paper's 0.5 ms. Given and different from the
+    /// controller's step, the scene is refused (the controller's damage holds at its step).
+    pub dt: Option<f64>,
     /// Integration scheme.
     pub integrator: Integrator,
     /// Simulated time, seconds.
@@ -35,7 +37,7 @@ impl Default for Simulation {
     fn default() -> Self {
         let c = FallConfig::default();
         Self {
-            dt: c.dt_s,
+            dt: None,
             integrator: c.integrator,
             duration: c.duration_s,
         }
@@ -75,6 +77,10 @@ pub struct Controller {
     pub kv: BTreeMap<String, f64>,
     /// Time the reaction toward the key pose starts, seconds.
     pub start_s: Option<f64>,
+    /// The time step this controller was evolved at, seconds: the step its damage holds at,
+    /// which the fall takes when `simulation.dt` is left out. A scene's own `controller.dt_s`
+    /// overrides the file's (e.g. half of it, to check the fall at half the step).
+    pub dt_s: Option<f64>,
 }
 
 /// A pushed fall: an elderly or adult figure with given PD settings, pushed.
@@ -151,6 +157,37 @@ fn override_per_dof(
 }
 
 impl FallScene {
+    /// The time step (s): `simulation.dt`, else the controller's `dt_s` (the scene's
+    /// `controller` block before the file's), else the paper's; a `simulation.dt` that
+    /// differs from the controller's step is an error naming both.
+    fn step(&self, from_file: Option<&Controller>) -> Result<f64, SceneError> {
+        let controller = match (self.controller.dt_s, from_file.and_then(|c| c.dt_s)) {
+            (Some(dt), _) => Some((dt, "controller.dt_s".to_string())),
+            (None, Some(dt)) => Some((
+                dt,
+                format!(
+                    "the controller file '{}'",
+                    self.controller_file.as_deref().unwrap_or_default()
+                ),
+            )),
+            (None, None) => None,
+        };
+        match (self.simulation.dt, controller) {
+            (Some(dt), Some((evolved, from))) if dt != evolved => {
+                Err(SceneError::Invalid(format!(
+                    "simulation.dt = {dt} s, but {from} gives the step the controller was \
+                     evolved at, dt_s = {evolved} s (its damage holds at that step): leave \
+                     simulation.dt out to replay it, or set controller.dt_s to run it at \
+                     another step (e.g. --set controller.dt_s={} for half the step)",
+                    evolved / 2.0
+                )))
+            }
+            (Some(dt), _) => Ok(dt),
+            (None, Some((evolved, _))) => Ok(evolved),
+            (None, None) => Ok(FallConfig::default().dt_s),
+        }
+    }
+
     /// The simulation configuration: the paper's experiment for the age group, with this
     /// scene's settings.
     pub fn config(&self, base: &Path) -> Result<FallConfig, SceneError> {
@@ -158,7 +195,6 @@ impl FallScene {
         if let Some(f) = &self.ranges_file {
             c.ranges = Ranges::Table(RangeTable::load(&resolve_path(f, base))?);
         }
-        c.dt_s = self.simulation.dt;
         c.integrator = self.simulation.integrator;
         c.duration_s = self.simulation.duration;
         c.push = self.push.clone();
@@ -190,6 +226,7 @@ impl FallScene {
                 c.control_start_s = s;
             }
         }
+        c.dt_s = self.step(from_file.as_ref())?;
         for (link, w) in &self.damage_weights {
             if !c.damage_weights.contains_key(link) {
                 return Err(SceneError::Invalid(format!(
