@@ -91,6 +91,43 @@ fn start_editor(scene: &Path) -> (Child, String, SocketAddr, f64) {
 
 /// The folder of the browser tests' screenshots and numbers.
 fn shots() -> PathBuf {
+    let shots = Path::new(env!("CARGO_MANIFEST_DIR")).join("target/editor-browser");
+    std::fs::create_dir_all(&shots).unwrap();
+    shots
+}
+
+/// Runs `node SCRIPT ARGS` in `tests/browser`; its last line of output as JSON.
+fn node(script: &str, args: &[&Path], chromium: &Path, child: &mut Child) -> serde_json::Value {
+    let out = Command::new("node")
+        .arg(script)
+        .args(args)
+        .env("CHROMIUM", chromium)
+        .current_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/browser"))
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout).to_string();
+    let stderr = String::from_utf8_lossy(&out.stderr).to_string();
+    if !out.status.success() {
+        let _ = child.kill();
+        panic!("{script} failed:\n{stdout}\n{stderr}");
+    }
+    println!("{stdout}");
+    serde_json::from_str(stdout.trim().lines().last().unwrap()).unwrap()
+}
+
+#[test]
+fn the_page_searches_sets_generates_plays_saves_and_exports_in_chromium() {
+    let Some(chromium) = browser() else { return };
+    // A copy of the project's own dance scene (Save writes it back).
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let dir = std::env::temp_dir().join(format!("marionette-editor-page-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("dance.ron");
+    std::fs::copy(root.join("scenes/dance.ron"), &path).unwrap();
+    let mut pins = Session::open(&path).unwrap().edit().pins().clone();
+    assert_eq!(pins.len(), 3, "scenes/dance.ron pins bars 0, 5 and 12");
+    let (mut child, url, addr, _) = start_editor(&path);
     let shots = shots();
     let seen = node(
         "editor.mjs",
