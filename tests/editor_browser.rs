@@ -1,8 +1,11 @@
-//! The dance editor end to end in a real browser: `marionette edit` on a database built here
-//! from generated clips, and `tests/browser/editor.mjs` driving headless Chromium through
-//! playwright-core — click a bar, six animated candidates drawn, like two, Search gives six new
-//! ones, Set, Generate, play, next bar by key, save, export — then the server's state, the
-//! saved scene and the exported BVH checked here. Screenshots go to
+//! The dance editor end to end in a real browser: `marionette edit` on (a copy of) the
+//! project's own dance scene, `scenes/dance.ron`, and `tests/browser/editor.mjs` driving
+//! headless Chromium through playwright-core — click a bar, six animated candidates drawn,
+//! like two, Search gives six new ones, Set, Generate, play, next bar by key, save, export —
+//! then the server's state, the saved scene and the exported BVH checked here, and `marionette
+//! run` of the saved scene shown to write that same BVH. Then the latency the page sees on a
+//! 2,000-segment database (`tests/browser/latency.mjs`; printed and written to
+//! `target/editor-browser/latency.json`, never asserted). Screenshots go to
 //! `target/editor-browser/`. Needs `/usr/bin/chromium` (or `$CHROMIUM`) and `npm ci` in
 //! `tests/browser`: skipped with a SKIPPED line when absent, a failure under CI.
 
@@ -12,10 +15,14 @@ mod editor_fixture;
 use std::io::{BufRead, BufReader, Write};
 use std::net::SocketAddr;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
+use std::process::{Child, Command, Stdio};
+use std::time::Instant;
 
-use editor_fixture::{assert_bvh_lasts_the_bars, get, scene};
-use marionette::editor::scene::EditScene;
+use editor_fixture::{assert_bvh_lasts_the_bars, get, scene_on};
+use marionette::choreo::augment::augment;
+use marionette::choreo::database::{BuildParams, Database, Manifest};
+use marionette::editor::session::Session;
+use marionette::experiments::dance_fill::generated_database;
 
 /// Chromium and the Node modules of `tests/browser`, or `None` after saying what is missing.
 fn browser() -> Option<PathBuf> {
@@ -54,12 +61,12 @@ fn browser() -> Option<PathBuf> {
     None
 }
 
-#[test]
-fn the_page_searches_sets_generates_plays_saves_and_exports_in_chromium() {
-    let Some(chromium) = browser() else { return };
-    let path = scene("browser", 8, 10, 16);
+/// `marionette edit SCENE --port 0` started; its child process, URL, address and the seconds
+/// until it printed the URL (loading the scene and building the transition table).
+fn start_editor(scene: &Path) -> (Child, String, SocketAddr, f64) {
+    let t0 = Instant::now();
     let mut child = Command::new(env!("CARGO_BIN_EXE_marionette"))
-        .args(["edit", path.to_str().unwrap(), "--port", "0"])
+        .args(["edit", scene.to_str().unwrap(), "--port", "0"])
         .stdout(Stdio::piped())
         .spawn()
         .unwrap();
@@ -67,6 +74,7 @@ fn the_page_searches_sets_generates_plays_saves_and_exports_in_chromium() {
     BufReader::new(child.stdout.take().unwrap())
         .read_line(&mut line)
         .unwrap();
+    let startup_s = t0.elapsed().as_secs_f64();
     let url = line
         .trim()
         .strip_prefix("dance editor: ")
@@ -78,14 +86,22 @@ fn the_page_searches_sets_generates_plays_saves_and_exports_in_chromium() {
         .parse()
         .unwrap();
     assert!(addr.ip().is_loopback());
+    (child, url, addr, startup_s)
+}
 
+/// The folder of the browser tests' screenshots and numbers.
+fn shots() -> PathBuf {
     let shots = Path::new(env!("CARGO_MANIFEST_DIR")).join("target/editor-browser");
     std::fs::create_dir_all(&shots).unwrap();
+    shots
+}
+
+/// Runs `node SCRIPT ARGS` in `tests/browser`; its last line of output as JSON.
+fn node(script: &str, args: &[&Path], chromium: &Path, child: &mut Child) -> serde_json::Value {
     let out = Command::new("node")
-        .arg("editor.mjs")
-        .arg(&url)
-        .arg(&shots)
-        .env("CHROMIUM", &chromium)
+        .arg(script)
+        .args(args)
+        .env("CHROMIUM", chromium)
         .current_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/browser"))
         .output()
         .unwrap();
@@ -93,11 +109,32 @@ fn the_page_searches_sets_generates_plays_saves_and_exports_in_chromium() {
     let stderr = String::from_utf8_lossy(&out.stderr).to_string();
     if !out.status.success() {
         let _ = child.kill();
-        panic!("the browser script failed:\n{stdout}\n{stderr}");
+        panic!("{script} failed:\n{stdout}\n{stderr}");
     }
     println!("{stdout}");
-    let seen: serde_json::Value =
-        serde_json::from_str(stdout.trim().lines().last().unwrap()).unwrap();
+    serde_json::from_str(stdout.trim().lines().last().unwrap()).unwrap()
+}
+
+#[test]
+fn the_page_searches_sets_generates_plays_saves_and_exports_in_chromium() {
+    let Some(chromium) = browser() else { return };
+    // A copy of the project's own dance scene (Save writes it back).
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let dir = std::env::temp_dir().join(format!("marionette-editor-page-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("dance.ron");
+    std::fs::copy(root.join("scenes/dance.ron"), &path).unwrap();
+    let mut pins = Session::open(&path).unwrap().edit().pins().clone();
+    assert_eq!(pins.len(), 3, "scenes/dance.ron pins bars 0, 5 and 12");
+    let (mut child, url, addr, _) = start_editor(&path);
+    let shots = shots();
+    let seen = node(
+        "editor.mjs",
+        &[Path::new(&url), &shots],
+        &chromium,
+        &mut child,
+    );
 
     // What the page did, as the server has it.
     let ids = |k: &str| -> Vec<u64> {
@@ -121,21 +158,114 @@ fn the_page_searches_sets_generates_plays_saves_and_exports_in_chromium() {
     );
     let pinned = seen["pinned"].as_u64().unwrap();
     let state = get(addr, "/api/state");
-    assert_eq!(state["pins"], serde_json::json!({ "2": pinned }));
+    pins.insert(2, pinned as usize);
+    let want: serde_json::Map<String, serde_json::Value> = pins
+        .iter()
+        .map(|(b, s)| (b.to_string(), (*s).into()))
+        .collect();
+    assert_eq!(state["pins"], serde_json::Value::Object(want));
     let fill = state["fill"]["segments"].as_array().unwrap();
     assert_eq!(fill.len(), 16, "every bar filled");
     assert_eq!(fill[2], pinned, "the pin holds");
     let segments = state["segments"].as_u64().unwrap();
     assert!(fill.iter().all(|s| s.as_u64().unwrap() < segments));
 
-    // The saved scene has the pin; the exported BVH lasts the 16 bars at 30 fps.
-    let back = EditScene::load(&path).unwrap();
-    assert_eq!(
-        back.pins,
-        std::collections::BTreeMap::from([(2, pinned as usize)])
-    );
+    // The saved scene has the pins, its comments kept; the exported BVH lasts the 16 bars at
+    // 30 fps, and `marionette run` of the saved scene writes that same BVH.
+    let text = std::fs::read_to_string(&path).unwrap();
+    assert!(text.starts_with("// The dance-editing paper"), "{text}");
+    let back = Session::open(&path).unwrap();
+    assert_eq!(back.edit().pins(), &pins);
     let bvh = std::fs::read_to_string(seen["bvh"].as_str().unwrap()).unwrap();
     assert_bvh_lasts_the_bars(addr, &bvh);
     let _ = child.kill();
     let _ = child.wait();
+    let out = dir.join("run");
+    let run = Command::new(env!("CARGO_BIN_EXE_marionette"))
+        .args([
+            "run",
+            path.to_str().unwrap(),
+            "--set",
+            "render.gif=false",
+            "--out",
+        ])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    assert!(std::fs::read_to_string(out.join("motion.bvh")).unwrap() == bvh);
+}
+
+#[test]
+fn latency_of_search_generate_and_first_load_on_2000_segments() {
+    let Some(chromium) = browser() else { return };
+    // The 2,000-segment database of benches/choreo_fill.rs: the shared dance clips (or, without
+    // them, the project's generated clips) grown by mirror images and time offsets.
+    let dir = marionette::io::data_dir().join("dance");
+    let base = Manifest::from_folder(&dir)
+        .and_then(|m| Database::build(&m, &BuildParams::default(), |_, _| {}));
+    let (base, source) = match base {
+        Ok(db) => (db, format!("the shared dance clips of {}", dir.display())),
+        Err(_) => (
+            generated_database(1, 12, 10).unwrap(),
+            "generated clips (no shared dance data)".to_string(),
+        ),
+    };
+    let db = augment(&base, 2000, 1);
+    assert_eq!(db.segments.len(), 2000);
+    let path = scene_on("latency", &db, 66);
+    let text = std::fs::read_to_string(&path).unwrap();
+    std::fs::write(
+        &path,
+        text.replace("    render:", "    bars: Some(64),\n    render:"),
+    )
+    .unwrap();
+    let (mut child, url, addr, startup_s) = start_editor(&path);
+    assert_eq!(get(addr, "/api/state")["bars"], 64);
+    let mut seen = node("latency.mjs", &[Path::new(&url)], &chromium, &mut child);
+    let _ = child.kill();
+    let _ = child.wait();
+    let ms = |k: &str| -> Vec<f64> {
+        let mut v: Vec<f64> = seen[k]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.as_f64().unwrap())
+            .collect();
+        v.sort_by(f64::total_cmp);
+        v
+    };
+    let summary = |v: &[f64]| {
+        format!(
+            "median {:.1} ms, max {:.1} ms",
+            v[v.len() / 2],
+            v[v.len() - 1]
+        )
+    };
+    let (search, click, generate) = (
+        ms("search_ms"),
+        ms("search_click_to_drawn_ms"),
+        ms("generate_ms"),
+    );
+    seen["database"] = format!("2,000 segments from {source}").into();
+    seen["startup_s"] = startup_s.into();
+    let shots = shots();
+    std::fs::write(shots.join("latency.json"), seen.to_string()).unwrap();
+    println!(
+        "editor latency, 2,000 segments from {source}, 64 bars:\n  server start (scene, \
+         transition table) to URL: {startup_s:.2} s\n  first load: {:.0} ms\n  Search round \
+         (POST answered, JSON read; {} rounds): {}\n  Search button to six candidates drawn \
+         ({} rounds): {}\n  Generate of 64 bars ({} runs): {}",
+        seen["load_ms"].as_f64().unwrap(),
+        search.len(),
+        summary(&search),
+        click.len(),
+        summary(&click),
+        generate.len(),
+        summary(&generate),
+    );
 }

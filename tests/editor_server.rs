@@ -6,10 +6,11 @@
 mod editor_fixture;
 
 use std::collections::BTreeSet;
-use std::net::SocketAddr;
+use std::io::Write;
+use std::net::{SocketAddr, TcpStream};
+use std::time::Duration;
 
 use editor_fixture::{assert_bvh_lasts_the_bars, get, post, raw, request, scene};
-use marionette::editor::scene::EditScene;
 use marionette::editor::server::{Editor, MAX_BODY};
 use marionette::editor::session::Session;
 
@@ -17,6 +18,11 @@ fn start(name: &str) -> (Editor, std::path::PathBuf) {
     let path = scene(name, 6, 10, 12);
     let editor = Editor::start(Session::open(&path).unwrap(), 0).unwrap();
     (editor, path)
+}
+
+/// The pins of the scene file at `path`, as a fresh editor session reads them.
+fn pins_of(path: &std::path::Path) -> std::collections::BTreeMap<usize, usize> {
+    Session::open(path).unwrap().edit().pins().clone()
 }
 
 fn segments(v: &serde_json::Value) -> Vec<u64> {
@@ -108,9 +114,14 @@ fn the_api_flow_search_like_search_set_generate_save_export() {
 
     let saved = post(a, "/api/save", "{}");
     assert_eq!(saved["saved"], path.display().to_string());
-    let back = EditScene::load(&path).unwrap();
+    let text = std::fs::read_to_string(&path).unwrap();
+    assert!(
+        text.starts_with("// The editor tests' dance"),
+        "comments kept: {text}"
+    );
+    assert!(text.contains("// written by the test"), "{text}");
     assert_eq!(
-        back.pins,
+        pins_of(&path),
         std::collections::BTreeMap::from([(3, second[2] as usize)])
     );
 
@@ -119,8 +130,31 @@ fn the_api_flow_search_like_search_set_generate_save_export() {
     let text = bvh.text();
     let frames = assert_bvh_lasts_the_bars(a, &text);
 
+    // `marionette run` of the saved scene dances what the editor showed: the same segments per
+    // bar, and its motion.bvh is the editor's export byte for byte.
+    let out = path.with_file_name("run");
+    let report = marionette::scene::run(
+        &marionette::scene::Scene::load(&path).unwrap(),
+        path.parent().unwrap(),
+        &out,
+    )
+    .unwrap();
+    let ran: Vec<u64> = report["per_bar"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|b| b["segment"].as_u64().unwrap())
+        .collect();
+    let shown: Vec<u64> = fill.iter().map(|s| s.as_u64().unwrap()).collect();
+    assert_eq!(ran, shown);
+    assert_eq!(
+        std::fs::read_to_string(out.join("motion.bvh")).unwrap(),
+        text
+    );
+
     let dance = get(a, "/api/dance");
-    assert_eq!(dance["frames"].as_array().unwrap().len(), frames);
+    let lead = (dance["start_s"].as_f64().unwrap() * 30.0).round() as usize;
+    assert_eq!(dance["frames"].as_array().unwrap().len() + lead, frames);
 
     let wav = request(a, "GET", "/api/audio.wav", None);
     assert_eq!(wav.status, 200);
@@ -171,6 +205,30 @@ fn bad_requests_get_clear_refusals_and_the_server_keeps_serving() {
     );
     assert_eq!(localhost.status, 200);
     assert!(localhost.text().contains("dance editor"));
+    // Another site's page posting to the editor (its Origin is not the editor's own).
+    for origin in [
+        "http://evil.com".to_string(),
+        "null".to_string(),
+        format!("http://127.0.0.1:{}", a.port() ^ 1),
+    ] {
+        let r = raw(
+            a,
+            format!(
+                "POST /api/set HTTP/1.1\r\nHost: {a}\r\nOrigin: {origin}\r\nContent-Length: 24\r\nConnection: close\r\n\r\n{{\"bar\": 0, \"segment\": 1}}"
+            )
+            .as_bytes(),
+        );
+        assert_eq!(r.status, 403, "{origin}");
+    }
+    let own = raw(
+        a,
+        format!(
+            "GET /api/state HTTP/1.1\r\nHost: {a}\r\nOrigin: http://{a}\r\nConnection: close\r\n\r\n"
+        )
+        .as_bytes(),
+    );
+    assert_eq!(own.status, 200);
+    assert!(own.json()["pins"].as_object().unwrap().is_empty());
 
     // Only the embedded files: every other path is 404, whatever it spells.
     for p in [
@@ -308,9 +366,75 @@ fn thousands_of_bad_and_concurrent_requests_leave_the_edit_intact() {
     let want: BTreeSet<(String, u64)> = (0..4).map(|t| (t.to_string(), 4)).collect();
     assert_eq!(pins, want);
     post(a, "/api/save", "{}");
-    let back = EditScene::load(&path).unwrap();
-    assert_eq!(back.pins.len(), 4);
-    assert!(back.pins.values().all(|&s| s == 4));
+    let back = pins_of(&path);
+    assert_eq!(back.len(), 4);
+    assert!(back.values().all(|&s| s == 4));
     assert_eq!(segments(&post(a, "/api/search", r#"{"bar": 5}"#)).len(), 6);
+    ed.stop();
+}
+
+#[test]
+fn clients_that_stall_hold_no_one_else_up() {
+    let (ed, _) = start("stalled");
+    let a = ed.addr();
+    // Clients that stop mid-request and never close: bodies shorter than their Content-Length
+    // (over and under the 1,024 bytes tiny_http reads ahead), a chunked body cut off, an
+    // `Expect: 100-continue` never followed by its body, headers cut off.
+    let cut: [&[u8]; 5] = [
+        b"POST /api/set HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Length: 2000\r\n\r\n{\"bar\": 1,",
+        b"POST /api/set HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Length: 500\r\n\r\n{\"bar\"",
+        b"POST /api/search HTTP/1.1\r\nHost: 127.0.0.1\r\nTransfer-Encoding: chunked\r\n\r\n9\r\n{\"bar",
+        b"POST /api/search HTTP/1.1\r\nHost: 127.0.0.1\r\nExpect: 100-continue\r\nContent-Length: 1500\r\n\r\n",
+        b"GET /api/state HTTP/1.1\r\nHost: 127.0.0.1\r\nX-Slow: ",
+    ];
+    let mut stalled: Vec<TcpStream> = (0..20)
+        .map(|k| {
+            let mut s = TcpStream::connect(a).unwrap();
+            s.write_all(cut[k % cut.len()]).unwrap();
+            s
+        })
+        .collect();
+    // Clients that ask for the song (the longest answer) again and again and never read.
+    for _ in 0..4 {
+        let mut s = TcpStream::connect(a).unwrap();
+        for _ in 0..8 {
+            s.write_all(b"GET /api/audio.wav HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n")
+                .unwrap();
+        }
+        stalled.push(s);
+    }
+    std::thread::sleep(Duration::from_millis(300));
+    // Everyone else is answered (each request gives up after 10 s), from four tabs at once.
+    std::thread::scope(|sc| {
+        for tab in 0..4usize {
+            sc.spawn(move || {
+                for k in 0..5 {
+                    post(
+                        a,
+                        "/api/set",
+                        &format!(r#"{{"bar": {tab}, "segment": {}}}"#, k + 1),
+                    );
+                    assert_eq!(
+                        segments(&get(a, &format!("/api/candidates?bar={tab}"))).len(),
+                        0
+                    );
+                }
+            });
+        }
+    });
+    let big = format!(
+        r#"{{"bar": 6, "segment": 2, "pad": "{}"}}"#,
+        " ".repeat(3000)
+    );
+    let r = request(a, "POST", "/api/set", Some(&big));
+    assert_eq!(r.status, 400, "{}", r.text());
+    assert!(r.text().contains("unknown field `pad`"), "{}", r.text());
+    let s = get(a, "/api/state");
+    assert_eq!(s["undo"], 20);
+    assert_eq!(s["pins"]["3"], 5);
+    // The stalled clients go away; their requests end and the server goes on.
+    drop(stalled);
+    std::thread::sleep(Duration::from_millis(200));
+    assert_eq!(post(a, "/api/generate", "{}")["fill"]["segments"][3], 5);
     ed.stop();
 }

@@ -6,7 +6,7 @@
 //! | `GET /api/state` | | pins, undo/redo depth, last fill, tempo, song length, figure links |
 //! | `GET /api/bars` | | every bar (span, dB, normalised intensity, pin, filled segment), beats |
 //! | `GET /api/candidates` | `?bar=K` | bar K's round, τ, liked, and its six candidates' frames |
-//! | `GET /api/dance` | | the whole dance of the current pins at 30 fps (generates first) |
+//! | `GET /api/dance` | | the whole dance of the current pins at the scene's fps (generates first) |
 //! | `GET /api/audio.wav` | | the song as 16-bit WAV |
 //! | `POST /api/search` | `{"bar": K}` | the next relevance-feedback round; as `candidates` |
 //! | `POST /api/like` | `{"bar": K, "segment": S}` | S into bar K's liked set L_l |
@@ -16,7 +16,7 @@
 //! | `POST /api/undo`, `POST /api/redo` | `{}` | the pin change undone/redone |
 //! | `POST /api/generate` | `{}` | every unpinned bar filled: segments and total cost |
 //! | `POST /api/save` | `{}` | the scene written back with its pins (atomically) |
-//! | `POST /api/export-bvh` | `{}` | the dance as BVH (a download) |
+//! | `POST /api/export-bvh` | `{}` | the dance as BVH, `marionette run`'s motion.bvh (a download) |
 //!
 //! Errors are `{"error": "one line"}`: 400 for a malformed request (bad JSON, unknown field,
 //! index out of range), 404 for an unknown route, 405 for a wrong method, 409 for an action the
@@ -30,9 +30,6 @@ use serde_json::{Value, json};
 use super::EditorError;
 use super::session::Session;
 use crate::choreo::edit::EditError;
-
-/// Frames per second of the whole dance sent to the page.
-pub const DANCE_FPS: f64 = 30.0;
 
 /// An HTTP answer.
 #[derive(Debug, Clone, PartialEq)]
@@ -169,8 +166,8 @@ fn route(s: &mut Session, method: &str, path: &str, query: &str, b: &[u8]) -> Re
             candidates(s, bar).map(|v| Reply::json(200, &v))
         }
         "/api/dance" => {
-            let (frames, start_s) = s.dance_frames(DANCE_FPS).map_err(fail)?;
-            ok(json!({ "fps": DANCE_FPS, "start_s": start_s, "frames": frames }))
+            let (frames, start_s) = s.dance_frames().map_err(fail)?;
+            ok(json!({ "fps": s.fps(), "start_s": start_s, "frames": frames }))
         }
         "/api/audio.wav" => {
             let song = s.song();

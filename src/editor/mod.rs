@@ -2,7 +2,8 @@
 //! page in the browser over one [`crate::choreo::edit::Edit`], no second copy of the
 //! algorithms.
 //!
-//! - [`scene`]: the edit-scene file (song, database, pins) that `marionette edit` opens;
+//! - [`scene`]: the `Dance` scene file (song, database, pins) that `marionette edit` opens and
+//!   saves — the same file `marionette run` reads;
 //! - [`session`]: what the server holds — the edit, the song, the transition table, the fill;
 //! - [`api`]: the JSON API, one route per action, as a pure function over the session;
 //! - [`server`]: the HTTP server (tiny_http) on 127.0.0.1 — Host check against DNS
@@ -31,7 +32,10 @@ pub enum EditorError {
         /// The operating system's reason.
         message: String,
     },
-    /// An edit scene that does not parse or fit.
+    /// A dance scene: its syntax, fields, song, database or pins.
+    #[error(transparent)]
+    DanceScene(#[from] crate::scene::SceneError),
+    /// A scene the editor cannot open or save.
     #[error("{path}: {message}")]
     Scene {
         /// The scene file.

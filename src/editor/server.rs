@@ -1,9 +1,16 @@
-//! The editor's HTTP server: tiny_http on 127.0.0.1 only, a few worker threads over one
-//! [`Session`] behind a `Mutex` (one action at a time, so several tabs never interleave inside
-//! an action).
+//! The editor's HTTP server: tiny_http on 127.0.0.1 only, one [`Session`] behind a `Mutex`
+//! (one action at a time, so several tabs never interleave inside an action).
+//!
+//! Every request is answered on its own thread, at most [`MAX_IN_FLIGHT`] at once: a client
+//! that sends part of a body and never closes (tiny_http 0.12 has no read timeout, and drains an
+//! unread body when a request is dropped), or never reads a long answer, holds only its own
+//! thread — as tiny_http already gives every connection's headers their own thread — never the
+//! one that takes requests, so every other client is answered. Only when [`MAX_IN_FLIGHT`]
+//! requests are all stuck does the next one wait for a thread.
 //!
 //! Every request is checked before it reaches the session: a `Host` that is not loopback
 //! (`127.0.0.1`, `localhost`, `[::1]`, any port) gets 403 (a DNS-rebinding page cannot talk to
+//! it), and so does an `Origin` other than the editor's own (another site's page cannot post to
 //! it); a path that is not exactly one of the embedded files or an API route gets 404 (no path
 //! from a request reaches the file system, so `..`, encoded slashes and absolute paths are
 //! simply unknown); a body over [`MAX_BODY`] bytes gets 413. Nothing in the request path
@@ -13,7 +20,7 @@
 use std::io::Read;
 use std::net::SocketAddr;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::{Arc, Mutex};
+use std::sync::{Arc, Condvar, Mutex};
 use std::thread::JoinHandle;
 use std::time::Duration;
 
@@ -27,8 +34,8 @@ pub const DEFAULT_PORT: u16 = 8765;
 /// Largest request body accepted (bytes); the API's bodies are a few dozen bytes.
 pub const MAX_BODY: usize = 16 * 1024;
 
-/// Worker threads answering requests.
-const WORKERS: usize = 4;
+/// Requests answered at once, each on its own thread; the next waits for one to finish.
+pub const MAX_IN_FLIGHT: usize = 256;
 
 /// The page's files, embedded in the binary: (path, content type, bytes).
 const ASSETS: [(&str, &str, &[u8]); 5] = [
@@ -59,12 +66,49 @@ const ASSETS: [(&str, &str, &[u8]); 5] = [
     ),
 ];
 
+/// How many requests are being answered, and a signal when one is done.
+#[derive(Default)]
+struct InFlight {
+    count: Mutex<usize>,
+    done: Condvar,
+}
+
+/// One request's place among the [`MAX_IN_FLIGHT`]; given back when dropped.
+struct Slot(Arc<InFlight>);
+
+impl InFlight {
+    /// Waits for a free place (or for `stop`).
+    fn acquire(self: &Arc<Self>, stop: &AtomicBool) -> Option<Slot> {
+        let mut n = self.count.lock().unwrap_or_else(|e| e.into_inner());
+        while *n >= MAX_IN_FLIGHT {
+            if stop.load(Ordering::Relaxed) {
+                return None;
+            }
+            n = self
+                .done
+                .wait_timeout(n, Duration::from_millis(100))
+                .unwrap_or_else(|e| e.into_inner())
+                .0;
+        }
+        *n += 1;
+        Some(Slot(self.clone()))
+    }
+}
+
+impl Drop for Slot {
+    fn drop(&mut self) {
+        let mut n = self.0.count.lock().unwrap_or_else(|e| e.into_inner());
+        *n -= 1;
+        self.0.done.notify_one();
+    }
+}
+
 /// A running editor server.
 pub struct Editor {
     server: Arc<tiny_http::Server>,
     addr: SocketAddr,
     stop: Arc<AtomicBool>,
-    workers: Vec<JoinHandle<()>>,
+    dispatcher: JoinHandle<()>,
 }
 
 impl Editor {
@@ -85,23 +129,34 @@ impl Editor {
         let server = Arc::new(server);
         let session = Arc::new(Mutex::new(session));
         let stop = Arc::new(AtomicBool::new(false));
-        let workers = (0..WORKERS)
-            .map(|_| {
-                let (server, session, stop) = (server.clone(), session.clone(), stop.clone());
-                std::thread::spawn(move || {
-                    while !stop.load(Ordering::Relaxed) {
-                        if let Ok(Some(rq)) = server.recv_timeout(Duration::from_millis(100)) {
-                            serve(rq, &session);
-                        }
-                    }
-                })
+        let in_flight = Arc::new(InFlight::default());
+        let dispatcher = {
+            let (server, stop) = (server.clone(), stop.clone());
+            std::thread::spawn(move || {
+                while !stop.load(Ordering::Relaxed) {
+                    let Ok(Some(rq)) = server.recv_timeout(Duration::from_millis(100)) else {
+                        continue;
+                    };
+                    let Some(slot) = in_flight.acquire(&stop) else {
+                        break;
+                    };
+                    let session = session.clone();
+                    // Should the system refuse a thread, the request is dropped (tiny_http
+                    // answers 500).
+                    let _ = std::thread::Builder::new()
+                        .name("editor-request".into())
+                        .spawn(move || {
+                            let _slot = slot;
+                            serve(rq, &session, addr.port());
+                        });
+                }
             })
-            .collect();
+        };
         Ok(Editor {
             server,
             addr,
             stop,
-            workers,
+            dispatcher,
         })
     }
 
@@ -117,17 +172,13 @@ impl Editor {
 
     /// Serves until the process ends.
     pub fn wait(self) {
-        for w in self.workers {
-            let _ = w.join();
-        }
+        let _ = self.dispatcher.join();
     }
 
-    /// Stops serving and waits for the workers.
+    /// Stops taking requests (those being answered finish on their own threads).
     pub fn stop(self) {
         self.stop.store(true, Ordering::Relaxed);
-        for w in self.workers {
-            let _ = w.join();
-        }
+        let _ = self.dispatcher.join();
         drop(self.server);
     }
 }
@@ -156,18 +207,41 @@ fn port_ok(p: &str) -> bool {
     p.parse::<u16>().is_ok()
 }
 
-fn answer(rq: &mut tiny_http::Request, session: &Mutex<Session>) -> Reply {
-    let hosts: Vec<&str> = rq
-        .headers()
+/// Whether an `Origin` header value is the editor's own page: `http://` a loopback host and
+/// `port` (80 when the origin names none).
+pub fn own_origin(origin: &str, port: u16) -> bool {
+    let Some(host) = origin.trim().strip_prefix("http://") else {
+        return false;
+    };
+    let given = match host.rsplit_once(':') {
+        Some((h, p)) if !h.is_empty() && !p.contains(']') => p.parse::<u16>().ok(),
+        _ => Some(80),
+    };
+    loopback_host(host) && given == Some(port)
+}
+
+/// The values of every header `name` of `rq`.
+fn header_values<'a>(rq: &'a tiny_http::Request, name: &'static str) -> Vec<&'a str> {
+    rq.headers()
         .iter()
-        .filter(|h| h.field.equiv("Host"))
+        .filter(|h| h.field.equiv(name))
         .map(|h| h.value.as_str())
-        .collect();
+        .collect()
+}
+
+fn answer(rq: &mut tiny_http::Request, session: &Mutex<Session>, port: u16) -> Reply {
+    let hosts = header_values(rq, "Host");
     if hosts.len() != 1 || !loopback_host(hosts[0]) {
         return Reply::error(
             403,
             "the editor answers only requests to 127.0.0.1 or localhost",
         );
+    }
+    if header_values(rq, "Origin")
+        .iter()
+        .any(|o| !own_origin(o, port))
+    {
+        return Reply::error(403, "the editor answers only its own page (Origin)");
     }
     let method = rq.method().as_str().to_string();
     let url = rq.url().to_string();
@@ -207,8 +281,8 @@ fn header(name: &str, value: &str) -> Option<tiny_http::Header> {
     tiny_http::Header::from_bytes(name.as_bytes(), value.as_bytes()).ok()
 }
 
-fn serve(mut rq: tiny_http::Request, session: &Mutex<Session>) {
-    let r = answer(&mut rq, session);
+fn serve(mut rq: tiny_http::Request, session: &Mutex<Session>, port: u16) {
+    let r = answer(&mut rq, session, port);
     let mut resp = tiny_http::Response::from_data(r.body).with_status_code(r.status);
     let headers = [
         header("Content-Type", r.content_type),
@@ -259,6 +333,29 @@ mod tests {
             "localhost:99999",
         ] {
             assert!(!loopback_host(h), "{h}");
+        }
+    }
+
+    #[test]
+    fn own_origins() {
+        for o in [
+            "http://127.0.0.1:8765",
+            "http://localhost:8765",
+            "http://[::1]:8765",
+        ] {
+            assert!(own_origin(o, 8765), "{o}");
+        }
+        assert!(own_origin("http://localhost", 80));
+        for o in [
+            "http://127.0.0.1:8766",
+            "http://evil.com:8765",
+            "https://127.0.0.1:8765",
+            "null",
+            "http://127.0.0.1.evil.com:8765",
+            "http://[::1]",
+            "",
+        ] {
+            assert!(!own_origin(o, 8765), "{o}");
         }
     }
 }

@@ -1,23 +1,24 @@
 //! What the editor's server holds: the [`Edit`] (pins, per-bar search, undo/redo), the song
-//! (samples, beats, bars), the last fill, and the scene file it saves to. The edit keeps the
-//! database's transition table from the first Generate on, so later ones are a path search only.
+//! (samples, beats, bars), the last fill, and the `Dance` scene file it opened and saves to.
+//! The scene is loaded by [`crate::scene::load_dance`], the one path `marionette run` takes
+//! too; the edit's transition table is built when the session opens (its first Generate), so
+//! every Generate the page asks for is the path search only.
 //!
 //! Every method answers bad input with an [`EditorError`], never a panic; the server keeps one
 //! `Session` behind a `Mutex`.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::Arc;
 
 use glam::DVec3;
 
 use super::EditorError;
-use super::scene::{EditScene, SongSource, resolve};
-use crate::choreo::dance::{DanceParams, assemble};
-use crate::choreo::database::Database;
+use super::scene::DanceFile;
+use crate::choreo::dance::assemble;
 use crate::choreo::edit::Edit;
 use crate::choreo::fill::Fill;
-use crate::choreo::music::{MusicParams, analyze, synth::synthesize};
 use crate::humanoid::{Model, ModelClip, humanoid24};
+use crate::scene::{load_dance, scene_pins, song_timed_bvh};
 
 /// The song the edit dances to.
 #[derive(Debug, Clone)]
@@ -35,8 +36,7 @@ pub struct Song {
 /// The editor's state (module docs).
 pub struct Session {
     edit: Edit,
-    scene: EditScene,
-    scene_path: PathBuf,
+    file: DanceFile,
     song: Song,
     model: Model,
     fill: Option<Fill>,
@@ -46,52 +46,40 @@ pub struct Session {
 pub type Frames = Vec<Vec<[f32; 3]>>;
 
 impl Session {
-    /// Opens the edit scene at `path`: loads the database, synthesizes or decodes the song,
-    /// finds its beats and bars, applies the scene's pins (checked against song and database).
+    /// Opens the `Dance` scene at `path`: loads its song, bars, database and pins as
+    /// `marionette run` does ([`load_dance`]), starts an edit with the scene's search and fill
+    /// parameters and pins, and generates once (building the transition table and filling the
+    /// scene's dance, which the page shows from the start).
     pub fn open(path: &Path) -> Result<Session, EditorError> {
-        let scene = EditScene::load(path)?;
-        let db = Database::load(&resolve(path, &scene.database))?;
-        let (samples, sample_rate) = match &scene.song {
-            SongSource::Synth(s) => {
-                let t = synthesize(s)?;
-                (t.samples, t.sample_rate)
-            }
-            SongSource::File(f) => decode(&resolve(path, f))?,
-        };
-        let music = analyze(&samples, sample_rate, &MusicParams::default())?;
-        let song = Song {
-            samples,
-            sample_rate,
-            tempo_bpm: music.tempo_bpm,
-            beats_s: music.beats_s,
-        };
-        Session::new(Arc::new(db), music.bars, song, scene, path.to_path_buf())
-    }
-
-    /// A session over a database and an analysed song; `scene` gives the pins and parameters
-    /// and is saved to `scene_path`.
-    pub fn new(
-        db: Arc<Database>,
-        bars: Vec<crate::choreo::music::Bar>,
-        song: Song,
-        scene: EditScene,
-        scene_path: PathBuf,
-    ) -> Result<Session, EditorError> {
-        let mut edit = Edit::new(db, bars, scene.search.clone(), scene.fill.clone())?;
-        for (&bar, &seg) in &scene.pins {
+        let file = DanceFile::load(path)?;
+        let scene = file.scene();
+        let inputs = load_dance(scene, file.base())?;
+        let mut edit = Edit::new(
+            Arc::new(inputs.db),
+            inputs.bars,
+            scene.search.clone(),
+            scene.fill.clone(),
+        )?;
+        for (&bar, &seg) in &inputs.pins {
             edit.set(bar, seg)?;
         }
         // The scene's pins are the starting point, not an undoable change.
         let mut state = edit.state().clone();
         state.undo.clear();
         let edit = Edit::with_index(edit.database().clone(), edit.index().clone(), state)?;
+        let fill = edit.generate()?;
+        let song = Song {
+            samples: inputs.samples,
+            sample_rate: inputs.sample_rate,
+            tempo_bpm: inputs.analysis.tempo_bpm,
+            beats_s: inputs.analysis.beats_s,
+        };
         Ok(Session {
             edit,
-            scene,
-            scene_path,
+            file,
             song,
             model: humanoid24(),
-            fill: None,
+            fill: Some(fill),
         })
     }
 
@@ -110,14 +98,20 @@ impl Session {
         &self.song
     }
 
-    /// The last fill ([`Session::generate`]), if any.
+    /// The last fill ([`Session::generate`]; the scene's own from the start).
     pub fn fill(&self) -> Option<&Fill> {
         self.fill.as_ref()
     }
 
     /// The scene file the session saves to.
     pub fn scene_path(&self) -> &Path {
-        &self.scene_path
+        self.file.path()
+    }
+
+    /// Frames per second of the dance ([`crate::choreo::dance::DanceParams::fps`] of the
+    /// scene).
+    pub fn fps(&self) -> f64 {
+        self.file.scene().dance.fps
     }
 
     /// Parents of the stick figure's points (joints then end sites; `None` for the pelvis).
@@ -164,8 +158,8 @@ impl Session {
     }
 
     /// Generate: every unpinned bar filled by the minimum-cost path through the pins
-    /// ([`Edit::generate`]: the exact DP on the edit's transition table, built at the first
-    /// Generate and kept).
+    /// ([`Edit::generate`]: the exact DP on the edit's transition table, built when the
+    /// session opened and kept).
     pub fn generate(&mut self) -> Result<&Fill, EditorError> {
         let f = self.edit.generate()?;
         Ok(self.fill.insert(f))
@@ -187,53 +181,39 @@ impl Session {
         Ok(points(&clip, DVec3::new(start.x, 0.0, start.z)))
     }
 
-    /// The whole dance of the current pins (generated now), assembled at the song's bars at
-    /// `fps`: its stick-figure frames and the song time of frame 0 (s).
-    pub fn dance_frames(&mut self, fps: f64) -> Result<(Frames, f64), EditorError> {
-        let d = self.dance(fps)?;
+    /// The whole dance of the current pins (generated now), assembled at the song's bars as
+    /// the scene says ([`Session::fps`], seams): its stick-figure frames and the song time of
+    /// frame 0 (s).
+    pub fn dance_frames(&mut self) -> Result<(Frames, f64), EditorError> {
+        let d = self.dance()?;
         Ok((points(&d.clip, DVec3::ZERO), d.start_s))
     }
 
-    fn dance(&mut self, fps: f64) -> Result<crate::choreo::dance::Dance, EditorError> {
+    fn dance(&mut self) -> Result<crate::choreo::dance::Dance, EditorError> {
         let segments = self.generate()?.segments.clone();
-        let p = DanceParams {
-            fps,
-            ..DanceParams::default()
-        };
         Ok(assemble(
             self.edit.database(),
             &segments,
             self.edit.bars(),
-            &p,
+            &self.file.scene().dance,
         )?)
     }
 
-    /// The whole dance of the current pins as BVH text on humanoid24 at 30 fps.
+    /// The whole dance of the current pins as the `motion.bvh` that `marionette run` writes
+    /// for the saved scene ([`song_timed_bvh`]: humanoid24 at the scene's fps, frame 0 the
+    /// song's t = 0).
     pub fn export_bvh(&mut self) -> Result<String, EditorError> {
-        let d = self.dance(30.0)?;
-        Ok(crate::bvh::to_string(&d.clip.to_clip().to_bvh()))
+        let d = self.dance()?;
+        Ok(song_timed_bvh(&d).0)
     }
 
-    /// Save: the scene written back to its file with the current pins, atomically.
+    /// Save: the scene written back to its file with the current pins (by clip and bar where
+    /// the clip's name is unique), atomically, nothing else in the file changed.
     pub fn save(&mut self) -> Result<&Path, EditorError> {
-        self.scene.pins = self.edit.pins().clone();
-        self.scene.save(&self.scene_path)?;
-        Ok(&self.scene_path)
+        let pins = scene_pins(self.edit.pins(), self.edit.database());
+        self.file.save(&pins)?;
+        Ok(self.file.path())
     }
-}
-
-#[cfg(feature = "audio")]
-fn decode(path: &Path) -> Result<(Vec<f32>, u32), EditorError> {
-    let a = crate::choreo::music::decode::decode_file(path)?;
-    Ok((a.samples, a.sample_rate))
-}
-
-#[cfg(not(feature = "audio"))]
-fn decode(path: &Path) -> Result<(Vec<f32>, u32), EditorError> {
-    Err(EditorError::Scene {
-        path: path.display().to_string(),
-        message: "song files need the `audio` feature; use a Synth song".into(),
-    })
 }
 
 /// Every frame's drawable points of `clip`, less `origin`, in single precision.

@@ -23,8 +23,9 @@ use crate::choreo::database::{BuildParams, Database, Manifest};
 use crate::choreo::fill::{self, FillParams, Pins};
 use crate::choreo::metrics;
 use crate::choreo::music::synth::{SynthSong, synthesize};
-use crate::choreo::music::{MusicParams, analyze};
+use crate::choreo::music::{Bar, MusicAnalysis, MusicParams, analyze};
 use crate::choreo::relevance;
+use crate::choreo::search::SearchParams;
 use crate::choreo::segments::{Beat, TempoSource};
 use crate::render::{Plot, Series, Track, View, animation_gif, filmstrip_at_png, plot};
 
@@ -118,6 +119,10 @@ pub struct DanceScene {
     /// How the dance is assembled.
     #[serde(default)]
     pub dance: DanceParams,
+    /// The relevance-feedback search of eqs. (1)–(4) that `marionette edit` runs on this scene
+    /// (`marionette run` does not search: it fills the unpinned bars).
+    #[serde(default)]
+    pub search: SearchParams,
     /// Pictures.
     #[serde(default)]
     pub render: DanceRender,
@@ -165,6 +170,61 @@ struct Song {
     sample_rate: u32,
     known_bpm: Option<f64>,
     origin: String,
+}
+
+/// What a [`DanceScene`] stands on, loaded once by [`load_dance`] for `marionette run` and
+/// `marionette edit` alike: the song and its analysis, the bars danced, the database and the
+/// pins as bar → segment.
+pub struct DanceInputs {
+    /// Mono samples of the song (full scale ±1).
+    pub samples: Vec<f32>,
+    /// Their sample rate (Hz).
+    pub sample_rate: u32,
+    /// The synthesized song's tempo (BPM), `None` for a song file.
+    pub known_bpm: Option<f64>,
+    /// Where the song comes from, for reports.
+    pub song_origin: String,
+    /// The song's analysis (tempo, beats, every bar).
+    pub analysis: MusicAnalysis,
+    /// The bars danced: the song's first [`DanceScene::bars`] bars (all when absent).
+    pub bars: Vec<Bar>,
+    /// The segment database.
+    pub db: Database,
+    /// For the project's own dance, each clip's moves per bar (empty otherwise).
+    pub moves: Vec<Vec<String>>,
+    /// Where the database comes from, for reports.
+    pub db_origin: String,
+    /// The pins as bar → segment index, checked against the database.
+    pub pins: Pins,
+}
+
+/// Loads what `scene` names (song, analysis, bars, database, pins), paths relative to `base`.
+pub fn load_dance(scene: &DanceScene, base: &Path) -> Result<DanceInputs, SceneError> {
+    let song = load_song(&scene.song, base)?;
+    let analysis = analyze(&song.samples, song.sample_rate, &scene.music)?;
+    analysis.require_bars(1)?;
+    let bars_n = match scene.bars {
+        Some(n) => {
+            analysis.require_bars(n)?;
+            n
+        }
+        None => analysis.bars.len(),
+    };
+    let bars = analysis.bars[..bars_n].to_vec();
+    let (db, moves, db_origin) = load_database(scene, base)?;
+    let pins = resolve_pins(&scene.pins, &db)?;
+    Ok(DanceInputs {
+        samples: song.samples,
+        sample_rate: song.sample_rate,
+        known_bpm: song.known_bpm,
+        song_origin: song.origin,
+        analysis,
+        bars,
+        db,
+        moves,
+        db_origin,
+        pins,
+    })
 }
 
 fn load_song(src: &SongSource, base: &Path) -> Result<Song, SceneError> {
@@ -247,6 +307,56 @@ fn clip_name(file: &str) -> String {
         .map_or_else(|| file.to_string(), |s| s.to_string_lossy().to_string())
 }
 
+/// The pins as scene entries: by clip and bar within it when the clip's name is unique in the
+/// database and names this segment (stable however the database is rebuilt), else by segment
+/// index.
+pub fn scene_pins(pins: &Pins, db: &Database) -> Vec<Pin> {
+    let names: Vec<String> = db.sources.iter().map(|s| clip_name(&s.file)).collect();
+    pins.iter()
+        .map(|(&bar, &seg)| {
+            let s = &db.segments[seg];
+            let name = &names[s.clip];
+            let first = db
+                .segments
+                .iter()
+                .position(|x| x.clip == s.clip && x.bar == s.bar);
+            if names.iter().filter(|n| *n == name).count() == 1 && first == Some(seg) {
+                Pin {
+                    bar,
+                    segment: None,
+                    clip: Some(name.clone()),
+                    clip_bar: Some(s.bar),
+                }
+            } else {
+                Pin {
+                    bar,
+                    segment: Some(seg),
+                    clip: None,
+                    clip_bar: None,
+                }
+            }
+        })
+        .collect()
+}
+
+/// The dance as `motion.bvh` text at the song's timing: frame 0 is the song's t = 0, the
+/// dance's first frame held until the first bar; also the number of frames held.
+pub fn song_timed_bvh(d: &dance::Dance) -> (String, usize) {
+    let lead = (d.start_s / d.clip.frame_time).round() as usize;
+    let mut synced = d.clip.clone();
+    let dofs = synced.dof_count();
+    for _ in 0..lead {
+        synced
+            .root_translation
+            .insert(0, d.clip.root_translation[0]);
+        synced.root_rotation.insert(0, d.clip.root_rotation[0]);
+        let first: Vec<f64> = d.clip.frame_angles(0).to_vec();
+        synced.angles.splice(0..0, first);
+    }
+    debug_assert_eq!(synced.angles.len(), synced.frame_count() * dofs);
+    (crate::bvh::to_string(&synced.to_clip().to_bvh()), lead)
+}
+
 /// The pins as bar → segment index.
 fn resolve_pins(pins: &[Pin], db: &Database) -> Result<Pins, SceneError> {
     let mut out = Pins::new();
@@ -287,43 +397,29 @@ pub fn run_dance(
     base: &Path,
     out: &Path,
 ) -> Result<serde_json::Value, SceneError> {
-    let song = load_song(&scene.song, base)?;
-    let analysis = analyze(&song.samples, song.sample_rate, &scene.music)?;
-    analysis.require_bars(1)?;
-    let bars_n = match scene.bars {
-        Some(n) => {
-            analysis.require_bars(n)?;
-            n
-        }
-        None => analysis.bars.len(),
-    };
-    let bars = &analysis.bars[..bars_n];
-    let (db, moves, db_origin) = load_database(scene, base)?;
-    let pins = resolve_pins(&scene.pins, &db)?;
+    let DanceInputs {
+        samples,
+        sample_rate,
+        known_bpm,
+        song_origin,
+        analysis,
+        bars,
+        db,
+        moves,
+        db_origin,
+        pins,
+    } = load_dance(scene, base)?;
+    let bars = &bars[..];
+    let bars_n = bars.len();
     let filled = fill::fill(&db, bars_n, &pins, &scene.fill)?;
     let d = dance::assemble(&db, &filled.segments, bars, &scene.dance)?;
     let m = metrics::dance_metrics(&d, &analysis.beats_s, &filled);
 
     // motion.bvh at the song's timing: the first frame held from t = 0 to the first bar.
-    let lead = (d.start_s / d.clip.frame_time).round() as usize;
-    let mut synced = d.clip.clone();
-    let dofs = synced.dof_count();
-    for _ in 0..lead {
-        synced
-            .root_translation
-            .insert(0, d.clip.root_translation[0]);
-        synced.root_rotation.insert(0, d.clip.root_rotation[0]);
-        let first: Vec<f64> = d.clip.frame_angles(0).to_vec();
-        synced.angles.splice(0..0, first);
-    }
-    debug_assert_eq!(synced.angles.len(), synced.frame_count() * dofs);
-    let clip = synced.to_clip();
-    write_output(
-        &out.join("motion.bvh"),
-        crate::bvh::to_string(&clip.to_bvh()).as_bytes(),
-    )?;
+    let (bvh, lead) = song_timed_bvh(&d);
+    write_output(&out.join("motion.bvh"), bvh.as_bytes())?;
     if matches!(scene.song, SongSource::Synth(_)) {
-        let wav = crate::choreo::music::wav::wav_bytes(&song.samples, 1, song.sample_rate)
+        let wav = crate::choreo::music::wav::wav_bytes(&samples, 1, sample_rate)
             .ok_or_else(|| SceneError::Invalid("the song is too long for a WAV file".into()))?;
         write_output(&out.join("song.wav"), &wav)?;
     }
@@ -437,8 +533,8 @@ pub fn run_dance(
     let dance_s = d.clip.frame_count() as f64 * d.clip.frame_time;
     let bars_s = bars[bars_n - 1].end_s - bars[0].start_s;
     Ok(json!({
-        "song": song.origin,
-        "song_known_tempo_bpm": song.known_bpm,
+        "song": song_origin,
+        "song_known_tempo_bpm": known_bpm,
         "tempo_bpm": analysis.tempo_bpm,
         "song_duration_s": analysis.duration_s,
         "song_bars": analysis.bars.len(),
@@ -475,7 +571,7 @@ pub fn run_dance(
         "motion_bvh": format!(
             "humanoid24, {} frames; frame 0 is the song's t = 0 (the dance's first frame held \
              for {lead} frames until the first bar at {:.3} s)",
-            clip.frame_count(),
+            d.clip.frame_count() + lead,
             d.start_s
         ),
         "intensity_normalisation": "percentile rank: a bar's RMS (dB) among the song's bars \

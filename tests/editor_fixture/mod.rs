@@ -1,4 +1,4 @@
-//! Shared by the editor tests: an edit scene on a database of generated dance clips and a
+//! Shared by the editor tests: a `Dance` scene on a database of generated dance clips and a
 //! synthesized song, and a plain HTTP/1.1 client over `std::net`.
 
 #![allow(dead_code)] // each test file uses some of these
@@ -8,32 +8,35 @@ use std::net::{SocketAddr, TcpStream};
 use std::path::PathBuf;
 use std::time::Duration;
 
-use marionette::choreo::music::synth::SynthSong;
-use marionette::editor::scene::{EDIT_SCENE_VERSION, EditScene, SongSource};
+use marionette::choreo::database::Database;
 use marionette::experiments::dance_fill::generated_database;
 
 /// A fresh folder holding `dance.db.json` (generated clips: `clips` × `bars_per_clip` bars) and
-/// `edit.ron` (a 120 BPM synthesized song of `song_bars` bars); returns the scene's path.
+/// `dance.ron` (a `Dance` scene: a 120 BPM synthesized song of `song_bars` bars, no pins);
+/// returns the scene's path.
 pub fn scene(name: &str, clips: usize, bars_per_clip: usize, song_bars: usize) -> PathBuf {
+    scene_on(
+        name,
+        &generated_database(7, clips, bars_per_clip).unwrap(),
+        song_bars,
+    )
+}
+
+/// [`scene`] on the database `db`.
+pub fn scene_on(name: &str, db: &Database, song_bars: usize) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("marionette-editor-{name}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
-    let db = generated_database(7, clips, bars_per_clip).unwrap();
     db.save(&dir.join("dance.db.json")).unwrap();
-    let scene = EditScene {
-        format_version: EDIT_SCENE_VERSION,
-        song: SongSource::Synth(SynthSong {
-            bpm: 120.0,
-            bars: song_bars,
-            ..SynthSong::default()
-        }),
-        database: "dance.db.json".into(),
-        pins: Default::default(),
-        search: Default::default(),
-        fill: Default::default(),
-    };
-    let path = dir.join("edit.ron");
-    scene.save(&path).unwrap();
+    let text = format!(
+        "// The editor tests' dance: generated clips, a synthesized song.\n\
+         Dance(\n    format_version: 1,\n    name: \"editor-{name}\",\n    \
+         song: Synth(bpm: 120.0, bars: {song_bars}),\n    \
+         database: File(\"dance.db.json\"), // written by the test\n    \
+         dance: (fps: 30.0, seam_frames: 5),\n    render: (gif: false),\n)\n"
+    );
+    let path = dir.join("dance.ron");
+    std::fs::write(&path, text).unwrap();
     path
 }
 
@@ -153,8 +156,8 @@ pub fn post(addr: SocketAddr, path: &str, body: &str) -> serde_json::Value {
     a.json()
 }
 
-/// Checks that `bvh` is a BVH file lasting the song's bars (from `GET /api/bars`) at 30 fps,
-/// within a frame; returns its frame count.
+/// Checks that `bvh` is a BVH file from the song's t = 0 to the end of its last bar (from
+/// `GET /api/bars`) at 30 fps, within a frame; returns its frame count.
 pub fn assert_bvh_lasts_the_bars(addr: SocketAddr, bvh: &str) -> usize {
     assert!(
         bvh.starts_with("HIERARCHY"),
@@ -163,8 +166,7 @@ pub fn assert_bvh_lasts_the_bars(addr: SocketAddr, bvh: &str) -> usize {
     );
     let bars = get(addr, "/api/bars");
     let bars = bars["bars"].as_array().unwrap();
-    let span =
-        bars[bars.len() - 1]["end_s"].as_f64().unwrap() - bars[0]["start_s"].as_f64().unwrap();
+    let span = bars[bars.len() - 1]["end_s"].as_f64().unwrap();
     let frames: usize = bvh
         .lines()
         .find_map(|l| l.strip_prefix("Frames:"))

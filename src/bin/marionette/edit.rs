@@ -1,6 +1,6 @@
-//! `marionette edit SCENE.ron [--port P]`: opens an edit scene (song, database, pins; see
-//! `marionette::editor::scene`) in the dance editor, a page served on 127.0.0.1, and prints
-//! its URL. Serves until interrupted.
+//! `marionette edit SCENE.ron [--port P]`: opens a `Dance` scene (song, database, pins: the
+//! file `marionette run` reads) in the dance editor, a page served on 127.0.0.1, and prints
+//! its URL once the database's transition table is built. Serves until interrupted.
 
 use std::io::Write;
 use std::path::PathBuf;
@@ -13,7 +13,7 @@ use marionette::editor::session::Session;
 // The command's arguments (its help text is on `Command::Edit`).
 #[derive(clap::Args)]
 pub struct Args {
-    /// The edit scene (.ron): song, database, pins.
+    /// The Dance scene (.ron): song, database, pins; Save writes its pins back.
     scene: PathBuf,
     /// The port on 127.0.0.1 (0: any free port).
     #[arg(long, default_value_t = DEFAULT_PORT)]

@@ -266,6 +266,8 @@ window.addEventListener('resize', () => timeline.draw());
   danceView.dist = 4.6;
   await refreshBars();
   status(`${s.bars} bars · ${s.segments} segments · ${s.tempo_bpm.toFixed(1)} BPM`);
+  // The first load (navigation start to a usable page), for tests/browser/latency.mjs.
+  document.body.dataset.readyMs = performance.now().toFixed(1);
   document.body.dataset.ready = '1';
   requestAnimationFrame(frame);
 })().catch((e) => status(e.message, true));
