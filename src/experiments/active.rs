@@ -47,6 +47,10 @@ pub struct ActiveConfig {
     pub push: Option<Push>,
     /// Seconds after the push at which the assistance is released; `None` keeps it.
     pub release_delay_s: Option<f64>,
+    /// A key pose the PD switches to at the release (the falling paper's fall controller):
+    /// angle (degrees) per DOF name, DOFs not named held at 0; the PD keeps the character's
+    /// own gains and strength. `None` keeps following the primitives.
+    pub key_pose_deg: Option<BTreeMap<String, f64>>,
     /// Damage weight per link (links not named weigh 1).
     pub damage_weights: BTreeMap<String, f64>,
     /// Frames kept per second in the outcome.
@@ -64,6 +68,7 @@ impl Default for ActiveConfig {
             duration_s: 2.0,
             push: None,
             release_delay_s: None,
+            key_pose_deg: None,
             damage_weights: BTreeMap::new(),
             record_hz: 60.0,
         }
@@ -240,6 +245,27 @@ pub fn run_active(
         &config.settings,
         reaction,
     )?;
+    if let Some(key) = &config.key_pose_deg {
+        let mut pd = world.get::<PdController>(e).expect("pd").0.clone();
+        pd.target.iter_mut().for_each(|t| *t = 0.0);
+        pd.target_velocity.iter_mut().for_each(|t| *t = 0.0);
+        pd.feedforward.clear();
+        for (name, deg) in key {
+            let d = body
+                .figure
+                .dof_index(name)
+                .ok_or_else(|| ActiveError::Config {
+                    field: "key_pose_deg",
+                    message: format!(
+                        "'{name}' is not a DOF of {} ({:?})",
+                        body.figure.name,
+                        body.figure.dof_names()
+                    ),
+                })?;
+            pd.target[d] = deg.to_radians();
+        }
+        world.get_mut::<Reaction>(e).expect("reaction").key_pose = Some(pd);
+    }
     if let (Some(p), Some(link)) = (&config.push, push_link) {
         world
             .get_mut::<ExternalForces>(e)
