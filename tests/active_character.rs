@@ -218,3 +218,175 @@ fn worlds_of_characters_give_the_same_bits_on_one_and_two_threads() {
     };
     assert_eq!(run(1), run(2));
 }
+
+/// The high jump (A) and the jumping knee kick as their experiments make them from the scenes'
+/// clips (scenes/high_jump.ron, scenes/jumping_knee_kick.ron).
+fn jumps() -> (Vec<Primitive>, Vec<Primitive>) {
+    use marionette::experiments::high_jump::HighJumpConfig;
+    use marionette::experiments::knee_kick::{self, KneeKickConfig};
+    use marionette::primitive::{EventConfig, Gamma};
+    let clip = |file: &str| {
+        let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+            .join("scenes/clips")
+            .join(file);
+        KeyframeClip::load(&path).unwrap().to_model_clip()
+    };
+    let config = KneeKickConfig {
+        jump: HighJumpConfig {
+            model: marionette::humanoid::humanoid24(),
+            low: clip("low_jump.ron"),
+            normal: clip("normal_jump.ron"),
+            gamma: Gamma::Constant(-0.5),
+            learn: LearnConfig::default(),
+        },
+        kick: clip("knee_kick.ron").window(0.0, 0.5).unwrap(),
+        gamma: Gamma::Ramp { from: 1.0, to: 0.0 },
+        events: EventConfig::default(),
+    };
+    let kk = knee_kick::run(&config).unwrap();
+    (vec![kk.jump.learned.high.primitive.clone()], kk.sequence())
+}
+
+/// Prints what a run measured per DOF (RMS, saturation, the motion's demand against the
+/// strength) and per foot.
+fn print_tracking(label: &str, o: &marionette::experiments::active::ActiveOutcome) {
+    let worst = o
+        .demands
+        .iter()
+        .max_by(|a, b| a.rms_deg.total_cmp(&b.rms_deg))
+        .unwrap();
+    println!(
+        "{label}: joint RMS {:.3}°, worst DOF {} {:.3}°, worst tick {:.3} s ({:.2}°), fall {:?}",
+        o.tracking_rms_deg, worst.dof, worst.rms_deg, o.worst_tick.0, o.worst_tick.1, o.fall_s
+    );
+    for d in &o.demands {
+        println!(
+            "  {:28} RMS {:6.2}°  clamped {:5.1} %  demand {:7.1} .. {:7.1}  limit {:6.0} .. {:4.0} N·m",
+            d.dof,
+            d.rms_deg,
+            100.0 * d.saturated_fraction,
+            d.demand_nm.0,
+            d.demand_nm.1,
+            d.limit_nm.0,
+            d.limit_nm.1
+        );
+    }
+    for f in &o.feet {
+        println!(
+            "  {}: animated down {:.3} s, physical gap ≤ {:.4} m (at {:.3} s)",
+            f.link, f.animated_down_s, f.max_gap_m, f.max_gap_time_s
+        );
+    }
+}
+
+/// A physical foot counts as on the floor when its lowest corner is within this of the floor
+/// (m): the animated foot counts as down within 1 cm of its floor
+/// ([`marionette::ecs::character::ANIMATED_FOOT_DOWN_M`]), and the physical one may lag it by
+/// another centimetre of tracking error (the assisted pelvis follows to about 1 cm).
+const FOOT_ON_FLOOR_M: f64 = 0.02;
+
+/// The high jump and the jumping knee kick, fully assisted (the assistance carries the root's
+/// share of the motion's inverse dynamics). Under adult strength the waist is asked for more
+/// than the strength table gives (measured and asserted: that is why tracking there is not
+/// under 2°); with unbounded torques the knee kick tracks under 2° with the feet on the floor
+/// whenever the animated ones are.
+#[test]
+fn fully_assisted_tracking_of_both_jumps_under_adult_strength() {
+    let (high, kick) = jumps();
+    for (label, seq) in [("high jump", high), ("jumping knee kick", kick)] {
+        let duration: f64 = seq.iter().map(|p| p.duration).sum();
+        let cfg = ActiveConfig {
+            duration_s: duration,
+            ..ActiveConfig::default()
+        };
+        let o = run_active(&cfg, &seq).unwrap();
+        print_tracking(label, &o);
+        assert!(o.fall_s.is_none());
+        let waist = o.demands.iter().find(|d| d.dof == "waist_flexion").unwrap();
+        assert!(
+            waist.demand_nm.0 < waist.limit_nm.0 || waist.demand_nm.1 > waist.limit_nm.1,
+            "{waist:?}"
+        );
+        let mut c = cfg.clone();
+        c.settings.strength = None;
+        let o = run_active(&c, &seq).unwrap();
+        print_tracking(&format!("{label}, unbounded torques"), &o);
+        if label == "jumping knee kick" {
+            assert!(o.tracking_rms_deg < 2.0, "{}", o.tracking_rms_deg);
+            for f in &o.feet {
+                assert!(f.animated_down_s > 0.5, "{f:?}");
+                assert!(f.max_gap_m <= FOOT_ON_FLOOR_M, "{f:?}");
+            }
+        }
+    }
+}
+
+/// The key-pose switch: at the release the PD leaves the primitives for the key pose (the
+/// falling paper's fall controller), keeps it while the primitives play on, and the body
+/// moves toward it.
+#[test]
+fn the_release_switches_the_pd_to_the_key_pose() {
+    use marionette::dynamics::forces::pd::PdTargets;
+    use marionette::ecs::physics::PdController;
+    use marionette::ecs::primitive::DofPose;
+    let jump = Arc::new(primitive("normal_jump.ron"));
+    let body = Arc::new(humanoid24_body(1.70, 65.0, 9.81).unwrap());
+    let n = body.dof_v.len();
+    let knee = body.figure.dof_index("left_knee").unwrap();
+    let mut key_angles = vec![0.0; n];
+    key_angles[knee] = 90f64.to_radians();
+    let key = PdTargets::hold(key_angles.clone(), vec![200.0; n], vec![20.0; n]);
+    let reaction = Reaction {
+        release_delay_s: Some(0.05),
+        key_pose: Some(key.clone()),
+        ..Reaction::default()
+    };
+    let mut world = new_world(Clock::physics(5e-4));
+    let e = spawn_physical_character(
+        &mut world,
+        "k",
+        body.clone(),
+        vec![jump],
+        &PhysicalSettings::default(),
+        reaction,
+    )
+    .unwrap();
+    let link = body.link_index("chest").unwrap();
+    world
+        .get_mut::<marionette::ecs::physics::ExternalForces>(e)
+        .unwrap()
+        .push(chest_push(0.1).to_force(link));
+    let mut s = character_schedule();
+    run_ticks(&mut world, &mut s, 200);
+    let pd = &world.get::<PdController>(e).unwrap().0;
+    assert_ne!(pd.target, key.target, "switched before the release");
+    let knee_at = |w: &bevy_ecs::world::World| {
+        let st = w.get::<BodyState>(e).unwrap();
+        let mut a = vec![0.0; body.model.nv];
+        body.model.angles(&st.q, &mut a);
+        a[body.dof_v[knee]]
+    };
+    run_ticks(&mut world, &mut s, 200);
+    let released = world.get::<Reaction>(e).unwrap().released_at_s.unwrap();
+    assert!((released - 0.15).abs() < 1e-3, "{released}");
+    let knee_then = knee_at(&world);
+    run_ticks(&mut world, &mut s, 600);
+    let pd = &world.get::<PdController>(e).unwrap().0;
+    assert_eq!(pd.target, key.target);
+    assert!(pd.feedforward.is_empty());
+    let pose = world.get::<DofPose>(e).unwrap();
+    assert!(
+        pose.theta.iter().any(|t| t.abs() > 0.01),
+        "the primitives play on"
+    );
+    let knee_now = knee_at(&world);
+    println!(
+        "key pose: knee {:.1}° at the release ({released:.3} s), {:.1}° 0.3 s later (key 90°)",
+        knee_then.to_degrees(),
+        knee_now.to_degrees()
+    );
+    assert!(
+        (knee_now - key_angles[knee]).abs() < (knee_then - key_angles[knee]).abs(),
+        "the knee moved toward the key pose"
+    );
+}

@@ -56,3 +56,29 @@ fn bad_values_are_refused_before_anything_runs() {
         assert!(e.contains(expect), "{set}: {e}");
     }
 }
+
+#[test]
+fn the_key_pose_scene_switches_at_the_release_and_falls() {
+    let path =
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes/active_knee_kick_key_pose.ron");
+    let scene = Scene::load(&path).unwrap();
+    let out =
+        std::env::temp_dir().join(format!("marionette-test-{}-active-key", std::process::id()));
+    let r = run(&scene, path.parent().unwrap(), &out).unwrap();
+    assert_eq!(r["key_pose_deg"]["left_knee"].as_f64(), Some(90.0));
+    let release = r["release_s"].as_f64().unwrap();
+    let fall = r["fall_s"].as_f64().unwrap();
+    println!(
+        "key pose scene: release {release} s, fallen {fall} s, damage {} N",
+        r["damage"]["total_n"]
+    );
+    assert!(fall > release);
+    let bad =
+        marionette::scene::apply_overrides(&scene, &["key_pose_deg={\"tail\": 1.0}".to_string()])
+            .unwrap();
+    let e = run(&bad, path.parent().unwrap(), &out)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("'tail' is not a DOF of humanoid24"), "{e}");
+    std::fs::remove_dir_all(&out).ok();
+}

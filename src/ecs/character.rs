@@ -77,6 +77,12 @@ pub struct RootAssist {
     pub inertia_kg_m2: f64,
     /// True once released: the force is zero from then on.
     pub released: bool,
+    /// The root's share of the animated motion's inverse dynamics (world, N, at the pelvis
+    /// origin): the force the pelvis needs for the whole body to move as animated with no
+    /// other support; set by [`pd_targets_from_pose`] with a [`Feedforward`], else zero.
+    pub feedforward_force: DVec3,
+    /// The same torque (world, N·m, about the pelvis origin).
+    pub feedforward_torque: DVec3,
     /// The force (N, world) at the pelvis origin for this tick.
     pub force: DVec3,
     /// The torque (N·m, world) for this tick.
@@ -140,7 +146,107 @@ pub struct CharacterLog {
     pub peak_torque_nm: Vec<f64>,
     /// Per link the largest normal floor force after the first push (N).
     pub peak_force_after_push_n: Vec<f64>,
+    /// Per DOF the ticks before the first push whose PD torque was clamped to the strength.
+    pub saturated_ticks: Vec<usize>,
+    /// Per DOF the smallest and largest feedforward torque before the first push (N·m): what
+    /// the animated motion asks of the joint (its inverse dynamics with the root carried).
+    pub demand_nm: Vec<(f64, f64)>,
     angles: Vec<f64>,
+}
+
+/// An animated foot counts as down while its lowest contact corner is within this height of
+/// the animated floor (m): the tolerance the jumps use for a planted foot
+/// ([`crate::experiments::knee_kick::FOOT_DOWN_M`]).
+pub const ANIMATED_FOOT_DOWN_M: f64 = crate::experiments::knee_kick::FOOT_DOWN_M;
+
+/// Whether the physical feet are on the floor when the animated ones are: for every foot link,
+/// over the ticks before the first push at which the animated foot is down (its lowest corner
+/// within [`ANIMATED_FOOT_DOWN_M`] of the animated floor, the start pose's lowest corner), the
+/// largest height of the physical foot's lowest corner above the physical floor (m; ≤ 0 means
+/// it touched the floor at every such tick).
+#[derive(Component, Clone, Debug)]
+pub struct FeetOnFloor {
+    /// Foot links (body indices).
+    pub links: Vec<usize>,
+    /// Height of the animated floor (m): the lowest corner of the start pose.
+    pub animated_floor_m: f64,
+    /// Ticks at which each animated foot was down.
+    pub down_ticks: Vec<usize>,
+    /// Per foot the largest physical gap above the floor at those ticks (m).
+    pub max_gap_m: Vec<f64>,
+    /// Per foot the time of that largest gap (s).
+    pub max_gap_time_s: Vec<f64>,
+    animated: Option<Data>,
+    physical: Option<Data>,
+}
+
+impl FeetOnFloor {
+    /// Feet check of the foot `links` over a floor whose animated height is `animated_floor_m`.
+    pub fn new(links: Vec<usize>, animated_floor_m: f64) -> Self {
+        let n = links.len();
+        Self {
+            links,
+            animated_floor_m,
+            down_ticks: vec![0; n],
+            max_gap_m: vec![f64::NEG_INFINITY; n],
+            max_gap_time_s: vec![0.0; n],
+            animated: None,
+            physical: None,
+        }
+    }
+}
+
+/// Lowest height along the floor normal of the contact corners of `link` posed by `data`.
+fn lowest_corner(contact: &ContactModel, data: &Data, link: usize) -> f64 {
+    let n = contact.params.floor_normal;
+    contact.corners[link]
+        .iter()
+        .map(|&c| n.dot(data.pos[link] + data.rot[link] * c))
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// What [`check_feet`] reads and writes.
+type FeetQuery<'a> = (
+    &'a PhysicsBody,
+    &'a BodyState,
+    &'a FloorContact,
+    &'a ModelBinding,
+    &'a DofPose,
+    &'a Reaction,
+    &'a mut FeetOnFloor,
+);
+
+/// Updates every character's [`FeetOnFloor`] after its step, before its first push.
+pub fn check_feet(mut q: Query<FeetQuery>) {
+    for (body, state, contact, binding, pose, reaction, mut feet) in &mut q {
+        if reaction.pushed_at_s.is_some_and(|p| state.time_s > p) {
+            continue;
+        }
+        let b = &*body.body;
+        let feet = &mut *feet;
+        let (q_d, v_d) = pose_configuration(b, binding, pose);
+        let anim = feet.animated.get_or_insert_with(|| Data::new(&b.model));
+        kinematics(&b.model, anim, &q_d, &v_d);
+        let phys = feet.physical.get_or_insert_with(|| Data::new(&b.model));
+        kinematics(&b.model, phys, &state.q, &state.v);
+        let floor = contact.0.params.floor_height;
+        for (k, &link) in feet.links.iter().enumerate() {
+            let (anim, phys) = (feet.animated.as_ref(), feet.physical.as_ref());
+            let (Some(anim), Some(phys)) = (anim, phys) else {
+                continue;
+            };
+            let a = lowest_corner(&contact.0, anim, link) - feet.animated_floor_m;
+            if a > ANIMATED_FOOT_DOWN_M {
+                continue;
+            }
+            let gap = lowest_corner(&contact.0, phys, link) - floor;
+            feet.down_ticks[k] += 1;
+            if gap > feet.max_gap_m[k] {
+                feet.max_gap_m[k] = gap;
+                feet.max_gap_time_s[k] = state.time_s;
+            }
+        }
+    }
 }
 
 /// Settings of a physical character.
@@ -164,6 +270,11 @@ pub struct PhysicalSettings {
     pub contact: ContactParams,
     /// Add the computed-torque feedforward ([`Feedforward`]) to the PD.
     pub feedforward: bool,
+    /// With `feedforward`, the root assistance also carries the root's share of the animated
+    /// motion's inverse dynamics ([`RootAssist::feedforward_force`]): the whole-body weight and
+    /// root wrench, so the joints only move the limbs, and the floor is placed for the weight
+    /// the assistance does not carry.
+    pub assist_feedforward: bool,
     /// How far the floor lies below the start pose's lowest contact corner (m, ≥ 0; 0 = the
     /// feet start on it).
     pub floor_clearance_m: f64,
@@ -183,6 +294,7 @@ impl Default for PhysicalSettings {
             },
             contact: ContactParams::default(),
             feedforward: true,
+            assist_feedforward: true,
             floor_clearance_m: 0.0,
         }
     }
@@ -300,12 +412,18 @@ pub fn spawn_physical_character(
         .flat_map(|(i, cs)| cs.iter().map(move |&c| (i, c)))
         .map(|(i, c)| params.floor_normal.dot(data.pos[i] + data.rot[i] * c))
         .fold(f64::INFINITY, f64::min);
-    let weight = model.total_mass() * model.gravity.length();
-    let foot = body
-        .link_names
-        .iter()
-        .position(|n| n.ends_with("foot"))
-        .unwrap_or(0);
+    // The floor carries the share of the weight the assistance does not (with the root
+    // feedforward a fully assisted body is carried by the assistance alone).
+    let carried = if settings.feedforward && settings.assist_feedforward {
+        1.0 - settings.assist
+    } else {
+        1.0
+    };
+    let weight = carried * model.total_mass() * model.gravity.length();
+    let feet: Vec<usize> = (0..body.link_names.len())
+        .filter(|&i| body.link_names[i].ends_with("foot"))
+        .collect();
+    let foot = feet.first().copied().unwrap_or(0);
     params.floor_height =
         lowest + probe.static_sink(foot, 0.5 * weight) - settings.floor_clearance_m;
     let contact = ContactModel::new(&body.boxes, &masses, &gains, params);
@@ -333,6 +451,8 @@ pub fn spawn_physical_character(
         mass_kg: model.total_mass(),
         inertia_kg_m2: (h[0] + h[nv + 1] + h[2 * nv + 2]) / 3.0,
         released: false,
+        feedforward_force: DVec3::ZERO,
+        feedforward_torque: DVec3::ZERO,
         force: DVec3::ZERO,
         torque: DVec3::ZERO,
     };
@@ -344,6 +464,8 @@ pub fn spawn_physical_character(
         dof_sq_error: vec![0.0; ndofs],
         peak_torque_nm: vec![0.0; ndofs],
         peak_force_after_push_n: vec![0.0; nlinks],
+        saturated_ticks: vec![0; ndofs],
+        demand_nm: vec![(0.0, 0.0); ndofs],
         ..CharacterLog::default()
     };
     let mut entity = world.spawn((
@@ -357,10 +479,14 @@ pub fn spawn_physical_character(
             assist,
             reaction,
             log,
+            FeetOnFloor::new(feet, lowest),
         ),
     ));
     if settings.feedforward {
-        entity.insert(Feedforward::default());
+        entity.insert(Feedforward {
+            root: settings.assist_feedforward,
+            ..Feedforward::default()
+        });
     }
     Ok(entity.id())
 }
@@ -391,6 +517,8 @@ pub fn push_now(world: &mut World, entity: Entity, push: &Push) -> bool {
 /// backward difference of `q̇_d` over one tick.
 #[derive(Component, Clone, Debug, Default)]
 pub struct Feedforward {
+    /// Also hand the root's share to the [`RootAssist`].
+    pub root: bool,
     previous_velocity: Option<Vec<f64>>,
     acceleration: Vec<f64>,
     data: Option<Data>,
@@ -403,6 +531,7 @@ type TargetQuery<'a> = (
     &'a DofPose,
     &'a mut PdController,
     Option<&'a mut Feedforward>,
+    Option<&'a mut RootAssist>,
 );
 
 /// What [`react_to_pushes`] reads and writes.
@@ -417,7 +546,7 @@ type ReactionQuery<'a> = (
 /// Copies every tracking character's DOF pose into its PD targets (θ_d and θ̇_d per DOF) and,
 /// with a [`Feedforward`], the inverse dynamics of the animated motion into its feedforward.
 pub fn pd_targets_from_pose(clock: Res<Clock>, mut q: Query<TargetQuery, With<TrackPose>>) {
-    for (body, binding, pose, mut pd, ff) in &mut q {
+    for (body, binding, pose, mut pd, ff, assist) in &mut q {
         let pd = &mut pd.0;
         for (d, &c) in binding.dof_columns().iter().enumerate() {
             pd.target[d] = pose.theta[c];
@@ -438,6 +567,12 @@ pub fn pd_targets_from_pose(clock: Res<Clock>, mut q: Query<TargetQuery, With<Tr
         let tau = crate::dynamics::rnea(&b.model, data, &q_d, &v_d, &ff.acceleration, &f_ext);
         pd.feedforward.clear();
         pd.feedforward.extend(b.dof_v.iter().map(|&k| tau[k]));
+        if let Some(mut a) = assist.filter(|_| ff.root) {
+            // The free root's entry is [n; f] in pelvis coordinates about its origin.
+            let rot = DQuat::from_xyzw(q_d[3], q_d[4], q_d[5], q_d[6]);
+            a.feedforward_torque = rot * DVec3::new(tau[0], tau[1], tau[2]);
+            a.feedforward_force = rot * DVec3::new(tau[3], tau[4], tau[5]);
+        }
         ff.previous_velocity = Some(v_d);
     }
 }
@@ -493,11 +628,11 @@ pub fn root_assist(mut q: Query<(&BodyState, &ModelBinding, &DofPose, &mut RootA
         let (kp, kd) = (om * om, 2.0 * z * om);
         let p_d = DVec3::new(th(0), th(1), th(2));
         let v_d = DVec3::new(rate(0), rate(1), rate(2));
-        a.force = s * a.mass_kg * (kp * (p_d - p) + kd * (v_d - v_world));
+        a.force = s * (a.feedforward_force + a.mass_kg * (kp * (p_d - p) + kd * (v_d - v_world)));
         let rot_d = DQuat::from_scaled_axis(DVec3::new(th(3), th(4), th(5)));
         let e = quat_log(rot_d * rot.inverse());
         let w_d = DVec3::new(rate(3), rate(4), rate(5));
-        a.torque = s * a.inertia_kg_m2 * (kp * e + kd * (w_d - w_world));
+        a.torque = s * (a.feedforward_torque + a.inertia_kg_m2 * (kp * e + kd * (w_d - w_world)));
     }
 }
 
@@ -531,6 +666,13 @@ pub fn log_characters(
             }
             let (tau, _) = pd.torque(d, log.angles[k], state.v[k]);
             log.peak_torque_nm[d] = log.peak_torque_nm[d].max(tau.abs());
+            if before_push {
+                log.saturated_ticks[d] += usize::from(pd.saturates(d, tau));
+                if let Some(&ff) = pd.feedforward.get(d) {
+                    let m = &mut log.demand_nm[d];
+                    *m = (m.0.min(ff), m.1.max(ff));
+                }
+            }
         }
         if before_push {
             log.tracked_ticks += 1;
@@ -573,7 +715,7 @@ pub fn add_character_systems(schedule: &mut Schedule) {
         pd_targets_from_pose.in_set(ControlSet::Targets),
         react_to_pushes.in_set(ControlSet::Reactions),
         root_assist.in_set(ControlSet::Assist),
-        log_characters.in_set(MotionSet::Record),
+        (log_characters, check_feet).in_set(MotionSet::Record),
     ));
 }
 

@@ -13,7 +13,7 @@ use glam::DVec3;
 
 use crate::dynamics::forces::external::Push;
 use crate::ecs::character::{
-    CharacterError, CharacterLog, PhysicalSettings, Reaction, character_schedule,
+    CharacterError, CharacterLog, FeetOnFloor, PhysicalSettings, Reaction, character_schedule,
     spawn_physical_character,
 };
 use crate::ecs::physics::{BodyState, ExternalForces, PdController, PhysicsBody, PhysicsStatus};
@@ -47,6 +47,10 @@ pub struct ActiveConfig {
     pub push: Option<Push>,
     /// Seconds after the push at which the assistance is released; `None` keeps it.
     pub release_delay_s: Option<f64>,
+    /// A key pose the PD switches to at the release (the falling paper's fall controller):
+    /// angle (degrees) per DOF name, DOFs not named held at 0; the PD keeps the character's
+    /// own gains and strength. `None` keeps following the primitives.
+    pub key_pose_deg: Option<BTreeMap<String, f64>>,
     /// Damage weight per link (links not named weigh 1).
     pub damage_weights: BTreeMap<String, f64>,
     /// Frames kept per second in the outcome.
@@ -64,6 +68,7 @@ impl Default for ActiveConfig {
             duration_s: 2.0,
             push: None,
             release_delay_s: None,
+            key_pose_deg: None,
             damage_weights: BTreeMap::new(),
             record_hz: 60.0,
         }
@@ -79,6 +84,36 @@ pub struct TorquePeak {
     pub peak_nm: f64,
     /// The strength limit in that direction's larger magnitude (N·m).
     pub limit_nm: f64,
+}
+
+/// What the motion asked of a DOF before the push against its strength.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct DofDemand {
+    /// DOF name.
+    pub dof: String,
+    /// Joint-angle RMS error before the push (degrees).
+    pub rms_deg: f64,
+    /// Fraction of the ticks before the push whose PD torque was clamped to the strength.
+    pub saturated_fraction: f64,
+    /// Smallest and largest feedforward torque (N·m): the animated motion's inverse dynamics
+    /// with the root carried by the assistance.
+    pub demand_nm: (f64, f64),
+    /// The strength range `(τ_min, τ_max)` (N·m; `(0, 0)` when unbounded).
+    pub limit_nm: (f64, f64),
+}
+
+/// A foot's floor check before the push (see [`crate::ecs::character::FeetOnFloor`]).
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct FootCheck {
+    /// Foot link name.
+    pub link: String,
+    /// Seconds at which the animated foot was down.
+    pub animated_down_s: f64,
+    /// Largest height of the physical foot's lowest corner above the floor while the animated
+    /// one was down (m; ≤ 0: always on it).
+    pub max_gap_m: f64,
+    /// When that was (s).
+    pub max_gap_time_s: f64,
 }
 
 /// A link's peak floor force after the push and its share of the damage.
@@ -118,6 +153,13 @@ pub struct ActiveOutcome {
     pub max_pelvis_gap_m: f64,
     /// Peak torques per DOF.
     pub torques: Vec<TorquePeak>,
+    /// Per DOF the tracking error, saturation and the motion's torque demand before the push.
+    pub demands: Vec<DofDemand>,
+    /// The tick before the push with the largest mean squared joint error: its time (s) and
+    /// RMS over the DOFs (degrees).
+    pub worst_tick: (f64, f64),
+    /// Per foot whether the physical foot was on the floor when the animated one was.
+    pub feet: Vec<FootCheck>,
     /// Peak floor force per link after the push.
     pub links: Vec<LinkDamage>,
     /// `D = Σ w_i f_i` (N).
@@ -203,6 +245,27 @@ pub fn run_active(
         &config.settings,
         reaction,
     )?;
+    if let Some(key) = &config.key_pose_deg {
+        let mut pd = world.get::<PdController>(e).expect("pd").0.clone();
+        pd.target.iter_mut().for_each(|t| *t = 0.0);
+        pd.target_velocity.iter_mut().for_each(|t| *t = 0.0);
+        pd.feedforward.clear();
+        for (name, deg) in key {
+            let d = body
+                .figure
+                .dof_index(name)
+                .ok_or_else(|| ActiveError::Config {
+                    field: "key_pose_deg",
+                    message: format!(
+                        "'{name}' is not a DOF of {} ({:?})",
+                        body.figure.name,
+                        body.figure.dof_names()
+                    ),
+                })?;
+            pd.target[d] = deg.to_radians();
+        }
+        world.get_mut::<Reaction>(e).expect("reaction").key_pose = Some(pd);
+    }
     if let (Some(p), Some(link)) = (&config.push, push_link) {
         world
             .get_mut::<ExternalForces>(e)
@@ -224,11 +287,20 @@ pub fn run_active(
     }
     let log = world.get::<CharacterLog>(e).expect("log").clone();
     let reaction = world.get::<Reaction>(e).expect("reaction").clone();
+    let feet = world.get::<FeetOnFloor>(e).expect("feet check");
     let rec = world.get::<Recorder>(e).expect("recorder");
     let pd = &world.get::<PdController>(e).expect("pd").0;
     let b = &world.get::<PhysicsBody>(e).expect("body").body;
     let motion = body_clip(b, &configurations, every as f64 * config.dt_s);
-    Ok(outcome(config, b, pd, &log, &reaction, &rec.frames, motion))
+    Ok(outcome(
+        config,
+        b,
+        pd,
+        (&log, feet),
+        &reaction,
+        &rec.frames,
+        motion,
+    ))
 }
 
 /// Ticks between kept frames.
@@ -261,7 +333,7 @@ fn outcome(
     config: &ActiveConfig,
     body: &HumanBody,
     pd: &crate::dynamics::forces::pd::PdTargets,
-    log: &CharacterLog,
+    (log, feet): (&CharacterLog, &FeetOnFloor),
     reaction: &Reaction,
     all_frames: &[Vec<DVec3>],
     motion: ModelClip,
@@ -306,6 +378,34 @@ fn outcome(
             }
         })
         .collect();
+    let demands = dof_rms_deg
+        .iter()
+        .enumerate()
+        .map(|(d, (name, rms))| DofDemand {
+            dof: name.clone(),
+            rms_deg: *rms,
+            saturated_fraction: log.saturated_ticks[d] as f64 / n,
+            demand_nm: log.demand_nm[d],
+            limit_nm: pd.torque_limits.get(d).copied().unwrap_or((0.0, 0.0)),
+        })
+        .collect();
+    let worst_tick = log
+        .samples
+        .iter()
+        .filter(|s| before(s.time_s))
+        .map(|s| (s.time_s, s.mean_sq_error.sqrt().to_degrees()))
+        .fold((0.0, 0.0), |a, b| if b.1 > a.1 { b } else { a });
+    let feet = feet
+        .links
+        .iter()
+        .enumerate()
+        .map(|(k, &l)| FootCheck {
+            link: body.link_names[l].clone(),
+            animated_down_s: feet.down_ticks[k] as f64 * config.dt_s,
+            max_gap_m: feet.max_gap_m[k],
+            max_gap_time_s: feet.max_gap_time_s[k],
+        })
+        .collect();
     let links: Vec<LinkDamage> = body
         .link_names
         .iter()
@@ -331,6 +431,9 @@ fn outcome(
         pelvis_height_m: (start_h, end_h),
         max_pelvis_gap_m,
         torques,
+        demands,
+        worst_tick,
+        feet,
         links,
         damage,
         pelvis_track: log

@@ -94,6 +94,10 @@ pub struct ActiveKneeKickScene {
     pub push: Push,
     /// Seconds after the push at which the assistance is released (`None`: kept).
     pub release_delay_s: Option<f64>,
+    /// A key pose the PD switches to at the release (degrees per DOF name; others 0), as the
+    /// falling paper's fall controller; `None` keeps following the primitives.
+    #[serde(default)]
+    pub key_pose_deg: Option<BTreeMap<String, f64>>,
     /// Simulated time (s).
     pub duration_s: f64,
     /// Physics step (s).
@@ -129,6 +133,7 @@ pub fn run_active_knee_kick(
         duration_s: scene.duration_s,
         push: Some(scene.push.clone()),
         release_delay_s: scene.release_delay_s,
+        key_pose_deg: scene.key_pose_deg.clone(),
         damage_weights: scene.damage_weights.clone(),
         record_hz: 60.0,
     };
@@ -217,9 +222,14 @@ fn report(
             "per_dof_rms_deg": o.dof_rms_deg.iter().cloned().collect::<BTreeMap<_, _>>(),
             "max_pelvis_height_gap_m": o.max_pelvis_gap_m,
             "window": "ticks before the push",
+            "worst_tick": { "time_s": o.worst_tick.0, "rms_deg": o.worst_tick.1 },
+            "per_dof_demand": o.demands,
+            "feet_on_floor": o.feet,
+            "feet_rule": format!("the animated foot is down within {} m of its floor; gap = the physical foot's lowest corner above the floor then", crate::ecs::character::ANIMATED_FOOT_DOWN_M),
         },
         "push": { "link": scene.push.link, "force_n": scene.push.force_n, "start_s": o.push_s, "duration_s": scene.push.duration_s },
         "release_s": o.release_s,
+        "key_pose_deg": scene.key_pose_deg,
         "fall_s": o.fall_s,
         "fallen_below_fraction_of_start_pelvis_height": crate::experiments::active::FALLEN_FRACTION,
         "pelvis_height_m": { "start": o.pelvis_height_m.0, "end": o.pelvis_height_m.1 },
