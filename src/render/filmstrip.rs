@@ -33,9 +33,9 @@ const TIME_SHARE: f64 = 0.25;
 /// The instants of a filmstrip of (at least) `n` columns, chosen by the motion of the first
 /// track: a column at the apex of every flight it has ([`flight_apexes`]: both feet and the
 /// body off the floor, the root highest), the others spread by distance travelled
-/// ([`spread_times`], the first at t = 0 and the last at the end). There are `n` columns, or
-/// more when the flights need them: `flights + 2`, at most [`MAX_COLUMNS`] (then the flights
-/// with the highest apexes are kept). A figure without feet has no flights found: its inner
+/// ([`spread_times`], the first at t = 0 and the last at the end; each apex takes the place of
+/// the spread column nearest to it). There are `n` columns, or more when the flights need them:
+/// `flights + 2`, at most [`MAX_COLUMNS`] (then the flights with the highest apexes are kept). A figure without feet has no flights found: its inner
 /// columns move to a root apex near them instead ([`snap_to_apexes`]).
 pub(crate) fn column_times(tracks: &[Track], n: usize) -> Vec<f64> {
     if n == 1 {
@@ -52,11 +52,21 @@ pub(crate) fn column_times(tracks: &[Track], n: usize) -> Vec<f64> {
         apexes.truncate(MAX_COLUMNS - 2);
         apexes.sort_by(|a, b| a.0.total_cmp(&b.0));
     }
-    let rest = n.saturating_sub(apexes.len()).max(2);
-    let mut times = spread_times(tracks, rest);
-    times.extend(apexes.iter().map(|a| a.0));
+    // Each apex replaces the spread inner column nearest to it, so none lands beside another.
+    let mut times = spread_times(tracks, n.max(apexes.len() + 2));
+    let last = times.len() - 1;
+    let mut free: Vec<usize> = (1..last).collect();
+    for &(t, _) in &apexes {
+        let Some(i) = (0..free.len()).min_by(|&a, &b| {
+            (times[free[a]] - t)
+                .abs()
+                .total_cmp(&(times[free[b]] - t).abs())
+        }) else {
+            break;
+        };
+        times[free.swap_remove(i)] = t;
+    }
     times.sort_by(f64::total_cmp);
-    times.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
     times
 }
 
@@ -78,23 +88,21 @@ pub(crate) fn flight_apexes(track: &Track) -> Option<Vec<(f64, f64)>> {
             .iter()
             .any(|w| name.contains(w))
     };
-    let mut foot = vec![false; n];
-    for i in 0..n {
-        // Walk up to the root: a point below a foot-named point is on the foot.
-        let mut j = Some(i);
-        let mut steps = 0;
-        while let Some(k) = j {
-            if named_foot(k) {
-                foot[i] = true;
-                break;
+    // A point is on a foot when it or a point above it is named like one.
+    let foot: Vec<bool> = (0..n)
+        .map(|i| {
+            let mut j = Some(i);
+            // At most n steps up: a cyclic figure is rejected before this, but never loops here.
+            for _ in 0..=n {
+                match j {
+                    Some(k) if named_foot(k) => return true,
+                    Some(k) => j = fig.parents[k],
+                    None => break,
+                }
             }
-            j = fig.parents[k];
-            steps += 1;
-            if steps > n {
-                break;
-            }
-        }
-    }
+            false
+        })
+        .collect();
     let proxy = track
         .frames
         .first()
