@@ -76,7 +76,10 @@ fn high_jump_rises_higher_and_flies_longer() {
     assert!((f.high.apex_above_standing_m - pred.apex_above_standing_m).abs() < 0.002);
     // The root extrapolated with the joints' γ: its apex over the floor is the blend of the
     // two jumps', and above the normal jump's.
-    assert!((f.high.apex_root_m - pred.apex_root_m).abs() < 0.002, "{f:?} {pred:?}");
+    assert!(
+        (f.high.apex_root_m - pred.apex_root_m).abs() < 0.002,
+        "{f:?} {pred:?}"
+    );
     assert!(f.high.apex_root_m > f.normal.apex_root_m + 0.015, "{f:?}");
     assert!(
         (f.high.flight_s - pred.flight_s).abs() < 0.015,

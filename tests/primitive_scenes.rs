@@ -173,7 +173,11 @@ fn check_kick(r: &serde_json::Value) {
         let lowest = f(r, &[k, "lowest_foot_above_floor_m"]);
         assert!(lowest > -1e-9, "{k}: a foot {lowest} m below the floor");
     }
-    assert!((0.0..0.01).contains(&f(r, &["floor_lift_m"])), "{}", r["floor_lift_m"]);
+    assert!(
+        (0.0..0.01).contains(&f(r, &["floor_lift_m"])),
+        "{}",
+        r["floor_lift_m"]
+    );
     let e = |k: &str| f(r, &["events_s", k]);
     assert!(
         e("start") < e("bend") && e("bend") < e("leap") && e("leap") < e("land"),
