@@ -125,24 +125,33 @@ mod tests {
     use super::*;
     use crate::render::Figure;
 
-    #[test]
-    fn a_figure_facing_plus_x_is_turned_to_face_plus_z() {
-        let fig = Figure {
+    /// A pelvis with its two hips.
+    fn hips() -> Figure {
+        Figure {
             names: vec!["pelvis".into(), "left_hip".into(), "right_hip".into()],
             parents: vec![None, Some(0), Some(0)],
-        };
+        }
+    }
+
+    fn track<'a>(fig: &'a Figure, frames: &'a [Vec<DVec3>]) -> Track<'a> {
+        Track {
+            figure: fig,
+            frames,
+            label: "t".into(),
+            frame_time: 0.1,
+        }
+    }
+
+    #[test]
+    fn a_figure_facing_plus_x_is_turned_to_face_plus_z() {
+        let fig = hips();
         // Facing +X: its left is −Z.
         let frames = vec![vec![
             DVec3::new(0.0, 1.0, 0.0),
             DVec3::new(0.0, 1.0, -0.1),
             DVec3::new(0.0, 1.0, 0.1),
         ]];
-        let t = Track {
-            figure: &fig,
-            frames: &frames,
-            label: "t".into(),
-            frame_time: 0.1,
-        };
+        let t = track(&fig, &frames);
         let q = facing_turn(&t);
         assert!((q * DVec3::X - DVec3::Z).length() < 1e-12);
         // Its left hip ends up on +X, the engine's left.
@@ -151,10 +160,7 @@ mod tests {
 
     #[test]
     fn each_frame_is_turned_by_its_own_facing_about_its_root() {
-        let fig = Figure {
-            names: vec!["pelvis".into(), "left_hip".into(), "right_hip".into()],
-            parents: vec![None, Some(0), Some(0)],
-        };
+        let fig = hips();
         // A figure at x = 2 that turns from facing +Z (left +X) to facing +X (left −Z) and on
         // to facing −Z (left −X): a half turn, mean facing +X.
         let at = |left: DVec3| {
@@ -162,12 +168,7 @@ mod tests {
             vec![c, c + 0.1 * left, c - 0.1 * left]
         };
         let frames = vec![at(DVec3::X), at(-DVec3::Z), at(-DVec3::X)];
-        let t = Track {
-            figure: &fig,
-            frames: &frames,
-            label: "t".into(),
-            frame_time: 0.1,
-        };
+        let t = track(&fig, &frames);
         let q = facing_turn(&t);
         let turned = turned_frames_each(std::slice::from_ref(&t));
         for (k, f) in turned[0].iter().enumerate() {
