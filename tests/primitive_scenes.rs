@@ -99,13 +99,20 @@ fn check_high_jump_follows(r: &serde_json::Value, gamma_at: &dyn Fn(f64) -> f64)
         "crouch {high_crouch:.2} vs γ-blend {crouch:.2} (γ = {gb})"
     );
     let apex = mix(ga, &["jumps", "x", "apex_above_standing_m"]);
+    let apex_root = mix(ga, &["jumps", "x", "apex_root_m"]);
     let flight = mix(ga, &["jumps", "x", "flight_s"]);
     assert!((pred("apex_above_standing_m") - apex).abs() < 1e-12);
+    assert!((pred("apex_root_m") - apex_root).abs() < 1e-12);
     assert!((pred("flight_s") - flight).abs() < 1e-12);
-    let high_apex = f(r, &["jumps", "high", "apex_above_standing_m"]);
+    // The root is extrapolated with the joints' γ: the high jump's root apex over the floor is
+    // the blend of the two jumps' (the flight plan scales the arc to it).
+    let high_apex = f(r, &["jumps", "high", "apex_root_m"]);
     assert!(
-        (high_apex - apex).abs() < 0.005,
-        "apex {high_apex:.4} m vs predicted {apex:.4} m"
+        (high_apex - apex_root).abs() < 0.005,
+        "root apex {high_apex:.4} m vs predicted {apex_root:.4} m"
+    );
+    assert!(
+        (f(r, &["high_minus_predicted", "apex_root_m"]) - (high_apex - apex_root)).abs() < 1e-12
     );
     for j in ["low", "normal", "high"] {
         let lowest = f(r, &["jumps", j, "lowest_foot_above_floor_m"]);
@@ -120,20 +127,18 @@ fn check_high_jump(r: &serde_json::Value) {
     assert_eq!(r["gamma"], "γ = −0.5");
     check_high_jump_follows(r, &|_| -0.5);
     let jump = |j: &str, k: &str| f(r, &["jumps", j, k]);
-    let (apex, normal_apex) = (
-        jump("high", "apex_above_standing_m"),
-        jump("normal", "apex_above_standing_m"),
-    );
-    assert!(
-        apex > normal_apex + 0.015,
-        "apex {apex} vs normal {normal_apex}"
-    );
+    // Higher than the normal jump both over the floor and above its own standing.
+    for k in ["apex_root_m", "apex_above_standing_m"] {
+        let (high, normal) = (jump("high", k), jump("normal", k));
+        assert!(high > normal + 0.015, "{k}: high {high} vs normal {normal}");
+    }
     let (flight, predicted) = (jump("high", "flight_s"), f(r, &["prediction", "flight_s"]));
     let normal_flight = jump("normal", "flight_s");
-    // Measured from foot contact on the model's rigid feet: within 10 % of the prediction (own
-    // clips: 0.383 s for 0.392 s predicted; CMU: 0.500 s for 0.458 s).
+    // Measured from foot contact on the model's rigid feet: within 15 % of the prediction (own
+    // clips: 0.383 s for 0.392 s predicted; CMU: 0.517 s for 0.458 s, the extrapolated legs
+    // tucked higher keeping the feet off the floor longer than the root's flight).
     assert!(
-        flight > normal_flight && (flight - predicted).abs() < 0.1 * predicted,
+        flight > normal_flight && (flight - predicted).abs() < 0.15 * predicted,
         "flight {flight} s vs predicted {predicted} s (normal {normal_flight} s)"
     );
 }
@@ -162,7 +167,17 @@ fn check_kick(r: &serde_json::Value) {
         f(r, &["jumping_knee_kick", "apex_above_standing_m"])
             > 0.9 * f(r, &["jump", "apex_above_standing_m"])
     );
-    assert!(f(r, &["jumping_knee_kick", "lowest_foot_above_floor_m"]) > -0.005);
+    // No foot below the floor anywhere, the landing's connection included; the floor
+    // constraint takes up only what the fits miss by.
+    for k in ["jump", "jumping_knee_kick"] {
+        let lowest = f(r, &[k, "lowest_foot_above_floor_m"]);
+        assert!(lowest > -1e-9, "{k}: a foot {lowest} m below the floor");
+    }
+    assert!(
+        (0.0..0.01).contains(&f(r, &["floor_lift_m"])),
+        "{}",
+        r["floor_lift_m"]
+    );
     let e = |k: &str| f(r, &["events_s", k]);
     assert!(
         e("start") < e("bend") && e("bend") < e("leap") && e("leap") < e("land"),

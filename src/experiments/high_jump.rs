@@ -3,20 +3,24 @@
 //! the blend `θ = γ·θ_A + (1 − γ)·θ_B` with constant γ = −0.5 gives `1.5·normal − 0.5·low`, a
 //! jump deeper than either demonstration.
 //!
-//! **The root.** The root channels (`root_ty` …) are blended with the joints, pointwise, as a
-//! user of DMP blending expects: the apex of A and B above standing does not change under
-//! time-scaling, so the blend's apex above standing is about `γ·apex_A + (1 − γ)·apex_B`, γ at
-//! the normal jump's apex. Time-scaling A to B's duration, however, gives both the same flight
-//! time, so a pointwise blend keeps the normal jump's flight however high it rises, which no
-//! ballistic flight does. So the blend's flight (the normal jump's, from foot contact) is
-//! stretched in time by what ballistics says the higher apex needs: from the same take-off and
-//! landing heights, a flight over the high apex takes `√(2h_up/g) + √(2h_down/g)` (gravity
-//! [`GRAVITY`]), longer than one over the normal apex by [`FlightPlan::extra_flight_s`]; the
-//! motion before take-off is unchanged, the landing comes that much later, and the root's arc
-//! is scaled to reach the predicted apex exactly (on the project's ballistic keyframed jumps the
-//! blend's own arc is within a few millimetres of it, and the stretched arc is again ballistic to
-//! within a few per cent; [`FlightPlan::arc_scale`] says how much was needed). Before
-//! that the root is raised or lowered so that the lowest foot point stands on the normal jump's
+//! **The root.** The root channels (`root_ty` …) are blended with the joints, pointwise, with
+//! the same γ, as a user of DMP blending expects: both jumps stand on one floor and the apex
+//! height does not change under time-scaling, so at the apex the blend's root is at about
+//! `γ·apex_A + (1 − γ)·apex_B`, the demonstrations' highest root heights over the floor, γ at
+//! the normal jump's apex ([`JumpPrediction::apex_root_m`]); the high jump is made to reach that
+//! height. (Its apex *above its own standing* is then higher still than `γ·` of the two jumps'
+//! apexes above standing wherever the extrapolated stance bends the knees more than the
+//! demonstrations' and so stands lower: both figures are reported.) Time-scaling A to B's
+//! duration, however, gives both the same flight time, so a pointwise blend keeps the normal
+//! jump's flight however high it rises, which no ballistic flight does. So the blend's flight
+//! (the normal jump's, from foot contact) is stretched in time by what ballistics says the
+//! higher apex needs: from the same take-off and landing heights, a flight over the high apex
+//! takes `√(2h_up/g) + √(2h_down/g)` (gravity [`GRAVITY`]), longer than one over the normal
+//! jump's apex by [`FlightPlan::extra_flight_s`]; the motion before take-off is unchanged, the
+//! landing comes that much later, and the root's arc is scaled to reach the predicted apex
+//! exactly ([`FlightPlan::arc_scale`] says how much was needed: on the project's keyframed
+//! jumps and on the CMU ones the blend's own arc is within a few per cent of it). Before that
+//! the root is raised or lowered so that the lowest foot point stands on the normal jump's
 //! floor outside the flight (blending joint angles and root height separately lifts or sinks the
 //! feet). The flight time this gives is compared with the blend of the demonstrations' own
 //! flight times, `γ·flight_A + (1 − γ)·flight_B` ([`JumpPrediction`]).
@@ -104,9 +108,14 @@ pub struct JumpPrediction {
     pub gamma_at_apex: f64,
     /// Left-knee crouch flexion: γ_bend·low + (1 − γ_bend)·normal, degrees.
     pub crouch_knee_flexion_deg: f64,
-    /// Root apex above standing: γ_apex·low + (1 − γ_apex)·normal, metres (the high jump is made
-    /// to reach it).
+    /// Root apex above standing: γ_apex·low + (1 − γ_apex)·normal, metres (compared with the
+    /// high jump's; its standing is that of the extrapolated stance, see `apex_root_m`).
     pub apex_above_standing_m: f64,
+    /// Root apex over the floor: γ_apex·low + (1 − γ_apex)·normal of the demonstrations' highest
+    /// root heights (both on the normal jump's floor), metres. The root channel is blended
+    /// pointwise with the same γ as the joints, so this is where the blend's root is at the
+    /// apex; the high jump is made to reach it.
+    pub apex_root_m: f64,
     /// Flight time of the demonstrations at their own durations blended: γ_apex·low +
     /// (1 − γ_apex)·normal, seconds (the high jump's own flight follows from its apex by
     /// ballistics and is compared with this).
@@ -125,10 +134,9 @@ pub struct FlightPlan {
     pub take_off_root_m: f64,
     /// See `take_off_root_m`.
     pub land_root_m: f64,
-    /// The normal jump's apex above standing, put on the blend's standing height, metres.
+    /// The normal jump's root apex over the floor, metres.
     pub normal_apex_root_m: f64,
-    /// The apex the high jump is to reach (the prediction on the blend's standing height),
-    /// metres.
+    /// The root apex the high jump is to reach ([`JumpPrediction::apex_root_m`]), metres.
     pub apex_root_m: f64,
     /// How much longer a ballistic flight over `apex_root_m` is than one over
     /// `normal_apex_root_m`, from the same take-off and landing heights, seconds.
@@ -282,6 +290,7 @@ pub fn learn_primitives(
             fl.apex_above_standing_m,
             fn_.apex_above_standing_m,
         ),
+        apex_root_m: mix(gamma_at_apex, fl.apex_root_m, fn_.apex_root_m),
         flight_s: mix(gamma_at_apex, fl.flight_s, fn_.flight_s),
     };
 
@@ -304,13 +313,12 @@ pub fn learn_primitives(
     let mut blended = on_model(model, &result.trajectory)?;
     let (take_off, land) = feet_leave_and_touch(&normal_clip, normal_flight, floor);
     let ground_correction_m = blended.keep_feet_on_floor(&[(take_off, land)], floor);
-    let standing = jump_figures(&blended, floor).standing_root_m;
     let (high_clip, flight) = lengthen_flight(
         &blended,
         take_off,
         land,
-        standing + prediction.apex_above_standing_m,
-        standing + fn_.apex_above_standing_m,
+        prediction.apex_root_m,
+        fn_.apex_root_m,
     )?;
     let high = Primitive::learn("high_jump", &high_clip.to_trajectory(), &config.learn)?;
     Ok(HighJumpPrimitives {

@@ -14,7 +14,10 @@
 //! floor before take-off (the correction fading to zero at Leap, the apex), and after the
 //! connection the "land" part is learned again from the landing as it is played (the
 //! connection's pull from the kick posture back onto the jump's course) with the feet on the
-//! floor from Land on, so that the figure lands without sinking.
+//! floor from Land on, so that the figure lands without sinking. What the parts' DMP fits and
+//! the connection still miss by (millimetres) is taken up by the floor constraint on the
+//! connected motion ([`ModelClip::lift_above_floor`], as on the high jump's rollouts): no foot
+//! goes below the floor.
 //!
 //! [`run`] returns the primitives, the played motions and the paper's checks: the postures at
 //! Bend and Leap, the jumps at the junction, the figure airborne at Leap and both feet down
@@ -96,7 +99,7 @@ pub struct KneeKickOutcome {
     pub jump: HighJumpPrimitives,
     /// A played over its duration.
     pub jump_rollout: Trajectory,
-    /// A as a clip on the model.
+    /// A as a clip on the model, lifted where a foot went below the floor.
     pub jump_clip: ModelClip,
     /// A's events (Start, Bend, take-off, Leap, Land), seconds, found on `jump_clip`.
     pub events: JumpEvents,
@@ -115,8 +118,12 @@ pub struct KneeKickOutcome {
     pub parts: [Learned; 2],
     /// The two parts connected, sampled at `jump.dt`.
     pub connected: Connected,
-    /// The connected motion as a clip on the model.
+    /// The connected motion as a clip on the model, lifted where a foot of it went below the
+    /// floor ([`ModelClip::lift_above_floor`]; `connected` is the motion as the primitives play
+    /// it, before the lift).
     pub result_clip: ModelClip,
+    /// The largest lift that put `result_clip`'s feet on or above the floor, metres.
+    pub floor_lift_m: f64,
     /// The jumps at the junction.
     pub junction: JunctionFigures,
     /// The result's posture at Bend and at Leap against A's and the kick's.
@@ -166,7 +173,9 @@ pub fn run(config: &KneeKickConfig) -> Result<KneeKickOutcome, PrimitiveExperime
     let floor = jump.floor_y_m;
     let a = &jump.learned.high.primitive;
     let jump_rollout = rollout(a, dt)?;
-    let jump_clip = on_model(model, &jump_rollout)?;
+    let mut jump_clip = on_model(model, &jump_rollout)?;
+    // The floor constraint on the rollout, as the high jump's own clips have it.
+    jump_clip.lift_above_floor(floor);
     let (root_y, feet) = heights(&jump_clip);
     let ev = find_jump_events(&root_y, dt, Some(&feet), &config.events)?;
     let jump_fig = jump_figures(&jump_clip, floor);
@@ -253,7 +262,11 @@ pub fn run(config: &KneeKickConfig) -> Result<KneeKickOutcome, PrimitiveExperime
         max_angle_jump_deg: junction.map_or(0.0, |j| j.max_angle_jump.to_degrees()),
         max_velocity_jump_deg_s: junction.map_or(0.0, |j| j.max_velocity_jump.to_degrees()),
     };
-    let result_clip = on_model(model, &connected.trajectory)?;
+    // The floor constraint on the connected motion: the parts' DMP fits and the connection's
+    // pull reproduce the landing to within millimetres, which puts a foot that far through the
+    // floor; the root is lifted by the depth where it is.
+    let mut result_clip = on_model(model, &connected.trajectory)?;
+    let floor_lift_m = result_clip.lift_above_floor(floor);
 
     // Checks of the paper's figure: the jump's posture at Bend, the kick's at Leap, in the air at
     // Leap, both feet down after landing.
@@ -310,6 +323,7 @@ pub fn run(config: &KneeKickConfig) -> Result<KneeKickOutcome, PrimitiveExperime
         parts,
         connected,
         result_clip,
+        floor_lift_m,
         junction,
         posture_gap_deg,
         feet_above_floor_after_landing_m: feet_after_landing,

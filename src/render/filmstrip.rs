@@ -9,9 +9,11 @@ use super::canvas::{
     INK, Style, WHITE, blit, draw_figure, draw_key, encode_png, key_width, new_pixmap,
     panel_background, sheet_size,
 };
-use super::figure::{Track, validate_tracks};
+use super::figure::{Side, Track, validate_tracks};
 use super::text::{Align, Pen, ascent, draw_text, font};
 use super::{RenderError, require_extension, write};
+use crate::analysis::{ContactConfig, ground_contacts};
+use glam::DVec3;
 
 /// Height of each cell (pixels).
 const CELL_HEIGHT: u32 = 220;
@@ -28,14 +30,126 @@ pub fn filmstrip_png(tracks: &[Track], n: usize, path: &Path) -> Result<(), Rend
 /// Share of the column spacing given to elapsed time; the rest follows the motion.
 const TIME_SHARE: f64 = 0.25;
 
-/// The instants of a filmstrip of `n` columns: spread evenly in a blend of elapsed time and
-/// distance travelled. With D(t) the distance all points of all tracks have travelled up to t
+/// The instants of a filmstrip of (at least) `n` columns, chosen by the motion of the first
+/// track: a column at the apex of every flight it has ([`flight_apexes`]: both feet and the
+/// body off the floor, the root highest), the others spread by distance travelled
+/// ([`spread_times`], the first at t = 0 and the last at the end; each apex takes the place of
+/// the spread column nearest to it). There are `n` columns, or more when the flights need them:
+/// `flights + 2`, at most [`MAX_COLUMNS`] (then the flights with the highest apexes are kept). A figure without feet has no flights found: its inner
+/// columns move to a root apex near them instead ([`snap_to_apexes`]).
+pub(crate) fn column_times(tracks: &[Track], n: usize) -> Vec<f64> {
+    if n == 1 {
+        return spread_times(tracks, 1);
+    }
+    let Some(mut apexes) = flight_apexes(&tracks[0]) else {
+        let mut times = spread_times(tracks, n);
+        snap_to_apexes(&tracks[0], &mut times);
+        return times;
+    };
+    if apexes.len() + 2 > MAX_COLUMNS {
+        let y = |&(_, h): &(f64, f64)| h;
+        apexes.sort_by(|a, b| y(b).total_cmp(&y(a)));
+        apexes.truncate(MAX_COLUMNS - 2);
+        apexes.sort_by(|a, b| a.0.total_cmp(&b.0));
+    }
+    // Each apex replaces the spread inner column nearest to it, so none lands beside another.
+    let mut times = spread_times(tracks, n.max(apexes.len() + 2));
+    let last = times.len() - 1;
+    let mut free: Vec<usize> = (1..last).collect();
+    for &(t, _) in &apexes {
+        let Some(i) = (0..free.len()).min_by(|&a, &b| {
+            (times[free[a]] - t)
+                .abs()
+                .total_cmp(&(times[free[b]] - t).abs())
+        }) else {
+            break;
+        };
+        times[free.swap_remove(i)] = t;
+    }
+    times.sort_by(f64::total_cmp);
+    times
+}
+
+/// Most columns a filmstrip gets to show every flight.
+pub(crate) const MAX_COLUMNS: usize = 64;
+
+/// The flights of `track` and the instant of each one's apex: `(t, root height)` at the frame
+/// of the root's highest point within each flight found by [`ground_contacts`] (default
+/// settings) on its points: the foot points are those named like a foot (`foot`, `toe`,
+/// `ankle`, `heel`, see [`super::side_from_name`]) and every point below them, by side; every
+/// other point but a ground-proxy root is the body. `None` when a side has no foot point.
+pub(crate) fn flight_apexes(track: &Track) -> Option<Vec<(f64, f64)>> {
+    let fig = track.figure;
+    let sides = fig.sides();
+    let n = fig.names.len();
+    let named_foot = |i: usize| {
+        let name = fig.names[i].to_lowercase();
+        ["foot", "toe", "ankle", "heel"]
+            .iter()
+            .any(|w| name.contains(w))
+    };
+    // A point is on a foot when it or a point above it is named like one.
+    let foot: Vec<bool> = (0..n)
+        .map(|i| {
+            let mut j = Some(i);
+            // At most n steps up: a cyclic figure is rejected before this, but never loops here.
+            for _ in 0..=n {
+                match j {
+                    Some(k) if named_foot(k) => return true,
+                    Some(k) => j = fig.parents[k],
+                    None => break,
+                }
+            }
+            false
+        })
+        .collect();
+    let proxy = track
+        .frames
+        .first()
+        .and_then(|f| super::canvas::ground_proxy(fig, f));
+    let pick = |want: &dyn Fn(usize) -> bool| -> Vec<Vec<DVec3>> {
+        let idx: Vec<usize> = (0..n).filter(|&i| want(i)).collect();
+        track
+            .frames
+            .iter()
+            .map(|f| idx.iter().map(|&i| f[i]).collect())
+            .collect()
+    };
+    let left = pick(&|i| foot[i] && sides[i] == Side::Left);
+    let right = pick(&|i| foot[i] && sides[i] == Side::Right);
+    if left.first().is_none_or(Vec::is_empty) || right.first().is_none_or(Vec::is_empty) {
+        return None;
+    }
+    let body = pick(&|i| !foot[i] && Some(i) != proxy);
+    let contacts = ground_contacts(
+        &left,
+        &right,
+        &body,
+        track.frame_time,
+        &ContactConfig::default(),
+    );
+    let root = fig.root();
+    Some(
+        contacts
+            .flights
+            .iter()
+            .map(|fl| {
+                let (a, b) = (track.frame_at(fl.start_s), track.frame_at(fl.end_s));
+                let top = (a..=b.max(a))
+                    .max_by(|&p, &q| track.frames[p][root].y.total_cmp(&track.frames[q][root].y))
+                    .unwrap_or(a);
+                (top as f64 * track.frame_time, track.frames[top][root].y)
+            })
+            .collect(),
+    )
+}
+
+/// `n` instants spread evenly in a blend of elapsed time and distance travelled. With D(t) the distance all points of all tracks have travelled up to t
 /// (summed over frames at the finest frame time) and T the longest duration, the progress
 /// u(t) = s·t/T + (1 − s)·D(t)/D(T), s = [`TIME_SHARE`]; column j is at the first t with
-/// u(t) ≥ j/(n − 1), so the first column is t = 0 and the last t = T; inner columns then move
-/// to a jump's apex near them ([`snap_to_apexes`]). A motion that does not move is spread
-/// evenly in time; just t = 0 when n = 1.
-pub(crate) fn column_times(tracks: &[Track], n: usize) -> Vec<f64> {
+/// u(t) ≥ j/(n − 1), so the first column is t = 0 and the last t = T. A motion that does not
+/// move is spread evenly in time; just t = 0 when n = 1.
+fn spread_times(tracks: &[Track], n: usize) -> Vec<f64> {
     let duration = tracks.iter().map(Track::duration).fold(0.0, f64::max);
     if n == 1 {
         return vec![0.0];
@@ -81,7 +195,7 @@ pub(crate) fn column_times(tracks: &[Track], n: usize) -> Vec<f64> {
         share * time + (1.0 - share) * moved
     };
     let mut k = 0;
-    let mut times: Vec<f64> = (0..n)
+    (0..n)
         .map(|j| {
             let goal = j as f64 / (n - 1) as f64;
             while k < steps && progress(k) < goal - 1e-12 {
@@ -93,9 +207,7 @@ pub(crate) fn column_times(tracks: &[Track], n: usize) -> Vec<f64> {
                 (k as f64 * dt).min(duration)
             }
         })
-        .collect();
-    snap_to_apexes(&tracks[0], &mut times);
-    times
+        .collect()
 }
 
 /// Moves each inner column to the apex of a jump near it: to the highest root of the first
@@ -128,9 +240,10 @@ fn snap_to_apexes(track: &Track, times: &mut [f64]) {
 const APEX_RISE: f64 = 0.08;
 
 /// Draws `n` instants of every track as a PNG at `path`, one row per track (its label above
-/// it), in `view`, each figure turned to face +Z (see [`super::facing`]). Columns share one time
-/// t_j chosen by motion ([`column_times`]: a jump gets more columns than standing still),
-/// written above each column; a shorter track holds its last frame. All cells
+/// it), in `view`, each frame's figure turned to face +Z by its own facing (see
+/// [`super::facing`]). Columns share one time t_j chosen by motion ([`column_times`]: a column at
+/// every flight's apex of the first track, the rest spread by distance travelled; more than `n`
+/// when the flights need them), written above each column; a shorter track holds its last frame. All cells
 /// share one scale and one framing of the whole motion, so positions compare across the page;
 /// a motion that travels further than a cell shows follows the root, with floor ticks every
 /// 0.5 m. Footer: 1 m scale bar and left/right colour key.
@@ -155,7 +268,7 @@ pub fn filmstrip_view_png(
 }
 
 /// Draws `tracks` at the given instants (seconds), each column headed by its label, in `view`,
-/// each figure turned to face +Z; otherwise as [`filmstrip_view_png`] (one scale and framing
+/// each frame turned to face +Z; otherwise as [`filmstrip_view_png`] (one scale and framing
 /// for every cell, 1 m scale bar and colour key below). Used where the instants mean something
 /// (a bar of a dance per column).
 pub fn filmstrip_at_png(
@@ -185,7 +298,7 @@ fn draw_facing(
     path: &Path,
     columns: impl FnOnce(&[Track]) -> (Vec<f64>, Vec<String>),
 ) -> Result<(), RenderError> {
-    let turned = super::facing::turned_frames(tracks);
+    let turned = super::facing::turned_frames_each(tracks);
     let turned_tracks = super::facing::with_frames(tracks, &turned);
     let tracks = &turned_tracks[..];
     let (mpp, pad) = scale_for(tracks, CELL_HEIGHT);
@@ -298,6 +411,83 @@ mod tests {
             label: "t".into(),
             frame_time: 0.1,
         }
+    }
+
+    #[test]
+    fn every_flight_gets_a_column_at_its_apex() {
+        // A figure standing on two feet (ankles 0.08 m up, toes on the floor) that jumps 0.5 m
+        // forward three times, ballistic flights 1.0–1.4 s, 2.2–2.5 s and 3.3–3.8 s.
+        let fig = Figure {
+            names: [
+                "pelvis",
+                "left_ankle",
+                "left_toe",
+                "right_ankle",
+                "right_toe",
+                "head",
+            ]
+            .map(String::from)
+            .to_vec(),
+            parents: vec![None, Some(0), Some(1), Some(0), Some(3), Some(0)],
+        };
+        let flights = [(1.0, 1.4), (2.2, 2.5), (3.3, 3.8)];
+        let dt = 0.01;
+        let frames: Vec<Vec<DVec3>> = (0..=450)
+            .map(|k| {
+                let t = k as f64 * dt;
+                let lift: f64 = flights
+                    .iter()
+                    .map(|&(a, b)| {
+                        if t > a && t < b {
+                            4.9 * (t - a) * (b - t)
+                        } else {
+                            0.0
+                        }
+                    })
+                    .sum();
+                let x: f64 = flights
+                    .iter()
+                    .map(|&(a, b)| 0.5 * ((t - a) / (b - a)).clamp(0.0, 1.0))
+                    .sum();
+                vec![
+                    DVec3::new(x, 0.95 + lift, 0.0),
+                    DVec3::new(x + 0.1, 0.08 + lift, 0.0),
+                    DVec3::new(x + 0.1, lift, 0.15),
+                    DVec3::new(x - 0.1, 0.08 + lift, 0.0),
+                    DVec3::new(x - 0.1, lift, 0.15),
+                    DVec3::new(x, 1.6 + lift, 0.0),
+                ]
+            })
+            .collect();
+        let tr = Track {
+            figure: &fig,
+            frames: &frames,
+            label: "t".into(),
+            frame_time: dt,
+        };
+        let apexes = flight_apexes(&tr).unwrap();
+        assert_eq!(apexes.len(), 3, "{apexes:?}");
+        // Fewer columns asked than flights: every apex still gets one, with the clip's ends.
+        for n in [2, 4, 8] {
+            let times = column_times(std::slice::from_ref(&tr), n);
+            for &(a, b) in &flights {
+                let apex = 0.5 * (a + b);
+                assert!(
+                    times.iter().any(|t| (t - apex).abs() < dt + 1e-9),
+                    "n = {n}: no column at the apex {apex} s: {times:?}"
+                );
+            }
+            assert_eq!(times.len(), n.max(5), "{times:?}");
+            assert_eq!((times[0], *times.last().unwrap()), (0.0, 4.5));
+            assert!(times.windows(2).all(|w| w[0] < w[1]), "{times:?}");
+        }
+        // Standing still is not a flight.
+        let still = vec![frames[0].clone(); 200];
+        let tr = Track {
+            frames: &still,
+            ..tr
+        };
+        assert_eq!(flight_apexes(&tr).unwrap(), vec![]);
     }
 
     #[test]

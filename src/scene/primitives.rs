@@ -255,6 +255,7 @@ pub fn run_high_jump(
         "prediction": pred,
         "high_minus_predicted": {
             "apex_above_standing_m": fig.high.apex_above_standing_m - pred.apex_above_standing_m,
+            "apex_root_m": fig.high.apex_root_m - pred.apex_root_m,
             "flight_s": fig.high.flight_s - pred.flight_s,
         },
         "flight_plan": plan,
@@ -345,7 +346,9 @@ pub fn run_jumping_knee_kick(
     let model = Model::by_name("humanoid24")?;
     let config = knee_kick_config(scene, base)?;
     let kk = knee_kick::run(&config).map_err(SceneError::from)?;
-    let ecs_gap = play_in_world(&model, &kk.sequence(), &kk.result_clip)?;
+    // The world plays the primitives, so it is compared with the motion before the floor lift.
+    let played = ModelClip::from_trajectory(&model, &kk.connected.trajectory)?;
+    let ecs_gap = play_in_world(&model, &kk.sequence(), &played)?;
     let ev = &kk.events;
 
     write_bvh(&out.join("jumping_knee_kick.bvh"), &kk.result_clip)?;
@@ -404,6 +407,7 @@ pub fn run_jumping_knee_kick(
         },
         "ground_correction_m": kk.ground_correction_m,
         "landing_correction_m": kk.landing_correction_m,
+        "floor_lift_m": kk.floor_lift_m,
         "events_s": events_json(ev),
         "arrangement": format!("{:?}", kk.arrangement),
         "junction": { "time_s": j.time_s, "max_angle_jump_deg": j.max_angle_jump_deg, "max_velocity_jump_deg_s": j.max_velocity_jump_deg_s },
