@@ -121,7 +121,7 @@ pub(crate) fn with_frames<'a>(
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::render::Figure;
 
@@ -133,7 +133,8 @@ mod tests {
         }
     }
 
-    fn track<'a>(fig: &'a Figure, frames: &'a [Vec<DVec3>]) -> Track<'a> {
+    /// A track of `frames` at 10 frames/s (shared with the filmstrip tests).
+    pub(crate) fn track<'a>(fig: &'a Figure, frames: &'a [Vec<DVec3>]) -> Track<'a> {
         Track {
             figure: fig,
             frames,

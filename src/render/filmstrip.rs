@@ -402,16 +402,8 @@ mod tests {
     use super::*;
 
     use crate::render::Figure;
+    use crate::render::facing::tests::track;
     use glam::DVec3;
-
-    fn track<'a>(fig: &'a Figure, frames: &'a [Vec<DVec3>]) -> Track<'a> {
-        Track {
-            figure: fig,
-            frames,
-            label: "t".into(),
-            frame_time: 0.1,
-        }
-    }
 
     #[test]
     fn every_flight_gets_a_column_at_its_apex() {
