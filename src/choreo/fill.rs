@@ -11,10 +11,12 @@
 //! [`fill`] runs Dijkstra's algorithm on it (a binary heap, lazy deletion) with the consistent
 //! potential h(k) = Σ_{j ≥ k} m_j, m_j the smallest weight between layers j and j+1, so that
 //! nodes are settled in the order of d + h (Dijkstra on the reduced weights w − m_j ≥ 0, A*);
-//! [`fill_dp`] is the exact dynamic programme D_{k+1}(b) = min_a D_k(a) + C(a → b): column by
-//! column (in parallel with rayon) it takes the rows a in ascending C(a → b), from the table's
-//! sorted column prefixes, and stops once min_a' D_k(a') + C(a → b) exceeds the best sum found;
-//! the predecessors are recovered afterwards from the stored D_k. Both break ties the same way (at every node the
+//! [`fill_dp`] is the exact dynamic programme D_{k+1}(b) = min_a D_k(a) + C(a → b): each
+//! D_{k+1}(b) is a minimum over the table's column b (contiguous in the table's column copy),
+//! the columns in parallel with rayon, each minimum vectorised (the same IEEE sums at any
+//! vector width, and a minimum does not depend on the order it is taken in, so the same bits on
+//! any machine and thread count); the predecessors are recovered afterwards from the stored
+//! D_k. Both break ties the same way (at every node the
 //! predecessor of smallest index among those of equal sum, and the end of smallest index among
 //! equal totals), so they return the same path.
 
@@ -358,16 +360,6 @@ impl<'a> Graph<'a> {
     fn dp(&self) -> Option<Vec<usize>> {
         let (n, bars) = (self.table.n, self.bars);
         let t = self.table;
-        // Column minima of the table (without the diagonal under no-repeat), for the bound.
-        let mut colmin = vec![f64::INFINITY; n];
-        for a in 0..n {
-            for (b, (m, &c)) in colmin.iter_mut().zip(t.row(a)).enumerate() {
-                let c = f64::from(c);
-                if (a != b || !self.no_repeat) && c < *m {
-                    *m = c;
-                }
-            }
-        }
         // D_k(s) of every layer, row-major: the backtrack recovers the predecessors.
         let mut dist = vec![f64::INFINITY; n * bars];
         for (s, d) in dist[..n].iter_mut().enumerate() {
@@ -375,20 +367,12 @@ impl<'a> Graph<'a> {
                 *d = 0.0;
             }
         }
-        let mut order: Vec<usize> = Vec::with_capacity(n);
         for k in 0..bars - 1 {
             let (done, rest) = dist.split_at_mut((k + 1) * n);
             let d = &done[k * n..];
             let next = &mut rest[..n];
             match (self.pin[k], self.pin[k + 1]) {
-                (_, Some(b)) => {
-                    for (a, &da) in d.iter().enumerate() {
-                        let c = da + t.cost(a, b);
-                        if c < next[b] && self.edge(k, a, b) {
-                            next[b] = c;
-                        }
-                    }
-                }
+                (_, Some(b)) => next[b] = self.column_min(k, d, b),
                 (Some(a), None) => {
                     let row = t.row(a);
                     for (b, nb) in next.iter_mut().enumerate() {
@@ -398,15 +382,13 @@ impl<'a> Graph<'a> {
                     }
                 }
                 (None, None) => {
-                    order.clear();
-                    order.extend((0..n).filter(|&a| d[a].is_finite()));
-                    order.sort_by(|&x, &y| d[x].total_cmp(&d[y]).then(x.cmp(&y)));
                     use rayon::prelude::*;
-                    next.par_chunks_mut(SWEEP_COLUMNS)
-                        .zip(colmin.par_chunks(SWEEP_COLUMNS))
+                    next.par_chunks_mut(DP_COLUMNS)
                         .enumerate()
-                        .for_each(|(c, (out, cm))| {
-                            self.sweep(d, &order, c * SWEEP_COLUMNS, out, cm)
+                        .for_each(|(c, out)| {
+                            for (j, o) in out.iter_mut().enumerate() {
+                                *o = self.column_min(k, d, c * DP_COLUMNS + j);
+                            }
                         });
                 }
             }
@@ -425,9 +407,10 @@ impl<'a> Graph<'a> {
         for k in (1..bars).rev() {
             let target = dist[k * n + s];
             let d = &dist[(k - 1) * n..k * n];
+            let col = t.column(s);
             s = (0..n)
                 .find(|&a| {
-                    d[a].is_finite() && self.edge(k - 1, a, s) && d[a] + t.cost(a, s) == target
+                    d[a].is_finite() && self.edge(k - 1, a, s) && d[a] + f64::from(col[a]) == target
                 })
                 .expect("a finite D has a predecessor that gives it");
             path[k - 1] = s;
@@ -435,60 +418,62 @@ impl<'a> Graph<'a> {
         Some(path)
     }
 
-    /// One unpinned layer's columns `lo .. lo + out.len()`: out(b) = min_a D(a) + C(a → b) over
-    /// the rows a in ascending D, stopping once D(a) + colmin(b) > out(b) for every column of
-    /// the block (rounding is monotone, so no later row can lower any of them).
-    fn sweep(&self, d: &[f64], order: &[usize], lo: usize, out: &mut [f64], colmin: &[f64]) {
-        let hi = lo + out.len();
-        for (i, &a) in order.iter().enumerate() {
-            let da = d[a];
-            if i % 8 == 0 && !out.iter().zip(colmin).any(|(&o, &m)| da + m <= o) {
-                break;
-            }
-            let row = &self.table.row(a)[lo..hi];
-            if self.no_repeat && (lo..hi).contains(&a) {
-                let j = a - lo;
-                relax(&mut out[..j], &row[..j], da);
-                relax(&mut out[j + 1..], &row[j + 1..], da);
-            } else {
-                relax(out, row, da);
-            }
+    /// D_{k+1}(b) = min_a D_k(a) + C(a → b) over the edges into b (+∞ without one).
+    fn column_min(&self, k: usize, d: &[f64], b: usize) -> f64 {
+        let col = self.table.column(b);
+        if self.edge(k, b, b) {
+            min_plus(d, col)
+        } else {
+            min_plus(&d[..b], &col[..b]).min(min_plus(&d[b + 1..], &col[b + 1..]))
         }
     }
 }
 
-/// Columns per block of the DP's sweep (one rayon task; 1 KiB of each row).
-const SWEEP_COLUMNS: usize = 256;
+/// Columns per rayon task of the DP (each a minimum over a whole column).
+const DP_COLUMNS: usize = 32;
 
-/// out(b) = min(out(b), da + row(b)) for every b, with AVX2 where the processor has it (the
-/// same IEEE additions and comparisons at any vector width, so the same bits).
+/// min_a d(a) + c(a) (+∞ when empty), with AVX2 where the processor has it.
 #[inline]
-fn relax(out: &mut [f64], row: &[f32], da: f64) {
+fn min_plus(d: &[f64], c: &[f32]) -> f64 {
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") {
         // SAFETY: the processor supports AVX2 (checked just above).
-        unsafe { relax_avx2(out, row, da) };
-        return;
+        return unsafe { min_plus_avx2(d, c) };
     }
-    relax_plain(out, row, da);
+    min_plus_plain(d, c)
 }
 
-/// [`relax`] compiled for AVX2.
+/// [`min_plus`] compiled for AVX2.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-unsafe fn relax_avx2(out: &mut [f64], row: &[f32], da: f64) {
-    relax_plain(out, row, da);
+unsafe fn min_plus_avx2(d: &[f64], c: &[f32]) -> f64 {
+    min_plus_plain(d, c)
 }
 
-/// [`relax`] as a plain loop the compiler vectorises.
+/// Lanes of [`min_plus_plain`]'s independent minima (four vectors of four doubles).
+const LANES: usize = 16;
+
+/// [`min_plus`] as plain loops the compiler vectorises: [`LANES`] running minima, then their
+/// minimum. Every sum is the IEEE sum d(a) + c(a) widened, and a minimum of such sums is the
+/// same whatever the order, so the result is bit for bit the sequential one. No NaN reaches
+/// here (D and C are finite or +∞).
 #[inline(always)]
-fn relax_plain(out: &mut [f64], row: &[f32], da: f64) {
-    for (o, &c) in out.iter_mut().zip(row) {
-        let v = da + f64::from(c);
-        // A minimum, not a conditional store (masked stores are slow on some processors);
-        // no NaN reaches here (D and C are finite or +∞).
-        *o = o.min(v);
+fn min_plus_plain(d: &[f64], c: &[f32]) -> f64 {
+    let mut acc = [f64::INFINITY; LANES];
+    let (dc, cc) = (d.chunks_exact(LANES), c.chunks_exact(LANES));
+    let (dr, cr) = (dc.remainder(), cc.remainder());
+    for (x, y) in dc.zip(cc) {
+        for i in 0..LANES {
+            let v = x[i] + f64::from(y[i]);
+            acc[i] = if v < acc[i] { v } else { acc[i] };
+        }
     }
+    let mut m = f64::INFINITY;
+    for (&x, &y) in dr.iter().zip(cr) {
+        let v = x + f64::from(y);
+        m = if v < m { v } else { m };
+    }
+    acc.iter().fold(m, |m, &a| if a < m { a } else { m })
 }
 
 /// A heap entry of Dijkstra: d + h, then the layer, then the segment, smallest first.
@@ -532,19 +517,7 @@ mod tests {
                 None => rng.random_range(0.05..2.0),
             })
             .collect();
-        let wide = |i: usize| f64::from(cost[i]);
-        let min_cost = (0..n * n).map(wide).fold(f64::INFINITY, f64::min);
-        let min_cost_off_diagonal = (0..n * n)
-            .filter(|i| i / n != i % n)
-            .map(wide)
-            .fold(f64::INFINITY, f64::min);
-        TransitionTable {
-            n,
-            beta_sum: 1.0,
-            cost,
-            min_cost,
-            min_cost_off_diagonal,
-        }
+        TransitionTable::from_costs(n, 1.0, cost)
     }
 
     /// Every path by brute force: the cheapest total, and the paths reaching it.
@@ -632,8 +605,9 @@ mod tests {
 
     #[test]
     fn several_column_blocks_agree() {
-        // Three blocks of the DP's sweep, the last one partial, with ties and without.
-        let n = 2 * SWEEP_COLUMNS + 44;
+        // Three rayon tasks of the DP, the last one partial, columns not a multiple of the
+        // vector lanes, with ties and without.
+        let n = 2 * DP_COLUMNS + 3 * LANES + 5;
         for (seed, levels) in [(1, Some(2)), (2, None), (3, Some(1))] {
             let table = random_table(n, seed, levels);
             let pins = Pins::from([(3, 7), (4, 7), (9, n - 1)]);
