@@ -4,16 +4,16 @@
 //! of generated dance clips grown the same way. Four pins at bars 5, 21, 40 and 58.
 //!
 //! - `transition_table_2000`: every connection C(a → b) of the 2,000 × 2,000 pairs (rayon);
-//! - `fill_64x2000`: [`fill`] as the API gives it, Dijkstra, the table built inside;
-//! - `fill_with_table_64x2000` / `fill_dp_with_table_64x2000`: Dijkstra / the exact DP on a
-//!   prepared table (an editor builds the table once per database).
+//! - `fill_64x2000`: [`fill`] as the API gives it, the table built inside, then the exact DP;
+//! - `fill_with_table_64x2000` / `fill_dijkstra_with_table_64x2000`: the exact DP / Dijkstra on
+//!   a prepared table (an editor builds the table once per database).
 
 use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use marionette::choreo::augment::augment;
 use marionette::choreo::database::{BuildParams, Database, Manifest};
-use marionette::choreo::fill::{FillParams, Pins, fill, fill_dp_with_table, fill_with_table};
+use marionette::choreo::fill::{FillParams, Pins, fill, fill_dijkstra_with_table, fill_with_table};
 use marionette::choreo::transition::TransitionTable;
 use marionette::experiments::dance_fill::generated_database;
 
@@ -43,8 +43,8 @@ fn bench(c: &mut Criterion) {
     let n = db.segments.len();
     let pins = Pins::from([(5, 17 % n), (21, 901 % n), (40, 1402 % n), (58, 3 % n)]);
     let table = TransitionTable::new(&db, &p.transition).unwrap();
-    let a = fill_with_table(&db, &table, 64, &pins, &p).unwrap();
-    let b = fill_dp_with_table(&db, &table, 64, &pins, &p).unwrap();
+    let a = fill_dijkstra_with_table(&db, &table, 64, &pins, &p).unwrap();
+    let b = fill_with_table(&db, &table, 64, &pins, &p).unwrap();
     assert_eq!(a, b, "Dijkstra and the DP agree");
     eprintln!("64 bars: total cost {:.4}", a.total_cost);
     let mut g = c.benchmark_group("choreo_fill");
@@ -58,8 +58,8 @@ fn bench(c: &mut Criterion) {
     g.bench_function("fill_with_table_64x2000", |bch| {
         bch.iter(|| black_box(fill_with_table(&db, &table, 64, &pins, &p).unwrap()))
     });
-    g.bench_function("fill_dp_with_table_64x2000", |bch| {
-        bch.iter(|| black_box(fill_dp_with_table(&db, &table, 64, &pins, &p).unwrap()))
+    g.bench_function("fill_dijkstra_with_table_64x2000", |bch| {
+        bch.iter(|| black_box(fill_dijkstra_with_table(&db, &table, 64, &pins, &p).unwrap()))
     });
     g.finish();
 }

@@ -8,7 +8,7 @@ mod common;
 
 use marionette::choreo::dance::{DanceParams, assemble};
 use marionette::choreo::database::{BuildParams, Database, Manifest};
-use marionette::choreo::fill::{FillParams, Pins, fill, fill_dp};
+use marionette::choreo::fill::{FillParams, Pins, fill, fill_dijkstra};
 use marionette::choreo::metrics::dance_metrics;
 use marionette::choreo::music::Bar;
 use marionette::experiments::dance_fill::{
@@ -72,7 +72,7 @@ fn a_fill_keeps_its_pins_and_assembles_into_a_dance_as_long_as_its_bars() {
     let p = FillParams::default();
     let pins = Pins::from([(2, 7), (3, 8), (9, n - 1), (13, 0)]);
     let f = fill(&db, 16, &pins, &p).unwrap();
-    assert_eq!(f, fill_dp(&db, 16, &pins, &p).unwrap());
+    assert_eq!(f, fill_dijkstra(&db, 16, &pins, &p).unwrap());
     assert_eq!(f.segments.len(), 16);
     assert_eq!(f.connections.len(), 15);
     for (&bar, &s) in &pins {

@@ -16,7 +16,7 @@ use std::sync::{Arc, OnceLock};
 use serde::{Deserialize, Serialize};
 
 use super::database::Database;
-use super::fill::{Fill, FillError, FillParams, fill_dp_with_table};
+use super::fill::{Fill, FillError, FillParams, fill_with_table};
 use super::music::Bar;
 use super::relevance::music_intensity;
 use super::search::{BarSearch, SearchError, SearchIndex, SearchParams};
@@ -386,8 +386,8 @@ impl Edit {
     }
 
     /// The paper's Generate: every unpinned bar filled through the pins by the minimum-cost
-    /// path (the exact dynamic programme of [`super::fill::fill_dp`], which gives the same path
-    /// as Dijkstra and is several times faster on a large database, on the database's
+    /// path (the exact dynamic programme of [`super::fill::fill`], which gives the same path
+    /// as Dijkstra and is many times faster on a large database, on the database's
     /// transition table, built at the first call and kept). The pins are honoured exactly.
     pub fn generate(&self) -> Result<Fill, EditError> {
         let table = match self.table.get() {
@@ -397,7 +397,7 @@ impl Edit {
                 self.table.get_or_init(|| t).clone()
             }
         };
-        Ok(fill_dp_with_table(
+        Ok(fill_with_table(
             &self.db,
             &table,
             self.state.bars.len(),

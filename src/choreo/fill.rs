@@ -8,10 +8,10 @@
 //! unless both bars are pinned (a repeat the user chose is kept). A source joins every choice
 //! of bar 0 and every choice of the last bar joins the sink, both with weight 0.
 //!
-//! [`fill`] runs Dijkstra's algorithm on it (a binary heap, lazy deletion) with the consistent
+//! [`fill_dijkstra`] runs Dijkstra's algorithm on it (a binary heap, lazy deletion) with the consistent
 //! potential h(k) = Σ_{j ≥ k} m_j, m_j the smallest weight between layers j and j+1, so that
 //! nodes are settled in the order of d + h (Dijkstra on the reduced weights w − m_j ≥ 0, A*);
-//! [`fill_dp`] is the exact dynamic programme D_{k+1}(b) = min_a D_k(a) + C(a → b): each
+//! [`fill`] is the exact dynamic programme D_{k+1}(b) = min_a D_k(a) + C(a → b): each
 //! D_{k+1}(b) is a minimum over the table's column b (contiguous in the table's column copy),
 //! the columns in parallel with rayon, each minimum vectorised (the same IEEE sums at any
 //! vector width, and a minimum does not depend on the order it is taken in, so the same bits on
@@ -153,7 +153,7 @@ pub fn check(segments: usize, bars: usize, pins: &Pins) -> Result<(), FillError>
     Ok(())
 }
 
-/// Fills `bars` bars through `pins` by Dijkstra's algorithm (module docs), building the
+/// Fills `bars` bars through `pins` by the exact dynamic programme (module docs), building the
 /// transition table of `db` first.
 pub fn fill(db: &Database, bars: usize, pins: &Pins, p: &FillParams) -> Result<Fill, FillError> {
     check(db.segments.len(), bars, pins)?;
@@ -161,16 +161,8 @@ pub fn fill(db: &Database, bars: usize, pins: &Pins, p: &FillParams) -> Result<F
     fill_with_table(db, &table, bars, pins, p)
 }
 
-/// Fills `bars` bars through `pins` by the exact dynamic programme (module docs), building the
-/// transition table of `db` first.
-pub fn fill_dp(db: &Database, bars: usize, pins: &Pins, p: &FillParams) -> Result<Fill, FillError> {
-    check(db.segments.len(), bars, pins)?;
-    let table = TransitionTable::new(db, &p.transition)?;
-    fill_dp_with_table(db, &table, bars, pins, p)
-}
-
-/// [`fill`] (Dijkstra) on a prepared transition table of `db` built with `p.transition`: the
-/// table depends only on the database and the weights, so an editor builds it once.
+/// [`fill`] on a prepared transition table of `db` built with `p.transition`: the table depends
+/// only on the database and the weights, so an editor builds it once.
 pub fn fill_with_table(
     db: &Database,
     table: &TransitionTable,
@@ -178,18 +170,32 @@ pub fn fill_with_table(
     pins: &Pins,
     p: &FillParams,
 ) -> Result<Fill, FillError> {
-    solve(db, table, bars, pins, p, |g| g.dijkstra())
+    solve(db, table, bars, pins, p, |g| g.dp())
 }
 
-/// [`fill_dp`] on a prepared transition table of `db` built with `p.transition`.
-pub fn fill_dp_with_table(
+/// The same fill by Dijkstra's algorithm (module docs), building the transition table first:
+/// an independent way to the same path, slower on a large database (it settles nearly every
+/// node).
+pub fn fill_dijkstra(
+    db: &Database,
+    bars: usize,
+    pins: &Pins,
+    p: &FillParams,
+) -> Result<Fill, FillError> {
+    check(db.segments.len(), bars, pins)?;
+    let table = TransitionTable::new(db, &p.transition)?;
+    fill_dijkstra_with_table(db, &table, bars, pins, p)
+}
+
+/// [`fill_dijkstra`] on a prepared transition table of `db` built with `p.transition`.
+pub fn fill_dijkstra_with_table(
     db: &Database,
     table: &TransitionTable,
     bars: usize,
     pins: &Pins,
     p: &FillParams,
 ) -> Result<Fill, FillError> {
-    solve(db, table, bars, pins, p, |g| g.dp())
+    solve(db, table, bars, pins, p, |g| g.dijkstra())
 }
 
 /// Checks, builds the graph, finds the path with `path_of`.

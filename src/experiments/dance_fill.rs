@@ -33,7 +33,7 @@ use crate::humanoid::{ModelClip, humanoid24};
 /// How a fill is chosen.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub enum Strategy {
-    /// The minimum-cost path (Dijkstra over C = 1/S).
+    /// The minimum-cost path over C = 1/S ([`fill_with_table`]).
     ConnectionAware,
     /// Uniformly random segments.
     Random,
