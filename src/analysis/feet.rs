@@ -87,12 +87,24 @@ pub fn clip_contacts_with(clip: &Clip, config: &ContactConfig) -> Option<Contact
         .flat_map(|j| std::iter::once((j, false)).chain(joints[j].end_site.map(|_| (j, true))))
         .filter(|p| !is_foot(p))
         .collect();
+    let (l, r, b) = (
+        point_tracks(clip, &lf),
+        point_tracks(clip, &rf),
+        point_tracks(clip, &others),
+    );
+    Some(ground_contacts(&l, &r, &b, clip.frame_time, config))
+}
+
+/// The global positions of `points` at every frame of `clip`, frame-major: `out[f][i]` is point
+/// `points[i]` at frame f, metres.
+pub fn point_tracks(clip: &Clip, points: &[PointRef]) -> Vec<Vec<DVec3>> {
+    let joints = &clip.skeleton.joints;
     let mut g = vec![];
-    let (mut l, mut r, mut b) = (vec![], vec![], vec![]);
-    for f in 0..clip.frame_count() {
-        clip.globals(f, &mut g);
-        let at = |idx: &[PointRef]| -> Vec<DVec3> {
-            idx.iter()
+    (0..clip.frame_count())
+        .map(|f| {
+            clip.globals(f, &mut g);
+            points
+                .iter()
                 .map(|&(j, end)| {
                     let e = if end {
                         joints[j].end_site.unwrap_or_default()
@@ -102,10 +114,6 @@ pub fn clip_contacts_with(clip: &Clip, config: &ContactConfig) -> Option<Contact
                     g[j].translation + g[j].rotation * e
                 })
                 .collect()
-        };
-        l.push(at(&lf));
-        r.push(at(&rf));
-        b.push(at(&others));
-    }
-    Some(ground_contacts(&l, &r, &b, clip.frame_time, config))
+        })
+        .collect()
 }

@@ -139,8 +139,30 @@ fn is_manifest(p: &Path) -> bool {
 }
 
 /// A clip on humanoid24: a BVH mapped with the detected mapping and retargeted, or a keyframed
-/// .ron clip.
+/// .ron clip, set on its floor ([`grounded`]).
 pub fn load_model_clip(path: &Path) -> Result<ModelClip, SegmentError> {
+    load_unground(path).map(grounded)
+}
+
+/// `clip` with its root moved vertically so that its floor is at y = 0: the floor is the one
+/// [`crate::analysis::clip_contacts_with`] finds (the 2nd percentile over the clip of its
+/// lowest foot point), so clips captured or mapped with their feet above or below y = 0 (a
+/// mapped skeleton's feet are not the source's) stand on one floor when their bars are
+/// joined. A clip without feet is returned as it is.
+pub fn grounded(mut clip: ModelClip) -> ModelClip {
+    let config = crate::analysis::ContactConfig::default();
+    if let Some(c) = crate::analysis::clip_contacts_with(&clip.to_clip(), &config) {
+        let floor = c.floor_y_m;
+        if floor.is_finite() && floor != 0.0 {
+            for t in &mut clip.root_translation {
+                t.y -= floor;
+            }
+        }
+    }
+    clip
+}
+
+fn load_unground(path: &Path) -> Result<ModelClip, SegmentError> {
     let load = |e: crate::Error| SegmentError::Load {
         path: path.display().to_string(),
         source: Box::new(e),
@@ -337,5 +359,39 @@ impl Database {
     /// Segments cut from source clip `clip`.
     pub fn segments_of(&self, clip: usize) -> impl Iterator<Item = &Segment> {
         self.segments.iter().filter(move |s| s.clip == clip)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::{DQuat, DVec3};
+
+    #[test]
+    fn a_clip_is_set_on_its_floor_whatever_height_it_came_at() {
+        let model = humanoid24();
+        let d = model.dofs.len();
+        let n = 60;
+        for y in [0.3, 0.95, 2.0] {
+            let clip = ModelClip {
+                model: model.clone(),
+                frame_time: 1.0 / 30.0,
+                root_translation: vec![DVec3::new(0.5, y, -1.0); n],
+                root_rotation: vec![DQuat::IDENTITY; n],
+                angles: vec![0.0; n * d],
+            };
+            let g = grounded(clip);
+            let c = g.to_clip();
+            let feet: Vec<_> = crate::analysis::foot_points(&c.skeleton).concat();
+            let lowest = crate::analysis::point_tracks(&c, &feet)[0]
+                .iter()
+                .map(|p| p.y)
+                .fold(f64::INFINITY, f64::min);
+            assert!(
+                lowest.abs() < 1e-9,
+                "from {y} m: lowest foot point at {lowest} m"
+            );
+            assert_eq!(g.root_translation[0].x, 0.5, "only the height moves");
+        }
     }
 }

@@ -12,10 +12,12 @@
 //!   the DOFs; peak and mean over the samples whose stencil touches a seam window (the
 //!   rewritten frames and the frame on each side), and the same over every other sample for
 //!   scale ("inside").
-//! - **Foot skating**: the mean horizontal speed (m/s) of the heels (ankle joints) and toes (their
-//!   End Sites) over the frames they are in contact, a point being in contact when it is within
-//!   [`CONTACT_HEIGHT_M`] of the floor (the lowest any of them gets in the dance) and its vertical
-//!   speed is under [`CONTACT_VERTICAL_SPEED_M_S`] (not lifting or landing).
+//! - **Foot skating**: the mean horizontal speed (m/s) of the foot points (the ankles, heels and
+//!   toes of [`crate::analysis::foot_points`]) over the frames each is in contact, a point being
+//!   in contact as [`crate::analysis::ground_contacts`] finds it (within its threshold of the
+//!   height it rests at above the dance's floor, so the mapped ankle that stands 8–12 cm up
+//!   counts) and its vertical speed under [`CONTACT_VERTICAL_SPEED_M_S`] (not lifting or
+//!   landing).
 //! - **Transition cost**: Σ C over the seams of the fill, and the mean S.
 
 use glam::DVec3;
@@ -24,6 +26,7 @@ use serde::{Deserialize, Serialize};
 use super::dance::Dance;
 use super::fill::Fill;
 use super::segments::speed_curve;
+use crate::analysis::{ContactConfig, clip_contacts_with, foot_points, point_tracks};
 use crate::humanoid::ModelClip;
 
 /// σ of the beat alignment score: 3 frames at 60 fps, seconds.
@@ -31,9 +34,6 @@ pub const BAS_SIGMA_S: f64 = 3.0 / 60.0;
 
 /// Half-width of the neighbourhood a motion beat is the minimum of: 10 frames at 60 fps, seconds.
 pub const BEAT_ORDER_S: f64 = 10.0 / 60.0;
-
-/// A foot point is in contact within this height of the floor, metres.
-pub const CONTACT_HEIGHT_M: f64 = 0.05;
 
 /// A foot point is in contact while its vertical speed is under this, m/s.
 pub const CONTACT_VERTICAL_SPEED_M_S: f64 = 0.3;
@@ -172,40 +172,36 @@ pub fn seam_jerk(dance: &Dance) -> (Jerk, Jerk) {
     (Jerk::of(seam), Jerk::of(inside))
 }
 
-/// Foot skating of a clip: (mean horizontal speed in contact m/s, contact fraction) (module
-/// docs).
+/// Foot skating of a clip: (mean horizontal speed in contact m/s, contact fraction of the
+/// foot points' frames) (module docs).
 pub fn foot_skating(clip: &ModelClip) -> (f64, f64) {
     let c = clip.to_clip();
-    let names = c.skeleton.point_names();
-    let feet: Vec<usize> = [
-        "left_ankle",
-        "right_ankle",
-        "left_ankle_end",
-        "right_ankle_end",
-    ]
-    .iter()
-    .filter_map(|n| names.iter().position(|m| m == n))
-    .collect();
-    let pts = c.point_frames();
-    let n = pts.len();
-    if feet.is_empty() || n < 2 {
+    let n = c.frame_count();
+    let config = ContactConfig::default();
+    let Some(contacts) = clip_contacts_with(&c, &config) else {
+        return (0.0, 0.0);
+    };
+    if n < 2 {
         return (0.0, 0.0);
     }
-    let floor = pts
-        .iter()
-        .flat_map(|p| feet.iter().map(move |&i| p[i].y))
-        .fold(f64::INFINITY, f64::min);
     let fps = 1.0 / clip.frame_time;
     let (mut sum, mut contact, mut total) = (0.0, 0usize, 0usize);
-    for f in 0..n {
-        let (a, b) = (f.saturating_sub(1), (f + 1).min(n - 1));
-        let dt = (b - a) as f64 / fps;
-        for &i in &feet {
-            let v: DVec3 = (pts[b][i] - pts[a][i]) / dt;
-            total += 1;
-            if pts[f][i].y - floor < CONTACT_HEIGHT_M && v.y.abs() < CONTACT_VERTICAL_SPEED_M_S {
-                contact += 1;
-                sum += DVec3::new(v.x, 0.0, v.z).length();
+    for (points, rests) in foot_points(&c.skeleton)
+        .iter()
+        .zip(&contacts.rest_heights_m)
+    {
+        let track = point_tracks(&c, points);
+        for (i, rest) in rests.iter().enumerate() {
+            for f in 0..n {
+                total += 1;
+                let Some(rest) = rest else { continue };
+                let (a, b) = (f.saturating_sub(1), (f + 1).min(n - 1));
+                let v: DVec3 = (track[b][i] - track[a][i]) * (fps / (b - a) as f64);
+                let height = track[f][i].y - contacts.floor_y_m;
+                if height < rest + contacts.threshold_m && v.y.abs() < CONTACT_VERTICAL_SPEED_M_S {
+                    contact += 1;
+                    sum += DVec3::new(v.x, 0.0, v.z).length();
+                }
             }
         }
     }
@@ -214,7 +210,7 @@ pub fn foot_skating(clip: &ModelClip) -> (f64, f64) {
     } else {
         0.0
     };
-    (skating, contact as f64 / total as f64)
+    (skating, contact as f64 / total.max(1) as f64)
 }
 
 /// Every metric of a dance against the song's beats `beats_s` (song time, seconds) and the fill
@@ -259,6 +255,38 @@ mod tests {
         let s = beat_alignment_score(&late, &music, BAS_SIGMA_S);
         assert!((s - (-0.5f64).exp()).abs() < 1e-9, "{s}");
         assert_eq!(beat_alignment_score(&[], &music, BAS_SIGMA_S), 0.0);
+    }
+
+    /// humanoid24 standing still (angles 0) for 2 s at 60 fps, its pelvis at `y` and gliding
+    /// along x at `speed` m/s.
+    fn gliding(y: f64, speed: f64) -> ModelClip {
+        let model = crate::humanoid::humanoid24();
+        let d = model.dofs.len();
+        let n = 120;
+        ModelClip {
+            model,
+            frame_time: 1.0 / 60.0,
+            root_translation: (0..n)
+                .map(|f| DVec3::new(speed * f as f64 / 60.0, y, 0.0))
+                .collect(),
+            root_rotation: vec![glam::DQuat::IDENTITY; n],
+            angles: vec![0.0; n * d],
+        }
+    }
+
+    #[test]
+    fn foot_skating_is_the_speed_of_planted_feet_wherever_the_floor_is() {
+        for y in [0.95, 0.6, 1.4] {
+            let (still, contact) = foot_skating(&gliding(y, 0.0));
+            assert!(still.abs() < 1e-12, "standing still skates {still} m/s");
+            assert!(
+                (contact - 1.0).abs() < 1e-12,
+                "every foot point touches: {contact}"
+            );
+            let (glide, contact) = foot_skating(&gliding(y, 0.2));
+            assert!((glide - 0.2).abs() < 1e-9, "pelvis at {y} m: {glide} m/s");
+            assert!((contact - 1.0).abs() < 1e-12, "{contact}");
+        }
     }
 
     #[test]
