@@ -1,11 +1,15 @@
 //! The figures that say what a jump did: how high the root (pelvis) rose above standing, how long
 //! both feet were off the floor, and how far any foot went below the floor. The flight comes from
 //! foot contact ([`crate::analysis::clip_contacts`]: a flight is when no point of either foot
-//! touches), not from the root, so a deeper crouch without a higher flight shows as such.
+//! touches), not from the root, so a deeper crouch without a higher flight shows as such. Jumps
+//! compared with one another are measured against one reference ([`jump_figures_against`]): the
+//! floor and foot-point rest heights of one of them.
 
 use serde::Serialize;
 
-use crate::analysis::{Span, clip_contacts};
+use crate::analysis::{
+    ContactConfig, ContactReference, Contacts, Span, clip_contacts, clip_contacts_against,
+};
 use crate::humanoid::ModelClip;
 use crate::primitive::events::median;
 
@@ -42,11 +46,43 @@ pub struct JumpFigures {
 
 /// Measures a jump on `clip`, with the floor at height `floor_y` (metres) for the feet's lowest
 /// point; the flight is the longest span in which [`clip_contacts`] (threshold
-/// [`CONTACT_THRESHOLD_M`], shortest flight [`MIN_FLIGHT_S`]) finds no foot touching.
+/// [`CONTACT_THRESHOLD_M`], shortest flight [`MIN_FLIGHT_S`]) finds no foot touching, the
+/// clip's own floor and rest heights found in it.
 pub fn jump_figures(clip: &ModelClip, floor_y: f64) -> JumpFigures {
+    let contacts = clip_contacts(&clip.to_clip(), CONTACT_THRESHOLD_M, MIN_FLIGHT_S);
+    figures(clip, floor_y, contacts)
+}
+
+/// [`jump_figures`] against `reference` (the floor and foot-point rest heights of another jump
+/// of the same model, [`contact_reference`]): a foot point touches while within
+/// [`CONTACT_THRESHOLD_M`] of its reference rest height, and the lowest foot point is measured
+/// from the reference floor. So two jumps are compared by one standard: with rest heights
+/// estimated per clip, a point that rests just under the estimate's height limit in one jump and
+/// just over it in the other touches in one only, which moves the flight's ends.
+pub fn jump_figures_against(clip: &ModelClip, reference: &ContactReference) -> JumpFigures {
+    let contacts = clip_contacts_against(&clip.to_clip(), &contact_config(), reference);
+    figures(clip, reference.floor_y_m, contacts)
+}
+
+/// The floor and foot-point rest heights of `clip` (as [`jump_figures`] finds them), to measure
+/// other jumps of its model against ([`jump_figures_against`]); `None` when the model has no
+/// feet.
+pub fn contact_reference(clip: &ModelClip) -> Option<ContactReference> {
+    clip_contacts(&clip.to_clip(), CONTACT_THRESHOLD_M, MIN_FLIGHT_S).map(|c| c.reference())
+}
+
+fn contact_config() -> ContactConfig {
+    ContactConfig {
+        threshold_m: CONTACT_THRESHOLD_M,
+        min_flight_s: MIN_FLIGHT_S,
+        ..ContactConfig::default()
+    }
+}
+
+/// The figures of `clip` with its contacts found.
+fn figures(clip: &ModelClip, floor_y: f64, contacts: Option<Contacts>) -> JumpFigures {
     let root: Vec<f64> = clip.root_translation.iter().map(|t| t.y).collect();
-    let window = ((STANDING_WINDOW_S / clip.frame_time).round() as usize).clamp(1, root.len());
-    let standing_root_m = median(&root[..window]);
+    let standing_root_m = standing_root_m(clip);
     let (apex_frame, apex_root_m) =
         root.iter()
             .copied()
@@ -55,7 +91,7 @@ pub fn jump_figures(clip: &ModelClip, floor_y: f64) -> JumpFigures {
                 (0, f64::NEG_INFINITY),
                 |m, (k, y)| if y > m.1 { (k, y) } else { m },
             );
-    let flight = clip_contacts(&clip.to_clip(), CONTACT_THRESHOLD_M, MIN_FLIGHT_S).and_then(|c| {
+    let flight = contacts.and_then(|c| {
         c.flights
             .into_iter()
             .max_by(|a, b| a.duration().total_cmp(&b.duration()))
@@ -75,6 +111,14 @@ pub fn jump_figures(clip: &ModelClip, floor_y: f64) -> JumpFigures {
         flight_s: flight.map_or(0.0, |f| f.duration()),
         lowest_foot_above_floor_m,
     }
+}
+
+/// Root height of `clip` while standing: the median over its first [`STANDING_WINDOW_S`],
+/// metres.
+pub fn standing_root_m(clip: &ModelClip) -> f64 {
+    let root: Vec<f64> = clip.root_translation.iter().map(|t| t.y).collect();
+    let window = ((STANDING_WINDOW_S / clip.frame_time).round() as usize).clamp(1, root.len());
+    median(&root[..window])
 }
 
 /// The floor a clip stands on: the height [`clip_contacts`] finds its feet touching, metres
