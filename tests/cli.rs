@@ -427,3 +427,62 @@ fn the_mapped_cmu_jumps_keep_the_source_s_two_flights() {
         );
     }
 }
+
+/// `inspect` on the primitive scenes' own BVH outputs finds exactly the one flight of each jump,
+/// none while standing, the one the report gives as `own_contacts_flight`.
+#[test]
+fn inspect_finds_the_primitive_scenes_flights_in_their_outputs() {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    for (scene, files) in [
+        (
+            "high_jump",
+            vec![
+                ("low_jump.bvh", "low"),
+                ("normal_jump.bvh", "normal"),
+                ("high_jump.bvh", "high"),
+            ],
+        ),
+        (
+            "jumping_knee_kick",
+            vec![("jumping_knee_kick.bvh", "jumping_knee_kick")],
+        ),
+    ] {
+        let out = temp(&format!("{scene}_out"));
+        let (code, _, err) = run_cli(&[
+            "run".as_ref(),
+            root.join(format!("scenes/{scene}.ron")).as_os_str(),
+            "--out".as_ref(),
+            out.as_os_str(),
+            "--set".as_ref(),
+            "render.gif=false".as_ref(),
+        ]);
+        assert_eq!(code, Some(0), "{err}");
+        let report: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap())
+                .unwrap();
+        for (file, key) in files {
+            let flights = inspect_flights(&out.join(file));
+            assert_eq!(flights.len(), 1, "{scene}/{file}: {flights:?}");
+            let (a, b) = flights[0];
+            assert!(
+                a > 0.5,
+                "{scene}/{file}: a flight while standing: {flights:?}"
+            );
+            let figures = if scene == "high_jump" {
+                &report["jumps"][key]
+            } else {
+                &report[key]
+            };
+            let own = &figures["own_contacts_flight"];
+            let (s, e) = (
+                own["start_s"].as_f64().unwrap(),
+                own["end_s"].as_f64().unwrap(),
+            );
+            // inspect prints milliseconds.
+            assert!(
+                (a - s).abs() < 1e-3 && (b - e).abs() < 1e-3,
+                "{scene}/{file}: inspect {a}..{b} s, report {own}"
+            );
+        }
+    }
+}

@@ -465,7 +465,7 @@ mod tests {
         assert_eq!(against.rest_heights_m, a.rest_heights_m);
         let fb = against.flights[0];
         assert!(
-            fb.duration() > own.duration() + 0.05,
+            fb.duration() > own.duration() + dt,
             "{fb:?} vs own {own:?}"
         );
         // A point with no reference rest height never touches.

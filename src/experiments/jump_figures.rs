@@ -39,6 +39,10 @@ pub struct JumpFigures {
     pub flight: Option<Span>,
     /// Its length, seconds (0 without a flight).
     pub flight_s: f64,
+    /// The longest flight found with the clip's own floor and foot rest heights, as
+    /// `marionette inspect` finds it in the clip written as BVH (the same as `flight` unless the
+    /// figures were measured against another jump's, [`jump_figures_against`]).
+    pub own_contacts_flight: Option<Span>,
     /// The lowest any foot point (ankle or toe) comes relative to `floor_y`, metres: negative is
     /// how deep a foot went through the floor.
     pub lowest_foot_above_floor_m: f64,
@@ -50,7 +54,8 @@ pub struct JumpFigures {
 /// clip's own floor and rest heights found in it.
 pub fn jump_figures(clip: &ModelClip, floor_y: f64) -> JumpFigures {
     let contacts = clip_contacts(&clip.to_clip(), CONTACT_THRESHOLD_M, MIN_FLIGHT_S);
-    figures(clip, floor_y, contacts)
+    let own = longest_flight(contacts.as_ref());
+    figures(clip, floor_y, own, own)
 }
 
 /// [`jump_figures`] against `reference` (the floor and foot-point rest heights of another jump
@@ -60,8 +65,25 @@ pub fn jump_figures(clip: &ModelClip, floor_y: f64) -> JumpFigures {
 /// estimated per clip, a point that rests just under the estimate's height limit in one jump and
 /// just over it in the other touches in one only, which moves the flight's ends.
 pub fn jump_figures_against(clip: &ModelClip, reference: &ContactReference) -> JumpFigures {
-    let contacts = clip_contacts_against(&clip.to_clip(), &contact_config(), reference);
-    figures(clip, reference.floor_y_m, contacts)
+    let c = clip.to_clip();
+    let against = clip_contacts_against(&c, &contact_config(), reference);
+    let own = clip_contacts(&c, CONTACT_THRESHOLD_M, MIN_FLIGHT_S);
+    figures(
+        clip,
+        reference.floor_y_m,
+        longest_flight(against.as_ref()),
+        longest_flight(own.as_ref()),
+    )
+}
+
+/// The longest flight of `contacts`.
+fn longest_flight(contacts: Option<&Contacts>) -> Option<Span> {
+    contacts.and_then(|c| {
+        c.flights
+            .iter()
+            .copied()
+            .max_by(|a, b| a.duration().total_cmp(&b.duration()))
+    })
 }
 
 /// The floor and foot-point rest heights of `clip` (as [`jump_figures`] finds them), to measure
@@ -79,8 +101,8 @@ fn contact_config() -> ContactConfig {
     }
 }
 
-/// The figures of `clip` with its contacts found.
-fn figures(clip: &ModelClip, floor_y: f64, contacts: Option<Contacts>) -> JumpFigures {
+/// The figures of `clip` with its flight found (`own`: with its own contacts).
+fn figures(clip: &ModelClip, floor_y: f64, flight: Option<Span>, own: Option<Span>) -> JumpFigures {
     let root: Vec<f64> = clip.root_translation.iter().map(|t| t.y).collect();
     let standing_root_m = standing_root_m(clip);
     let (apex_frame, apex_root_m) =
@@ -91,11 +113,6 @@ fn figures(clip: &ModelClip, floor_y: f64, contacts: Option<Contacts>) -> JumpFi
                 (0, f64::NEG_INFINITY),
                 |m, (k, y)| if y > m.1 { (k, y) } else { m },
             );
-    let flight = contacts.and_then(|c| {
-        c.flights
-            .into_iter()
-            .max_by(|a, b| a.duration().total_cmp(&b.duration()))
-    });
     let lowest_foot_above_floor_m = clip
         .foot_heights()
         .iter()
@@ -109,6 +126,7 @@ fn figures(clip: &ModelClip, floor_y: f64, contacts: Option<Contacts>) -> JumpFi
         apex_time_s: apex_frame as f64 * clip.frame_time,
         flight,
         flight_s: flight.map_or(0.0, |f| f.duration()),
+        own_contacts_flight: own,
         lowest_foot_above_floor_m,
     }
 }
