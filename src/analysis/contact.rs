@@ -464,10 +464,7 @@ mod tests {
         let against = ground_contacts_against(&bl, &br, &[], dt, &config, &a.reference());
         assert_eq!(against.rest_heights_m, a.rest_heights_m);
         let fb = against.flights[0];
-        assert!(
-            fb.duration() > own.duration() + dt,
-            "{fb:?} vs own {own:?}"
-        );
+        assert!(fb.duration() > own.duration() + dt, "{fb:?} vs own {own:?}");
         // A point with no reference rest height never touches.
         let none = ContactReference {
             floor_y_m: a.floor_y_m,
