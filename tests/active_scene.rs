@@ -82,3 +82,39 @@ fn the_key_pose_scene_switches_at_the_release_and_falls() {
     assert!(e.contains("'tail' is not a DOF of humanoid24"), "{e}");
     std::fs::remove_dir_all(&out).ok();
 }
+
+/// Under `--set` of the push and the release delay the report gives the push as set and
+/// releases the assistance that long after it.
+#[test]
+fn the_report_follows_the_push_and_release_under_set() {
+    let path = scene_path();
+    let scene = Scene::load(&path).unwrap();
+    let sets: Vec<String> = [
+        "push.force_n=450",
+        "push.start_s=1.3",
+        "push.duration_s=0.15",
+        "release_delay_s=0.25",
+    ]
+    .map(String::from)
+    .to_vec();
+    let scene = apply_overrides(&scene, &sets).unwrap();
+    let out =
+        std::env::temp_dir().join(format!("marionette-test-{}-active-set", std::process::id()));
+    let r = run(&scene, path.parent().unwrap(), &out).unwrap();
+    assert_eq!(r["push"]["force_n"].as_f64(), Some(450.0), "{}", r["push"]);
+    assert_eq!(
+        r["push"]["duration_s"].as_f64(),
+        Some(0.15),
+        "{}",
+        r["push"]
+    );
+    let push = r["push"]["start_s"].as_f64().unwrap();
+    let release = r["release_s"].as_f64().unwrap();
+    // To the tick (dt 0.5 ms).
+    assert!((push - 1.3).abs() < 1e-3, "push at {push} s");
+    assert!(
+        (release - push - 0.25).abs() < 1e-3,
+        "release at {release} s"
+    );
+    std::fs::remove_dir_all(&out).ok();
+}

@@ -398,26 +398,33 @@ fn the_cmu_forward_jumps_have_exactly_their_ten_flights() {
     }
 }
 
-#[test]
-fn the_mapped_cmu_jumps_keep_the_source_s_two_flights() {
-    let Some(_) = common::data_dir() else {
-        return;
-    };
+/// Runs `scenes/<scene>.ron` without its GIF into the temporary folder `out`: the folder and
+/// the report.
+fn run_scene_without_gif(scene: &str, out: &str) -> (PathBuf, serde_json::Value) {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
-    let out = temp("cmu_jumps");
-    let (code, text, err) = run_cli(&[
+    let out = temp(out);
+    let (code, _, err) = run_cli(&[
         "run".as_ref(),
-        root.join("scenes/show_cmu_jumps.ron").as_os_str(),
+        root.join(format!("scenes/{scene}.ron")).as_os_str(),
         "--out".as_ref(),
         out.as_os_str(),
         "--set".as_ref(),
         "render.gif=false".as_ref(),
     ]);
     assert_eq!(code, Some(0), "{err}");
-    let report: serde_json::Value =
+    let report =
         serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    (out, report)
+}
+
+#[test]
+fn the_mapped_cmu_jumps_keep_the_source_s_two_flights() {
+    let Some(_) = common::data_dir() else {
+        return;
+    };
+    let (_, report) = run_scene_without_gif("show_cmu_jumps", "cmu_jumps");
     let flights = report["flights"].as_array().unwrap();
-    assert_eq!(flights.len(), 2, "{text}");
+    assert_eq!(flights.len(), 2, "{}", report["flights"]);
     // The source's flights in 0–5 s: 1.9–2.3 s and 3.6–3.9 s.
     for (f, (a, b)) in flights.iter().zip([(1.93, 2.25), (3.61, 3.89)]) {
         let (s, e) = (f["start_s"].as_f64().unwrap(), f["end_s"].as_f64().unwrap());
@@ -425,5 +432,51 @@ fn the_mapped_cmu_jumps_keep_the_source_s_two_flights() {
             (s - a).abs() < 0.12 && (e - b).abs() < 0.12,
             "{f} against {a}..{b}"
         );
+    }
+}
+
+/// `inspect` on the primitive scenes' own BVH outputs finds exactly the one flight of each jump,
+/// none while standing, the one the report gives as `own_contacts_flight`.
+#[test]
+fn inspect_finds_the_primitive_scenes_flights_in_their_outputs() {
+    for (scene, files) in [
+        (
+            "high_jump",
+            vec![
+                ("low_jump.bvh", "low"),
+                ("normal_jump.bvh", "normal"),
+                ("high_jump.bvh", "high"),
+            ],
+        ),
+        (
+            "jumping_knee_kick",
+            vec![("jumping_knee_kick.bvh", "jumping_knee_kick")],
+        ),
+    ] {
+        let (out, report) = run_scene_without_gif(scene, &format!("{scene}_out"));
+        for (file, key) in files {
+            let flights = inspect_flights(&out.join(file));
+            assert_eq!(flights.len(), 1, "{scene}/{file}: {flights:?}");
+            let (a, b) = flights[0];
+            assert!(
+                a > 0.5,
+                "{scene}/{file}: a flight while standing: {flights:?}"
+            );
+            let figures = if scene == "high_jump" {
+                &report["jumps"][key]
+            } else {
+                &report[key]
+            };
+            let own = &figures["own_contacts_flight"];
+            let (s, e) = (
+                own["start_s"].as_f64().unwrap(),
+                own["end_s"].as_f64().unwrap(),
+            );
+            // inspect prints milliseconds.
+            assert!(
+                (a - s).abs() < 1e-3 && (b - e).abs() < 1e-3,
+                "{scene}/{file}: inspect {a}..{b} s, report {own}"
+            );
+        }
     }
 }

@@ -107,9 +107,12 @@ fn a_resumed_evolution_ends_where_an_uninterrupted_one_does() {
     }
     let r = report(&a);
     assert_eq!(r["generations"], 3);
+    // The population and seeds given by --set are the ones reported.
+    assert_eq!(r["population"], 6);
     let groups = r["groups"].as_array().unwrap();
     assert_eq!(groups.len(), 2);
     for g in groups {
+        assert_eq!(g["seeds"], serde_json::json!([1, 2]), "{}", g["age_group"]);
         let initial = g["initial"]["mean"].as_f64().unwrap();
         let fin = g["final"]["mean"].as_f64().unwrap();
         assert!(fin <= initial, "best so far rose: {initial} → {fin}");

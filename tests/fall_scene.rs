@@ -133,3 +133,34 @@ fn impossible_runs_are_refused_up_front() {
     }
     std::fs::remove_dir_all(&out).ok();
 }
+
+/// Under `--set` of the damage weights and the age groups, the report's damage is
+/// `D = Σ w_i f_i` of the weights it lists (those given, the rest the defaults) and its peak
+/// forces, for the first figure and the compared one, and each names its own age group.
+#[test]
+fn the_report_follows_damage_weights_and_age_groups_under_set() {
+    let r = run_fall(&[
+        r#"damage_weights={"head":3.0,"pelvis":0.5}"#,
+        "age_group=adult",
+        "compare_with=elderly",
+        "render.gif=false",
+    ]);
+    assert_eq!(r["age_group"], "adult");
+    assert_eq!(r["compared"]["age_group"], "elderly");
+    let w = &r["damage_weights"];
+    assert_eq!(w["head"].as_f64(), Some(3.0), "{w}");
+    assert_eq!(w["pelvis"].as_f64(), Some(0.5), "{w}");
+    for (who, rep) in [("adult", &r), ("elderly", &r["compared"])] {
+        let forces = rep["peak_vertical_force_n"].as_object().unwrap();
+        let d: f64 = forces
+            .iter()
+            .map(|(link, f)| w[link].as_f64().unwrap_or(0.0) * f.as_f64().unwrap())
+            .sum();
+        let reported = rep["damage"].as_f64().unwrap();
+        assert!(
+            (d - reported).abs() <= 1e-9 * reported.abs().max(1.0),
+            "{who}: damage {reported} vs Σ w·f {d}"
+        );
+        assert!(reported > 0.0, "{who}: no damage");
+    }
+}

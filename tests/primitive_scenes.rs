@@ -38,6 +38,15 @@ fn run_scene_with(file: &str, sets: &[String], outputs: &[&str]) -> serde_json::
     report
 }
 
+/// How far the high jump's flight may be from the prediction, as a fraction of it: on the
+/// project's own clips 0.383 s for 0.381 s predicted (+0.5 %), on the CMU ones 0.458 s for
+/// 0.470 s (−2.4 %: the ballistic extra of 0.020 s is put in as two whole frames, and the
+/// extrapolated feet touch down a frame sooner); the γ sweep's jumps on the own clips are within
+/// −0.7 … +1.1 %.
+const FLIGHT_TOL_OWN: f64 = 0.02;
+/// See [`FLIGHT_TOL_OWN`].
+const FLIGHT_TOL_CMU: f64 = 0.03;
+
 const JUMP_BVHS: [&str; 3] = ["low_jump.bvh", "normal_jump.bvh", "high_jump.bvh"];
 
 /// Whether the CMU files the `_cmu` scenes read are present (else skipped, or failed under CI).
@@ -59,11 +68,13 @@ fn f(v: &serde_json::Value, path: &[&str]) -> f64 {
         .unwrap_or_else(|| panic!("{path:?} is not a number in {v}"))
 }
 
-/// The report's predictions are `γ·low + (1 − γ)·normal` of its own figures, γ taken at the
-/// normal jump's Bend (crouch) and apex (apex, flight) on the span, and the high jump comes
-/// within `apex_tol_m` and `flight_tol_s` of them; the feet never go more than 3 mm through the
-/// floor (the demonstrations' own DMP fits reach 1.3 mm).
-fn check_high_jump_follows(r: &serde_json::Value, gamma_at: &dyn Fn(f64) -> f64) {
+/// The report's predictions follow its own figures: crouch and root apex are
+/// `γ·low + (1 − γ)·normal`, γ taken at the normal jump's Bend (crouch) and apex (apex) on the
+/// span; the apex above standing is the apex over the extrapolated stance; the flight is the
+/// normal jump's plus the ballistic extra of the higher apex. The high jump comes within 2°,
+/// 5 mm and `flight_tol` (a fraction of the predicted flight) of them; the feet never go below
+/// the floor.
+fn check_high_jump_follows(r: &serde_json::Value, gamma_at: &dyn Fn(f64) -> f64, flight_tol: f64) {
     let pred = |k: &str| f(r, &["prediction", k]);
     let span = pred("span_s");
     let (gb, ga) = (
@@ -98,21 +109,33 @@ fn check_high_jump_follows(r: &serde_json::Value, gamma_at: &dyn Fn(f64) -> f64)
         (high_crouch - crouch).abs() < 2.0,
         "crouch {high_crouch:.2} vs γ-blend {crouch:.2} (γ = {gb})"
     );
-    let apex = mix(ga, &["jumps", "x", "apex_above_standing_m"]);
     let apex_root = mix(ga, &["jumps", "x", "apex_root_m"]);
-    let flight = mix(ga, &["jumps", "x", "flight_s"]);
-    assert!((pred("apex_above_standing_m") - apex).abs() < 1e-12);
     assert!((pred("apex_root_m") - apex_root).abs() < 1e-12);
+    assert!((pred("apex_above_standing_m") - (apex_root - pred("standing_root_m"))).abs() < 1e-12);
+    let flight = f(r, &["jumps", "normal", "flight_s"]) + f(r, &["flight_plan", "extra_flight_s"]);
     assert!((pred("flight_s") - flight).abs() < 1e-12);
     // The root is extrapolated with the joints' γ: the high jump's root apex over the floor is
-    // the blend of the two jumps' (the flight plan scales the arc to it).
-    let high_apex = f(r, &["jumps", "high", "apex_root_m"]);
+    // the blend of the two jumps' (the flight plan scales the arc to it), over the stance the
+    // extrapolated joints stand in.
+    let jump = |k: &str| f(r, &["jumps", "high", k]);
+    for k in ["apex_root_m", "standing_root_m", "apex_above_standing_m"] {
+        assert!(
+            (jump(k) - pred(k)).abs() < 0.005,
+            "{k}: {:.4} m vs predicted {:.4} m",
+            jump(k),
+            pred(k)
+        );
+    }
+    for k in ["apex_root_m", "apex_above_standing_m", "flight_s"] {
+        assert!(
+            (f(r, &["high_minus_predicted", k]) - (jump(k) - pred(k))).abs() < 1e-12,
+            "{k}"
+        );
+    }
+    let (high_flight, predicted) = (jump("flight_s"), pred("flight_s"));
     assert!(
-        (high_apex - apex_root).abs() < 0.005,
-        "root apex {high_apex:.4} m vs predicted {apex_root:.4} m"
-    );
-    assert!(
-        (f(r, &["high_minus_predicted", "apex_root_m"]) - (high_apex - apex_root)).abs() < 1e-12
+        (high_flight - predicted).abs() <= flight_tol * predicted,
+        "flight {high_flight} s vs predicted {predicted} s"
     );
     for j in ["low", "normal", "high"] {
         let lowest = f(r, &["jumps", j, "lowest_foot_above_floor_m"]);
@@ -122,31 +145,28 @@ fn check_high_jump_follows(r: &serde_json::Value, gamma_at: &dyn Fn(f64) -> f64)
 }
 
 /// The paper's γ = −0.5: a deeper crouch, and a jump that rises higher and flies longer than the
-/// normal one, by about what extrapolating the two jumps predicts.
-fn check_high_jump(r: &serde_json::Value) {
+/// normal one, by about what extrapolating the two jumps predicts (the flight within
+/// `flight_tol` of the prediction).
+fn check_high_jump(r: &serde_json::Value, flight_tol: f64) {
     assert_eq!(r["gamma"], "γ = −0.5");
-    check_high_jump_follows(r, &|_| -0.5);
+    check_high_jump_follows(r, &|_| -0.5, flight_tol);
     let jump = |j: &str, k: &str| f(r, &["jumps", j, k]);
     // Higher than the normal jump both over the floor and above its own standing.
     for k in ["apex_root_m", "apex_above_standing_m"] {
         let (high, normal) = (jump("high", k), jump("normal", k));
         assert!(high > normal + 0.015, "{k}: high {high} vs normal {normal}");
     }
-    let (flight, predicted) = (jump("high", "flight_s"), f(r, &["prediction", "flight_s"]));
-    let normal_flight = jump("normal", "flight_s");
-    // Measured from foot contact on the model's rigid feet: within 15 % of the prediction (own
-    // clips: 0.383 s for 0.392 s predicted; CMU: 0.517 s for 0.458 s, the extrapolated legs
-    // tucked higher keeping the feet off the floor longer than the root's flight).
+    let (flight, normal_flight) = (jump("high", "flight_s"), jump("normal", "flight_s"));
     assert!(
-        flight > normal_flight && (flight - predicted).abs() < 0.15 * predicted,
-        "flight {flight} s vs predicted {predicted} s (normal {normal_flight} s)"
+        flight > normal_flight,
+        "flight {flight} s vs normal {normal_flight} s"
     );
 }
 
 #[test]
 fn high_jump_on_the_projects_own_clips() {
     let r = run_scene_with("high_jump.ron", &[], &JUMP_BVHS);
-    check_high_jump(&r);
+    check_high_jump(&r, FLIGHT_TOL_OWN);
     let jump = |j: &str, k: &str| f(&r, &["jumps", j, k]);
     assert!(jump("high", "flight_s") > jump("normal", "flight_s") + 0.015);
     assert!((f(&r, &["peak_knee_flexion_deg", "low"]) - 70.0).abs() < 1.0);
@@ -219,7 +239,10 @@ fn jumping_knee_kick_on_the_projects_own_clips() {
 #[test]
 fn high_jump_on_the_cmu_jumps() {
     if data_present() {
-        check_high_jump(&run_scene_with("high_jump_cmu.ron", &[], &JUMP_BVHS));
+        check_high_jump(
+            &run_scene_with("high_jump_cmu.ron", &[], &JUMP_BVHS),
+            FLIGHT_TOL_CMU,
+        );
     }
 }
 
@@ -256,7 +279,7 @@ fn high_jump_report_follows_gamma() {
     for (set, label, from, to) in cases {
         let r = run_scene_with("high_jump.ron", &[format!("gamma={set}")], &[]);
         assert_eq!(r["gamma"], label, "{set}");
-        check_high_jump_follows(&r, &|t| from + (to - from) * t);
+        check_high_jump_follows(&r, &|t| from + (to - from) * t, FLIGHT_TOL_OWN);
     }
 }
 

@@ -149,3 +149,26 @@ fn windows_reaching_outside_the_clip_name_its_span() {
     assert!(e.contains("spans 0..2.000 s"), "{e}");
     std::fs::remove_dir_all(&d).unwrap();
 }
+
+/// `--set clip.unit_scale=1000` on a BVH clip (a 1.7 km figure) is refused with the human
+/// range before any output, as `inspect --unit-scale` refuses it.
+#[test]
+fn a_unit_scale_that_makes_no_human_is_refused_in_a_scene() {
+    let d = scratch("unit");
+    let clip = marionette::clips::KeyframeClip::load(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/clips/normal_jump.ron"),
+    )
+    .unwrap()
+    .to_model_clip();
+    marionette::bvh::write_file(&clip.to_clip().to_bvh(), &d.join("jump.bvh")).unwrap();
+    let s = Scene::parse(
+        r#"Show(format_version: 1, name: "unit", clip: (file: "jump.bvh"))"#,
+        "u.ron",
+    )
+    .unwrap();
+    let s = scene::apply_overrides(&s, &["clip.unit_scale=1000".into()]).unwrap();
+    let e = scene::run(&s, &d, &d.join("unit")).unwrap_err().to_string();
+    assert!(e.contains("human range 0.3..3 m"), "{e}");
+    assert!(!d.join("unit").exists());
+    std::fs::remove_dir_all(&d).unwrap();
+}

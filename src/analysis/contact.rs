@@ -172,6 +172,72 @@ fn spans(on: &[bool], frame_time: f64, min_s: f64) -> Vec<Span> {
     out
 }
 
+/// Where a motion's feet touch: the floor and each foot point's rest height, as
+/// [`ground_contacts`] finds them. Passed to [`ground_contacts_against`], it measures other
+/// motions of the same figure against the same floor and rest heights.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ContactReference {
+    /// Floor height, metres.
+    pub floor_y_m: f64,
+    /// Rest height above the floor of each foot point, `[left, right]`, metres (`None`: the
+    /// point never rests on the floor, so it never touches).
+    pub rest_heights_m: [Vec<Option<f64>>; 2],
+}
+
+impl Contacts {
+    /// The floor and rest heights these contacts were found with.
+    pub fn reference(&self) -> ContactReference {
+        ContactReference {
+            floor_y_m: self.floor_y_m,
+            rest_heights_m: self.rest_heights_m.clone(),
+        }
+    }
+}
+
+/// The floor of a motion: the 2nd percentile over its frames of the lowest foot point (0 with
+/// no foot point), metres.
+fn floor_of(hl: &[Vec<f64>], hr: &[Vec<f64>], frames: usize) -> f64 {
+    let mut lowest: Vec<f64> = (0..frames)
+        .map(|f| {
+            hl.iter()
+                .chain(hr)
+                .map(|h| h[f])
+                .fold(f64::INFINITY, f64::min)
+        })
+        .filter(|h| h.is_finite())
+        .collect();
+    lowest.sort_by(f64::total_cmp);
+    if lowest.is_empty() {
+        0.0
+    } else {
+        lowest[(lowest.len() - 1) * 2 / 100]
+    }
+}
+
+/// Each point's rest height above `floor` (the median height of the frames where it is slower
+/// than `rest_speed_mps` and lower than `max_rest_height_m`), metres.
+fn rest_heights(
+    frames_pts: &[Vec<DVec3>],
+    h: &[Vec<f64>],
+    floor: f64,
+    frame_time: f64,
+    config: &ContactConfig,
+) -> Vec<Option<f64>> {
+    (0..h.len())
+        .map(|p| {
+            let v = speeds(frames_pts, p, frame_time);
+            let resting: Vec<f64> = (0..v.len().min(h[p].len()))
+                .filter(|&f| {
+                    v[f] < config.rest_speed_mps && h[p][f] - floor < config.max_rest_height_m
+                })
+                .map(|f| h[p][f] - floor)
+                .filter(|x| x.is_finite())
+                .collect();
+            median(resting).map(|r| r.max(0.0))
+        })
+        .collect()
+}
+
 /// Finds ground contact and flight (see the module documentation): `left[f]` and `right[f]` are
 /// the foot points of frame `f` (the same points, in the same order, every frame), `body[f]` the
 /// other points of the body (may be empty). The floor is the 2nd percentile over the motion of
@@ -184,38 +250,40 @@ pub fn ground_contacts(
     config: &ContactConfig,
 ) -> Contacts {
     let frames = left.len().min(right.len());
-    let (hl, hr, hb) = (heights(left), heights(right), heights(body));
-    let mut lowest: Vec<f64> = (0..frames)
-        .map(|f| {
-            hl.iter()
-                .chain(&hr)
-                .map(|h| h[f])
-                .fold(f64::INFINITY, f64::min)
-        })
-        .filter(|h| h.is_finite())
-        .collect();
-    lowest.sort_by(f64::total_cmp);
-    let floor = if lowest.is_empty() {
-        0.0
-    } else {
-        lowest[(lowest.len() - 1) * 2 / 100]
+    let (hl, hr) = (heights(left), heights(right));
+    let floor_y_m = floor_of(&hl, &hr, frames);
+    let reference = ContactReference {
+        floor_y_m,
+        rest_heights_m: [
+            rest_heights(left, &hl, floor_y_m, frame_time, config),
+            rest_heights(right, &hr, floor_y_m, frame_time, config),
+        ],
     };
+    ground_contacts_against(left, right, body, frame_time, config, &reference)
+}
+
+/// [`ground_contacts`] against a given floor and given rest heights (those of another motion of
+/// the same figure, [`Contacts::reference`]) instead of the motion's own: a foot point touches
+/// while within `threshold_m` of its reference rest height. Motions compared with one another
+/// (a jump and a variation of it) are so measured by one standard; estimated per motion, a
+/// point resting just under [`ContactConfig::max_rest_height_m`] in one and just over it in the
+/// other would touch in one only. A point with no reference rest height never touches.
+pub fn ground_contacts_against(
+    left: &[Vec<DVec3>],
+    right: &[Vec<DVec3>],
+    body: &[Vec<DVec3>],
+    frame_time: f64,
+    config: &ContactConfig,
+    reference: &ContactReference,
+) -> Contacts {
+    let frames = left.len().min(right.len());
+    let (hl, hr, hb) = (heights(left), heights(right), heights(body));
+    let floor = reference.floor_y_m;
     let debounce_frames = (config.debounce_s / frame_time).round().max(1.0) as usize;
-    // Per foot: each point's rest height, then the frames where some point touches.
-    let foot = |frames_pts: &[Vec<DVec3>], h: &[Vec<f64>]| -> (Vec<Option<f64>>, Vec<bool>) {
+    // Per foot: the frames where some point is within the threshold of its rest height.
+    let foot = |h: &[Vec<f64>], rests: &[Option<f64>]| -> Vec<bool> {
         let mut on = vec![false; frames];
-        let mut rests = vec![];
-        for (p, hp) in h.iter().enumerate() {
-            let v = speeds(frames_pts, p, frame_time);
-            let resting: Vec<f64> = (0..frames)
-                .filter(|&f| {
-                    v[f] < config.rest_speed_mps && hp[f] - floor < config.max_rest_height_m
-                })
-                .map(|f| hp[f] - floor)
-                .filter(|x| x.is_finite())
-                .collect();
-            let rest = median(resting).map(|r| r.max(0.0));
-            rests.push(rest);
+        for (hp, rest) in h.iter().zip(rests) {
             if let Some(r) = rest {
                 for f in 0..frames {
                     on[f] |= hp[f] - floor < r + config.threshold_m;
@@ -223,10 +291,10 @@ pub fn ground_contacts(
             }
         }
         debounce(&mut on, debounce_frames);
-        (rests, on)
+        on
     };
-    let (rest_l, on_l) = foot(left, &hl);
-    let (rest_r, on_r) = foot(right, &hr);
+    let [rest_l, rest_r] = &reference.rest_heights_m;
+    let (on_l, on_r) = (foot(&hl, rest_l), foot(&hr, rest_r));
     let mut on_body: Vec<bool> = (0..frames)
         .map(|f| {
             hb.iter().any(|h| {
@@ -242,7 +310,7 @@ pub fn ground_contacts(
     Contacts {
         floor_y_m: floor,
         threshold_m: config.threshold_m,
-        rest_heights_m: [rest_l, rest_r],
+        rest_heights_m: reference.rest_heights_m.clone(),
         left: spans(&on_l, frame_time, 0.0),
         right: spans(&on_r, frame_time, 0.0),
         body: spans(&on_body, frame_time, 0.0),
@@ -360,5 +428,51 @@ mod tests {
         }
         let c = ground_contacts(&l, &r, &[], dt, &ContactConfig::default());
         assert_eq!(c.flights.len(), 1, "{:?}", c.flights);
+    }
+
+    #[test]
+    fn against_a_reference_a_motion_is_measured_by_the_reference_s_rest_heights() {
+        // One flight 1.0–1.4 s; motion B stands its feet 2 cm higher than motion A.
+        let dt = 1.0 / 120.0;
+        let motion = |stand: f64| {
+            let (mut l, mut r) = (vec![], vec![]);
+            for f in 0..240 {
+                let lift = ballistic(f as f64 * dt, 1.0, 1.4);
+                l.push(foot(0.1, 0.10 + stand, stand, lift));
+                r.push(foot(-0.1, 0.10 + stand, stand, lift));
+            }
+            (l, r)
+        };
+        let config = ContactConfig::default();
+        let (al, ar) = motion(0.0);
+        let a = ground_contacts(&al, &ar, &[], dt, &config);
+        // Against its own reference a motion gives its own contacts.
+        assert_eq!(
+            ground_contacts_against(&al, &ar, &[], dt, &config, &a.reference()),
+            a
+        );
+        // B's own estimate finds its floor 2 cm up, so its flight is A's; measured against A's
+        // floor its feet stand 2 cm up, leave the 3 cm band when 1 cm higher still (about
+        // 10 ms sooner) and come back that much later.
+        let (bl, br) = motion(0.02);
+        let own = ground_contacts(&bl, &br, &[], dt, &config).flights[0];
+        let fa = a.flights[0];
+        assert!(
+            (own.duration() - fa.duration()).abs() < 2.0 * dt,
+            "{own:?} {fa:?}"
+        );
+        let against = ground_contacts_against(&bl, &br, &[], dt, &config, &a.reference());
+        assert_eq!(against.rest_heights_m, a.rest_heights_m);
+        let fb = against.flights[0];
+        assert!(fb.duration() > own.duration() + dt, "{fb:?} vs own {own:?}");
+        // A point with no reference rest height never touches.
+        let none = ContactReference {
+            floor_y_m: a.floor_y_m,
+            rest_heights_m: [vec![None; 2], vec![None; 2]],
+        };
+        let c = ground_contacts_against(&al, &ar, &[], dt, &config, &none);
+        assert!(c.left.is_empty() && c.right.is_empty(), "{c:?}");
+        assert_eq!(c.flights.len(), 1);
+        assert!((c.flights[0].duration() - 240.0 * dt).abs() < 1e-9);
     }
 }

@@ -2,7 +2,9 @@
 
 use glam::DVec3;
 
-use super::contact::{ContactConfig, Contacts, ground_contacts};
+use super::contact::{
+    ContactConfig, ContactReference, Contacts, ground_contacts, ground_contacts_against,
+};
 use crate::mapping::Mapping;
 use crate::skeleton::{Clip, Side, Skeleton, side_from_name};
 
@@ -76,6 +78,33 @@ pub fn clip_contacts(clip: &Clip, threshold_m: f64, min_flight_s: f64) -> Option
 /// Ground contact and flight of a clip: its feet ([`foot_points`]) and every other point of the
 /// body but a ground-proxy root ([`Skeleton::ground_proxy_root`], [`ground_contacts`]); `None` when a side has no foot point.
 pub fn clip_contacts_with(clip: &Clip, config: &ContactConfig) -> Option<Contacts> {
+    let (l, r, b) = clip_points(clip)?;
+    Some(ground_contacts(&l, &r, &b, clip.frame_time, config))
+}
+
+/// [`clip_contacts_with`] against the floor and rest heights of another clip of the same
+/// skeleton ([`Contacts::reference`], [`ground_contacts_against`]); `None` when a side has no
+/// foot point.
+pub fn clip_contacts_against(
+    clip: &Clip,
+    config: &ContactConfig,
+    reference: &ContactReference,
+) -> Option<Contacts> {
+    let (l, r, b) = clip_points(clip)?;
+    Some(ground_contacts_against(
+        &l,
+        &r,
+        &b,
+        clip.frame_time,
+        config,
+        reference,
+    ))
+}
+
+/// Every frame's left-foot, right-foot and other points of `clip` (see [`clip_contacts_with`]);
+/// `None` when a side has no foot point.
+#[allow(clippy::type_complexity)]
+fn clip_points(clip: &Clip) -> Option<(Vec<Vec<DVec3>>, Vec<Vec<DVec3>>, Vec<Vec<DVec3>>)> {
     let [lf, rf] = foot_points(&clip.skeleton);
     if lf.is_empty() || rf.is_empty() {
         return None;
@@ -87,12 +116,11 @@ pub fn clip_contacts_with(clip: &Clip, config: &ContactConfig) -> Option<Contact
         .flat_map(|j| std::iter::once((j, false)).chain(joints[j].end_site.map(|_| (j, true))))
         .filter(|p| !is_foot(p))
         .collect();
-    let (l, r, b) = (
+    Some((
         point_tracks(clip, &lf),
         point_tracks(clip, &rf),
         point_tracks(clip, &others),
-    );
-    Some(ground_contacts(&l, &r, &b, clip.frame_time, config))
+    ))
 }
 
 /// The global positions of `points` at every frame of `clip`, frame-major: `out[f][i]` is point

@@ -3,5 +3,9 @@
 mod contact;
 mod feet;
 
-pub use contact::{ContactConfig, Contacts, Span, ground_contacts};
-pub use feet::{PointRef, clip_contacts, clip_contacts_with, foot_points, point_tracks};
+pub use contact::{
+    ContactConfig, ContactReference, Contacts, Span, ground_contacts, ground_contacts_against,
+};
+pub use feet::{
+    PointRef, clip_contacts, clip_contacts_against, clip_contacts_with, foot_points, point_tracks,
+};

@@ -8,9 +8,10 @@
 //! height does not change under time-scaling, so at the apex the blend's root is at about
 //! `γ·apex_A + (1 − γ)·apex_B`, the demonstrations' highest root heights over the floor, γ at
 //! the normal jump's apex ([`JumpPrediction::apex_root_m`]); the high jump is made to reach that
-//! height. (Its apex *above its own standing* is then higher still than `γ·` of the two jumps'
-//! apexes above standing wherever the extrapolated stance bends the knees more than the
-//! demonstrations' and so stands lower: both figures are reported.) Time-scaling A to B's
+//! height. (Its apex *above its own standing* is measured from the extrapolated stance, which
+//! stands lower wherever it bends the knees more than the demonstrations: the prediction's
+//! standing is the blend's with its feet on the floor, [`JumpPrediction::standing_root_m`].)
+//! Time-scaling A to B's
 //! duration, however, gives both the same flight time, so a pointwise blend keeps the normal
 //! jump's flight however high it rises, which no ballistic flight does. So the blend's flight
 //! (the normal jump's, from foot contact) is stretched in time by what ballistics says the
@@ -22,8 +23,9 @@
 //! jumps and on the CMU ones the blend's own arc is within a few per cent of it). Before that
 //! the root is raised or lowered so that the lowest foot point stands on the normal jump's
 //! floor outside the flight (blending joint angles and root height separately lifts or sinks the
-//! feet). The flight time this gives is compared with the blend of the demonstrations' own
-//! flight times, `γ·flight_A + (1 − γ)·flight_B` ([`JumpPrediction`]).
+//! feet). The prediction of the flight is then the normal jump's flight plus that ballistic
+//! extra time ([`JumpPrediction::flight_s`]); every jump's flight is measured from foot contact
+//! against the normal jump's floor and foot-point rest heights, so the three are measured alike.
 //!
 //! [`learn_primitives`] makes the three primitives (the jumping knee kick of
 //! [`knee_kick`](super::knee_kick) starts from them); [`run`] also plays them and measures them:
@@ -32,8 +34,8 @@
 //! Plain data in and out: the demonstrations come as [`ModelClip`]s already on the model,
 //! nothing is read or written.
 
-use super::jump_figures::{JumpFigures, floor_of, jump_figures};
-use crate::analysis::Span;
+use super::jump_figures::{JumpFigures, contact_reference, jump_figures_against, standing_root_m};
+use crate::analysis::{ContactReference, Span};
 use crate::clips::GRAVITY;
 use crate::humanoid::{Model, ModelClip};
 use crate::primitive::{
@@ -92,8 +94,10 @@ pub struct HighJumpConfig {
     pub learn: LearnConfig,
 }
 
-/// What extrapolating the two jumps predicts for the high jump: each figure of the low (A) and
-/// normal (B) jump blended as `γ·A + (1 − γ)·B`, γ taken where that figure happens in the blend.
+/// What extrapolating the two jumps predicts for the high jump: the crouch and the root apex are
+/// `γ·A + (1 − γ)·B` of the low (A) and normal (B) jumps' figures, γ taken where that figure
+/// happens in the blend; the standing height is the extrapolated stance's, and the flight follows
+/// from the apex by ballistics.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct JumpPrediction {
     /// The blend's span T (the normal jump's duration), seconds: t′ = t / T.
@@ -108,17 +112,24 @@ pub struct JumpPrediction {
     pub gamma_at_apex: f64,
     /// Left-knee crouch flexion: γ_bend·low + (1 − γ_bend)·normal, degrees.
     pub crouch_knee_flexion_deg: f64,
-    /// Root apex above standing: γ_apex·low + (1 − γ_apex)·normal, metres (compared with the
-    /// high jump's; its standing is that of the extrapolated stance, see `apex_root_m`).
-    pub apex_above_standing_m: f64,
     /// Root apex over the floor: γ_apex·low + (1 − γ_apex)·normal of the demonstrations' highest
     /// root heights (both on the normal jump's floor), metres. The root channel is blended
     /// pointwise with the same γ as the joints, so this is where the blend's root is at the
     /// apex; the high jump is made to reach it.
     pub apex_root_m: f64,
-    /// Flight time of the demonstrations at their own durations blended: γ_apex·low +
-    /// (1 − γ_apex)·normal, seconds (the high jump's own flight follows from its apex by
-    /// ballistics and is compared with this).
+    /// Root height of the extrapolated stance: the blend's root over its first
+    /// [`STANDING_WINDOW_S`](super::jump_figures::STANDING_WINDOW_S) (median) once its feet are
+    /// put on the floor, metres. The blended joint angles decide how high a stance with the feet
+    /// on the floor holds the root (a deeper knee bend stands lower); the blend of the two
+    /// demonstrations' standing heights does not.
+    pub standing_root_m: f64,
+    /// Root apex above standing: `apex_root_m − standing_root_m`, metres.
+    pub apex_above_standing_m: f64,
+    /// Flight from foot contact: the normal jump's flight plus what ballistics says the higher
+    /// apex adds, [`FlightPlan::extra_flight_s`] (from the same take-off and landing heights),
+    /// seconds. The pointwise blend keeps the normal jump's timing (A is time-scaled to B's
+    /// span), so the extrapolated apex is the only thing that can change how long the figure is
+    /// in the air.
     pub flight_s: f64,
 }
 
@@ -160,6 +171,9 @@ pub struct HighJumpPrimitives {
     pub dt: f64,
     /// The floor the jumps stand on: where the normal jump's feet touch, metres.
     pub floor_y_m: f64,
+    /// The floor and foot-point rest heights of the normal jump, which every jump's contacts
+    /// and flight are measured against ([`jump_figures_against`]).
+    pub contact_reference: ContactReference,
     /// Largest root-height correction that put the blend's feet back on the floor, metres.
     pub ground_correction_m: f64,
     /// The low and normal demonstrations measured (at their own durations).
@@ -252,14 +266,16 @@ pub fn learn_primitives(
     // What the demonstrations did, each at its own duration, on the normal jump's floor.
     let mut normal_clip = on_model(model, &rollout(&normal.primitive, dt)?)?;
     let mut low_clip = on_model(model, &rollout(&low.primitive, dt)?)?;
-    let floor = floor_of(&normal_clip)
+    // The normal jump's floor and foot rest heights: every jump is measured against them.
+    let reference = contact_reference(&normal_clip)
         .ok_or_else(|| PrimitiveExperimentError::NoFlight("the model has no feet".into()))?;
+    let floor = reference.floor_y_m;
     // Measured as `run` writes them: with the floor constraint.
     normal_clip.lift_above_floor(floor);
     low_clip.lift_above_floor(floor);
     let demo_figures = [
-        jump_figures(&low_clip, floor),
-        jump_figures(&normal_clip, floor),
+        jump_figures_against(&low_clip, &reference),
+        jump_figures_against(&normal_clip, &reference),
     ];
     let [fl, fn_] = demo_figures;
     let normal_flight = fn_.flight.ok_or_else(|| {
@@ -278,21 +294,8 @@ pub fn learn_primitives(
     let gamma_at_apex = config.gamma.at(fn_.apex_time_s / t);
     let mix = |g: f64, a: f64, b: f64| g * a + (1.0 - g) * b;
     let crouch = |c: &ModelClip| crouch_peak_deg(c, dt);
-    let prediction = JumpPrediction {
-        span_s: t,
-        normal_bend_s: ev.bend,
-        normal_apex_s: fn_.apex_time_s,
-        gamma_at_bend,
-        gamma_at_apex,
-        crouch_knee_flexion_deg: mix(gamma_at_bend, crouch(&low_clip)?, crouch(&normal_clip)?),
-        apex_above_standing_m: mix(
-            gamma_at_apex,
-            fl.apex_above_standing_m,
-            fn_.apex_above_standing_m,
-        ),
-        apex_root_m: mix(gamma_at_apex, fl.apex_root_m, fn_.apex_root_m),
-        flight_s: mix(gamma_at_apex, fl.flight_s, fn_.flight_s),
-    };
+    let crouch_knee_flexion_deg = mix(gamma_at_bend, crouch(&low_clip)?, crouch(&normal_clip)?);
+    let apex_root_m = mix(gamma_at_apex, fl.apex_root_m, fn_.apex_root_m);
 
     // The paper's blend: A time-scaled to B's duration, both on [0, T].
     let placement = BlendPlacement {
@@ -313,18 +316,27 @@ pub fn learn_primitives(
     let mut blended = on_model(model, &result.trajectory)?;
     let (take_off, land) = feet_leave_and_touch(&normal_clip, normal_flight, floor);
     let ground_correction_m = blended.keep_feet_on_floor(&[(take_off, land)], floor);
-    let (high_clip, flight) = lengthen_flight(
-        &blended,
-        take_off,
-        land,
-        prediction.apex_root_m,
-        fn_.apex_root_m,
-    )?;
+    let (high_clip, flight) =
+        lengthen_flight(&blended, take_off, land, apex_root_m, fn_.apex_root_m)?;
+    let standing = standing_root_m(&blended);
+    let prediction = JumpPrediction {
+        span_s: t,
+        normal_bend_s: ev.bend,
+        normal_apex_s: fn_.apex_time_s,
+        gamma_at_bend,
+        gamma_at_apex,
+        crouch_knee_flexion_deg,
+        apex_root_m,
+        standing_root_m: standing,
+        apex_above_standing_m: apex_root_m - standing,
+        flight_s: fn_.flight_s + flight.extra_flight_s,
+    };
     let high = Primitive::learn("high_jump", &high_clip.to_trajectory(), &config.learn)?;
     Ok(HighJumpPrimitives {
         learned: Jumps { low, normal, high },
         dt,
         floor_y_m: floor,
+        contact_reference: reference,
         ground_correction_m,
         demo_figures,
         prediction,
@@ -502,10 +514,11 @@ pub fn run(config: &HighJumpConfig) -> Result<HighJumpOutcome, PrimitiveExperime
     };
     let mut low_time_scaled = on_model(model, &rollouts.low)?;
     low_time_scaled.lift_above_floor(floor);
+    let reference = &primitives.contact_reference;
     let figures = Jumps {
-        low: jump_figures(&clips.low, floor),
-        normal: jump_figures(&clips.normal, floor),
-        high: jump_figures(&clips.high, floor),
+        low: jump_figures_against(&clips.low, reference),
+        normal: jump_figures_against(&clips.normal, reference),
+        high: jump_figures_against(&clips.high, reference),
     };
     // The paper's knee flexion of a jump is that of its crouch: the peak before take-off.
     let crouch = Jumps {

@@ -29,7 +29,7 @@ use super::high_jump::{
     HighJumpConfig, HighJumpPrimitives, PrimitiveExperimentError, heights, learn_primitives,
     on_model, peak_deg, rollout,
 };
-use super::jump_figures::{JumpFigures, jump_figures};
+use super::jump_figures::{JumpFigures, jump_figures, jump_figures_against};
 use crate::humanoid::ModelClip;
 use crate::primitive::{
     Arrangement, BlendPlacement, Connected, EventConfig, Gamma, JumpEvents, Learned, Primitive,
@@ -178,8 +178,11 @@ pub fn run(config: &KneeKickConfig) -> Result<KneeKickOutcome, PrimitiveExperime
     jump_clip.lift_above_floor(floor);
     let (root_y, feet) = heights(&jump_clip);
     let ev = find_jump_events(&root_y, dt, Some(&feet), &config.events)?;
-    let jump_fig = jump_figures(&jump_clip, floor);
-    let flight = jump_fig.flight.ok_or_else(|| {
+    // Reported as the high jump's scene measures it (against the normal jump's contacts); the
+    // floor constraint below keeps the feet down outside the span where this clip's own feet
+    // (their own rest heights) are off the floor.
+    let jump_fig = jump_figures_against(&jump_clip, &jump.contact_reference);
+    let flight = jump_figures(&jump_clip, floor).flight.ok_or_else(|| {
         PrimitiveExperimentError::NoFlight("the high jump never has both feet off the floor".into())
     })?;
 
@@ -309,7 +312,7 @@ pub fn run(config: &KneeKickConfig) -> Result<KneeKickOutcome, PrimitiveExperime
         left_knee: peak_deg(&connected.trajectory, "left_knee")?,
     };
     Ok(KneeKickOutcome {
-        figures: jump_figures(&result_clip, floor),
+        figures: jump_figures_against(&result_clip, &jump.contact_reference),
         jump_figures: jump_fig,
         jump,
         jump_rollout,

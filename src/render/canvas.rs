@@ -427,6 +427,35 @@ mod tests {
     use super::*;
 
     #[test]
+    fn a_root_on_the_floor_under_the_hips_is_a_ground_proxy_and_a_pelvis_root_is_not() {
+        // root (on the floor) → hips 0.9 m up → two legs down to the floor, a spine up.
+        let names = [
+            "root", "hips", "l_knee", "l_foot", "r_knee", "r_foot", "head",
+        ];
+        let fig = super::super::figure::Figure {
+            names: names.iter().map(|s| s.to_string()).collect(),
+            parents: vec![None, Some(0), Some(1), Some(2), Some(1), Some(4), Some(1)],
+        };
+        let y = |x: f64, y: f64| DVec3::new(x, y, 0.0);
+        let pts = [
+            y(0.0, 0.0),
+            y(0.0, 0.9),
+            y(0.1, 0.45),
+            y(0.1, 0.0),
+            y(-0.1, 0.45),
+            y(-0.1, 0.0),
+            y(0.0, 1.7),
+        ];
+        assert_eq!(ground_proxy(&fig, &pts), Some(0));
+        // The same body without the floor root: the hips are the root, with three children.
+        let body = super::super::figure::Figure {
+            names: fig.names[1..].to_vec(),
+            parents: vec![None, Some(0), Some(1), Some(0), Some(3), Some(0)],
+        };
+        assert_eq!(ground_proxy(&body, &pts[1..]), None);
+    }
+
+    #[test]
     fn scale_bar_is_one_metre_when_it_fits_and_a_round_fraction_otherwise() {
         assert_eq!(scale_length(0.01, 200.0), 1.0);
         assert_eq!(scale_length(0.01, 60.0), 0.5);

@@ -260,6 +260,8 @@ pub fn run_high_jump(
         },
         "flight_plan": plan,
         "floor_y_m": hj.primitives.floor_y_m,
+        "flights_measured_against": FLIGHTS_AGAINST,
+        "contact_reference": hj.primitives.contact_reference,
         "peak_knee_flexion_deg": { "low": p.low, "normal": p.normal, "high": p.high },
         "peak_knee_flexion_whole_clip_deg": { "low": whole.low, "normal": whole.normal, "high": whole.high },
         "expected_high_deg": hj.expected_high_deg,
@@ -272,6 +274,11 @@ pub fn run_high_jump(
         "floor_lift_m": { "low": hj.floor_lift_m.low, "normal": hj.floor_lift_m.normal, "high": hj.floor_lift_m.high },
     }))
 }
+
+/// What the primitive reports' `flight` of every jump is measured against.
+const FLIGHTS_AGAINST: &str = "the normal jump's floor and foot rest heights \
+    (contact_reference), so that the jumps are measured alike; own_contacts_flight is each \
+    clip's flight with its own, as `marionette inspect` finds it in the written BVH";
 
 /// Writes a clip on the model as BVH.
 pub(super) fn write_bvh(path: &Path, clip: &ModelClip) -> Result<(), SceneError> {
@@ -400,6 +407,8 @@ pub fn run_jumping_knee_kick(
         "jump_gamma": scene.jump.gamma.label(),
         "jump": kk.jump_figures,
         "jumping_knee_kick": kk.figures,
+        "flights_measured_against": FLIGHTS_AGAINST,
+        "contact_reference": kk.jump.contact_reference,
         "at_leap": {
             "airborne": kk.airborne_at_leap,
             "feet_above_floor_m": kk.feet_above_floor_at_leap_m,
