@@ -86,14 +86,14 @@ impl AxisRotation {
         }
     }
 
-    /// `Rᵀ v`.
+    /// `Rᵀ v`: the rotation by `−φ`.
     #[inline]
     pub fn apply_transpose(&self, v: DVec3) -> DVec3 {
-        match self.k {
-            0 => rot::<1, 2>(self.c, -self.s, v),
-            1 => rot::<2, 0>(self.c, -self.s, v),
-            _ => rot::<0, 1>(self.c, -self.s, v),
+        Self {
+            s: -self.s,
+            ..*self
         }
+        .apply(v)
     }
 
     /// `A R`: columns `i` and `j` of `A` mixed.
