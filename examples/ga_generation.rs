@@ -7,12 +7,17 @@
 //! to find what makes the age groups' first generations differ, the other group's joint
 //! ranges (`RANGES=adult|elderly`: θ_d bounds and the simulated ranges) or strength
 //! (`STRENGTH=adult|elderly`: torque limits and k_p bounds, the step re-derived from them).
+//! `RANGE_KEYS=knee,hip_flexion` takes only those side-less DOFs' ranges from `RANGES`;
+//! `RANGES_FOR=genes|sim` applies them only to the θ_d bounds or only to the simulated ranges.
+//! `KEY=stance` replaces every θ_d gene by the stance pose (random k_p only: the fall of a
+//! body that holds its stance). Besides each fall, it prints the mean damage share per link over the falls and the link
+//! that carries the most damage in the best one.
 
 use marionette::evolve::fall_fitness::{stable_step_for, strength_kp_max};
 use marionette::evolve::{FallProblem, GaConfig, GaState, InProcess};
 use marionette::experiments::fall::Ranges;
 use marionette::experiments::fall::{SettledStart, ecs::run_parallel_from};
-use marionette::humanoid::ranges::AgeGroup;
+use marionette::humanoid::ranges::{AgeGroup, RangeTable};
 
 fn env(name: &str) -> Option<f64> {
     std::env::var(name).ok().map(|v| v.parse().expect(name))
@@ -36,8 +41,33 @@ fn main() {
         _ => AgeGroup::Elderly,
     };
     let mut problem = FallProblem::paper(group);
+    let own = RangeTable::builtin(group);
+    let mut sim_ranges = Ranges::Table(own.clone());
     if let Some(g) = group_env("RANGES") {
-        problem.fall.ranges = Ranges::Builtin(g);
+        let other = RangeTable::builtin(g);
+        let mut table = own.clone();
+        match std::env::var("RANGE_KEYS") {
+            Ok(keys) => {
+                for k in keys.split(',') {
+                    let r = *other
+                        .ranges
+                        .get(k)
+                        .unwrap_or_else(|| panic!("RANGE_KEYS: {k}"));
+                    table.ranges.insert(k.to_string(), r);
+                }
+            }
+            Err(_) => table = other,
+        }
+        let table = Ranges::Table(table);
+        match std::env::var("RANGES_FOR").as_deref() {
+            Ok("genes") => problem.fall.ranges = table,
+            Ok("sim") => sim_ranges = table,
+            Ok(other) => panic!("RANGES_FOR={other}: genes or sim"),
+            Err(_) => {
+                problem.fall.ranges = table.clone();
+                sim_ranges = table;
+            }
+        }
     }
     if let Some(g) = group_env("STRENGTH") {
         problem.fall.torque_limits_nm = Some(marionette::humanoid::strength::torque_limits(g));
@@ -64,6 +94,10 @@ fn main() {
     }
     eprintln!("dt = {} s", problem.fall.dt_s);
     let bounds = problem.bounds().expect("bounds");
+    // The θ_d bounds are taken; from here the fall simulates `sim_ranges`.
+    if std::env::var("RANGES_FOR").is_ok() {
+        problem.fall.ranges = sim_ranges;
+    }
     let cfg = GaConfig {
         population: n.max(2),
         generations: 1,
@@ -75,6 +109,8 @@ fn main() {
     };
     let state = GaState::initial(cfg, bounds, &mut free).expect("GA");
     let edge = std::env::var("EDGE").is_ok();
+    let stance_key = std::env::var("KEY").as_deref() == Ok("stance");
+    let nd = problem.kp_max.len();
     let configs: Vec<_> = state.population[..n]
         .iter()
         .map(|g| {
@@ -86,6 +122,11 @@ fn main() {
                     *x = if *x - lo < hi - *x { lo } else { hi };
                 }
             }
+            if stance_key {
+                for (x, s) in g[..nd].iter_mut().zip(&problem.fall.stance_pose_deg) {
+                    *x = s.to_radians();
+                }
+            }
             problem.config(&g)
         })
         .collect();
@@ -95,11 +136,44 @@ fn main() {
     let wall = t0.elapsed().as_secs_f64();
     let mut steps = 0;
     let mut best = f64::INFINITY;
+    let mut best_link = String::new();
+    // Per link over the completed falls: damage share, damage (N), falls it touched in, summed
+    // impact velocity (m/s).
+    let mut share: Vec<(String, f64, f64, usize, f64)> = Vec::new();
+    let mut completed = 0.0;
     for (i, r) in results.iter().enumerate() {
         match r {
             Ok(f) => {
                 steps += f.steps;
-                best = best.min(f.damage);
+                completed += 1.0;
+                if share.is_empty() {
+                    share = f
+                        .impacts
+                        .iter()
+                        .map(|l| (l.link.clone(), 0.0, 0.0, 0, 0.0))
+                        .collect();
+                }
+                for (s, l) in share.iter_mut().zip(&f.impacts) {
+                    s.1 += l.damage_n / f.damage;
+                    s.2 += l.damage_n;
+                    if l.touchdown_s.is_some() {
+                        s.3 += 1;
+                        s.4 += l.impact_velocity_m_s;
+                    }
+                }
+                if f.damage < best {
+                    best = f.damage;
+                    let top = f
+                        .impacts
+                        .iter()
+                        .max_by(|a, b| a.damage_n.total_cmp(&b.damage_n));
+                    best_link = top.map_or(String::new(), |l| {
+                        format!(
+                            "{} {:.0} N ({:.2} m/s)",
+                            l.link, l.damage_n, l.impact_velocity_m_s
+                        )
+                    });
+                }
                 let (d, ex) = f
                     .max_limit_excursion_rad
                     .iter()
@@ -122,5 +196,28 @@ fn main() {
         "{n} falls, {steps} steps, {wall:.3} s wall, {:.1} falls/s",
         n as f64 / wall
     );
+    share.sort_by(|a, b| b.1.total_cmp(&a.1));
+    let shares: Vec<String> = share
+        .iter()
+        .take(4)
+        .map(|(l, x, d, k, v)| {
+            format!(
+                "{l} {:.0} % ({:.0} N; touched in {k}, at {:.2} m/s)",
+                100.0 * x / completed,
+                d / completed,
+                v / (*k).max(1) as f64
+            )
+        })
+        .collect();
+    println!("mean damage share: {}", shares.join(", "));
+    println!("best fall's largest share: {best_link}");
+    let mut damages: Vec<f64> = results.iter().flatten().map(|f| f.damage).collect();
+    damages.sort_by(f64::total_cmp);
+    if let Some(median) = damages.get(damages.len() / 2) {
+        println!(
+            "population damage: mean {:.0} N, median {median:.0} N",
+            damages.iter().sum::<f64>() / damages.len() as f64
+        );
+    }
     println!("best damage {best}");
 }

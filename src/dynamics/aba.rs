@@ -73,7 +73,7 @@ pub fn aba_passes(
                     ia.sub_outer(u, dinv);
                     let pa_a = pa + ia.apply(data.c[i]) + u * (dinv * uu);
                     let x = &data.xup[i];
-                    ia_head[p] += ia.transform_to_parent(x);
+                    ia_head[p] += ia.transform_to_parent_with(x, &data.xup_rotation[i]);
                     data.pa[p] += x.inv_apply_force(pa_a);
                 }
             }
@@ -108,7 +108,7 @@ pub fn aba_passes(
                         pa_a += u[k] * w[k];
                     }
                     let x = &data.xup[i];
-                    ia_head[p] += ia.transform_to_parent(x);
+                    ia_head[p] += ia.transform_to_parent_with(x, &data.xup_rotation[i]);
                     data.pa[p] += x.inv_apply_force(pa_a);
                 }
             }
@@ -117,7 +117,7 @@ pub fn aba_passes(
                 if let Some(p) = body.parent {
                     let pa_a = pa + ia.apply(data.c[i]);
                     let x = &data.xup[i];
-                    ia_head[p] += ia.transform_to_parent(x);
+                    ia_head[p] += ia.transform_to_parent_with(x, &data.xup_rotation[i]);
                     data.pa[p] += x.inv_apply_force(pa_a);
                 }
             }

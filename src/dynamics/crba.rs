@@ -43,7 +43,7 @@ pub fn crba<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> &'d [f64] {
     }
     for i in (0..n).rev() {
         if let Some(p) = model.bodies[i].parent {
-            let add = data.ic[i].transform_to_parent(&data.xup[i]);
+            let add = data.ic[i].transform_to_parent_with(&data.xup[i], &data.xup_rotation[i]);
             data.ic[p] += add;
         }
     }

@@ -1,6 +1,7 @@
 //! The scratch workspace of the dynamics algorithms (Pinocchio's `Data`): every buffer is sized
 //! once from a [`Model`], so the algorithms never allocate.
 
+use super::axis_rotation::JointRotation;
 use super::model::Model;
 use super::spatial::{ArticulatedInertia, ForceVec, MotionVec, SpatialTransform};
 use glam::{DMat3, DVec3};
@@ -11,6 +12,9 @@ use glam::{DMat3, DVec3};
 pub struct Data {
     /// `Xup[i]`: parent frame → body `i` frame (world → body for a root).
     pub xup: Vec<SpatialTransform>,
+    /// The joint rotation of each `Xup` as its coordinate-axis factors, where the model's
+    /// [`JointAxes`](super::axis_rotation::JointAxes) has them.
+    pub xup_rotation: Vec<JointRotation>,
     /// Motion-subspace columns `S` of each joint, body coordinates (first `nv` used; free: none).
     pub s: Vec<[MotionVec; 3]>,
     /// Body spatial velocity, body coordinates.
@@ -57,6 +61,7 @@ impl Data {
         let nv = model.nv;
         Self {
             xup: vec![SpatialTransform::IDENTITY; n],
+            xup_rotation: vec![JointRotation::General; n],
             s: vec![[MotionVec::ZERO; 3]; n],
             v: vec![MotionVec::ZERO; n],
             c: vec![MotionVec::ZERO; n],

@@ -10,6 +10,7 @@
 //! The motion-subspace columns of pin, universal and ball joints are pure rotations `[a; 0]`
 //! (the joint frame's origin is the rotation centre); the articulated-body algorithm relies on it.
 
+use super::axis_rotation::{AxisRotation, JointAxes, JointRotation};
 use super::spatial::{MotionVec, SpatialTransform};
 use glam::{DMat3, DQuat, DVec3};
 
@@ -205,6 +206,53 @@ impl JointType {
                 (x, vj, MotionVec::ZERO)
             }
             JointType::Fixed => (SpatialTransform::IDENTITY, MotionVec::ZERO, MotionVec::ZERO),
+        }
+    }
+
+    /// [`JointType::jcalc`] for a joint whose rotation factors into rotations about coordinate
+    /// axes (`axes`, from the model): the same `X_J`, `v_J`, `c_J` and `S` from the factors'
+    /// sines and cosines, without general 3×3 products, and the factors themselves. Joints
+    /// without that structure (`JointAxes::General`) take [`JointType::jcalc`].
+    #[inline]
+    pub fn jcalc_axes(
+        &self,
+        axes: JointAxes,
+        q: &[f64],
+        qd: &[f64],
+        s: &mut [MotionVec; 3],
+    ) -> (SpatialTransform, MotionVec, MotionVec, JointRotation) {
+        match (self, axes) {
+            (JointType::Pin { axis }, JointAxes::One(a)) => {
+                let r = AxisRotation::new(a, q[0]);
+                s[0] = MotionVec::new(*axis, DVec3::ZERO);
+                let e = r.matrix().transpose();
+                (
+                    SpatialTransform::rotation(e),
+                    s[0] * qd[0],
+                    MotionVec::ZERO,
+                    JointRotation::One(r),
+                )
+            }
+            (JointType::Universal { axis1, axis2 }, JointAxes::Two(a1, a2)) => {
+                let r1 = AxisRotation::new(a1, q[0]);
+                let r2 = AxisRotation::new(a2, q[1]);
+                let b = r2.apply_transpose(*axis1);
+                s[0] = MotionVec::new(b, DVec3::ZERO);
+                s[1] = MotionVec::new(*axis2, DVec3::ZERO);
+                let vj = MotionVec::new(b * qd[0] + *axis2 * qd[1], DVec3::ZERO);
+                let cj = MotionVec::new(b.cross(*axis2) * (qd[0] * qd[1]), DVec3::ZERO);
+                let r = r2.mul_right(&r1.matrix());
+                (
+                    SpatialTransform::rotation(r.transpose()),
+                    vj,
+                    cj,
+                    JointRotation::Two(r1, r2),
+                )
+            }
+            _ => {
+                let (x, vj, cj) = self.jcalc(q, qd, s);
+                (x, vj, cj, JointRotation::General)
+            }
         }
     }
 

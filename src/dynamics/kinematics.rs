@@ -2,9 +2,10 @@
 //! subspaces, body velocities `v_i = Xup_i v_λ(i) + v_J`, velocity products
 //! `c_i = c_J + v_i ×m v_J`, and world poses of every body.
 
+use super::axis_rotation::JointRotation;
 use super::data::Data;
 use super::model::Model;
-use super::spatial::MotionVec;
+use super::spatial::{MotionVec, SpatialTransform};
 
 /// Fills `data.xup, s, v, c, rot, pos` for configuration `q` (size nq) and velocity `v` (size nv).
 #[inline]
@@ -14,16 +15,35 @@ pub fn kinematics(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) {
     for (i, body) in model.bodies.iter().enumerate() {
         let (iq, iv) = (model.q_idx[i], model.v_idx[i]);
         let j = &body.joint;
-        let (xj, vj, cj) = j.jcalc(&q[iq..iq + j.nq()], &v[iv..iv + j.nv()], &mut data.s[i]);
-        let xup = xj * body.x_tree;
+        let axes = model.joint_axes[i];
+        let (xj, vj, cj, rotation) = j.jcalc_axes(
+            axes,
+            &q[iq..iq + j.nq()],
+            &v[iv..iv + j.nv()],
+            &mut data.s[i],
+        );
+        let xup = match rotation {
+            // `X_tree` is a pure translation and `X_J` a pure rotation: `X_J X_tree` is
+            // `rot(E_J)` with the tree's translation.
+            JointRotation::General => xj * body.x_tree,
+            _ => SpatialTransform {
+                rot: xj.rot,
+                trans: body.x_tree.trans,
+            },
+        };
         data.xup[i] = xup;
+        data.xup_rotation[i] = rotation;
         match body.parent {
             Some(p) => {
                 let vi = xup.apply_motion(data.v[p]) + vj;
                 data.v[i] = vi;
                 data.c[i] = cj + vi.cross_motion(vj);
                 let rp = data.rot[p];
-                data.rot[i] = rp * xup.rot.transpose();
+                data.rot[i] = match rotation {
+                    JointRotation::General => rp * xup.rot.transpose(),
+                    JointRotation::One(r) => r.mul_right(&rp),
+                    JointRotation::Two(r1, r2) => r2.mul_right(&r1.mul_right(&rp)),
+                };
                 data.pos[i] = data.pos[p] + rp * xup.trans;
             }
             None => {

@@ -14,6 +14,7 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod aba;
+pub mod axis_rotation;
 pub mod crba;
 pub mod data;
 pub mod forces;

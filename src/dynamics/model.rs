@@ -5,6 +5,7 @@
 //! `i`. Configuration `q` (size `nq`) and velocity `v` (size `nv`) differ in size because ball
 //! and free joints carry unit quaternions (4 numbers) for 3 rotational velocities.
 
+use super::axis_rotation::{CoordAxis, JointAxes};
 use super::joint::JointType;
 use super::spatial::{ArticulatedInertia, Inertia, SpatialTransform};
 use glam::DVec3;
@@ -91,6 +92,27 @@ pub struct Model {
     /// Each body's rigid inertia as 3×3 blocks, derived from `bodies` at construction (the
     /// articulated-body algorithm starts from these; rebuild the model after editing inertias).
     pub inertia_blocks: Vec<ArticulatedInertia>,
+    /// How each body's joint rotation factors into rotations about coordinate axes, derived
+    /// from `bodies` at construction (the kinematics and the ABA take the cheaper products where
+    /// it does).
+    pub joint_axes: Vec<JointAxes>,
+}
+
+/// The coordinate-axis structure of body `b`'s joint rotation: a pin or universal joint whose
+/// axes are coordinate axes and whose tree transform does not rotate.
+fn joint_axes(b: &Body) -> JointAxes {
+    if b.x_tree.rot != glam::DMat3::IDENTITY {
+        return JointAxes::General;
+    }
+    match b.joint {
+        JointType::Pin { axis } => CoordAxis::of(axis).map_or(JointAxes::General, JointAxes::One),
+        JointType::Universal { axis1, axis2 } => match (CoordAxis::of(axis1), CoordAxis::of(axis2))
+        {
+            (Some(a), Some(b)) => JointAxes::Two(a, b),
+            _ => JointAxes::General,
+        },
+        _ => JointAxes::General,
+    }
 }
 
 impl Model {
@@ -152,8 +174,10 @@ impl Model {
             nv += b.joint.nv();
         }
         let inertia_blocks = bodies.iter().map(|b| b.inertia.to_blocks()).collect();
+        let joint_axes = bodies.iter().map(joint_axes).collect();
         Ok(Self {
             inertia_blocks,
+            joint_axes,
             bodies,
             gravity,
             q_idx,

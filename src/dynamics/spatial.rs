@@ -6,6 +6,7 @@
 //! A [`SpatialTransform`] `X` from frame A to frame B is `rot(E)·xlt(r)`: `E` rotates A
 //! coordinates into B coordinates and `r` is B's origin expressed in A.
 
+use super::axis_rotation::JointRotation;
 use glam::{DMat3, DVec3};
 use serde::{Deserialize, Serialize};
 use std::ops::{Add, AddAssign, Mul, Neg, Sub, SubAssign};
@@ -417,11 +418,18 @@ impl ArticulatedInertia {
     /// `L_A = L'`.
     #[inline]
     pub fn transform_to_parent(&self, x: &SpatialTransform) -> Self {
+        self.transform_to_parent_with(x, &JointRotation::General)
+    }
+
+    /// [`ArticulatedInertia::transform_to_parent`] with `x`'s rotation also given as its
+    /// coordinate-axis factors (`rotation`, from the kinematics): `EᵀAE = R A Rᵀ` per block
+    /// through them.
+    #[inline]
+    pub fn transform_to_parent_with(&self, x: &SpatialTransform, rotation: &JointRotation) -> Self {
         let e = x.rot;
-        let et = e.transpose();
-        let m1 = et * self.m * e;
-        let h1 = et * self.h * e;
-        let l1 = et * self.l * e;
+        let m1 = rotation.conjugate(&e, &self.m);
+        let h1 = rotation.conjugate(&e, &self.h);
+        let l1 = rotation.conjugate(&e, &self.l);
         // The products with R = [r]× as cross products: `R A` has columns `r × a_j` and
         // `A R` columns `a_y r_z − a_z r_y, a_z r_x − a_x r_z, a_x r_y − a_y r_x`, the same
         // bits as multiplying by `skew(r)` (its zero entries add nothing) at a third of the work.

@@ -1,0 +1,231 @@
+//! Rotations about coordinate axes, the joints of a human model: a revolute joint whose axis is
+//! `±e_k` and whose tree transform does not rotate turns its child by `R = R_k(φ)`, which mixes
+//! only two coordinates. The kinematics and the articulated-body algorithm use that structure
+//! where it holds ([`JointAxes`] per body, found once in the model) instead of general 3×3
+//! products: `R A Rᵀ` costs 24 multiplications instead of 54, `A R` 12 instead of 27, `R v` 4
+//! instead of 9.
+
+use glam::{DMat3, DVec3};
+
+/// A signed coordinate axis `sign · e_k` (`k` = 0, 1, 2 for x, y, z; `sign` = ±1).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CoordAxis {
+    /// Coordinate index.
+    pub k: usize,
+    /// +1 or −1.
+    pub sign: f64,
+}
+
+impl CoordAxis {
+    /// The coordinate axis `a` is exactly, if it is one (`±e_x`, `±e_y`, `±e_z`).
+    pub fn of(a: DVec3) -> Option<Self> {
+        let v = a.to_array();
+        let k = (0..3).find(|&k| v[k].abs() == 1.0)?;
+        let others_zero = (0..3).all(|m| m == k || v[m] == 0.0);
+        others_zero.then_some(Self { k, sign: v[k] })
+    }
+}
+
+/// How a body's joint rotation `R` (child → parent coordinates) factors, found once per model:
+/// into one or two rotations about coordinate axes (a pin or universal joint with such axes and a
+/// tree transform without rotation), or not at all.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum JointAxes {
+    /// `R` has no coordinate-axis structure used here (ball, free, fixed joints, general axes, or
+    /// a rotating tree transform).
+    General,
+    /// `R = R_a(θ)`.
+    One(CoordAxis),
+    /// `R = R_a(θ₁) R_b(θ₂)`.
+    Two(CoordAxis, CoordAxis),
+}
+
+/// The rotation by angle `φ` about coordinate axis `k` (`c = cos φ`, `s = sin φ`): with
+/// `(i, j)` the next two coordinates in cyclic order, `R e_i = c e_i + s e_j`,
+/// `R e_j = −s e_i + c e_j`, `R e_k = e_k`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AxisRotation {
+    /// The axis' coordinate index.
+    pub k: usize,
+    /// `cos φ`.
+    pub c: f64,
+    /// `sin φ`.
+    pub s: f64,
+}
+
+impl AxisRotation {
+    /// The rotation by `theta` (rad) about the signed axis `axis`.
+    #[inline]
+    pub fn new(axis: CoordAxis, theta: f64) -> Self {
+        let (s, c) = theta.sin_cos();
+        Self {
+            k: axis.k,
+            c,
+            s: axis.sign * s,
+        }
+    }
+
+    /// `R` as a matrix.
+    #[inline]
+    pub fn matrix(&self) -> DMat3 {
+        let (c, s) = (self.c, self.s);
+        match self.k {
+            0 => DMat3::from_cols(DVec3::X, DVec3::new(0.0, c, s), DVec3::new(0.0, -s, c)),
+            1 => DMat3::from_cols(DVec3::new(c, 0.0, -s), DVec3::Y, DVec3::new(s, 0.0, c)),
+            _ => DMat3::from_cols(DVec3::new(c, s, 0.0), DVec3::new(-s, c, 0.0), DVec3::Z),
+        }
+    }
+
+    /// `R v`.
+    #[inline]
+    pub fn apply(&self, v: DVec3) -> DVec3 {
+        match self.k {
+            0 => rot::<1, 2>(self.c, self.s, v),
+            1 => rot::<2, 0>(self.c, self.s, v),
+            _ => rot::<0, 1>(self.c, self.s, v),
+        }
+    }
+
+    /// `Rᵀ v`: the rotation by `−φ`.
+    #[inline]
+    pub fn apply_transpose(&self, v: DVec3) -> DVec3 {
+        Self {
+            s: -self.s,
+            ..*self
+        }
+        .apply(v)
+    }
+
+    /// `A R`: columns `i` and `j` of `A` mixed.
+    #[inline]
+    pub fn mul_right(&self, a: &DMat3) -> DMat3 {
+        match self.k {
+            0 => mix_cols::<1, 2>(self.c, -self.s, a),
+            1 => mix_cols::<2, 0>(self.c, -self.s, a),
+            _ => mix_cols::<0, 1>(self.c, -self.s, a),
+        }
+    }
+
+    /// `R A Rᵀ`: `A Rᵀ` mixes columns `i` and `j`, then `R` rows `i` and `j`.
+    #[inline]
+    pub fn conjugate(&self, a: &DMat3) -> DMat3 {
+        match self.k {
+            0 => conjugate::<1, 2>(self.c, self.s, a),
+            1 => conjugate::<2, 0>(self.c, self.s, a),
+            _ => conjugate::<0, 1>(self.c, self.s, a),
+        }
+    }
+}
+
+/// `v` with components `I`, `J` rotated: `(c v_I − s v_J, s v_I + c v_J)`.
+#[inline(always)]
+fn rot<const I: usize, const J: usize>(c: f64, s: f64, v: DVec3) -> DVec3 {
+    let mut r = v;
+    r[I] = c * v[I] - s * v[J];
+    r[J] = s * v[I] + c * v[J];
+    r
+}
+
+/// `A` with columns `I`, `J` mixed as `(c a_I − s a_J, s a_I + c a_J)`: `A Rᵀ` for the rotation
+/// `(c, s)`, `A R` for `(c, −s)`.
+#[inline(always)]
+fn mix_cols<const I: usize, const J: usize>(c: f64, s: f64, a: &DMat3) -> DMat3 {
+    let mut m = *a;
+    let (ai, aj) = (a.col(I), a.col(J));
+    *m.col_mut(I) = ai * c - aj * s;
+    *m.col_mut(J) = ai * s + aj * c;
+    m
+}
+
+/// `R A Rᵀ` for the rotation `(c, s)` in the `I`–`J` plane.
+#[inline(always)]
+fn conjugate<const I: usize, const J: usize>(c: f64, s: f64, a: &DMat3) -> DMat3 {
+    let b = mix_cols::<I, J>(c, s, a);
+    DMat3::from_cols(
+        rot::<I, J>(c, s, b.x_axis),
+        rot::<I, J>(c, s, b.y_axis),
+        rot::<I, J>(c, s, b.z_axis),
+    )
+}
+
+/// A body's joint rotation `R` (child → parent) at the current configuration, in the form
+/// [`JointAxes`] allows: `E = Rᵀ` is the rotation of the body's `Xup`.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub enum JointRotation {
+    /// Only the matrix in `Xup` is known.
+    #[default]
+    General,
+    /// `R = R₁`.
+    One(AxisRotation),
+    /// `R = R₁ R₂`.
+    Two(AxisRotation, AxisRotation),
+}
+
+impl JointRotation {
+    /// `Eᵀ A E` for the rotation `e` (= `Rᵀ`) of `Xup`: `R A Rᵀ`, through the factors when known.
+    #[inline]
+    pub fn conjugate(&self, e: &DMat3, a: &DMat3) -> DMat3 {
+        match self {
+            JointRotation::General => e.transpose() * *a * *e,
+            JointRotation::One(r) => r.conjugate(a),
+            JointRotation::Two(r1, r2) => r1.conjugate(&r2.conjugate(a)),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn a() -> DMat3 {
+        DMat3::from_cols(
+            DVec3::new(0.3, -1.2, 0.7),
+            DVec3::new(2.1, 0.4, -0.9),
+            DVec3::new(-0.5, 1.6, 0.8),
+        )
+    }
+
+    fn close(x: DMat3, y: DMat3) -> bool {
+        (x - y).to_cols_array().iter().all(|e| e.abs() < 1e-14)
+    }
+
+    #[test]
+    fn axis_rotation_matches_the_general_rotation_about_that_axis() {
+        for (axis, k, sign) in [
+            (DVec3::X, 0, 1.0),
+            (DVec3::NEG_X, 0, -1.0),
+            (DVec3::Y, 1, 1.0),
+            (DVec3::NEG_Y, 1, -1.0),
+            (DVec3::Z, 2, 1.0),
+            (DVec3::NEG_Z, 2, -1.0),
+        ] {
+            let ax = CoordAxis::of(axis).unwrap();
+            assert_eq!(ax, CoordAxis { k, sign });
+            let theta = 0.83;
+            let r = AxisRotation::new(ax, theta);
+            let g = DMat3::from_axis_angle(axis, theta);
+            assert!(close(r.matrix(), g), "{axis}");
+            let v = DVec3::new(0.4, -1.1, 2.3);
+            assert!((r.apply(v) - g * v).length() < 1e-14);
+            assert!((r.apply_transpose(v) - g.transpose() * v).length() < 1e-14);
+            assert!(close(r.mul_right(&a()), a() * g));
+            assert!(close(r.conjugate(&a()), g * a() * g.transpose()));
+            let e = g.transpose();
+            let r2 = AxisRotation::new(CoordAxis::of(DVec3::Y).unwrap(), -0.4);
+            let g2 = DMat3::from_axis_angle(DVec3::Y, -0.4);
+            let two = JointRotation::Two(r, r2).conjugate(&(g * g2).transpose(), &a());
+            assert!(close(two, g * g2 * a() * (g * g2).transpose()));
+            assert!(close(
+                JointRotation::General.conjugate(&e, &a()),
+                g * a() * g.transpose()
+            ));
+        }
+    }
+
+    #[test]
+    fn only_exact_coordinate_axes_qualify() {
+        assert!(CoordAxis::of(DVec3::new(0.6, 0.8, 0.0)).is_none());
+        assert!(CoordAxis::of(DVec3::new(1.0, 1e-17, 0.0)).is_none());
+        assert!(CoordAxis::of(DVec3::ZERO).is_none());
+    }
+}
