@@ -158,6 +158,10 @@ const KNOWN: [Known; 6] = [
 ];
 
 #[test]
+#[cfg_attr(
+    not(shared_data),
+    ignore = "needs the shared data: set MARIONETTE_DATA (default ../shared/data)"
+)]
 fn all_data_files_parse_with_their_known_shape_and_round_trip_exactly() {
     let Some(dir) = data_dir() else { return };
     for k in &KNOWN {
@@ -185,6 +189,10 @@ fn all_data_files_parse_with_their_known_shape_and_round_trip_exactly() {
 }
 
 #[test]
+#[cfg_attr(
+    not(shared_data),
+    ignore = "needs the shared data: set MARIONETTE_DATA (default ../shared/data)"
+)]
 fn jumps_file_has_the_cmu_skeleton() {
     let Some(dir) = data_dir() else { return };
     let (b, _) = bvh::parse_file(&dir.join("cmu/cmu_01_01_forward_jumps.bvh")).unwrap();
@@ -209,6 +217,10 @@ fn jumps_file_has_the_cmu_skeleton() {
 }
 
 #[test]
+#[cfg_attr(
+    not(shared_data),
+    ignore = "needs the shared data: set MARIONETTE_DATA (default ../shared/data)"
+)]
 fn bandai_files_have_six_channels_on_every_joint() {
     let Some(dir) = data_dir() else { return };
     let (b, _) = bvh::parse_file(&dir.join("bandai/bandai1_kick_normal_001.bvh")).unwrap();
@@ -865,6 +877,10 @@ fn parse_file_errors_name_the_file() {
 }
 
 #[test]
+#[cfg_attr(
+    not(shared_data),
+    ignore = "needs the shared data: set MARIONETTE_DATA (default ../shared/data)"
+)]
 fn a_value_or_a_frame_missing_from_the_jumps_file() {
     let Some(dir) = data_dir() else { return };
     let text = std::fs::read_to_string(dir.join("cmu/cmu_01_01_forward_jumps.bvh")).unwrap();

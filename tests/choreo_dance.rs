@@ -259,6 +259,10 @@ fn every_bad_input_is_one_clear_error_and_leaves_the_outputs() {
 }
 
 #[test]
+#[cfg_attr(
+    not(shared_data),
+    ignore = "needs the shared data: set MARIONETTE_DATA (default ../shared/data)"
+)]
 fn the_salsa_scene_runs_on_the_shared_data() {
     let (Some(_), Some(_)) = (
         common::data_path("dance"),

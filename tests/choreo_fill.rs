@@ -130,6 +130,10 @@ fn shared_database() -> Option<Database> {
 }
 
 #[test]
+#[cfg_attr(
+    not(shared_data),
+    ignore = "needs the shared data: set MARIONETTE_DATA (default ../shared/data)"
+)]
 fn fig5_on_the_shared_dance_database() {
     let Some(db) = shared_database() else {
         return;

@@ -187,6 +187,10 @@ fn a_stereo_wav_decodes_to_its_mono_mix_and_analyses_like_the_buffer() {
 
 #[cfg(feature = "audio")]
 #[test]
+#[cfg_attr(
+    not(shared_data),
+    ignore = "needs the shared data: set MARIONETTE_DATA (default ../shared/data)"
+)]
 fn the_real_songs_decode_and_have_a_steady_beat() {
     use marionette::choreo::music::decode::decode_file;
     let Some(dir) = common::data_path("audio") else {

@@ -187,6 +187,10 @@ fn fig4_on_a_generated_database() {
 }
 
 #[test]
+#[cfg_attr(
+    not(shared_data),
+    ignore = "needs the shared data: set MARIONETTE_DATA (default ../shared/data)"
+)]
 fn fig4_on_the_shared_dance_clips() {
     let Some(dir) = common::data_path("dance") else {
         return;

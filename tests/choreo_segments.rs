@@ -180,6 +180,10 @@ fn kinematic_tempo_of_a_generated_clip_is_within_2_percent() {
 }
 
 #[test]
+#[cfg_attr(
+    not(shared_data),
+    ignore = "needs the shared data: set MARIONETTE_DATA (default ../shared/data)"
+)]
 fn shared_dance_clips_segments_and_tempo() {
     let Some(dir) = common::data_path("dance") else {
         return;

@@ -385,6 +385,10 @@ fn lying_after_the_project_s_fall_is_not_flight() {
 }
 
 #[test]
+#[cfg_attr(
+    not(shared_data),
+    ignore = "needs the shared data: set MARIONETTE_DATA (default ../shared/data)"
+)]
 fn the_cmu_forward_jumps_have_exactly_their_ten_flights() {
     let Some(file) = common::data_path("cmu/cmu_01_01_forward_jumps.bvh") else {
         return;
@@ -418,6 +422,10 @@ fn run_scene_without_gif(scene: &str, out: &str) -> (PathBuf, serde_json::Value)
 }
 
 #[test]
+#[cfg_attr(
+    not(shared_data),
+    ignore = "needs the shared data: set MARIONETTE_DATA (default ../shared/data)"
+)]
 fn the_mapped_cmu_jumps_keep_the_source_s_two_flights() {
     let Some(_) = common::data_dir() else {
         return;

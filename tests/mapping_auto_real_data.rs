@@ -27,6 +27,10 @@ fn real_files() -> Option<Vec<std::path::PathBuf>> {
 }
 
 #[test]
+#[cfg_attr(
+    not(shared_data),
+    ignore = "needs the shared data: set MARIONETTE_DATA (default ../shared/data)"
+)]
 fn every_real_file_maps_automatically_as_with_its_hand_written_file() {
     let Some(files) = real_files() else { return };
     for file in &files {
@@ -79,6 +83,10 @@ fn every_real_file_maps_automatically_as_with_its_hand_written_file() {
 }
 
 #[test]
+#[cfg_attr(
+    not(shared_data),
+    ignore = "needs the shared data: set MARIONETTE_DATA (default ../shared/data)"
+)]
 fn real_files_with_meaningless_joint_names_map_by_structure_within_the_same_bounds() {
     let Some(files) = real_files() else { return };
     let model = Model::by_name("humanoid24").unwrap();

@@ -20,6 +20,10 @@ const FILES: [&str; 6] = [
 ];
 
 #[test]
+#[cfg_attr(
+    not(shared_data),
+    ignore = "needs the shared data: set MARIONETTE_DATA (default ../shared/data)"
+)]
 fn every_data_file_maps_onto_both_models_and_looks_like_itself() {
     let Some(dir) = data_dir() else { return };
     for file in FILES {

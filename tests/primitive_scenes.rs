@@ -237,6 +237,10 @@ fn jumping_knee_kick_on_the_projects_own_clips() {
 }
 
 #[test]
+#[cfg_attr(
+    not(shared_data),
+    ignore = "needs the shared data: set MARIONETTE_DATA (default ../shared/data)"
+)]
 fn high_jump_on_the_cmu_jumps() {
     if data_present() {
         check_high_jump(
@@ -247,6 +251,10 @@ fn high_jump_on_the_cmu_jumps() {
 }
 
 #[test]
+#[cfg_attr(
+    not(shared_data),
+    ignore = "needs the shared data: set MARIONETTE_DATA (default ../shared/data)"
+)]
 fn jumping_knee_kick_on_cmu_capture() {
     if data_present() {
         check_kick(&run_scene("jumping_knee_kick_cmu.ron"));

@@ -1,9 +1,11 @@
 //! Shared by the integration tests: finding the shared motion-capture data.
 //!
 //! The data folder is [`marionette::io::data_dir`]: `$MARIONETTE_DATA`, else `../shared/data`
-//! relative to the working directory. When what a test needs is absent, the test is skipped
-//! with a `SKIPPED:` line on stderr, except under CI (`CI` set, e.g. `CI=true`), where the
-//! real-data tests must run and the test fails instead.
+//! relative to the working directory. When the folder is absent, the tests that need it are
+//! ignored with that reason (`build.rs` sets `cfg(shared_data)` when it is present, or under
+//! CI); when a file a test needs is absent from a present folder, the test is skipped with a
+//! `SKIPPED:` line on stderr, except under CI (`CI` set, e.g. `CI=true`), where the real-data
+//! tests must run and the test fails instead.
 
 #![allow(dead_code)] // each test file uses some of these
 
