@@ -288,8 +288,8 @@ const FOOT_ON_FLOOR_M: f64 = 0.02;
 /// The high jump and the jumping knee kick, fully assisted (the assistance carries the root's
 /// share of the motion's inverse dynamics). Under adult strength the waist is asked for more
 /// than the strength table gives (measured and asserted: that is why tracking there is not
-/// under 2°); with unbounded torques the knee kick tracks under 2° with the feet on the floor
-/// whenever the animated ones are.
+/// under 2°); with unbounded torques both track under 2° with the feet on the floor whenever
+/// the animated ones are.
 #[test]
 fn fully_assisted_tracking_of_both_jumps_under_adult_strength() {
     let (high, kick) = jumps();
@@ -311,12 +311,12 @@ fn fully_assisted_tracking_of_both_jumps_under_adult_strength() {
         c.settings.strength = None;
         let o = run_active(&c, &seq).unwrap();
         print_tracking(&format!("{label}, unbounded torques"), &o);
-        if label == "jumping knee kick" {
-            assert!(o.tracking_rms_deg < 2.0, "{}", o.tracking_rms_deg);
-            for f in &o.feet {
-                assert!(f.animated_down_s > 0.5, "{f:?}");
-                assert!(f.max_gap_m <= FOOT_ON_FLOOR_M, "{f:?}");
-            }
+        // Both jumps (the high jump's arms swing through a shoulder rotation of π: read
+        // nearest the targets, not on the principal branch's opposite side).
+        assert!(o.tracking_rms_deg < 2.0, "{label}: {}", o.tracking_rms_deg);
+        for f in &o.feet {
+            assert!(f.animated_down_s > 0.5, "{f:?}");
+            assert!(f.max_gap_m <= FOOT_ON_FLOOR_M, "{f:?}");
         }
     }
 }

@@ -152,6 +152,7 @@ pub struct CharacterLog {
     /// the animated motion asks of the joint (its inverse dynamics with the root carried).
     pub demand_nm: Vec<(f64, f64)>,
     angles: Vec<f64>,
+    reference: Vec<f64>,
 }
 
 /// An animated foot counts as down while its lowest contact corner is within this height of
@@ -323,7 +324,9 @@ pub enum CharacterError {
 }
 
 /// The body configuration and velocity of a DOF pose: the pelvis at the root channels, every
-/// joint at its DOF angles.
+/// joint at its DOF angles, every joint velocity from its DOF rates (a ball joint's DOFs are
+/// the components of its rotation vector, whose rates become its angular velocity through
+/// [`crate::dynamics::joint::dexp`]: [`crate::dynamics::Model::velocity_from_rates`]).
 pub fn pose_configuration(
     body: &HumanBody,
     binding: &ModelBinding,
@@ -338,10 +341,14 @@ pub fn pose_configuration(
     let at = |k: usize| pose.theta[r[k]];
     let rot = DQuat::from_scaled_axis(DVec3::new(at(3), at(4), at(5)));
     let q = body.configuration(&angles, DVec3::new(at(0), at(1), at(2)), rot);
-    let mut v = vec![0.0; body.model.nv];
+    let nv = body.model.nv;
+    let (mut at_v, mut rates) = (vec![0.0; nv], vec![0.0; nv]);
     for (d, &c) in binding.dof_columns().iter().enumerate() {
-        v[body.dof_v[d]] = pose.theta_dot[c];
+        at_v[body.dof_v[d]] = pose.theta[c];
+        rates[body.dof_v[d]] = pose.theta_dot[c];
     }
+    let mut v = vec![0.0; nv];
+    body.model.velocity_from_rates(&at_v, &rates, &mut v);
     let rate = |k: usize| pose.theta_dot[r[k]];
     let rt = DMat3::from_quat(rot).transpose();
     let w = rt * DVec3::new(rate(3), rate(4), rate(5));
@@ -543,18 +550,19 @@ type ReactionQuery<'a> = (
     Option<&'a mut PdController>,
 );
 
-/// Copies every tracking character's DOF pose into its PD targets (θ_d and θ̇_d per DOF) and,
+/// Copies every tracking character's DOF pose into its PD targets (θ_d per DOF, θ̇_d the joint
+/// velocity of the pose: [`pose_configuration`]) and,
 /// with a [`Feedforward`], the inverse dynamics of the animated motion into its feedforward.
 pub fn pd_targets_from_pose(clock: Res<Clock>, mut q: Query<TargetQuery, With<TrackPose>>) {
     for (body, binding, pose, mut pd, ff, assist) in &mut q {
         let pd = &mut pd.0;
-        for (d, &c) in binding.dof_columns().iter().enumerate() {
-            pd.target[d] = pose.theta[c];
-            pd.target_velocity[d] = pose.theta_dot[c];
-        }
-        let Some(mut ff) = ff else { continue };
         let b = &*body.body;
         let (q_d, v_d) = pose_configuration(b, binding, pose);
+        for (d, &c) in binding.dof_columns().iter().enumerate() {
+            pd.target[d] = pose.theta[c];
+            pd.target_velocity[d] = v_d[b.dof_v[d]];
+        }
+        let Some(mut ff) = ff else { continue };
         let ff = &mut *ff;
         ff.acceleration.resize(v_d.len(), 0.0);
         if let Some(prev) = &ff.previous_velocity {
@@ -654,7 +662,13 @@ pub fn log_characters(
         let b = &*body.body;
         let log = &mut *log;
         log.angles.resize(b.model.nv, 0.0);
-        b.model.angles(&state.q, &mut log.angles);
+        log.reference.resize(b.model.nv, 0.0);
+        for (d, &c) in binding.dof_columns().iter().enumerate() {
+            log.reference[b.dof_v[d]] = pose.theta[c];
+        }
+        // Read as the PD reads them (ball joints nearest the targets).
+        b.model
+            .angles_near(&state.q, &log.reference, &mut log.angles);
         let before_push = reaction.pushed_at_s.is_none_or(|p| state.time_s <= p);
         let mut sum = 0.0;
         for (d, &c) in binding.dof_columns().iter().enumerate() {

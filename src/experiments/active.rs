@@ -315,7 +315,9 @@ fn body_clip(body: &HumanBody, configurations: &[Vec<f64>], frame_time: f64) -> 
     let mut root_translation = Vec::with_capacity(configurations.len());
     let mut root_rotation = Vec::with_capacity(configurations.len());
     for q in configurations {
-        body.model.angles(q, &mut all);
+        // Each frame's ball joints read nearest the previous frame's (continuous curves).
+        let previous = all.clone();
+        body.model.angles_near(q, &previous, &mut all);
         angles.extend(body.dof_v.iter().map(|&k| all[k]));
         root_translation.push(DVec3::new(q[0], q[1], q[2]));
         root_rotation.push(glam::DQuat::from_xyzw(q[3], q[4], q[5], q[6]));
