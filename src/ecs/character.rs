@@ -151,6 +151,14 @@ pub struct CharacterLog {
     /// Per DOF the smallest and largest feedforward torque before the first push (N·m): what
     /// the animated motion asks of the joint (its inverse dynamics with the root carried).
     pub demand_nm: Vec<(f64, f64)>,
+    /// The largest downward whole-body external force the animated motion needs before the
+    /// first push (N, ≥ 0): of its root feedforward ([`RootAssist::feedforward_force`]) the
+    /// component against gravity, where negative. A floor can only push up, so a motion that
+    /// needs to be pulled down (e.g. a flight whose centre of mass falls faster than gravity)
+    /// is not one a body can make; the assistance supplies it and the joints feel it.
+    pub max_pull_n: f64,
+    /// When that was (s).
+    pub max_pull_time_s: f64,
     angles: Vec<f64>,
     reference: Vec<f64>,
 }
@@ -655,10 +663,11 @@ pub fn log_characters(
         &ModelBinding,
         &DofPose,
         &Reaction,
+        Option<&RootAssist>,
         &mut CharacterLog,
     )>,
 ) {
-    for (body, state, monitor, pd, binding, pose, reaction, mut log) in &mut q {
+    for (body, state, monitor, pd, binding, pose, reaction, assist, mut log) in &mut q {
         let b = &*body.body;
         let log = &mut *log;
         log.angles.resize(b.model.nv, 0.0);
@@ -690,6 +699,12 @@ pub fn log_characters(
         }
         if before_push {
             log.tracked_ticks += 1;
+            let up = -b.model.gravity.normalize_or_zero();
+            let pull = assist.map_or(0.0, |a| -a.feedforward_force.dot(up));
+            if pull > log.max_pull_n {
+                log.max_pull_n = pull;
+                log.max_pull_time_s = state.time_s;
+            }
         }
         if reaction.pushed_at_s.is_some() && !before_push {
             for (peak, f) in log

@@ -116,6 +116,15 @@ pub struct FootCheck {
     pub max_gap_time_s: f64,
 }
 
+/// The downward pull a motion needs, which no floor gives (see [`CharacterLog::max_pull_n`]).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct FloorPull {
+    /// The largest downward whole-body external force, in body weights (`M g`).
+    pub max_bw: f64,
+    /// When that was (s).
+    pub at_s: f64,
+}
+
 /// A link's peak floor force after the push and its share of the damage.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct LinkDamage {
@@ -160,6 +169,10 @@ pub struct ActiveOutcome {
     pub worst_tick: (f64, f64),
     /// Per foot whether the physical foot was on the floor when the animated one was.
     pub feet: Vec<FootCheck>,
+    /// The largest downward whole-body external force the animated motion needs before the
+    /// push (see [`CharacterLog::max_pull_n`]): 0 for a motion a floor can carry; 0 also when
+    /// the root feedforward is off (`assist_feedforward`), which then is not computed.
+    pub pull: FloorPull,
     /// Peak floor force per link after the push.
     pub links: Vec<LinkDamage>,
     /// `D = Σ w_i f_i` (N).
@@ -397,6 +410,11 @@ fn outcome(
         .filter(|s| before(s.time_s))
         .map(|s| (s.time_s, s.mean_sq_error.sqrt().to_degrees()))
         .fold((0.0, 0.0), |a, b| if b.1 > a.1 { b } else { a });
+    let weight = body.model.total_mass() * body.model.gravity.length();
+    let pull = FloorPull {
+        max_bw: log.max_pull_n / weight,
+        at_s: log.max_pull_time_s,
+    };
     let feet = feet
         .links
         .iter()
@@ -436,6 +454,7 @@ fn outcome(
         demands,
         worst_tick,
         feet,
+        pull,
         links,
         damage,
         pelvis_track: log
