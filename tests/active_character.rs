@@ -473,3 +473,63 @@ fn captured_jumps_track_under_adult_strength_and_keyframed_ones_need_pulling_dow
         }
     }
 }
+
+/// Joint ranges (humanoid24's adult table) on a character that is pushed and falls once its
+/// assistance is released: the joint model holds every joint near its range through the fall,
+/// where the same fall without ranges takes some joint further past it.
+#[test]
+fn joint_ranges_hold_a_falling_character() {
+    use marionette::humanoid::ranges::{AgeGroup, RangeTable};
+    let jump = primitive("normal_jump.ron");
+    let free_cfg = ActiveConfig {
+        duration_s: 2.5,
+        push: Some(chest_push(0.3)),
+        release_delay_s: Some(0.1),
+        ..ActiveConfig::default()
+    };
+    let mut cfg = free_cfg.clone();
+    cfg.settings.joint_ranges = Some(AgeGroup::Adult);
+    let held = run_active(&cfg, std::slice::from_ref(&jump)).unwrap();
+    let free = run_active(&free_cfg, &[jump]).unwrap();
+    assert_eq!(held.range_excursion_deg.len(), 24);
+    assert!(free.range_excursion_deg.is_empty());
+    let worst = |v: &[(String, f64)]| {
+        v.iter()
+            .cloned()
+            .max_by(|a, b| a.1.total_cmp(&b.1))
+            .unwrap()
+    };
+    let held_worst = worst(&held.range_excursion_deg);
+    // The free fall's excursions, read off its recorded motion against the same table.
+    let model = marionette::humanoid::humanoid24();
+    let ranges = RangeTable::builtin_for("humanoid24", AgeGroup::Adult)
+        .unwrap()
+        .for_model(&model)
+        .unwrap();
+    let m = &free.motion;
+    let free_ex: Vec<(String, f64)> = model
+        .dofs
+        .iter()
+        .enumerate()
+        .map(|(d, dof)| {
+            let (lo, hi) = ranges[d];
+            let ex = (0..m.frame_count())
+                .map(|f| {
+                    let a = m.frame_angles(f)[d];
+                    (lo - a).max(a - hi).max(0.0)
+                })
+                .fold(0.0, f64::max);
+            (dof.name.clone(), ex.to_degrees())
+        })
+        .collect();
+    let free_worst = worst(&free_ex);
+    println!(
+        "fall with joint ranges: fall at {:?} s, worst excursion {} {:.1}°; without: fall at {:?} s, worst {} {:.1}°",
+        held.fall_s, held_worst.0, held_worst.1, free.fall_s, free_worst.0, free_worst.1
+    );
+    assert!(held.fall_s.is_some() && free.fall_s.is_some());
+    assert!(
+        held_worst.1 < free_worst.1,
+        "{held_worst:?} vs {free_worst:?}"
+    );
+}

@@ -29,7 +29,7 @@ use glam::{DMat3, DQuat, DVec3};
 use super::clock::Clock;
 use super::dof_pose::ModelBinding;
 use super::physics::{
-    BodyState, ExternalForces, FloorContact, PdController, PhysicsBody, PhysicsBundle,
+    BodyState, ExternalForces, FloorContact, JointLimits, PdController, PhysicsBody, PhysicsBundle,
     PhysicsMonitor, PhysicsStatus, drawn_body,
 };
 use super::primitive::{DofPose, PrimitivePlayer};
@@ -37,12 +37,13 @@ use super::sets::{MotionSet, configure_motion_sets};
 use crate::dynamics::data::Data;
 use crate::dynamics::forces::contact::{ContactModel, ContactParams};
 use crate::dynamics::forces::external::{ExternalForce, Push};
+use crate::dynamics::forces::limits::{JointLimitParams, JointRanges};
 use crate::dynamics::forces::pd::PdTargets;
 use crate::dynamics::integrator::Integrator;
 use crate::dynamics::joint::quat_log;
 use crate::dynamics::kinematics::kinematics;
 use crate::humanoid::body::HumanBody;
-use crate::humanoid::ranges::AgeGroup;
+use crate::humanoid::ranges::{AgeGroup, RangeTable};
 use crate::humanoid::strength::{NoStrength, torque_limits_for};
 use crate::humanoid::tissue;
 use crate::primitive::{Primitive, PrimitiveError};
@@ -287,6 +288,11 @@ pub struct PhysicalSettings {
     /// How far the floor lies below the start pose's lowest contact corner (m, ≥ 0; 0 = the
     /// feet start on it).
     pub floor_clearance_m: f64,
+    /// Whose joint ranges bound the joints (the joint model of
+    /// [`crate::dynamics::forces::limits`] with its default gains: a spring and damper past
+    /// each range, joint friction inside it), from the model's built-in table
+    /// ([`RangeTable::builtin_for`]); `None` leaves the joints free.
+    pub joint_ranges: Option<AgeGroup>,
 }
 
 impl Default for PhysicalSettings {
@@ -305,6 +311,7 @@ impl Default for PhysicalSettings {
             feedforward: true,
             assist_feedforward: true,
             floor_clearance_m: 0.0,
+            joint_ranges: None,
         }
     }
 }
@@ -459,6 +466,28 @@ pub fn spawn_physical_character(
         .map(|&c| pose.theta[c])
         .collect();
     let pd = PdTargets::hold(targets, kp, kv).with_torque_limits(limits);
+    let joint_limits = match settings.joint_ranges {
+        Some(g) => {
+            let name = &body.figure.name;
+            let table =
+                RangeTable::builtin_for(name, g).ok_or_else(|| CharacterError::Setting {
+                    field: "joint_ranges",
+                    message: format!("no built-in {g:?} joint ranges for model {name}"),
+                })?;
+            let ranges = table
+                .for_model(&body.figure)
+                .map_err(|e| CharacterError::Setting {
+                    field: "joint_ranges",
+                    message: e.to_string(),
+                })?;
+            Some(JointLimits(JointRanges {
+                ranges,
+                params: JointLimitParams::default(),
+                limit_gains: Vec::new(),
+            }))
+        }
+        None => None,
+    };
     let assist = RootAssist {
         strength: settings.assist,
         omega: settings.assist_omega,
@@ -497,6 +526,9 @@ pub fn spawn_physical_character(
             FeetOnFloor::new(feet, lowest),
         ),
     ));
+    if let Some(l) = joint_limits {
+        entity.insert(l);
+    }
     if settings.feedforward {
         entity.insert(Feedforward {
             root: settings.assist_feedforward,

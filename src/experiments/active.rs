@@ -16,7 +16,10 @@ use crate::ecs::character::{
     CharacterError, CharacterLog, FeetOnFloor, PhysicalSettings, Reaction, character_schedule,
     spawn_physical_character,
 };
-use crate::ecs::physics::{BodyState, ExternalForces, PdController, PhysicsBody, PhysicsStatus};
+use crate::ecs::physics::{
+    BodyState, ExternalForces, JointLimits, PdController, PhysicsBody, PhysicsMonitor,
+    PhysicsStatus,
+};
 use crate::ecs::{Clock, Recorder};
 use crate::humanoid::ModelClip;
 use crate::humanoid::body::{HumanBody, HumanError, humanoid24_body};
@@ -162,6 +165,9 @@ pub struct ActiveOutcome {
     pub max_pelvis_gap_m: f64,
     /// Peak torques per DOF.
     pub torques: Vec<TorquePeak>,
+    /// Per DOF the largest excursion past its joint range over the whole run (degrees), with
+    /// [`PhysicalSettings::joint_ranges`]; empty without.
+    pub range_excursion_deg: Vec<(String, f64)>,
     /// Per DOF the tracking error, saturation and the motion's torque demand before the push.
     pub demands: Vec<DofDemand>,
     /// The tick before the push with the largest mean squared joint error: its time (s) and
@@ -303,17 +309,23 @@ pub fn run_active(
     let feet = world.get::<FeetOnFloor>(e).expect("feet check");
     let rec = world.get::<Recorder>(e).expect("recorder");
     let pd = &world.get::<PdController>(e).expect("pd").0;
+    let excursion: Vec<f64> = if world.get::<JointLimits>(e).is_some() {
+        let m = &world.get::<PhysicsMonitor>(e).expect("monitor").0;
+        m.max_excursion.iter().map(|x| x.to_degrees()).collect()
+    } else {
+        Vec::new()
+    };
     let b = &world.get::<PhysicsBody>(e).expect("body").body;
     let motion = body_clip(b, &configurations, every as f64 * config.dt_s);
-    Ok(outcome(
-        config,
-        b,
-        pd,
-        (&log, feet),
-        &reaction,
-        &rec.frames,
-        motion,
-    ))
+    let mut o = outcome(config, b, pd, (&log, feet), &reaction, &rec.frames, motion);
+    o.range_excursion_deg = b
+        .figure
+        .dofs
+        .iter()
+        .zip(&excursion)
+        .map(|(d, x)| (d.name.clone(), *x))
+        .collect();
+    Ok(o)
 }
 
 /// Ticks between kept frames.
@@ -451,6 +463,7 @@ fn outcome(
         pelvis_height_m: (start_h, end_h),
         max_pelvis_gap_m,
         torques,
+        range_excursion_deg: Vec::new(),
         demands,
         worst_tick,
         feet,
