@@ -430,6 +430,14 @@ fn cmu_jumps() -> Option<(Vec<Primitive>, Vec<Primitive>)> {
     Some((vec![kk.jump.learned.high.primitive.clone()], kk.sequence()))
 }
 
+/// The default character (fully assisted, adult strength) run for the whole of `seq`.
+fn whole_sequence(seq: &[Primitive]) -> ActiveConfig {
+    ActiveConfig {
+        duration_s: seq.iter().map(|p| p.duration).sum(),
+        ..ActiveConfig::default()
+    }
+}
+
 /// Why the keyframed jumps do not track under adult strength: their motion is not one a body
 /// can make. A floor only pushes up, but the keyframed high jump and knee kick need the body
 /// pulled down by more than a body weight at times (their flights keep the pelvis, not the
@@ -440,12 +448,7 @@ fn cmu_jumps() -> Option<(Vec<Primitive>, Vec<Primitive>)> {
 fn captured_jumps_track_under_adult_strength_and_keyframed_ones_need_pulling_down() {
     let (high, kick) = jumps();
     for (label, seq) in [("high jump", &high), ("jumping knee kick", &kick)] {
-        let duration: f64 = seq.iter().map(|p| p.duration).sum();
-        let cfg = ActiveConfig {
-            duration_s: duration,
-            ..ActiveConfig::default()
-        };
-        let o = run_active(&cfg, seq).unwrap();
+        let o = run_active(&whole_sequence(seq), seq).unwrap();
         println!(
             "keyframed {label}: downward pull up to {:.2} body weights (at {:.3} s)",
             o.pull.max_bw, o.pull.at_s
@@ -456,12 +459,7 @@ fn captured_jumps_track_under_adult_strength_and_keyframed_ones_need_pulling_dow
         return;
     };
     for (label, seq) in [("CMU high jump", &high), ("CMU jumping knee kick", &kick)] {
-        let duration: f64 = seq.iter().map(|p| p.duration).sum();
-        let cfg = ActiveConfig {
-            duration_s: duration,
-            ..ActiveConfig::default()
-        };
-        let o = run_active(&cfg, seq).unwrap();
+        let o = run_active(&whole_sequence(seq), seq).unwrap();
         print_tracking(&format!("{label}, adult strength"), &o);
         assert!(o.fall_s.is_none());
         for f in &o.feet {
