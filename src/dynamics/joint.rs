@@ -59,6 +59,22 @@ pub fn dexp_inv(u: DVec3, w: DVec3) -> DVec3 {
     w + 0.5 * uw + beta * u.cross(uw)
 }
 
+/// The right-trivialised exponential differential on SO(3), the inverse of [`dexp_inv`]:
+/// `ω = u̇ − ((1 − cos θ)/θ²) u×u̇ + ((θ − sin θ)/θ³) u×(u×u̇)`, `θ = |u|`: the body angular
+/// velocity of `R = R₀ exp(u)` when the rotation vector moves at `u̇`.
+#[inline]
+pub fn dexp(u: DVec3, u_dot: DVec3) -> DVec3 {
+    let t2 = u.length_squared();
+    let (a, b) = if t2 < 1e-6 {
+        (0.5 - t2 / 24.0, 1.0 / 6.0 - t2 / 120.0)
+    } else {
+        let t = t2.sqrt();
+        ((1.0 - t.cos()) / t2, (t - t.sin()) / (t2 * t))
+    };
+    let uw = u.cross(u_dot);
+    u_dot - a * uw + b * u.cross(uw)
+}
+
 /// The rotation vector (axis·angle, |angle| ≤ π) of a unit quaternion.
 #[inline]
 pub fn quat_log(q: DQuat) -> DVec3 {
@@ -340,6 +356,50 @@ impl JointType {
         }
     }
 
+    /// The joint's angles as [`JointType::angles`], but a ball's rotation vector `v` read as the
+    /// representative of the same rotation nearest `reference` (`v` or `v − 2π v̂`): a rotation
+    /// tracked through |θ| = π (an arm swung overhead) reads on without the principal branch's
+    /// jump to the opposite side. The other joints read as [`JointType::angles`].
+    #[inline]
+    pub fn angles_near(&self, q: &[f64], reference: &[f64], out: &mut [f64]) {
+        self.angles(q, out);
+        if matches!(self, JointType::Ball { .. }) {
+            let v = DVec3::new(out[0], out[1], out[2]);
+            let angle = v.length();
+            if angle > 1e-9 {
+                let r = DVec3::new(reference[0], reference[1], reference[2]);
+                let alt = v * (1.0 - std::f64::consts::TAU / angle);
+                // Distances are the same in the DOF coordinates and the joint frame (A is
+                // orthonormal).
+                if (alt - r).length_squared() < (v - r).length_squared() {
+                    out[..3].copy_from_slice(&alt.to_array());
+                }
+            }
+        }
+    }
+
+    /// The joint velocity (as `v`) of angles `angles` moving at rates `rates` (the DOFs' time
+    /// derivatives): pin and universal `v = θ̇`; ball `v = Aᵀ dexp(Aθ, Aθ̇)` (the child's angular
+    /// velocity in its own coordinates, see [`dexp`]); free and fixed unchanged (`out` is left
+    /// as it is).
+    #[inline]
+    pub fn velocity_from_rates(&self, angles: &[f64], rates: &[f64], out: &mut [f64]) {
+        match self {
+            JointType::Pin { .. } => out[0] = rates[0],
+            JointType::Universal { .. } => {
+                out[0] = rates[0];
+                out[1] = rates[1];
+            }
+            JointType::Ball { axes } => {
+                let u = *axes * DVec3::new(angles[0], angles[1], angles[2]);
+                let ud = *axes * DVec3::new(rates[0], rates[1], rates[2]);
+                let w = axes.transpose() * dexp(u, ud);
+                out[..3].copy_from_slice(&w.to_array());
+            }
+            JointType::Free | JointType::Fixed => {}
+        }
+    }
+
     /// Sets the configuration from anatomical angles (inverse of [`JointType::angles`]); a free
     /// joint is left unchanged.
     pub fn set_angles(&self, angles: &[f64], q: &mut [f64]) {
@@ -373,6 +433,51 @@ mod tests {
         let r1 = DMat3::from_quat(DQuat::from_scaled_axis(u0 + ud * h));
         let wh = quat_log(DQuat::from_mat3(&(r0.transpose() * r1))) / h;
         assert!((wh - w).length() < 1e-5, "{wh} vs {w}");
+    }
+
+    #[test]
+    fn dexp_inverts_dexp_inv_and_is_the_body_rate_of_exp() {
+        for u in [
+            DVec3::new(0.4, -0.9, 0.3),
+            DVec3::new(3.0, 0.2, -0.1),
+            DVec3::ZERO,
+        ] {
+            let w = DVec3::new(0.7, 0.2, -1.1);
+            assert!((dexp(u, dexp_inv(u, w)) - w).length() < 1e-12, "{u}");
+            let ud = DVec3::new(-0.3, 1.2, 0.5);
+            let h = 1e-6;
+            let r0 = DMat3::from_quat(DQuat::from_scaled_axis(u));
+            let r1 = DMat3::from_quat(DQuat::from_scaled_axis(u + ud * h));
+            let wh = quat_log(DQuat::from_mat3(&(r0.transpose() * r1))) / h;
+            assert!(
+                (wh - dexp(u, ud)).length() < 1e-5,
+                "{wh} vs {}",
+                dexp(u, ud)
+            );
+        }
+    }
+
+    #[test]
+    fn ball_angles_near_a_reference_read_on_through_pi() {
+        let axes = DMat3::from_cols(DVec3::NEG_X, DVec3::NEG_Z, DVec3::NEG_Y);
+        let j = JointType::Ball { axes };
+        let mut q = [0.0; 4];
+        // An arm flexed 190° with 8° of abduction: the principal branch reads it as the
+        // opposite rotation of 170°.
+        let set = [190f64.to_radians(), 8f64.to_radians(), 0.0];
+        j.set_angles(&set, &mut q);
+        let (mut plain, mut near) = ([0.0; 3], [0.0; 3]);
+        j.angles(&q, &mut plain);
+        assert!(plain[0] < 0.0, "{plain:?}");
+        j.angles_near(&q, &[3.2, 0.1, 0.0], &mut near);
+        for k in 0..3 {
+            assert!((near[k] - set[k]).abs() < 1e-9, "{near:?}");
+        }
+        // Near zero the reading is the principal one, bit for bit.
+        j.set_angles(&[0.3, -0.2, 0.1], &mut q);
+        j.angles(&q, &mut plain);
+        j.angles_near(&q, &[0.0; 3], &mut near);
+        assert_eq!(plain, near);
     }
 
     #[test]

@@ -242,6 +242,34 @@ impl Model {
         }
     }
 
+    /// The angles as [`Model::angles`], every ball joint read nearest `reference` (size nv; see
+    /// [`JointType::angles_near`]).
+    pub fn angles_near(&self, q: &[f64], reference: &[f64], out: &mut [f64]) {
+        for (i, b) in self.bodies.iter().enumerate() {
+            let (iq, iv) = (self.q_idx[i], self.v_idx[i]);
+            let nv = b.joint.nv();
+            b.joint.angles_near(
+                &q[iq..iq + b.joint.nq()],
+                &reference[iv..iv + nv],
+                &mut out[iv..iv + nv],
+            );
+        }
+    }
+
+    /// The joint velocities of angles `angles` moving at rates `rates` (all size nv; see
+    /// [`JointType::velocity_from_rates`]); a free joint's entries of `v` are left as they are.
+    pub fn velocity_from_rates(&self, angles: &[f64], rates: &[f64], v: &mut [f64]) {
+        for (i, b) in self.bodies.iter().enumerate() {
+            let iv = self.v_idx[i];
+            let nv = b.joint.nv();
+            b.joint.velocity_from_rates(
+                &angles[iv..iv + nv],
+                &rates[iv..iv + nv],
+                &mut v[iv..iv + nv],
+            );
+        }
+    }
+
     /// Total mass (kg).
     pub fn total_mass(&self) -> f64 {
         self.bodies.iter().map(|b| b.inertia.mass).sum()

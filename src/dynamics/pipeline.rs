@@ -9,7 +9,8 @@
 //! 3. **contact**: friction anchors brought to the step start, contact forces there, per-link
 //!    statistics ([`ContactStats`]);
 //! 4. **integrate**: the scheme's evaluations of `q̈ = ABA(q, v, τ, f_ext)`, each summing PD
-//!    torques `τ = k_p(θ_d − θ) + k_v(θ̇_d − θ̇)`, the joint model, contact and external forces;
+//!    torques `τ = k_p(θ_d − θ) + k_v(θ̇_d − θ̇)` (θ read by [`read_angles`]: a ball joint's
+//!    rotation vector nearest its targets), the joint model, contact and external forces;
 //! 5. **check**: kinematics of the new state; a non-finite or runaway body stops the run with
 //!    its time, body and value.
 //!
@@ -140,6 +141,9 @@ pub struct EvalScratch {
     pub armature: Vec<f64>,
     /// Angles (nv).
     pub angles: Vec<f64>,
+    /// The PD targets in velocity order (nv, zero where no DOF is driven): the reference
+    /// ball joints are read nearest ([`read_angles`]).
+    pub reference: Vec<f64>,
     /// Per-link normal forces (scratch).
     pub normal: Vec<f64>,
     /// PD torque and velocity coefficient per actuated DOF at the step start (N·m, N·m·s/rad),
@@ -168,6 +172,7 @@ impl StepWorkspace {
                 damping: vec![0.0; nv],
                 armature: vec![0.0; nv],
                 angles: vec![0.0; nv],
+                reference: vec![0.0; nv],
                 normal: vec![0.0; nb],
                 pd_start: Vec::new(),
                 step_start_angles: false,
@@ -251,6 +256,29 @@ fn position_stage(model: &Model, state: &State, ws: &mut StepWorkspace) {
     ws.kinematics_of(model, state);
 }
 
+/// The DOF angles of `q` as the PD and the joint model see them: with PD targets, every ball
+/// joint is read nearest its targets ([`Model::angles_near`]), so an arm tracked through a
+/// rotation of π is not read on the opposite side; without, the principal reading
+/// ([`Model::angles`]). `reference` is scratch of size nv.
+pub fn read_angles(
+    model: &Model,
+    forces: &Forces,
+    q: &[f64],
+    reference: &mut [f64],
+    out: &mut [f64],
+) {
+    match forces.pd {
+        Some(pd) => {
+            reference.fill(0.0);
+            for (d, &k) in forces.dofs.iter().enumerate() {
+                reference[k] = pd.target[d];
+            }
+            model.angles_near(q, reference, out);
+        }
+        None => model.angles(q, out),
+    }
+}
+
 /// Stage 2: the largest excursion past each DOF's range at the step start, and which PD
 /// torques are at their strength limit.
 fn limits_stage(
@@ -268,7 +296,7 @@ fn limits_stage(
     if forces.limits.is_none() && limited.is_none() {
         return;
     }
-    model.angles(&state.q, &mut e.angles);
+    read_angles(model, forces, &state.q, &mut e.reference, &mut e.angles);
     // The integrator's first evaluation is at this same state: it reuses the angles and the
     // PD torques computed here (the same bits, computed once).
     e.step_start_angles = true;
@@ -438,7 +466,7 @@ impl Dynamics for Evaluation<'_> {
         }
         apply_external(&ws.data, forces.external, t, &mut ws.f_ext);
         if (forces.pd.is_some() || forces.limits.is_some()) && !start_angles {
-            model.angles(q, &mut ws.angles);
+            read_angles(model, forces, q, &mut ws.reference, &mut ws.angles);
         }
         for (d, &k) in forces.dofs.iter().enumerate() {
             let (th, thd) = (ws.angles[k], v[k]);

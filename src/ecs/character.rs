@@ -29,7 +29,7 @@ use glam::{DMat3, DQuat, DVec3};
 use super::clock::Clock;
 use super::dof_pose::ModelBinding;
 use super::physics::{
-    BodyState, ExternalForces, FloorContact, PdController, PhysicsBody, PhysicsBundle,
+    BodyState, ExternalForces, FloorContact, JointLimits, PdController, PhysicsBody, PhysicsBundle,
     PhysicsMonitor, PhysicsStatus, drawn_body,
 };
 use super::primitive::{DofPose, PrimitivePlayer};
@@ -37,12 +37,13 @@ use super::sets::{MotionSet, configure_motion_sets};
 use crate::dynamics::data::Data;
 use crate::dynamics::forces::contact::{ContactModel, ContactParams};
 use crate::dynamics::forces::external::{ExternalForce, Push};
+use crate::dynamics::forces::limits::{JointLimitParams, JointRanges};
 use crate::dynamics::forces::pd::PdTargets;
 use crate::dynamics::integrator::Integrator;
 use crate::dynamics::joint::quat_log;
 use crate::dynamics::kinematics::kinematics;
 use crate::humanoid::body::HumanBody;
-use crate::humanoid::ranges::AgeGroup;
+use crate::humanoid::ranges::{AgeGroup, RangeTable};
 use crate::humanoid::strength::{NoStrength, torque_limits_for};
 use crate::humanoid::tissue;
 use crate::primitive::{Primitive, PrimitiveError};
@@ -151,7 +152,16 @@ pub struct CharacterLog {
     /// Per DOF the smallest and largest feedforward torque before the first push (N·m): what
     /// the animated motion asks of the joint (its inverse dynamics with the root carried).
     pub demand_nm: Vec<(f64, f64)>,
+    /// The largest downward whole-body external force the animated motion needs before the
+    /// first push (N, ≥ 0): of its root feedforward ([`RootAssist::feedforward_force`]) the
+    /// component against gravity, where negative. A floor can only push up, so a motion that
+    /// needs to be pulled down (e.g. a flight whose centre of mass falls faster than gravity)
+    /// is not one a body can make; the assistance supplies it and the joints feel it.
+    pub max_pull_n: f64,
+    /// When that was (s).
+    pub max_pull_time_s: f64,
     angles: Vec<f64>,
+    reference: Vec<f64>,
 }
 
 /// An animated foot counts as down while its lowest contact corner is within this height of
@@ -278,6 +288,11 @@ pub struct PhysicalSettings {
     /// How far the floor lies below the start pose's lowest contact corner (m, ≥ 0; 0 = the
     /// feet start on it).
     pub floor_clearance_m: f64,
+    /// Whose joint ranges bound the joints (the joint model of
+    /// [`crate::dynamics::forces::limits`] with its default gains: a spring and damper past
+    /// each range, joint friction inside it), from the model's built-in table
+    /// ([`RangeTable::builtin_for`]); `None` leaves the joints free.
+    pub joint_ranges: Option<AgeGroup>,
 }
 
 impl Default for PhysicalSettings {
@@ -296,6 +311,7 @@ impl Default for PhysicalSettings {
             feedforward: true,
             assist_feedforward: true,
             floor_clearance_m: 0.0,
+            joint_ranges: None,
         }
     }
 }
@@ -323,7 +339,9 @@ pub enum CharacterError {
 }
 
 /// The body configuration and velocity of a DOF pose: the pelvis at the root channels, every
-/// joint at its DOF angles.
+/// joint at its DOF angles, every joint velocity from its DOF rates (a ball joint's DOFs are
+/// the components of its rotation vector, whose rates become its angular velocity through
+/// [`crate::dynamics::joint::dexp`]: [`crate::dynamics::Model::velocity_from_rates`]).
 pub fn pose_configuration(
     body: &HumanBody,
     binding: &ModelBinding,
@@ -338,10 +356,14 @@ pub fn pose_configuration(
     let at = |k: usize| pose.theta[r[k]];
     let rot = DQuat::from_scaled_axis(DVec3::new(at(3), at(4), at(5)));
     let q = body.configuration(&angles, DVec3::new(at(0), at(1), at(2)), rot);
-    let mut v = vec![0.0; body.model.nv];
+    let nv = body.model.nv;
+    let (mut at_v, mut rates) = (vec![0.0; nv], vec![0.0; nv]);
     for (d, &c) in binding.dof_columns().iter().enumerate() {
-        v[body.dof_v[d]] = pose.theta_dot[c];
+        at_v[body.dof_v[d]] = pose.theta[c];
+        rates[body.dof_v[d]] = pose.theta_dot[c];
     }
+    let mut v = vec![0.0; nv];
+    body.model.velocity_from_rates(&at_v, &rates, &mut v);
     let rate = |k: usize| pose.theta_dot[r[k]];
     let rt = DMat3::from_quat(rot).transpose();
     let w = rt * DVec3::new(rate(3), rate(4), rate(5));
@@ -444,6 +466,28 @@ pub fn spawn_physical_character(
         .map(|&c| pose.theta[c])
         .collect();
     let pd = PdTargets::hold(targets, kp, kv).with_torque_limits(limits);
+    let joint_limits = match settings.joint_ranges {
+        Some(g) => {
+            let name = &body.figure.name;
+            let table =
+                RangeTable::builtin_for(name, g).ok_or_else(|| CharacterError::Setting {
+                    field: "joint_ranges",
+                    message: format!("no built-in {g:?} joint ranges for model {name}"),
+                })?;
+            let ranges = table
+                .for_model(&body.figure)
+                .map_err(|e| CharacterError::Setting {
+                    field: "joint_ranges",
+                    message: e.to_string(),
+                })?;
+            Some(JointLimits(JointRanges {
+                ranges,
+                params: JointLimitParams::default(),
+                limit_gains: Vec::new(),
+            }))
+        }
+        None => None,
+    };
     let assist = RootAssist {
         strength: settings.assist,
         omega: settings.assist_omega,
@@ -482,6 +526,9 @@ pub fn spawn_physical_character(
             FeetOnFloor::new(feet, lowest),
         ),
     ));
+    if let Some(l) = joint_limits {
+        entity.insert(l);
+    }
     if settings.feedforward {
         entity.insert(Feedforward {
             root: settings.assist_feedforward,
@@ -543,18 +590,19 @@ type ReactionQuery<'a> = (
     Option<&'a mut PdController>,
 );
 
-/// Copies every tracking character's DOF pose into its PD targets (θ_d and θ̇_d per DOF) and,
+/// Copies every tracking character's DOF pose into its PD targets (θ_d per DOF, θ̇_d the joint
+/// velocity of the pose: [`pose_configuration`]) and,
 /// with a [`Feedforward`], the inverse dynamics of the animated motion into its feedforward.
 pub fn pd_targets_from_pose(clock: Res<Clock>, mut q: Query<TargetQuery, With<TrackPose>>) {
     for (body, binding, pose, mut pd, ff, assist) in &mut q {
         let pd = &mut pd.0;
-        for (d, &c) in binding.dof_columns().iter().enumerate() {
-            pd.target[d] = pose.theta[c];
-            pd.target_velocity[d] = pose.theta_dot[c];
-        }
-        let Some(mut ff) = ff else { continue };
         let b = &*body.body;
         let (q_d, v_d) = pose_configuration(b, binding, pose);
+        for (d, &c) in binding.dof_columns().iter().enumerate() {
+            pd.target[d] = pose.theta[c];
+            pd.target_velocity[d] = v_d[b.dof_v[d]];
+        }
+        let Some(mut ff) = ff else { continue };
         let ff = &mut *ff;
         ff.acceleration.resize(v_d.len(), 0.0);
         if let Some(prev) = &ff.previous_velocity {
@@ -647,14 +695,21 @@ pub fn log_characters(
         &ModelBinding,
         &DofPose,
         &Reaction,
+        Option<&RootAssist>,
         &mut CharacterLog,
     )>,
 ) {
-    for (body, state, monitor, pd, binding, pose, reaction, mut log) in &mut q {
+    for (body, state, monitor, pd, binding, pose, reaction, assist, mut log) in &mut q {
         let b = &*body.body;
         let log = &mut *log;
         log.angles.resize(b.model.nv, 0.0);
-        b.model.angles(&state.q, &mut log.angles);
+        log.reference.resize(b.model.nv, 0.0);
+        for (d, &c) in binding.dof_columns().iter().enumerate() {
+            log.reference[b.dof_v[d]] = pose.theta[c];
+        }
+        // Read as the PD reads them (ball joints nearest the targets).
+        b.model
+            .angles_near(&state.q, &log.reference, &mut log.angles);
         let before_push = reaction.pushed_at_s.is_none_or(|p| state.time_s <= p);
         let mut sum = 0.0;
         for (d, &c) in binding.dof_columns().iter().enumerate() {
@@ -676,6 +731,12 @@ pub fn log_characters(
         }
         if before_push {
             log.tracked_ticks += 1;
+            let up = -b.model.gravity.normalize_or_zero();
+            let pull = assist.map_or(0.0, |a| -a.feedforward_force.dot(up));
+            if pull > log.max_pull_n {
+                log.max_pull_n = pull;
+                log.max_pull_time_s = state.time_s;
+            }
         }
         if reaction.pushed_at_s.is_some() && !before_push {
             for (peak, f) in log

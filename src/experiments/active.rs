@@ -16,7 +16,10 @@ use crate::ecs::character::{
     CharacterError, CharacterLog, FeetOnFloor, PhysicalSettings, Reaction, character_schedule,
     spawn_physical_character,
 };
-use crate::ecs::physics::{BodyState, ExternalForces, PdController, PhysicsBody, PhysicsStatus};
+use crate::ecs::physics::{
+    BodyState, ExternalForces, JointLimits, PdController, PhysicsBody, PhysicsMonitor,
+    PhysicsStatus,
+};
 use crate::ecs::{Clock, Recorder};
 use crate::humanoid::ModelClip;
 use crate::humanoid::body::{HumanBody, HumanError, humanoid24_body};
@@ -116,6 +119,15 @@ pub struct FootCheck {
     pub max_gap_time_s: f64,
 }
 
+/// The downward pull a motion needs, which no floor gives (see [`CharacterLog::max_pull_n`]).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct FloorPull {
+    /// The largest downward whole-body external force, in body weights (`M g`).
+    pub max_bw: f64,
+    /// When that was (s).
+    pub at_s: f64,
+}
+
 /// A link's peak floor force after the push and its share of the damage.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct LinkDamage {
@@ -153,6 +165,9 @@ pub struct ActiveOutcome {
     pub max_pelvis_gap_m: f64,
     /// Peak torques per DOF.
     pub torques: Vec<TorquePeak>,
+    /// Per DOF the largest excursion past its joint range over the whole run (degrees), with
+    /// [`PhysicalSettings::joint_ranges`]; empty without.
+    pub range_excursion_deg: Vec<(String, f64)>,
     /// Per DOF the tracking error, saturation and the motion's torque demand before the push.
     pub demands: Vec<DofDemand>,
     /// The tick before the push with the largest mean squared joint error: its time (s) and
@@ -160,6 +175,10 @@ pub struct ActiveOutcome {
     pub worst_tick: (f64, f64),
     /// Per foot whether the physical foot was on the floor when the animated one was.
     pub feet: Vec<FootCheck>,
+    /// The largest downward whole-body external force the animated motion needs before the
+    /// push (see [`CharacterLog::max_pull_n`]): 0 for a motion a floor can carry; 0 also when
+    /// the root feedforward is off (`assist_feedforward`), which then is not computed.
+    pub pull: FloorPull,
     /// Peak floor force per link after the push.
     pub links: Vec<LinkDamage>,
     /// `D = Σ w_i f_i` (N).
@@ -290,17 +309,23 @@ pub fn run_active(
     let feet = world.get::<FeetOnFloor>(e).expect("feet check");
     let rec = world.get::<Recorder>(e).expect("recorder");
     let pd = &world.get::<PdController>(e).expect("pd").0;
+    let excursion: Vec<f64> = if world.get::<JointLimits>(e).is_some() {
+        let m = &world.get::<PhysicsMonitor>(e).expect("monitor").0;
+        m.max_excursion.iter().map(|x| x.to_degrees()).collect()
+    } else {
+        Vec::new()
+    };
     let b = &world.get::<PhysicsBody>(e).expect("body").body;
     let motion = body_clip(b, &configurations, every as f64 * config.dt_s);
-    Ok(outcome(
-        config,
-        b,
-        pd,
-        (&log, feet),
-        &reaction,
-        &rec.frames,
-        motion,
-    ))
+    let mut o = outcome(config, b, pd, (&log, feet), &reaction, &rec.frames, motion);
+    o.range_excursion_deg = b
+        .figure
+        .dofs
+        .iter()
+        .zip(&excursion)
+        .map(|(d, x)| (d.name.clone(), *x))
+        .collect();
+    Ok(o)
 }
 
 /// Ticks between kept frames.
@@ -315,7 +340,9 @@ fn body_clip(body: &HumanBody, configurations: &[Vec<f64>], frame_time: f64) -> 
     let mut root_translation = Vec::with_capacity(configurations.len());
     let mut root_rotation = Vec::with_capacity(configurations.len());
     for q in configurations {
-        body.model.angles(q, &mut all);
+        // Each frame's ball joints read nearest the previous frame's (continuous curves).
+        let previous = all.clone();
+        body.model.angles_near(q, &previous, &mut all);
         angles.extend(body.dof_v.iter().map(|&k| all[k]));
         root_translation.push(DVec3::new(q[0], q[1], q[2]));
         root_rotation.push(glam::DQuat::from_xyzw(q[3], q[4], q[5], q[6]));
@@ -395,6 +422,11 @@ fn outcome(
         .filter(|s| before(s.time_s))
         .map(|s| (s.time_s, s.mean_sq_error.sqrt().to_degrees()))
         .fold((0.0, 0.0), |a, b| if b.1 > a.1 { b } else { a });
+    let weight = body.model.total_mass() * body.model.gravity.length();
+    let pull = FloorPull {
+        max_bw: log.max_pull_n / weight,
+        at_s: log.max_pull_time_s,
+    };
     let feet = feet
         .links
         .iter()
@@ -431,9 +463,11 @@ fn outcome(
         pelvis_height_m: (start_h, end_h),
         max_pelvis_gap_m,
         torques,
+        range_excursion_deg: Vec::new(),
         demands,
         worst_tick,
         feet,
+        pull,
         links,
         damage,
         pelvis_track: log

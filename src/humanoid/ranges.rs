@@ -1,5 +1,6 @@
-//! Age-dependent joint ranges of the fall21 model, as data a user can edit
-//! (`src/humanoid/data/fall21_elderly.ron`, `src/humanoid/data/fall21_adult.ron`).
+//! Joint ranges as data a user can edit: age-dependent for the fall21 model
+//! (`src/humanoid/data/fall21_elderly.ron`, `src/humanoid/data/fall21_adult.ron`), adult for the
+//! humanoid24 model (`src/humanoid/data/humanoid24_adult.ron`; its sources are named there).
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -57,6 +58,23 @@ impl RangeTable {
             AgeGroup::Adult => ("fall21_adult.ron", include_str!("data/fall21_adult.ron")),
         };
         RangeTable::parse(text, name).expect("built-in range tables are valid")
+    }
+
+    /// The built-in table of `group` for the model named `model` (`fall21` or `humanoid24`), or
+    /// `None` when there is none: humanoid24 has an adult table only (the elderly table is the
+    /// falling paper's, published for fall21's DOFs).
+    pub fn builtin_for(model: &str, group: AgeGroup) -> Option<RangeTable> {
+        match (model, group) {
+            ("fall21", g) => Some(RangeTable::builtin(g)),
+            ("humanoid24", AgeGroup::Adult) => Some(
+                RangeTable::parse(
+                    include_str!("data/humanoid24_adult.ron"),
+                    "humanoid24_adult.ron",
+                )
+                .expect("built-in range tables are valid"),
+            ),
+            _ => None,
+        }
     }
 
     /// Reads a table from a RON file.
@@ -137,6 +155,39 @@ mod tests {
         assert!(
             (e[knee].0.to_degrees() - 32.0).abs() < 1e-9
                 && (e[knee].1.to_degrees() - 127.0).abs() < 1e-9
+        );
+    }
+
+    #[test]
+    fn humanoid24_has_adult_ranges_for_every_dof() {
+        let m = crate::humanoid::humanoid24();
+        let t = RangeTable::builtin_for("humanoid24", AgeGroup::Adult).unwrap();
+        let r = t.for_model(&m).unwrap();
+        assert_eq!(r.len(), 24);
+        for (d, (lo, hi)) in m.dofs.iter().zip(&r) {
+            assert!(
+                *lo <= 0.0 && 0.0 <= *hi && lo < hi,
+                "{}: ({lo}, {hi})",
+                d.name
+            );
+        }
+        // Where the two models share a DOF, the same normative rows as fall21's adult table.
+        let f = RangeTable::builtin(AgeGroup::Adult);
+        for k in [
+            "waist_flexion",
+            "shoulder_flexion",
+            "shoulder_rotation",
+            "hip_flexion",
+            "hip_abduction",
+            "knee",
+        ] {
+            assert_eq!(t.ranges[k], f.ranges[k], "{k}");
+        }
+        assert_eq!(t.ranges["elbow_flexion"], f.ranges["elbow"]);
+        assert!(RangeTable::builtin_for("humanoid24", AgeGroup::Elderly).is_none());
+        assert_eq!(
+            RangeTable::builtin_for("fall21", AgeGroup::Elderly),
+            Some(RangeTable::builtin(AgeGroup::Elderly))
         );
     }
 

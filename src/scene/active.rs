@@ -225,6 +225,8 @@ fn report(
             "worst_tick": { "time_s": o.worst_tick.0, "rms_deg": o.worst_tick.1 },
             "per_dof_demand": o.demands,
             "feet_on_floor": o.feet,
+            "downward_pull": o.pull,
+            "pull_rule": "before the push, the largest downward whole-body external force the animated motion needs (its inverse dynamics' root force, carried by the assistance), in body weights: a floor only pushes up, so anything above 0 is motion no body can make (e.g. a flight falling faster than gravity)",
             "feet_rule": format!("the animated foot is down within {} m of its floor; gap = the physical foot's lowest corner above the floor then", crate::ecs::character::ANIMATED_FOOT_DOWN_M),
         },
         "push": { "link": scene.push.link, "force_n": scene.push.force_n, "start_s": o.push_s, "duration_s": scene.push.duration_s },
