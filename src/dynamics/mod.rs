@@ -16,6 +16,7 @@
 pub mod aba;
 pub mod crba;
 pub mod data;
+pub mod equilibrium;
 pub mod forces;
 pub mod integrator;
 pub mod joint;
