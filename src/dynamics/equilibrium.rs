@@ -292,6 +292,131 @@ pub fn holding_torques(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::dynamics::Integrator;
+    use crate::dynamics::forces::contact::{ContactGains, ContactModel, ContactParams, LinkBox};
+    use crate::dynamics::forces::pd::PdTargets;
+    use crate::dynamics::joint::JointType;
+    use crate::dynamics::model::Body;
+    use crate::dynamics::pipeline::{self, StepMonitor, StepSettings};
+    use crate::dynamics::spatial::{Inertia, SpatialTransform};
+    use glam::DVec3;
+
+    /// A 10 kg block on the floor with a 2 kg arm on a pin at its top edge, held out sideways
+    /// by a PD too weak to hold it level on its own.
+    fn block_with_arm() -> (Model, ContactModel, PdTargets) {
+        let block = DVec3::new(0.4, 0.2, 0.3);
+        let model = Model::new(
+            vec![
+                Body {
+                    name: "block".into(),
+                    joint_name: "free".into(),
+                    parent: None,
+                    joint: JointType::Free,
+                    x_tree: SpatialTransform::IDENTITY,
+                    inertia: Inertia::solid_box(10.0, DVec3::ZERO, block),
+                },
+                Body {
+                    name: "arm".into(),
+                    joint_name: "pin".into(),
+                    parent: Some(0),
+                    joint: JointType::Pin { axis: DVec3::Z },
+                    x_tree: SpatialTransform::translation(DVec3::new(0.2, 0.1, 0.0)),
+                    inertia: Inertia::solid_box(
+                        2.0,
+                        DVec3::new(0.25, 0.0, 0.0),
+                        DVec3::new(0.5, 0.05, 0.05),
+                    ),
+                },
+            ],
+            DVec3::new(0.0, -9.81, 0.0),
+        )
+        .unwrap();
+        let boxes = [
+            LinkBox {
+                center: DVec3::ZERO,
+                half: block * 0.5,
+            },
+            // Far from the floor: the arm never touches.
+            LinkBox {
+                center: DVec3::new(0.25, 0.0, 0.0),
+                half: DVec3::splat(0.01),
+            },
+        ];
+        let gains = [
+            ContactGains {
+                stiffness_n_per_m: 4.0e4,
+                damping_n_s_per_m: 400.0,
+            },
+            ContactGains {
+                stiffness_n_per_m: 1.0e3,
+                damping_n_s_per_m: 10.0,
+            },
+        ];
+        let cm = ContactModel::new(&boxes, &[10.0, 2.0], &gains, ContactParams::default());
+        let pd = PdTargets::hold(vec![0.0], vec![20.0], vec![2.0]);
+        (model, cm, pd)
+    }
+
+    #[test]
+    fn a_balanced_base_with_its_holding_torques_stays_at_rest() {
+        let (model, cm, pd) = block_with_arm();
+        let dofs = [6];
+        let mut q = model.neutral();
+        // Resting on its bottom face, the springs not yet compressed.
+        q[1] = 0.1 - 1e-4;
+        let mut state = State::new(q, vec![0.0; model.nv], 2);
+        let mut ws = StepWorkspace::new(&model);
+        let forces = Forces {
+            dofs: &dofs,
+            pd: Some(&pd),
+            limits: None,
+            contact: Some(&cm),
+            external: &[],
+        };
+        // The first contact evaluation anchors the corners where they are.
+        reseat_anchors(&model, &forces, &mut state, &mut ws);
+        let b = balance_base(
+            &model,
+            &forces,
+            &mut state,
+            &mut ws,
+            0..6,
+            BalanceSettings::default(),
+        )
+        .unwrap();
+        assert!(b.residual <= 1e-6, "{b:?}");
+        // The arm (2 kg, 0.25 m out) needs about m g l = 4.9 N·m to stay level.
+        let hold = holding_torques(&model, &forces, &state, &mut ws, &dofs).unwrap();
+        assert!((hold[0] - 2.0 * 9.81 * 0.25).abs() < 0.05, "{hold:?}");
+        let mut held = pd.clone();
+        held.feedforward = hold;
+        let forces = Forces {
+            pd: Some(&held),
+            ..forces
+        };
+        let mut qdd = vec![0.0; model.nv];
+        pipeline::acceleration(&model, &forces, &state, &mut ws, &mut qdd).unwrap();
+        assert!(max_abs(&qdd) < 1e-6, "{qdd:?}");
+        // Stepped for a second, it does not move.
+        let q0 = state.q.clone();
+        let mut monitor = StepMonitor::new(2, 1);
+        let settings = StepSettings {
+            integrator: Integrator::SemiImplicitEuler {
+                implicit_damping: true,
+            },
+            dt: 5e-4,
+        };
+        for _ in 0..2000 {
+            pipeline::step(&model, settings, &forces, &mut state, &mut ws, &mut monitor).unwrap();
+        }
+        let moved = state
+            .q
+            .iter()
+            .zip(&q0)
+            .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+        assert!(moved < 1e-6, "moved {moved}");
+        assert!((monitor.sample.normal[0] - 12.0 * 9.81).abs() < 1e-6);
+    }
 
     #[test]
     fn gaussian_elimination_solves_a_system_that_needs_pivoting() {
