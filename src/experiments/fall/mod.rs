@@ -530,7 +530,8 @@ const SETTLED_QDD: f64 = 1e-6;
 /// 2. That state is not an equilibrium. The PD stance alone leans on a very soft whole-body
 ///    mode (the body pivoting over its ankles against stance gains barely above `m g h`): the
 ///    damping slows that lean to a creep of about a millimetre per second long before it is
-///    balanced, and its equilibrium lies some ten degrees further on. A standing person holds
+///    balanced (a Newton step toward a balance of the PD stance alone asks for 0.18 rad, ten
+///    degrees, more lean: far outside its linearisation). A standing person holds
 ///    the posture with the static torque of their muscles, and so does the stance here: the
 ///    body is placed where gravity and the floor balance on it
 ///    ([`balance_base`]: the net wrench on the free base zeroed, joints held, anchors
