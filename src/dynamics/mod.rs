@@ -17,6 +17,7 @@ pub mod aba;
 pub mod axis_rotation;
 pub mod crba;
 pub mod data;
+pub mod equilibrium;
 pub mod forces;
 pub mod integrator;
 pub mod joint;

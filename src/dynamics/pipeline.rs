@@ -251,6 +251,31 @@ pub fn step(
     check_stage(model, state, ws)
 }
 
+/// The acceleration `q̈(q, v)` (size nv) the body of `state` has under `forces` at its
+/// configuration and velocity, with its friction anchors as they are (not brought to the state)
+/// and joint damping explicit; time `state.time_s`. The force model is the one a step
+/// integrates; the workspace's cached kinematics are invalidated.
+pub fn acceleration(
+    model: &Model,
+    forces: &Forces,
+    state: &State,
+    ws: &mut StepWorkspace,
+    qdd: &mut [f64],
+) -> Result<(), StepError> {
+    let eval = &mut ws.eval;
+    eval.kinematics_at_step = None;
+    eval.step_start_ready = false;
+    eval.step_start_angles = false;
+    eval.step_start_pd = false;
+    let mut f = Evaluation {
+        model,
+        forces,
+        anchors: &state.anchors,
+        ws: eval,
+    };
+    f.acceleration(state.time_s, &state.q, &state.v, None, qdd)
+}
+
 /// Stage 1: kinematics at the step start.
 fn position_stage(model: &Model, state: &State, ws: &mut StepWorkspace) {
     ws.kinematics_of(model, state);

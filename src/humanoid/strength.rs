@@ -2,27 +2,46 @@
 //! PD control can ask of a joint (the dynamics clamps the PD torque to it, see
 //! [`crate::dynamics::forces::pd`]; a genetic algorithm reads it to bound its gains).
 //!
-//! Source: **Harbo, Brincks & Andersen (2012)**, *Maximal isokinetic and isometric muscle
-//! strength of major muscle groups related to age, body mass, height, and sex in 178 healthy
-//! subjects*, Eur. J. Appl. Physiol. 112:267–275 (isometric maxima of the shoulder, elbow, wrist,
-//! hip, knee and ankle flexors and extensors, ages 15–83). The values below are rounded
-//! representative isometric maxima of men of about 70–75 kg: `Adult` for ages 20–40, `Elderly`
-//! for ages 60–80, where the lower-limb extensors have lost the most (about 35–40 %), the upper
-//! limb less (about 25 %). They were transcribed as orders of magnitude, not row by row from the
-//! paper's regression tables: check them against it before relying on a single value. The knee
-//! row was checked against the meta-analysis of Šarabon, Kozinc & Perman (2021), *Establishing
-//! reference values for isometric knee extension and flexion strength*, Front. Physiol.
-//! 12:767941 (411 studies): at mid-range knee angles its pooled 95 % intervals for men are
-//! 2.92–3.45 N·m/kg (extension) and 1.15–1.62 N·m/kg (flexion) in adults, 1.74–2.16 and
-//! 0.69–0.89 N·m/kg in older adults, i.e. 210–248, 83–117, 125–156 and 50–64 N·m at 72 kg: the
-//! extension values below lie inside, adult flexion (120) just above and elderly flexion (75)
-//! above its interval (see the unit test). Trunk and
-//! neck are not in that study; their values (trunk flexion/extension about 150/200 N·m, neck
-//! 25/40 N·m in young men) are this project's rounded reading of the dynamometry literature, with
-//! the same age decline. The DOFs only humanoid24 has (waist lateral bend, the clavicle's
-//! elevation and protraction, shoulder abduction and rotation about the long axis, forearm
-//! pronation, hip rotation) are likewise the project's rounded reading of that literature (adult
-//! young men; elderly about 30 % less), orders of magnitude to bound a PD controller, not data.
+//! Sources, row by row. The table is this project's rounded reading of the dynamometry
+//! literature for men of about 70–75 kg (`Adult` ages 20–40, `Elderly` 60–80), lower-limb
+//! extensors about 35–40 % weaker in old age, the upper limb about 25 %. It was **not**
+//! transcribed from one paper. What each row has been checked against:
+//!
+//! - **Harbo, Brincks & Andersen (2012)**, *Maximal isokinetic and isometric muscle strength of
+//!   major muscle groups related to age, body mass, height, and sex in 178 healthy subjects*,
+//!   Eur. J. Appl. Physiol. 112:267–275: linear regressions `τ = I + A·age + H·height + W·mass`
+//!   per sex and muscle group (Biodex; ages 15–83). The paper itself was not available here;
+//!   its male coefficients were read from the open calculator that implements them
+//!   (D. Bachasson, `dambach/app_strength-Harbo`, `coeff_men.csv`), so they are a second-hand
+//!   transcription. Evaluated for the fall's subject (1.70 m, 65 kg) at 30 and 70 years
+//!   (`the_rows_against_harbo_2012` below prints them):
+//!   - isometric models: knee extension 232 / 176 N·m (table 240 / 150: +3 %, −15 %); hip
+//!     flexion 150 / 121 (table 150 / 100: 0 %, −17 %); ankle "extension", read as dorsiflexion
+//!     (its magnitude is a dorsiflexor's), 36 / 34 (table 40 / 28: +11 %, −18 %); shoulder
+//!     abduction 55 / 45 (table 55 / 41); elbow flexion 43 / 38 (table 70 / 52: **+63 %,
+//!     +38 %**, above Harbo); wrist flexion 22 / 19 (table 12 / 9: **−45 %, −52 %**, below).
+//!   - isokinetic only (concentric, lower than isometric maxima, so a floor for them): knee
+//!     flexion 84 / 64 (table 120 / 75), hip extension 170 / 132 (table 200 / 130), ankle
+//!     "flexion" read as plantar flexion 117 / 88 (table 150 / 95), shoulder adduction 72 / 70
+//!     (table 70 / 52: the elderly row is below this floor), elbow extension 41 / 38 (table
+//!     50 / 38), wrist extension 11 / 10 (table 12 / 9).
+//!
+//!   The rows were left as they are: Harbo's cross-sectional regression at 70 years is stronger
+//!   than the older adults of the meta-analysis below (knee extension 176 against 125–156 N·m),
+//!   and changing the strength changes every fall the GA has been run on.
+//! - **Šarabon, Kozinc & Perman (2021)**, *Establishing reference values for isometric knee
+//!   extension and flexion strength*, Front. Physiol. 12:767941 (411 studies), for the knee
+//!   row: at mid-range knee angles its pooled 95 % intervals for men are 2.92–3.45 N·m/kg
+//!   (extension) and 1.15–1.62 N·m/kg (flexion) in adults, 1.74–2.16 and 0.69–0.89 N·m/kg in
+//!   older adults, i.e. 210–248, 83–117, 125–156 and 50–64 N·m at 72 kg: the extension values
+//!   lie inside, adult flexion (120) just above and elderly flexion (75) above its interval
+//!   (see the unit test).
+//! - **No source checked**: waist flexion/extension (about 150 / 200 N·m in young men), waist
+//!   rotation, neck (25 / 40 N·m), shoulder flexion/extension and rotation, hip
+//!   abduction/adduction, and the DOFs only humanoid24 has (waist lateral bend, the clavicle's
+//!   elevation and protraction, shoulder rotation about the long axis, forearm pronation, hip
+//!   rotation): the project's rounded reading of the dynamometry literature for young men,
+//!   elderly about 30 % less — orders of magnitude to bound a PD controller, not data.
 //!
 //! Signs follow the DOFs' anatomical convention (positive = flexion, abduction, external
 //! rotation, dorsiflexion, lateral bend to the right, turn to the left): a DOF's range is
@@ -157,6 +176,54 @@ mod tests {
         assert!(inside(knee.elderly_negative, at(1.74, 2.16)), "{knee:?}");
         assert!(knee.adult_positive <= 1.2 * at(1.15, 1.62).1, "{knee:?}");
         assert!(knee.elderly_positive <= 1.2 * at(0.69, 0.89).1, "{knee:?}");
+    }
+
+    /// Harbo et al. (2012)'s male regression `τ = I + A·age + H·height + W·mass` (N·m; age in
+    /// years, height in m, mass in kg), coefficients `(I, A, H, W)` as transcribed in
+    /// `dambach/app_strength-Harbo` (module docs).
+    fn harbo_men((i, a, h, w): (f64, f64, f64, f64), age: f64) -> f64 {
+        i + a * age + h * 1.70 + w * 65.0
+    }
+
+    /// The rows the module docs compare with Harbo et al. (2012): those said to lie within
+    /// 20 % of its isometric regressions do, at 30 and 70 years for 1.70 m and 65 kg; elbow
+    /// flexion lies above and wrist flexion below, as the docs say.
+    #[test]
+    fn the_rows_against_harbo_2012() {
+        let row = |dof: &str| *strength(dof).unwrap();
+        // (row, sign: true = the positive direction, isometric coefficients).
+        let within = [
+            ("knee", false, (-107.9, -1.4, 158.0, 1.75)),
+            ("hip_flexion", true, (37.6, -0.72, 36.0, 1.12)),
+            ("ankle", true, (-88.9, -0.04, 68.0, 0.16)),
+            ("shoulder_abduction", true, (-30.8, -0.24, 36.0, 0.49)),
+        ];
+        let pick = |r: Strength, positive: bool| {
+            if positive {
+                (r.adult_positive, r.elderly_positive)
+            } else {
+                (r.adult_negative, r.elderly_negative)
+            }
+        };
+        for (dof, positive, c) in within {
+            let (adult, elderly) = pick(row(dof), positive);
+            let (h30, h70) = (harbo_men(c, 30.0), harbo_men(c, 70.0));
+            println!("{dof}: table {adult} / {elderly}, Harbo {h30:.1} / {h70:.1} N·m");
+            assert!(
+                (adult / h30 - 1.0).abs() <= 0.2,
+                "{dof} adult {adult} vs {h30}"
+            );
+            assert!(
+                (elderly / h70 - 1.0).abs() <= 0.2,
+                "{dof} elderly {elderly} vs {h70}"
+            );
+        }
+        let elbow = (-23.8, -0.13, 22.0, 0.51);
+        let (adult, elderly) = pick(row("elbow"), true);
+        assert!(adult > 1.3 * harbo_men(elbow, 30.0) && elderly > 1.3 * harbo_men(elbow, 70.0));
+        let wrist = (-6.9, -0.07, 10.0, 0.21);
+        let (adult, elderly) = pick(row("wrist"), true);
+        assert!(adult < 0.6 * harbo_men(wrist, 30.0) && elderly < 0.6 * harbo_men(wrist, 70.0));
     }
 
     #[test]

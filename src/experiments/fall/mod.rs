@@ -28,6 +28,7 @@ use std::sync::Arc;
 use glam::{DQuat, DVec3};
 
 use crate::dynamics::data::Data;
+use crate::dynamics::equilibrium::{BalanceSettings, balance_base, holding_torques};
 use crate::dynamics::forces::contact::ContactModel;
 use crate::dynamics::forces::limits::{JointRanges, limit_gains};
 use crate::dynamics::forces::pd::PdTargets;
@@ -391,6 +392,8 @@ pub struct SettledStart {
     key: FallConfig,
     /// The settled state (at rest).
     state: pipeline::State,
+    /// The stance's holding torque per DOF (N·m), its feedforward.
+    hold: Vec<f64>,
 }
 
 /// `cfg` with every field that does not affect the settling phase set to a fixed value.
@@ -419,6 +422,7 @@ impl SettledStart {
         Ok(Self {
             key: settle_key(cfg),
             state: ch.physics.state.0,
+            hold: ch.controller.stance.feedforward,
         })
     }
 
@@ -436,14 +440,16 @@ pub fn build_fall_from(
 ) -> Result<FallCharacter, SimError> {
     let mut ch = assemble(cfg)?;
     check_stability(cfg, &ch)?;
-    let settled = match start {
-        Some(s) if s.fits(cfg) => s.state.clone(),
+    let (settled, hold) = match start {
+        Some(s) if s.fits(cfg) => (s.state.clone(), s.hold.clone()),
         _ => settle(cfg, &ch)?,
     };
     ch.recorder.settle_s = settled.time_s;
     let st = &mut ch.physics.state.0;
     st.q = settled.q;
     st.anchors = settled.anchors;
+    ch.controller.stance.feedforward = hold.clone();
+    ch.pd.0.feedforward = hold;
     Ok(ch)
 }
 
@@ -507,19 +513,35 @@ fn assemble(cfg: &FallConfig) -> Result<FallCharacter, SimError> {
 
 /// Relaxation time of the settling phase's velocity damping (s).
 const SETTLE_TAU_S: f64 = 0.02;
-/// The body counts as settled once its kinetic energy stays below this (J)… (a standing body
-/// keeps a residual ~1e-5 J of chatter where foot corners sit at the floor's surface)
+/// The damped phase ends once the kinetic energy stays below this (J)…
 const SETTLED_KE_J: f64 = 1e-4;
 /// …for this long (s).
 const SETTLED_HOLD_S: f64 = 0.05;
+/// Largest joint acceleration (rad/s², m/s²) the settled state may keep under the stance with
+/// its holding torques: rounding only.
+const SETTLED_QDD: f64 = 1e-6;
 
-/// The settling phase: from the standing configuration the body is stepped with the stance
-/// control, joint model and floor (no push), its velocity relaxed by `v ← v e^{−h/τ}` (τ =
-/// 20 ms) after each step, until the kinetic energy has stayed below 1e-4 J for 50 ms. Returns
-/// that state (its friction anchors where the feet came to rest, its time the settling time);
-/// the fall starts there with `v = 0`, so the push acts on a body at rest: forces in
+/// The settling phase, in two parts.
+///
+/// 1. From the standing configuration the body is stepped with the stance control, joint model
+///    and floor (no push), its velocity relaxed by `v ← v e^{−h/τ}` (τ = 20 ms) after each
+///    step, until the kinetic energy has stayed below 1e-4 J for 50 ms: the feet land and
+///    anchor where they come to rest, the joints sag under the stance gains.
+/// 2. That state is not an equilibrium. The PD stance alone leans on a very soft whole-body
+///    mode (the body pivoting over its ankles against stance gains barely above `m g h`): the
+///    damping slows that lean to a creep of about a millimetre per second long before it is
+///    balanced (a Newton step toward a balance of the PD stance alone asks for 0.18 rad, ten
+///    degrees, more lean: far outside its linearisation). A standing person holds
+///    the posture with the static torque of their muscles, and so does the stance here: the
+///    body is placed where gravity and the floor balance on it
+///    ([`balance_base`]: the net wrench on the free base zeroed, joints held, anchors
+///    re-seated), and the joint torques that hold the pose there ([`holding_torques`],
+///    `τ_hold = −(H q̈)_joints` at rest) are added to the stance PD as its feedforward.
+///
+/// Returns the state (`v = 0`, its anchors, its time the settling time) and the holding torque
+/// per DOF (N·m); with them `q̈ = 0` to rounding, so the push acts on a body at rest: forces in
 /// equilibrium, foot force equal to the weight.
-fn settle(cfg: &FallConfig, ch: &FallCharacter) -> Result<pipeline::State, SimError> {
+fn settle(cfg: &FallConfig, ch: &FallCharacter) -> Result<(pipeline::State, Vec<f64>), SimError> {
     let body = &*ch.physics.body.body;
     let model = &body.model;
     let mut state = ch.physics.state.0.clone();
@@ -538,7 +560,17 @@ fn settle(cfg: &FallConfig, ch: &FallCharacter) -> Result<pipeline::State, SimEr
     };
     let relax = (-cfg.dt_s / SETTLE_TAU_S).exp();
     let mut quiet_since: Option<f64> = None;
-    while state.time_s < cfg.settle_max_s {
+    loop {
+        if state.time_s >= cfg.settle_max_s {
+            return Err(cfg_err(
+                "settle_max_s",
+                format!(
+                    "the standing body did not come to rest within {} s (stance gains too weak \
+                     or the stance pose out of balance)",
+                    cfg.settle_max_s
+                ),
+            ));
+        }
         pipeline::step(model, settings, &forces, &mut state, &mut ws, &mut monitor)?;
         state.v.iter_mut().for_each(|x| *x *= relax);
         ws.eval.kinematics_at_step = None;
@@ -549,21 +581,55 @@ fn settle(cfg: &FallConfig, ch: &FallCharacter) -> Result<pipeline::State, SimEr
         if ke < SETTLED_KE_J {
             let t0 = *quiet_since.get_or_insert(state.time_s);
             if state.time_s - t0 >= SETTLED_HOLD_S {
-                state.v.iter_mut().for_each(|x| *x = 0.0);
-                return Ok(state);
+                break;
             }
         } else {
             quiet_since = None;
         }
     }
-    Err(cfg_err(
-        "settle_max_s",
-        format!(
-            "the standing body did not come to rest within {} s (stance gains too weak or the \
-             stance pose out of balance)",
-            cfg.settle_max_s
-        ),
-    ))
+    let base = model.v_idx[0]..model.v_idx[0] + model.bodies[0].joint.nv();
+    balance_base(
+        model,
+        &forces,
+        &mut state,
+        &mut ws,
+        base,
+        BalanceSettings::default(),
+    )?;
+    let hold = holding_torques(model, &forces, &state, &mut ws, &body.dof_v)?;
+    let mut held = ch.pd.0.clone();
+    held.feedforward = hold.clone();
+    let mut angles = vec![0.0; model.nv];
+    model.angles(&state.q, &mut angles);
+    for (d, &k) in body.dof_v.iter().enumerate() {
+        let (tau, _) = held.torque(d, angles[k], 0.0);
+        if held.saturates(d, tau) {
+            return Err(cfg_err(
+                "torque_limits_nm",
+                format!(
+                    "holding the settled stance needs {tau:.1} N·m at {}, at or beyond its \
+                     strength {:?} N·m",
+                    body.figure.dofs[d].name, held.torque_limits[d]
+                ),
+            ));
+        }
+    }
+    let mut qdd = vec![0.0; model.nv];
+    let held_forces = Forces {
+        pd: Some(&held),
+        ..forces
+    };
+    pipeline::acceleration(model, &held_forces, &state, &mut ws, &mut qdd)?;
+    let left = qdd.iter().fold(0.0f64, |m, a| m.max(a.abs()));
+    if left > SETTLED_QDD {
+        return Err(cfg_err(
+            "settle_max_s",
+            format!(
+                "the settled stance is not at rest: a joint acceleration of {left:.2e} remains"
+            ),
+        ));
+    }
+    Ok((state, hold))
 }
 
 /// Simulates one pushed fall from `config` without a World (the same parts and steps as

@@ -3,6 +3,7 @@
 //! body and quantity).
 
 pub use super::recorder::StandingStart;
+use crate::dynamics::equilibrium::EquilibriumError;
 use crate::dynamics::pipeline::StepError;
 use crate::humanoid::body::HumanError;
 use crate::humanoid::ranges::RangeError;
@@ -199,4 +200,7 @@ pub enum SimError {
     /// A step went wrong: a non-finite or runaway state, with time, body and value.
     #[error(transparent)]
     Step(#[from] StepError),
+    /// The settled standing body has no static equilibrium near where it came to rest.
+    #[error("settling the standing body: {0}")]
+    Equilibrium(#[from] EquilibriumError),
 }
