@@ -43,11 +43,16 @@ export class StickView {
     return [w / 2 + x * f, h / 2 - y * f, d];
   }
 
-  // Draws one frame (a list of points); `follow` centres the camera on the pelvis.
+  // Draws one frame (a list of points); `follow` centres the camera on the pelvis. A call that
+  // would draw the picture already on the canvas (the same frame, camera and size) does nothing,
+  // so a view whose motion has fewer frames than the display refreshes costs nothing between them.
   draw(points, follow = false) {
     const c = this.canvas;
     const dpr = window.devicePixelRatio || 1;
     const w = Math.round(c.clientWidth * dpr) || c.width, h = Math.round(c.clientHeight * dpr) || c.height;
+    const key = [points, follow, this.yaw, this.pitch, this.dist, w, h];
+    if (this.drawn && key.every((v, i) => v === this.drawn[i])) return;
+    this.drawn = key;
     if (c.width !== w || c.height !== h) { c.width = w; c.height = h; }
     const g = this.ctx;
     g.clearRect(0, 0, w, h);
