@@ -4,7 +4,7 @@
 //! real-data tests must run, and fail when their files are absent). Without it the tests that
 //! need the data are ignored with that reason, so `cargo test` shows them as skipped.
 
-use std::path::PathBuf;
+use std::path::{Component, Path, PathBuf};
 
 fn main() {
     println!("cargo::rustc-check-cfg=cfg(shared_data)");
@@ -15,10 +15,33 @@ fn main() {
         Some(d) if !d.is_empty() => PathBuf::from(d),
         _ => PathBuf::from("../shared/data"),
     };
-    // Re-run when the folder appears or changes (a missing path re-runs every build).
-    println!("cargo::rerun-if-changed={}", dir.display());
+    // Re-run when the folder changes, or when it appears: watch its nearest existing ancestor,
+    // unless that holds the package itself (a missing path, or a folder the build writes into,
+    // would re-run the script, and so recompile the crate, on every build).
+    let package = PathBuf::from(std::env::var_os("CARGO_MANIFEST_DIR").unwrap_or_default());
+    let absolute = normalised(&package.join(&dir));
+    if let Some(watch) = absolute.ancestors().find(|a| a.exists())
+        && !package.starts_with(watch)
+    {
+        println!("cargo::rerun-if-changed={}", watch.display());
+    }
     let ci = std::env::var("CI").is_ok_and(|v| !matches!(v.trim(), "" | "0" | "false" | "FALSE"));
     if dir.is_dir() || ci {
         println!("cargo::rustc-cfg=shared_data");
     }
+}
+
+/// `p` with its `.` and `..` components resolved lexically.
+fn normalised(p: &Path) -> PathBuf {
+    let mut out = PathBuf::new();
+    for c in p.components() {
+        match c {
+            Component::CurDir => {}
+            Component::ParentDir => {
+                out.pop();
+            }
+            c => out.push(c),
+        }
+    }
+    out
 }

@@ -78,8 +78,19 @@ pub fn clip_contacts(clip: &Clip, threshold_m: f64, min_flight_s: f64) -> Option
 /// Ground contact and flight of a clip: its feet ([`foot_points`]) and every other point of the
 /// body but a ground-proxy root ([`Skeleton::ground_proxy_root`], [`ground_contacts`]); `None` when a side has no foot point.
 pub fn clip_contacts_with(clip: &Clip, config: &ContactConfig) -> Option<Contacts> {
+    clip_contacts_and_feet(clip, config).map(|(c, _)| c)
+}
+
+/// [`clip_contacts_with`] and the foot points' tracks it was found from, `[left, right]`, each
+/// frame-major in [`foot_points`] order (as [`point_tracks`]), so a caller measuring the feet
+/// does not run the clip's forward kinematics again.
+pub fn clip_contacts_and_feet(
+    clip: &Clip,
+    config: &ContactConfig,
+) -> Option<(Contacts, [Vec<Vec<DVec3>>; 2])> {
     let (l, r, b) = clip_points(clip)?;
-    Some(ground_contacts(&l, &r, &b, clip.frame_time, config))
+    let c = ground_contacts(&l, &r, &b, clip.frame_time, config);
+    Some((c, [l, r]))
 }
 
 /// [`clip_contacts_with`] against the floor and rest heights of another clip of the same

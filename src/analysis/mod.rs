@@ -7,5 +7,6 @@ pub use contact::{
     ContactConfig, ContactReference, Contacts, Span, ground_contacts, ground_contacts_against,
 };
 pub use feet::{
-    PointRef, clip_contacts, clip_contacts_against, clip_contacts_with, foot_points, point_tracks,
+    PointRef, clip_contacts, clip_contacts_against, clip_contacts_and_feet, clip_contacts_with,
+    foot_points, point_tracks,
 };

@@ -26,7 +26,7 @@ use serde::{Deserialize, Serialize};
 use super::dance::Dance;
 use super::fill::Fill;
 use super::segments::speed_curve;
-use crate::analysis::{ContactConfig, clip_contacts_with, foot_points, point_tracks};
+use crate::analysis::{ContactConfig, clip_contacts_and_feet};
 use crate::humanoid::ModelClip;
 
 /// σ of the beat alignment score: 3 frames at 60 fps, seconds.
@@ -178,7 +178,7 @@ pub fn foot_skating(clip: &ModelClip) -> (f64, f64) {
     let c = clip.to_clip();
     let n = c.frame_count();
     let config = ContactConfig::default();
-    let Some(contacts) = clip_contacts_with(&c, &config) else {
+    let Some((contacts, feet)) = clip_contacts_and_feet(&c, &config) else {
         return (0.0, 0.0);
     };
     if n < 2 {
@@ -186,11 +186,7 @@ pub fn foot_skating(clip: &ModelClip) -> (f64, f64) {
     }
     let fps = 1.0 / clip.frame_time;
     let (mut sum, mut contact, mut total) = (0.0, 0usize, 0usize);
-    for (points, rests) in foot_points(&c.skeleton)
-        .iter()
-        .zip(&contacts.rest_heights_m)
-    {
-        let track = point_tracks(&c, points);
+    for (track, rests) in feet.iter().zip(&contacts.rest_heights_m) {
         for (i, rest) in rests.iter().enumerate() {
             for f in 0..n {
                 total += 1;
