@@ -78,10 +78,15 @@ pub fn render(args: Args) -> Result<()> {
     };
     let figure = clip.skeleton.figure();
     let points = clip.point_frames();
-    let label = file
+    let stem = file
         .file_stem()
         .map(|s| s.to_string_lossy().to_string())
         .unwrap_or_default();
+    // The tiles' times count from the window's start: say where that is in the clip.
+    let label = match start {
+        Some(s) if s > 0.0 => format!("{stem}: t from {s:.2} s of the clip"),
+        _ => stem,
+    };
     let track = Track {
         figure: &figure,
         frames: &points,
