@@ -16,7 +16,15 @@
 //! the columns in parallel with rayon, each minimum vectorised (the same IEEE sums at any
 //! vector width, and a minimum does not depend on the order it is taken in, so the same bits on
 //! any machine and thread count); the predecessors are recovered afterwards from the stored
-//! D_k. Both break ties the same way (at every node the
+//! D_k.
+//!
+//! A pinned bar has one choice, so the path splits there: the bars are cut at bar 0, at every
+//! pin and at the last bar into runs (each from a cut to the next, sharing its pinned ends), and
+//! each run's cheapest path is found on its own, with its sums starting from 0 at the run's
+//! first bar; the fill is the runs' paths joined, its cost their sum. Both algorithms work run
+//! by run; the DP advances every run's layer k in one pass over the table's columns, so a
+//! column is read once for all the runs (with four pins the table is read about a third as
+//! often as layer by layer). Both break ties the same way (at every node the
 //! predecessor of smallest index among those of equal sum, and the end of smallest index among
 //! equal totals), so they return the same path.
 
@@ -297,8 +305,9 @@ impl<'a> Graph<'a> {
         h
     }
 
-    /// Dijkstra's algorithm with the potential (module docs); `None` without a path.
-    fn dijkstra(&self) -> Option<Vec<usize>> {
+    /// Dijkstra's algorithm with the potential (module docs) on the whole graph; `None`
+    /// without a path. [`Graph::dijkstra`] runs it on each run.
+    fn dijkstra_run(&self) -> Option<Vec<usize>> {
         let (n, bars) = (self.table.n, self.bars);
         let h = self.potential();
         if !h[0].is_finite() {
@@ -362,45 +371,139 @@ impl<'a> Graph<'a> {
         None
     }
 
-    /// The exact dynamic programme (module docs); `None` without a path.
-    fn dp(&self) -> Option<Vec<usize>> {
-        let (n, bars) = (self.table.n, self.bars);
-        let t = self.table;
-        // D_k(s) of every layer, row-major: the backtrack recovers the predecessors.
-        let mut dist = vec![f64::INFINITY; n * bars];
-        for (s, d) in dist[..n].iter_mut().enumerate() {
-            if self.allowed(0, s) {
-                *d = 0.0;
-            }
+    /// The runs of the fill: the inclusive bar ranges between consecutive cuts, the cuts being
+    /// bar 0, every pinned bar and the last bar (one run [0, 0] for a single bar). A path
+    /// through the pins is the runs' paths joined at their pinned ends, and its cost their
+    /// costs' sum, so each run is solved on its own (module docs).
+    fn runs(&self) -> Vec<(usize, usize)> {
+        let mut cuts = vec![0];
+        cuts.extend((0..self.bars).filter(|&k| self.pin[k].is_some()));
+        cuts.push(self.bars - 1);
+        cuts.dedup();
+        if cuts.len() == 1 {
+            return vec![(0, 0)];
         }
-        for k in 0..bars - 1 {
-            let (done, rest) = dist.split_at_mut((k + 1) * n);
-            let d = &done[k * n..];
-            let next = &mut rest[..n];
-            match (self.pin[k], self.pin[k + 1]) {
-                (_, Some(b)) => next[b] = self.column_min(k, d, b),
-                (Some(a), None) => {
-                    let row = t.row(a);
-                    for (b, nb) in next.iter_mut().enumerate() {
-                        if self.edge(k, a, b) {
-                            *nb = d[a] + f64::from(row[b]);
-                        }
+        cuts.windows(2).map(|w| (w[0], w[1])).collect()
+    }
+
+    /// The graph of bars `first..=last` alone (their pins, the same table and rule).
+    fn run(&self, (first, last): (usize, usize)) -> Graph<'a> {
+        Graph {
+            table: self.table,
+            bars: last - first + 1,
+            pin: self.pin[first..=last].to_vec(),
+            no_repeat: self.no_repeat,
+        }
+    }
+
+    /// The runs' paths joined at their shared pinned bars; `None` if a run has none.
+    fn joined(
+        &self,
+        mut path_of: impl FnMut(&Graph<'a>) -> Option<Vec<usize>>,
+    ) -> Option<Vec<usize>> {
+        let mut path = Vec::with_capacity(self.bars);
+        for r in self.runs() {
+            let p = path_of(&self.run(r))?;
+            let skip = usize::from(!path.is_empty());
+            path.extend_from_slice(&p[skip..]);
+        }
+        Some(path)
+    }
+
+    /// Dijkstra's algorithm ([`Graph::dijkstra_run`]) on each run, joined.
+    fn dijkstra(&self) -> Option<Vec<usize>> {
+        self.joined(|g| g.dijkstra_run())
+    }
+
+    /// The exact dynamic programme (module docs) on every run at once; `None` without a path.
+    /// Round j advances layer j of every run still going: the free layers of all runs are
+    /// computed in one pass over the table's columns, so each column is read once per round
+    /// however many runs use it.
+    fn dp(&self) -> Option<Vec<usize>> {
+        let n = self.table.n;
+        let runs: Vec<Graph<'a>> = self.runs().into_iter().map(|r| self.run(r)).collect();
+        // D_k(s) of every layer of every run, row-major: the backtrack recovers the
+        // predecessors.
+        let mut dist: Vec<Vec<f64>> = runs
+            .iter()
+            .map(|g| {
+                let mut d = vec![f64::INFINITY; n * g.bars];
+                for (s, v) in d[..n].iter_mut().enumerate() {
+                    if g.allowed(0, s) {
+                        *v = 0.0;
                     }
                 }
-                (None, None) => {
-                    use rayon::prelude::*;
-                    next.par_chunks_mut(DP_COLUMNS)
-                        .enumerate()
-                        .for_each(|(c, out)| {
-                            for (j, o) in out.iter_mut().enumerate() {
-                                *o = self.column_min(k, d, c * DP_COLUMNS + j);
+                d
+            })
+            .collect();
+        let rounds = runs.iter().map(|g| g.bars).max().unwrap_or(1) - 1;
+        let mut free = Vec::new();
+        let mut block = Vec::new();
+        for k in 0..rounds {
+            free.clear();
+            for (r, g) in runs.iter().enumerate() {
+                if k + 1 >= g.bars {
+                    continue;
+                }
+                let (done, rest) = dist[r].split_at_mut((k + 1) * n);
+                let d = &done[k * n..];
+                let next = &mut rest[..n];
+                match (g.pin[k], g.pin[k + 1]) {
+                    (_, Some(b)) => next[b] = g.column_min(k, d, b),
+                    (Some(a), None) => {
+                        let row = self.table.row(a);
+                        for (b, nb) in next.iter_mut().enumerate() {
+                            if g.edge(k, a, b) {
+                                *nb = d[a] + f64::from(row[b]);
                             }
-                        });
+                        }
+                    }
+                    (None, None) => free.push(r),
+                }
+            }
+            if free.is_empty() {
+                continue;
+            }
+            // The free layers: column b of every such run side by side in `block`.
+            let m = free.len();
+            block.clear();
+            block.resize(n * m, f64::INFINITY);
+            {
+                use rayon::prelude::*;
+                let (runs, dist, free) = (&runs, &dist, &free);
+                block
+                    .par_chunks_mut(DP_COLUMNS * m)
+                    .enumerate()
+                    .for_each(|(c, out)| {
+                        for (j, o) in out.chunks_exact_mut(m).enumerate() {
+                            let b = c * DP_COLUMNS + j;
+                            for (o, &r) in o.iter_mut().zip(free) {
+                                *o = runs[r].column_min(k, &dist[r][k * n..(k + 1) * n], b);
+                            }
+                        }
+                    });
+            }
+            for (i, &r) in free.iter().enumerate() {
+                let next = &mut dist[r][(k + 1) * n..(k + 2) * n];
+                for (b, v) in next.iter_mut().enumerate() {
+                    *v = block[b * m + i];
                 }
             }
         }
-        // The end of smallest total (smallest index among equal totals), then back layer by
-        // layer: the predecessor of smallest index whose sum gives the node's D exactly.
+        let mut path = Vec::with_capacity(self.bars);
+        for (g, d) in runs.iter().zip(&dist) {
+            let p = g.backtrack(d)?;
+            let skip = usize::from(!path.is_empty());
+            path.extend_from_slice(&p[skip..]);
+        }
+        Some(path)
+    }
+
+    /// The path of a run from its layers' D (row-major): the end of smallest total (smallest
+    /// index among equal totals), then back layer by layer, the predecessor of smallest index
+    /// whose sum gives the node's D exactly; `None` when no end is reached.
+    fn backtrack(&self, dist: &[f64]) -> Option<Vec<usize>> {
+        let (n, bars) = (self.table.n, self.bars);
         let last = &dist[(bars - 1) * n..];
         let mut end = None;
         for (s, &v) in last.iter().enumerate() {
@@ -413,7 +516,7 @@ impl<'a> Graph<'a> {
         for k in (1..bars).rev() {
             let target = dist[k * n + s];
             let d = &dist[(k - 1) * n..k * n];
-            let col = t.column(s);
+            let col = self.table.column(s);
             s = (0..n)
                 .find(|&a| {
                     d[a].is_finite() && self.edge(k - 1, a, s) && d[a] + f64::from(col[a]) == target

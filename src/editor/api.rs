@@ -23,12 +23,12 @@
 //! edit's state refuses (nothing to undo, not shown, no candidate left), 500 for a failure to
 //! write the scene.
 
-use serde::Deserialize;
 use serde::de::DeserializeOwned;
+use serde::{Deserialize, Serialize};
 use serde_json::{Value, json};
 
 use super::EditorError;
-use super::session::Session;
+use super::session::{Frames, Session};
 use crate::choreo::edit::EditError;
 
 /// An HTTP answer.
@@ -45,13 +45,19 @@ pub struct Reply {
 }
 
 impl Reply {
-    /// A JSON answer.
-    pub fn json(status: u16, v: &Value) -> Reply {
-        Reply {
-            status,
-            content_type: "application/json",
-            body: v.to_string().into_bytes(),
-            download: None,
+    /// A JSON answer, serialised straight from `v` (no intermediate [`Value`] tree).
+    pub fn json<T: Serialize + ?Sized>(status: u16, v: &T) -> Reply {
+        match serde_json::to_vec(v) {
+            Ok(body) => Reply {
+                status,
+                content_type: "application/json",
+                body,
+                download: None,
+            },
+            Err(e) => Reply::error(
+                500,
+                &format!("the answer could not be written as JSON: {e}"),
+            ),
         }
     }
 
@@ -163,11 +169,18 @@ fn route(s: &mut Session, method: &str, path: &str, query: &str, b: &[u8]) -> Re
         "/api/bars" => ok(bars(s)),
         "/api/candidates" => {
             let bar = query_index(query, "bar")?;
-            candidates(s, bar).map(|v| Reply::json(200, &v))
+            candidates(s, bar)
         }
         "/api/dance" => {
             let (frames, start_s) = s.dance_frames().map_err(fail)?;
-            ok(json!({ "fps": s.fps(), "start_s": start_s, "frames": frames }))
+            Ok(Reply::json(
+                200,
+                &DanceAnswer {
+                    fps: s.fps(),
+                    start_s,
+                    frames: &frames,
+                },
+            ))
         }
         "/api/audio.wav" => {
             let song = s.song();
@@ -183,7 +196,7 @@ fn route(s: &mut Session, method: &str, path: &str, query: &str, b: &[u8]) -> Re
         "/api/search" => {
             let BarBody { bar } = body(b)?;
             s.edit_mut().search(bar).map_err(|e| fail(e.into()))?;
-            candidates(s, bar).map(|v| Reply::json(200, &v))
+            candidates(s, bar)
         }
         "/api/like" | "/api/unlike" => {
             let BarSegmentBody { bar, segment } = body(b)?;
@@ -286,33 +299,68 @@ fn bars(s: &Session) -> Value {
     json!({ "bars": list, "beats_s": s.song().beats_s })
 }
 
-fn candidates(s: &Session, bar: usize) -> Result<Value, Reply> {
+/// `GET /api/dance`.
+#[derive(Serialize)]
+struct DanceAnswer<'a> {
+    fps: f64,
+    start_s: f64,
+    frames: &'a Frames,
+}
+
+/// One candidate of `GET /api/candidates` and `POST /api/search`.
+#[derive(Serialize)]
+struct Candidate<'a> {
+    segment: usize,
+    liked: bool,
+    intensity: f64,
+    source: Option<&'a str>,
+    source_bar: usize,
+    frames: Frames,
+}
+
+/// `GET /api/candidates` and `POST /api/search`.
+#[derive(Serialize)]
+struct Candidates<'a> {
+    bar: usize,
+    start_s: f64,
+    end_s: f64,
+    round: usize,
+    tau: f64,
+    shown: usize,
+    liked: &'a [usize],
+    pin: Option<&'a usize>,
+    candidates: Vec<Candidate<'a>>,
+}
+
+fn candidates(s: &Session, bar: usize) -> Result<Reply, Reply> {
     let e = s.edit();
     let search = e.bar_search(bar).map_err(|e| fail(e.into()))?;
     let b = e.bars()[bar];
     let db = e.database();
     let mut list = vec![];
     for &seg in &search.current {
-        let frames = s.segment_frames(seg).map_err(fail)?;
         let m = &db.segments[seg];
-        list.push(json!({
-            "segment": seg,
-            "liked": search.liked.contains(&seg),
-            "intensity": m.intensity,
-            "source": db.sources.get(m.clip).map(|c| c.file.as_str()),
-            "source_bar": m.bar,
-            "frames": frames,
-        }));
+        list.push(Candidate {
+            segment: seg,
+            liked: search.liked.contains(&seg),
+            intensity: m.intensity,
+            source: db.sources.get(m.clip).map(|c| c.file.as_str()),
+            source_bar: m.bar,
+            frames: s.segment_frames(seg).map_err(fail)?,
+        });
     }
-    Ok(json!({
-        "bar": bar,
-        "start_s": b.start_s,
-        "end_s": b.end_s,
-        "round": search.round,
-        "tau": search.tau,
-        "shown": search.shown.len(),
-        "liked": search.liked,
-        "pin": e.pins().get(&bar),
-        "candidates": list,
-    }))
+    Ok(Reply::json(
+        200,
+        &Candidates {
+            bar,
+            start_s: b.start_s,
+            end_s: b.end_s,
+            round: search.round,
+            tau: search.tau,
+            shown: search.shown.len(),
+            liked: &search.liked,
+            pin: e.pins().get(&bar),
+            candidates: list,
+        },
+    ))
 }

@@ -42,7 +42,9 @@ pub struct Session {
     fill: Option<Fill>,
 }
 
-/// Stick-figure frames: per frame, every drawable point (joints then end sites), metres.
+/// Stick-figure frames: per frame, every drawable point (joints then end sites), metres rounded
+/// to the millimetre (what a stick view draws; the answers stay short: "0.913", not
+/// "0.91283154").
 pub type Frames = Vec<Vec<[f32; 3]>>;
 
 impl Session {
@@ -224,7 +226,7 @@ fn points(clip: &ModelClip, origin: DVec3) -> Frames {
         .map(|f| {
             f.into_iter()
                 .map(|p| {
-                    let p = p - origin;
+                    let p = ((p - origin) * 1000.0).round() / 1000.0;
                     [p.x as f32, p.y as f32, p.z as f32]
                 })
                 .collect()
