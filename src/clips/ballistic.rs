@@ -70,12 +70,13 @@ pub fn make_flights_ballistic(
         }
         let (ta, tb) = (fa as f64 * dt, fb as f64 * dt);
         let (ca, cb) = (com[fa], com[fb]);
-        for k in fa + 1..fb {
+        let root = &mut clip.root_translation[fa + 1..fb];
+        for (k, (r, c)) in (fa + 1..).zip(root.iter_mut().zip(&com[fa + 1..fb])) {
             let t = k as f64 * dt;
             let u = (t - ta) / (tb - ta);
             let arc = ca.lerp(cb, u) + DVec3::new(0.0, -0.5 * GRAVITY * (t - ta) * (t - tb), 0.0);
-            let shift = arc - com[k];
-            clip.root_translation[k] += shift;
+            let shift = arc - *c;
+            *r += shift;
             largest = largest.max(shift.length());
         }
     }
