@@ -285,6 +285,19 @@ fn print_tracking(label: &str, o: &marionette::experiments::active::ActiveOutcom
     );
 }
 
+/// Prints each junction of `seq`: the step in θ̈ the two DMPs' own accelerations make there,
+/// which the connection's hand-over removes.
+fn print_junctions(label: &str, seq: &[Primitive]) {
+    let c = marionette::primitive::connect(seq, 1.0 / 120.0, None).unwrap();
+    for j in &c.junctions {
+        println!(
+            "{label}: junction at {:.3} s, the DMPs' accelerations differ by up to {:.1} rad/s² \
+             (the hand-over plays through it without a step)",
+            j.time, j.max_acceleration_step
+        );
+    }
+}
+
 /// A physical foot counts as on the floor when its lowest corner is within this of the floor
 /// (m): the animated foot counts as down within 1 cm of its floor
 /// ([`marionette::ecs::character::ANIMATED_FOOT_DOWN_M`]), and the physical one may lag it by
@@ -307,6 +320,7 @@ fn fully_assisted_tracking_of_both_jumps_under_adult_strength() {
         };
         let o = run_active(&cfg, &seq).unwrap();
         print_tracking(label, &o);
+        print_junctions(label, &seq);
         assert!(o.fall_s.is_none());
         let waist = o.demands.iter().find(|d| d.dof == "waist_flexion").unwrap();
         assert!(
@@ -461,6 +475,7 @@ fn captured_jumps_track_under_adult_strength_and_keyframed_ones_need_pulling_dow
     for (label, seq) in [("CMU high jump", &high), ("CMU jumping knee kick", &kick)] {
         let o = run_active(&whole_sequence(seq), seq).unwrap();
         print_tracking(&format!("{label}, adult strength"), &o);
+        print_junctions(label, seq);
         assert!(o.fall_s.is_none());
         for f in &o.feet {
             assert!(f.max_gap_m <= FOOT_ON_FLOOR_M, "{label}: {f:?}");

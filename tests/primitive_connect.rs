@@ -132,3 +132,38 @@ fn a_hand_over_far_from_the_start_keeps_the_primitives_own_scaling() {
     );
     assert!((s.values[180] - p.dofs[0].goal).abs() < 0.5 * DEG);
 }
+
+/// The hand-over keeps the acceleration: sampled finely, the connected motion's second
+/// differences change across a junction no more than the hand-over's correction
+/// `δ = −½Δa t²(1 − t/W)³` allows (its jerk is at most 9|Δa|/W), where the two DMPs' own
+/// accelerations differ by a step Δa (which would show as about Δa/2 in one tick).
+#[test]
+fn a_sequence_has_no_step_in_acceleration_at_its_junctions() {
+    use marionette::primitive::connect::HANDOVER_WINDOW_S;
+    let seq = [clip_primitive(1, 0, 150), clip_primitive(2, 200, 380)];
+    let dt = 2e-4;
+    let c = connect(&seq, dt, None).unwrap();
+    let jn = &c.junctions[0];
+    let k = (jn.time / dt).round() as usize;
+    let acc = |i: usize, d: usize| {
+        (c.trajectory.value(i + 1, d) - 2.0 * c.trajectory.value(i, d)
+            + c.trajectory.value(i - 1, d))
+            / (dt * dt)
+    };
+    let mut worst: f64 = 0.0;
+    for d in 0..c.trajectory.dofs() {
+        for i in k - 3..k + 3 {
+            worst = worst.max((acc(i + 1, d) - acc(i, d)).abs());
+        }
+    }
+    let allowed = 10.0 * jn.max_acceleration_step * dt / HANDOVER_WINDOW_S;
+    println!(
+        "junction at {:.3} s: the DMPs' own accelerations differ by up to {:.1} rad/s²; the \
+         connected motion's acceleration changes by at most {worst:.3} rad/s² per {dt} s tick \
+         there (allowed {allowed:.3})",
+        jn.time, jn.max_acceleration_step
+    );
+    assert!(jn.max_acceleration_step > 1.0, "{jn:?}");
+    assert!(worst < allowed, "{worst} vs {allowed}");
+    assert!(allowed < 0.1 * jn.max_acceleration_step);
+}

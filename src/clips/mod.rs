@@ -5,8 +5,10 @@
 //! each DOF is interpolated over the keys that name it (monotone cubic, [`pchip`]). The root's
 //! horizontal path and turn are keyed too; its height is solved so that the lowest foot point
 //! touches the floor, except during the listed flight spans, where it follows a ballistic arc
-//! between take-off and landing heights (gravity 9.81 m/s²).
+//! between take-off and landing heights (gravity 9.81 m/s²). [`ballistic`] takes the whole-body
+//! centre of mass of a clip and can put it, instead of the root, on the arc.
 
+pub mod ballistic;
 mod pchip;
 
 pub use pchip::pchip;

@@ -1,7 +1,8 @@
 //! ECS wiring (bevy_ecs): characters carry primitive players; systems step them every frame.
 //!
 //! - [`PrimitivePlayer`] plays a sequence of primitives, connected: each starts from the state the
-//!   previous one ended in (as [`super::connect()`]); after the last one the DMP keeps running and
+//!   previous one ended in and takes over without a step in acceleration (as
+//!   [`super::connect()`], with its [`HandOver`]); after the last one the DMP keeps running and
 //!   settles on its goal.
 //! - [`BlendPlayer`] plays two primitives placed on a time line and mixes them live with γ(t′)
 //!   (step 3 of the paper's blending, as [`super::blend()`] without re-learning).
@@ -21,6 +22,7 @@ use super::dof_pose::pose_from_dofs;
 use super::sets::{MotionSet, configure_motion_sets};
 
 use crate::primitive::blend::{BlendPlacement, Gamma};
+use crate::primitive::connect::HandOver;
 use crate::primitive::error::{PrimitiveError, Result};
 use crate::primitive::primitive::Primitive;
 use crate::primitive::rollout::Rollout;
@@ -53,6 +55,8 @@ pub struct PrimitivePlayer {
     names: Arc<[String]>,
     upcoming: VecDeque<Arc<Primitive>>,
     current: Rollout,
+    /// The previous primitive playing on while the current one takes over.
+    handover: Option<HandOver>,
     index: usize,
     elapsed: f64,
     finished: bool,
@@ -80,6 +84,7 @@ impl PrimitivePlayer {
             names: first.names().into(),
             upcoming,
             current: Rollout::new(&first, None)?,
+            handover: None,
             index: 0,
             elapsed: 0.0,
             finished: false,
@@ -120,6 +125,13 @@ impl PrimitivePlayer {
             let to_end = self.current.duration() - self.current.time();
             if left < to_end || self.upcoming.is_empty() {
                 self.current.advance(left);
+                if self
+                    .handover
+                    .as_ref()
+                    .is_some_and(|h| !h.active(self.current.time()))
+                {
+                    self.handover = None;
+                }
                 if self.upcoming.is_empty()
                     && self.current.time() >= self.current.duration() - 1e-12
                 {
@@ -133,6 +145,7 @@ impl PrimitivePlayer {
             let next = self.upcoming.pop_front().expect("checked non-empty");
             match Rollout::new(&next, Some(&state)) {
                 Ok(r) => {
+                    self.handover = Some(HandOver::new(&self.current, &r, next.duration));
                     self.current = r;
                     self.index += 1;
                 }
@@ -144,12 +157,16 @@ impl PrimitivePlayer {
         }
     }
 
-    /// Writes the current θ and θ̇ into `pose`.
+    /// Writes the current θ and θ̇ into `pose` (inside a hand-over window, the mix of the
+    /// previous primitive played on and the current one).
     pub fn write_pose(&self, pose: &mut DofPose) {
         pose.theta.clear();
         pose.theta.extend_from_slice(self.current.theta());
         pose.theta_dot.resize(pose.theta.len(), 0.0);
         self.current.theta_dot_into(&mut pose.theta_dot);
+        if let Some(h) = &self.handover {
+            h.mix(self.current.time(), &mut pose.theta, &mut pose.theta_dot);
+        }
     }
 }
 

@@ -320,6 +320,53 @@ impl Rollout {
         }
     }
 
+    /// Current θ̈ per DOF (per second²) into `out`: θ″/τ² with θ″ = z′ + F′ (2002, F′ = dF/du
+    /// by a central difference of the forcing, step 10⁻⁶ in u, one-sided at u < 10⁻⁶) or z′, and
+    /// z′ the transformation system's ([`Formulation::derivative`]).
+    pub fn theta_ddot_into(&self, out: &mut [f64]) {
+        const DU: f64 = 1e-6;
+        let in_velocity = self.formulation.forcing_in_velocity();
+        let dofs = self.theta.len();
+        let mut rate = vec![0.0; dofs];
+        if in_velocity {
+            let (mut hi, mut lo) = (vec![0.0; dofs], vec![0.0; dofs]);
+            let mut psi = vec![0.0; self.psi.len()];
+            let (ua, ub) = if self.u >= DU {
+                (self.u - DU, self.u + DU)
+            } else {
+                (self.u, self.u + DU)
+            };
+            let eval = |u: f64, out: &mut [f64], psi: &mut [f64]| {
+                forcing(
+                    &self.canonical,
+                    &self.kernels,
+                    &self.weights,
+                    &self.scale,
+                    psi,
+                    u,
+                    out,
+                );
+            };
+            eval(ub, &mut hi, &mut psi);
+            eval(ua, &mut lo, &mut psi);
+            for j in 0..dofs {
+                rate[j] = (hi[j] - lo[j]) / (ub - ua);
+            }
+        }
+        let tau2 = self.tau * self.tau;
+        for (j, o) in out.iter_mut().enumerate() {
+            let (_, dz) = self.formulation.derivative(
+                self.theta[j],
+                self.z[j],
+                self.goal[j],
+                self.start[j],
+                self.x_now,
+                self.f_now[j],
+            );
+            *o = (dz + rate[j]) / tau2;
+        }
+    }
+
     /// The current state (θ, θ̇).
     pub fn state(&self) -> DofState {
         let mut v = vec![0.0; self.theta.len()];
