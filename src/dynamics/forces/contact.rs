@@ -380,18 +380,15 @@ impl ContactModel {
         }
         for i in 0..self.corners.len() {
             let anchors = &mut state.anchors[i * 8..i * 8 + 8];
-            // Two call sites, so the explicit one is compiled without the implicit terms.
-            let (f, fn_i, d, power) = match implicit.as_mut() {
-                None => self.link_contact::<true>(data, i, anchors, None),
-                Some((h, added)) => {
-                    let mut ic = ArticulatedInertia::ZERO;
-                    let r = self.link_contact::<true>(data, i, anchors, Some((*h, &mut ic)));
-                    if ic != ArticulatedInertia::ZERO {
-                        added.push((i, ic));
-                    }
-                    r
-                }
-            };
+            let mut ic = ArticulatedInertia::ZERO;
+            let h = implicit.as_ref().map(|(h, _)| *h);
+            let (f, fn_i, d, power) =
+                self.link_contact::<true>(data, i, anchors, h.map(|h| (h, &mut ic)));
+            if let Some((_, added)) = implicit.as_mut()
+                && ic != ArticulatedInertia::ZERO
+            {
+                added.push((i, ic));
+            }
             let (c, _) = self.bounds[i];
             let v = data.v[i];
             sample.normal[i] = fn_i;
