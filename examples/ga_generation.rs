@@ -9,6 +9,8 @@
 //! (`STRENGTH=adult|elderly`: torque limits and k_p bounds, the step re-derived from them).
 //! `RANGE_KEYS=knee,hip_flexion` takes only those side-less DOFs' ranges from `RANGES`;
 //! `RANGES_FOR=genes|sim` applies them only to the θ_d bounds or only to the simulated ranges.
+//! `IMPLICIT_CONTACT_DAMPING=1` takes the floor's normal damping implicitly and re-derives the
+//! step without its bound (before `DT`).
 //! `KEY=stance` replaces every θ_d gene by the stance pose (random k_p only: the fall of a
 //! body that holds its stance). Besides each fall, it prints the mean damage share per link over the falls and the link
 //! that carries the most damage in the best one.
@@ -72,6 +74,11 @@ fn main() {
     if let Some(g) = group_env("STRENGTH") {
         problem.fall.torque_limits_nm = Some(marionette::humanoid::strength::torque_limits(g));
         problem.kp_max = strength_kp_max(g, 1.0);
+        problem.fall.dt_s = stable_step_for(&problem.fall, &problem.kp_max).expect("step");
+    }
+    if std::env::var("IMPLICIT_CONTACT_DAMPING").is_ok() {
+        // The floor's damping taken implicitly: the step re-derived without its bound.
+        problem.fall.contact.implicit_damping = true;
         problem.fall.dt_s = stable_step_for(&problem.fall, &problem.kp_max).expect("step");
     }
     if let Some(dt) = env("DT") {

@@ -61,6 +61,7 @@ impl Dynamics for Passive<'_> {
                     &self.tau,
                     &self.f_ext,
                     Some(&arm),
+                    &[],
                 );
             }
         }

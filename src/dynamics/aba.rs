@@ -8,11 +8,12 @@
 //! `q̈ = D⁻¹(u − Uᵀ a')`, `a = a' + S q̈`. A free root has `S = 1₆`, so its acceleration is
 //! `a = (I^A)⁻¹(τ − p^A)` (Featherstone's floating-base variant, `FDfb`).
 
+use super::axis_rotation::JointAxes;
 use super::data::Data;
 use super::joint::JointType;
 use super::kinematics::{base_acceleration, kinematics};
 use super::model::Model;
-use super::spatial::ForceVec;
+use super::spatial::{ArticulatedInertia, ForceVec};
 use glam::{DMat3, DVec3};
 
 /// Forward dynamics: returns `q̈` (size nv, in `data.qdd`) for configuration `q` (nq), velocity
@@ -27,19 +28,26 @@ pub fn aba<'d>(
     f_ext: &[ForceVec],
 ) -> &'d [f64] {
     kinematics(model, data, q, v);
-    aba_passes(model, data, tau, f_ext, None);
+    aba_passes(model, data, tau, f_ext, None, &[]);
     &data.qdd
 }
 
 /// Passes 2 and 3 of the ABA on kinematics already in `data`. `armature` (size nv, N·m·s²)
 /// is added to each joint's `D`, so that the algorithm solves `(H + diag(armature)) q̈ = τ − C`;
 /// the integrator uses it to take joint damping implicitly (armature = `dt·k_v`).
+///
+/// `implicit` lists bodies `b` with an inertia `I_c` (body coordinates) through which a force
+/// `−I_c (a_b − ā_b)` acts, `ā_b` the body's acceleration at `q̈ = 0` (gravity and velocity
+/// products): the linearisation of a force taken implicitly, `J q̈ = a_b − ā_b` being the
+/// body's acceleration due to `q̈`. It enters as `I^A_b += I_c`, `p^A_b −= I_c ā_b`
+/// ([`ContactParams::implicit_damping`](super::forces::contact::ContactParams::implicit_damping)).
 pub fn aba_passes(
     model: &Model,
     data: &mut Data,
     tau: &[f64],
     f_ext: &[ForceVec],
     armature: Option<&[f64]>,
+    implicit: &[(usize, ArticulatedInertia)],
 ) {
     let n = model.nbodies();
     debug_assert_eq!(f_ext.len(), n);
@@ -48,6 +56,18 @@ pub fn aba_passes(
         let vi = data.v[i];
         data.ia[i] = model.inertia_blocks[i];
         data.pa[i] = vi.cross_force(inertia.apply(vi)) - f_ext[i];
+    }
+    if !implicit.is_empty() {
+        // ā: the accelerations at q̈ = 0, parents first (pass 3 overwrites `a`).
+        let a0 = base_acceleration(model);
+        for i in 0..n {
+            let a_parent = model.bodies[i].parent.map_or(a0, |p| data.a[p]);
+            data.a[i] = data.xup[i].apply_motion(a_parent) + data.c[i];
+        }
+        for (b, ic) in implicit {
+            data.ia[*b] += *ic;
+            data.pa[*b] -= ic.apply(data.a[*b]);
+        }
     }
     for i in (0..n).rev() {
         let body = &model.bodies[i];
@@ -60,11 +80,22 @@ pub fn aba_passes(
         let arm = |k: usize| armature.map_or(0.0, |a| a[iv + k]);
         match body.joint {
             JointType::Pin { .. } => {
-                // Revolute columns are pure rotations: S = [a; 0].
-                let a = data.s[i][0].ang;
-                let u = ia.apply_angular(a);
-                let d = a.dot(u.ang) + arm(0);
-                let uu = tau[iv] - a.dot(pa.ang);
+                // Revolute columns are pure rotations: S = [a; 0]; about a coordinate axis
+                // `a = ±e_k`, `U` is ± column k of `[M; Hᵀ]` and `D = M_kk` (the same bits as
+                // the products, whose other terms are zeros).
+                let (u, d, uu) = match model.joint_axes[i] {
+                    JointAxes::One(ax) => (
+                        ForceVec::new(ia.m.col(ax.k) * ax.sign, ia.h.row(ax.k) * ax.sign),
+                        ia.m.col(ax.k)[ax.k],
+                        tau[iv] - ax.sign * pa.ang[ax.k],
+                    ),
+                    _ => {
+                        let a = data.s[i][0].ang;
+                        let u = ia.apply_angular(a);
+                        (u, a.dot(u.ang), tau[iv] - a.dot(pa.ang))
+                    }
+                };
+                let d = d + arm(0);
                 let dinv = 1.0 / d;
                 data.u[i][0] = u;
                 data.dinv[i].x_axis.x = dinv;

@@ -66,7 +66,10 @@ pub struct DofStiffness {
 }
 
 /// The stiffest mode of a body at configuration `q`: per link the contact bound of
-/// [`ContactModel::link_frequency`]; per DOF `ω² = k (H⁻¹)_jj`, `2ζω = d (H⁻¹)_jj` with `H` the
+/// [`ContactModel::link_frequency`] (undamped, `ζ = 0`, when semi-implicit Euler takes the contact
+/// damping implicitly, [`ContactParams::implicit_damping`](super::forces::contact::ContactParams::implicit_damping);
+/// the undamped bound `2/ω` is then
+/// conservative); per DOF `ω² = k (H⁻¹)_jj`, `2ζω = d (H⁻¹)_jj` with `H` the
 /// joint-space inertia at `q`. `None` when there is nothing stiff.
 pub fn stiffest_mode(
     model: &Model,
@@ -87,9 +90,14 @@ pub fn stiffest_mode(
             });
         }
     };
+    // Contact damping taken implicitly in semi-implicit Euler leaves the undamped bound 2/ω.
+    let implicit_damping = contact.is_some_and(|cm| {
+        cm.params.implicit_damping && matches!(integrator, Integrator::SemiImplicitEuler { .. })
+    });
     if let Some(cm) = contact {
         for i in 0..model.nbodies() {
             let (omega, zeta) = cm.link_frequency(i, &model.bodies[i].inertia);
+            let zeta = if implicit_damping { 0.0 } else { zeta };
             let bound = stable_step(integrator, omega, zeta);
             consider(bound, &|| "contact".to_string(), i, omega, zeta);
         }

@@ -81,6 +81,11 @@ pub struct Controller {
     /// which the fall takes when `simulation.dt` is left out. A scene's own `controller.dt_s`
     /// overrides the file's (e.g. half of it, to check the fall at half the step).
     pub dt_s: Option<f64>,
+    /// Whether the floor's normal damping was taken implicitly when this controller was
+    /// evolved ([`ContactParams::implicit_damping`]): the fall replays with the same contact.
+    /// A scene's own `controller` block overrides the file's; left out everywhere, the scene's
+    /// `contact` decides.
+    pub contact_implicit_damping: Option<bool>,
 }
 
 /// A pushed fall: an elderly or adult figure with given PD settings, pushed.
@@ -227,6 +232,13 @@ impl FallScene {
             }
         }
         c.dt_s = self.step(from_file.as_ref())?;
+        if let Some(b) = self
+            .controller
+            .contact_implicit_damping
+            .or(from_file.as_ref().and_then(|f| f.contact_implicit_damping))
+        {
+            c.contact.implicit_damping = b;
+        }
         for (link, w) in &self.damage_weights {
             if !c.damage_weights.contains_key(link) {
                 return Err(SceneError::Invalid(format!(
