@@ -482,7 +482,7 @@ fn status_text(
         }
         if let Some(last) = log.samples.last() {
             line.push_str(&format!(
-                ", joint RMS error {:.1}°",
+                ", joint RMS error {:.1} deg",
                 last.mean_sq_error.sqrt().to_degrees()
             ));
         }
