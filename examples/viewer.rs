@@ -8,8 +8,11 @@
 //! drawn side by side (a display offset along x: they do not touch each other); each stands on
 //! its own floor, which is drawn.
 //!
-//!     cargo run --release --example viewer --features viewer
-//!     cargo run --release --example viewer --features viewer -- --screenshot docs/viewer.png --after-s 1.0
+//!     cargo run --release --example viewer --features viewer --ignore-rust-version
+//!     cargo run --release --example viewer --features viewer --ignore-rust-version -- \
+//!         --screenshot docs/viewer.png --after-s 1.0
+//!
+//! (`--ignore-rust-version`: bevy 0.20.1 declares Rust 1.97.1; it builds on 1.95.)
 //!
 //! Options: `--scene PATH` (another `ActiveKneeKick` scene), `--set FIELD=VALUE` (as the
 //! command's `run --set`, repeatable), `--screenshot PATH --after-s T` (simulate T seconds
