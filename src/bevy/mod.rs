@@ -7,6 +7,11 @@
 //! transforms are published as [`Transform`]s of one child entity per joint
 //! ([`spawn_joint_entities`], [`publish_joint_transforms`], after [`MotionSet::Kinematics`]), for
 //! meshes to follow.
+//!
+//! In an app with Bevy's `TimePlugin` (part of `DefaultPlugins`), Bevy's own fixed loop also
+//! runs [`FixedMain`] from virtual time (each run one more engine tick); to advance the engine
+//! only through [`TicksPerUpdate`], pause `Time<Virtual>` (as `examples/viewer.rs` does), or
+//! set `ticks_per_update` to 0 and `Time<Fixed>` to the clock's tick to let Bevy pace it.
 
 use bevy_app::{App, FixedMain, FixedUpdate, Plugin, RunFixedMainLoop, RunFixedMainLoopSystems};
 use bevy_ecs::prelude::*;

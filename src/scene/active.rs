@@ -76,6 +76,20 @@ impl Default for ActiveCharacter {
     }
 }
 
+impl ActiveCharacter {
+    /// The engine's settings for this character: the scene's PD and assistance bandwidths,
+    /// assistance strength and torque bounds, the rest at their defaults.
+    pub fn settings(&self) -> PhysicalSettings {
+        PhysicalSettings {
+            joint_omega: self.joint_omega,
+            assist: self.assist,
+            assist_omega: self.assist_omega,
+            strength: self.strength,
+            ..PhysicalSettings::default()
+        }
+    }
+}
+
 /// The active jumping knee kick.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -122,13 +136,7 @@ pub fn run_active_knee_kick(
         height_m: c.height_m,
         mass_kg: c.mass_kg,
         gravity: 9.81,
-        settings: PhysicalSettings {
-            joint_omega: c.joint_omega,
-            assist: c.assist,
-            assist_omega: c.assist_omega,
-            strength: c.strength,
-            ..PhysicalSettings::default()
-        },
+        settings: c.settings(),
         dt_s: scene.dt_s,
         duration_s: scene.duration_s,
         push: Some(scene.push.clone()),

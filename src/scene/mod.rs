@@ -23,7 +23,8 @@ pub use dance::{
 pub use evolve::{EvaluatorChoice, EvolveFallScene, run_evolve};
 pub use fall::{Body, Controller, FallScene, Simulation, fall_report, run_fall};
 pub use primitives::{
-    HighJumpScene, JumpingKneeKickScene, PrimitiveRender, run_high_jump, run_jumping_knee_kick,
+    HighJumpScene, JumpingKneeKickScene, PrimitiveRender, knee_kick_config, run_high_jump,
+    run_jumping_knee_kick,
 };
 pub use show::{RenderSettings, ShowScene, run_show};
 pub use source::{ClipSource, LoadedMotion, data_dir, load_motion, resolve_path};

@@ -326,7 +326,7 @@ fn events_json(e: &JumpEvents) -> serde_json::Value {
 }
 
 /// The jumping knee kick's configuration: the scene's clips loaded onto humanoid24, γs checked.
-pub(super) fn knee_kick_config(
+pub fn knee_kick_config(
     scene: &JumpingKneeKickScene,
     base: &Path,
 ) -> Result<KneeKickConfig, SceneError> {
