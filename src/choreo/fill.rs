@@ -396,14 +396,11 @@ impl<'a> Graph<'a> {
         }
     }
 
-    /// The runs' paths joined at their shared pinned bars; `None` if a run has none.
-    fn joined(
-        &self,
-        mut path_of: impl FnMut(&Graph<'a>) -> Option<Vec<usize>>,
-    ) -> Option<Vec<usize>> {
+    /// The runs' paths, in order, joined at their shared pinned bars; `None` if a run has none.
+    fn joined(&self, paths: impl IntoIterator<Item = Option<Vec<usize>>>) -> Option<Vec<usize>> {
         let mut path = Vec::with_capacity(self.bars);
-        for r in self.runs() {
-            let p = path_of(&self.run(r))?;
+        for p in paths {
+            let p = p?;
             let skip = usize::from(!path.is_empty());
             path.extend_from_slice(&p[skip..]);
         }
@@ -412,7 +409,7 @@ impl<'a> Graph<'a> {
 
     /// Dijkstra's algorithm ([`Graph::dijkstra_run`]) on each run, joined.
     fn dijkstra(&self) -> Option<Vec<usize>> {
-        self.joined(|g| g.dijkstra_run())
+        self.joined(self.runs().into_iter().map(|r| self.run(r).dijkstra_run()))
     }
 
     /// The exact dynamic programme (module docs) on every run at once; `None` without a path.
@@ -490,13 +487,7 @@ impl<'a> Graph<'a> {
                 }
             }
         }
-        let mut path = Vec::with_capacity(self.bars);
-        for (g, d) in runs.iter().zip(&dist) {
-            let p = g.backtrack(d)?;
-            let skip = usize::from(!path.is_empty());
-            path.extend_from_slice(&p[skip..]);
-        }
-        Some(path)
+        self.joined(runs.iter().zip(&dist).map(|(g, d)| g.backtrack(d)))
     }
 
     /// The path of a run from its layers' D (row-major): the end of smallest total (smallest
