@@ -251,6 +251,7 @@ fn latency_of_search_generate_and_first_load_on_2000_segments() {
         ms("search_click_to_drawn_ms"),
         ms("generate_ms"),
     );
+    let (search_server, generate_server) = (ms("search_server_ms"), ms("generate_server_ms"));
     seen["database"] = format!("2,000 segments from {source}").into();
     seen["startup_s"] = startup_s.into();
     let shots = shots();
@@ -258,14 +259,17 @@ fn latency_of_search_generate_and_first_load_on_2000_segments() {
     println!(
         "editor latency, 2,000 segments from {source}, 64 bars:\n  server start (scene, \
          transition table) to URL: {startup_s:.2} s\n  first load: {:.0} ms\n  Search round \
-         (POST answered, JSON read; {} rounds): {}\n  Search button to six candidates drawn \
-         ({} rounds): {}\n  Generate of 64 bars ({} runs): {}",
+         (POST answered, JSON read; {} rounds): {} (the server's own time: {})\n  Search \
+         button to six candidates drawn ({} rounds): {}\n  Generate of 64 bars ({} runs): {} \
+         (the server's own time: {})",
         seen["load_ms"].as_f64().unwrap(),
         search.len(),
         summary(&search),
+        summary(&search_server),
         click.len(),
         summary(&click),
         generate.len(),
         summary(&generate),
+        summary(&generate_server),
     );
 }

@@ -2,7 +2,8 @@
 // node latency.mjs URL
 // In headless Chromium, with performance.now() in the page: the first load (navigation start
 // to a usable page), Search rounds (the POST answered and its JSON read; and the Search
-// button to six new candidates drawn), and Generate (every unpinned bar filled). Prints one
+// button to six new candidates drawn), and Generate (every unpinned bar filled); for the POSTs
+// also the server's own time from its Server-Timing header. Prints one
 // JSON line of every measurement; these are measurements, not checks: only correctness
 // (six candidates, every bar filled) fails the script.
 import { chromium } from 'playwright-core';
@@ -36,7 +37,9 @@ try {
           body: JSON.stringify({ bar }),
         });
         const j = await r.json();
-        out.push({ ms: performance.now() - t0, candidates: j.candidates.length, bytes: JSON.stringify(j).length });
+        const ms = performance.now() - t0;
+        const server = Number((r.headers.get('Server-Timing') || '').match(/dur=([0-9.]+)/)?.[1]);
+        out.push({ ms, server, candidates: j.candidates.length, bytes: JSON.stringify(j).length });
       }
     }
     return out;
@@ -73,8 +76,13 @@ try {
     const out = [];
     for (let k = 0; k < 5; k++) {
       const t0 = performance.now();
-      const j = await post('/api/generate', {});
-      out.push({ ms: performance.now() - t0, bars: j.fill.segments.length });
+      const r = await fetch('/api/generate', {
+        method: 'POST', headers: { 'Content-Type': 'application/json' }, body: '{}',
+      });
+      const j = await r.json();
+      const ms = performance.now() - t0;
+      const server = Number((r.headers.get('Server-Timing') || '').match(/dur=([0-9.]+)/)?.[1]);
+      out.push({ ms, server, bars: j.fill.segments.length });
     }
     return out;
   }, (await (await page.request.get(url + 'api/state')).json()).segments);
@@ -82,9 +90,10 @@ try {
   if (errors.length) fail('page errors: ' + errors.join(' | '));
   console.log(JSON.stringify({
     load_ms: loadMs, bars,
-    search_ms: search.map((s) => s.ms), search_bytes: search[0].bytes,
+    search_ms: search.map((s) => s.ms), search_server_ms: search.map((s) => s.server),
+    search_bytes: search[0].bytes,
     search_click_to_drawn_ms: clicks,
-    generate_ms: generate.map((g) => g.ms),
+    generate_ms: generate.map((g) => g.ms), generate_server_ms: generate.map((g) => g.server),
   }));
 } finally {
   await browser.close();
