@@ -65,7 +65,7 @@ fn full_assistance_tracks_the_jump_and_none_falls() {
             t.peak_nm, t.limit_nm
         );
     }
-    // assert!(full.tracking_rms_deg < 2.0, "{}", full.tracking_rms_deg);
+    assert!(full.tracking_rms_deg < 2.0, "{}", full.tracking_rms_deg);
     assert!(full.fall_s.is_none());
     let mut none_cfg = cfg.clone();
     none_cfg.settings.assist = 0.0;
@@ -305,10 +305,11 @@ fn print_junctions(label: &str, seq: &[Primitive]) {
 const FOOT_ON_FLOOR_M: f64 = 0.02;
 
 /// The high jump and the jumping knee kick, fully assisted (the assistance carries the root's
-/// share of the motion's inverse dynamics). Under adult strength the waist is asked for more
-/// than the strength table gives (measured and asserted: that is why tracking there is not
-/// under 2°); with unbounded torques both track under 2° with the feet on the floor whenever
-/// the animated ones are.
+/// share of the motion's inverse dynamics): under adult strength and with unbounded torques
+/// both track under 2° with the feet on the floor whenever the animated ones are. (The
+/// keyframed jumps are keyed as a body can make them: the legs still extending fast at
+/// take-off, the trunk lean and the arm swing within what the waist and shoulders' strength
+/// can carry; `scenes/clips/normal_jump.ron`.)
 #[test]
 fn fully_assisted_tracking_of_both_jumps_under_adult_strength() {
     let (high, kick) = jumps();
@@ -322,11 +323,11 @@ fn fully_assisted_tracking_of_both_jumps_under_adult_strength() {
         print_tracking(label, &o);
         print_junctions(label, &seq);
         assert!(o.fall_s.is_none());
-        let waist = o.demands.iter().find(|d| d.dof == "waist_flexion").unwrap();
-        assert!(
-            waist.demand_nm.0 < waist.limit_nm.0 || waist.demand_nm.1 > waist.limit_nm.1,
-            "{waist:?}"
-        );
+        assert!(o.tracking_rms_deg < 2.0, "{label}: {}", o.tracking_rms_deg);
+        for f in &o.feet {
+            assert!(f.animated_down_s > 0.5, "{label}: {f:?}");
+            assert!(f.max_gap_m <= FOOT_ON_FLOOR_M, "{label}: {f:?}");
+        }
         let mut c = cfg.clone();
         c.settings.strength = None;
         let o = run_active(&c, &seq).unwrap();
@@ -452,14 +453,15 @@ fn whole_sequence(seq: &[Primitive]) -> ActiveConfig {
     }
 }
 
-/// Why the keyframed jumps do not track under adult strength: their motion is not one a body
-/// can make. A floor only pushes up, but the keyframed high jump and knee kick need the body
-/// pulled down by more than a body weight at times (their flights keep the pelvis, not the
-/// centre of mass, on a ballistic arc while the limbs swing), and the assistance that supplies
-/// it loads the trunk. The same jump blended from the CMU capture needs little pull and, fully
-/// assisted under adult strength, tracks under 2° with the feet on the floor.
+/// The downward pull each motion needs (a floor only pushes up, so a motion a body can make
+/// needs none; the assistance carries it), and the same two motions blended from the CMU
+/// capture, fully assisted under adult strength: both track under 2° with the feet on the
+/// floor, the high jump needing little pull. The keyframed ones still need a pull at times (printed:
+/// the flight keeps the pelvis, not the centre of mass, on its ballistic arc while the limbs
+/// swing, and the kick is blended into the flight), which no longer keeps them from tracking
+/// under 2° ([`fully_assisted_tracking_of_both_jumps_under_adult_strength`]).
 #[test]
-fn captured_jumps_track_under_adult_strength_and_keyframed_ones_need_pulling_down() {
+fn captured_jumps_track_under_adult_strength() {
     let (high, kick) = jumps();
     for (label, seq) in [("high jump", &high), ("jumping knee kick", &kick)] {
         let o = run_active(&whole_sequence(seq), seq).unwrap();
@@ -467,7 +469,6 @@ fn captured_jumps_track_under_adult_strength_and_keyframed_ones_need_pulling_dow
             "keyframed {label}: downward pull up to {:.2} body weights (at {:.3} s)",
             o.pull.max_bw, o.pull.at_s
         );
-        assert!(o.pull.max_bw > 1.0, "{label}: {:?}", o.pull);
     }
     let Some((high, kick)) = cmu_jumps() else {
         return;
@@ -482,8 +483,8 @@ fn captured_jumps_track_under_adult_strength_and_keyframed_ones_need_pulling_dow
         }
         if label == "CMU high jump" {
             assert!(o.pull.max_bw < 0.5, "{label}: {:?}", o.pull);
-            assert!(o.tracking_rms_deg < 2.0, "{label}: {}", o.tracking_rms_deg);
         }
+        assert!(o.tracking_rms_deg < 2.0, "{label}: {}", o.tracking_rms_deg);
     }
 }
 
