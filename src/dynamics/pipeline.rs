@@ -421,6 +421,19 @@ fn integrate_stage(
 fn check_stage(model: &Model, state: &State, ws: &mut StepWorkspace) -> Result<(), StepError> {
     let t = state.time_s;
     let data = ws.kinematics_of(model, state);
+    // The common case first, without square roots: every body finite and within bounds
+    // (`|v|² ≤ MAX_SPEED²`); only a failing state is searched for its first culprit below.
+    let within = (0..model.nbodies()).all(|i| {
+        let (p, vel) = (data.pos[i], data.v[i]);
+        p.is_finite()
+            && data.rot[i].is_finite()
+            && vel.is_finite()
+            && vel.ang.length_squared().max(vel.lin.length_squared()) <= MAX_SPEED * MAX_SPEED
+            && p.abs().max_element() <= MAX_EXTENT
+    });
+    if within {
+        return Ok(());
+    }
     for i in 0..model.nbodies() {
         let (p, vel) = (data.pos[i], data.v[i]);
         let name = || model.bodies[i].name.clone();
