@@ -13,7 +13,7 @@ use super::data::Data;
 use super::joint::JointType;
 use super::kinematics::{base_acceleration, kinematics};
 use super::model::Model;
-use super::spatial::{ArticulatedInertia, ForceVec};
+use super::spatial::{ArticulatedInertia, ForceVec, MotionVec};
 use glam::{DMat3, DVec3};
 
 /// Forward dynamics: returns `q̈` (size nv, in `data.qdd`) for configuration `q` (nq), velocity
@@ -198,20 +198,8 @@ pub fn aba_passes(
                 a.ang += data.s[i][0].ang * qdd;
                 data.a[i] = a;
             }
-            JointType::Universal { .. } | JointType::Ball { .. } => {
-                let nv = body.joint.nv();
-                let mut r = DVec3::ZERO;
-                for k in 0..nv {
-                    r[k] = data.uu[i][k] - data.u[i][k].dot_motion(a_prime);
-                }
-                let qdd = data.dinv[i] * r;
-                let mut a = a_prime;
-                for k in 0..nv {
-                    data.qdd[iv + k] = qdd[k];
-                    a.ang += data.s[i][k].ang * qdd[k];
-                }
-                data.a[i] = a;
-            }
+            JointType::Universal { .. } => multi_dof_acceleration::<2>(data, i, iv, a_prime),
+            JointType::Ball { .. } => multi_dof_acceleration::<3>(data, i, iv, a_prime),
             JointType::Fixed => data.a[i] = a_prime,
             JointType::Free => {
                 let f = ForceVec::new(
@@ -242,4 +230,25 @@ fn coordinate_column(
         ia.m.col(ax.k)[ax.k],
         tau - ax.sign * pa.ang[ax.k],
     )
+}
+
+/// Pass 3 for a joint of `N` rotational DOFs: `q̈ = D⁻¹(u − Uᵀ a')`, `a = a' + S q̈`.
+#[inline(always)]
+fn multi_dof_acceleration<const N: usize>(
+    data: &mut Data,
+    i: usize,
+    iv: usize,
+    a_prime: MotionVec,
+) {
+    let mut r = DVec3::ZERO;
+    for k in 0..N {
+        r[k] = data.uu[i][k] - data.u[i][k].dot_motion(a_prime);
+    }
+    let qdd = data.dinv[i] * r;
+    let mut a = a_prime;
+    for k in 0..N {
+        data.qdd[iv + k] = qdd[k];
+        a.ang += data.s[i][k].ang * qdd[k];
+    }
+    data.a[i] = a;
 }
