@@ -488,6 +488,10 @@ impl ContactStats {
     pub fn accumulate(&mut self, sample: &ContactSample, t: f64, dt: f64) {
         for i in 0..sample.normal.len() {
             let f = sample.normal[i];
+            if f == 0.0 && sample.depth[i] == 0.0 && sample.absorbed_power[i] == 0.0 {
+                // A link off the floor adds nothing (the same bits as adding its zeros).
+                continue;
+            }
             self.peak[i] = self.peak[i].max(f);
             self.impulse[i] += f * dt;
             self.max_depth[i] = self.max_depth[i].max(sample.depth[i]);
