@@ -8,12 +8,12 @@
 //! `q̈ = D⁻¹(u − Uᵀ a')`, `a = a' + S q̈`. A free root has `S = 1₆`, so its acceleration is
 //! `a = (I^A)⁻¹(τ − p^A)` (Featherstone's floating-base variant, `FDfb`).
 
-use super::axis_rotation::JointAxes;
+use super::axis_rotation::{CoordAxis, JointAxes};
 use super::data::Data;
 use super::joint::JointType;
 use super::kinematics::{base_acceleration, kinematics};
 use super::model::Model;
-use super::spatial::{ArticulatedInertia, ForceVec};
+use super::spatial::{ArticulatedInertia, ForceVec, MotionVec};
 use glam::{DMat3, DVec3};
 
 /// Forward dynamics: returns `q̈` (size nv, in `data.qdd`) for configuration `q` (nq), velocity
@@ -51,10 +51,10 @@ pub fn aba_passes(
 ) {
     let n = model.nbodies();
     debug_assert_eq!(f_ext.len(), n);
+    data.ia.copy_from_slice(&model.inertia_blocks);
     for i in 0..n {
         let inertia = &model.bodies[i].inertia;
         let vi = data.v[i];
-        data.ia[i] = model.inertia_blocks[i];
         data.pa[i] = vi.cross_force(inertia.apply(vi)) - f_ext[i];
     }
     if !implicit.is_empty() {
@@ -78,17 +78,15 @@ pub fn aba_passes(
         let ia = &mut ia_tail[0];
         let pa = data.pa[i];
         let arm = |k: usize| armature.map_or(0.0, |a| a[iv + k]);
-        match body.joint {
-            JointType::Pin { .. } => {
+        let has_parent = body.parent.is_some();
+        // `p^a − I^a c`: the bias force the body passes on (before the inertia's product).
+        let pa_a = match (&body.joint, model.joint_axes[i]) {
+            (JointType::Pin { .. }, axes) => {
                 // Revolute columns are pure rotations: S = [a; 0]; about a coordinate axis
                 // `a = ±e_k`, `U` is ± column k of `[M; Hᵀ]` and `D = M_kk` (the same bits as
                 // the products, whose other terms are zeros).
-                let (u, d, uu) = match model.joint_axes[i] {
-                    JointAxes::One(ax) => (
-                        ForceVec::new(ia.m.col(ax.k) * ax.sign, ia.h.row(ax.k) * ax.sign),
-                        ia.m.col(ax.k)[ax.k],
-                        tau[iv] - ax.sign * pa.ang[ax.k],
-                    ),
+                let (u, d, uu) = match axes {
+                    JointAxes::One(ax) => coordinate_column(ia, ax, tau[iv], pa),
                     _ => {
                         let a = data.s[i][0].ang;
                         let u = ia.apply_angular(a);
@@ -100,15 +98,45 @@ pub fn aba_passes(
                 data.u[i][0] = u;
                 data.dinv[i].x_axis.x = dinv;
                 data.uu[i].x = uu;
-                if let Some(p) = body.parent {
-                    ia.sub_outer(u, dinv);
-                    let pa_a = pa + ia.apply(data.c[i]) + u * (dinv * uu);
-                    let x = &data.xup[i];
-                    ia_head[p] += ia.transform_to_parent_with(x, &data.xup_rotation[i]);
-                    data.pa[p] += x.inv_apply_force(pa_a);
+                if !has_parent {
+                    continue;
                 }
+                ia.sub_outer(u, dinv);
+                pa + u * (dinv * uu)
             }
-            JointType::Universal { .. } | JointType::Ball { .. } => {
+            (JointType::Universal { .. }, JointAxes::Two(_, a2)) => {
+                // The second column is the coordinate axis `a2` itself (taken as in a pin),
+                // the first `R₂ᵀ a₁` (from the kinematics); `D` is 2×2.
+                let b = data.s[i][0].ang;
+                let u0 = ia.apply_angular(b);
+                let (u1, d11, uu1) = coordinate_column(ia, a2, tau[iv + 1], pa);
+                let d00 = b.dot(u0.ang) + arm(0);
+                let d11 = d11 + arm(1);
+                let (d01, d10) = (b.dot(u1.ang), a2.sign * u0.ang[a2.k]);
+                let uu0 = tau[iv] - b.dot(pa.ang);
+                let inv_det = 1.0 / (d00 * d11 - d01 * d10);
+                let dinv = DMat3::from_cols(
+                    DVec3::new(d11 * inv_det, -d10 * inv_det, 0.0),
+                    DVec3::new(-d01 * inv_det, d00 * inv_det, 0.0),
+                    DVec3::Z,
+                );
+                let u = [u0, u1];
+                data.u[i][0] = u0;
+                data.u[i][1] = u1;
+                data.dinv[i] = dinv;
+                data.uu[i] = DVec3::new(uu0, uu1, 0.0);
+                if !has_parent {
+                    continue;
+                }
+                let w = [
+                    u0 * dinv.x_axis.x + u1 * dinv.x_axis.y,
+                    u0 * dinv.y_axis.x + u1 * dinv.y_axis.y,
+                ];
+                ia.sub_products(&w, &u);
+                pa + u0 * (dinv.x_axis.x * uu0 + dinv.y_axis.x * uu1)
+                    + u1 * (dinv.x_axis.y * uu0 + dinv.y_axis.y * uu1)
+            }
+            (JointType::Universal { .. } | JointType::Ball { .. }, _) => {
                 let nv = body.joint.nv();
                 let mut u = [ForceVec::ZERO; 3];
                 let mut d = DMat3::IDENTITY;
@@ -131,28 +159,26 @@ pub fn aba_passes(
                 data.u[i] = u;
                 data.dinv[i] = dinv;
                 data.uu[i] = uu;
-                if let Some(p) = body.parent {
-                    ia.sub_u_dinv_ut(&u[..nv], &dinv);
-                    let w = dinv * uu;
-                    let mut pa_a = pa + ia.apply(data.c[i]);
-                    for k in 0..nv {
-                        pa_a += u[k] * w[k];
-                    }
-                    let x = &data.xup[i];
-                    ia_head[p] += ia.transform_to_parent_with(x, &data.xup_rotation[i]);
-                    data.pa[p] += x.inv_apply_force(pa_a);
+                if !has_parent {
+                    continue;
                 }
-            }
-            JointType::Fixed => {
-                // No DOF: the whole articulated inertia and bias force reach the parent.
-                if let Some(p) = body.parent {
-                    let pa_a = pa + ia.apply(data.c[i]);
-                    let x = &data.xup[i];
-                    ia_head[p] += ia.transform_to_parent_with(x, &data.xup_rotation[i]);
-                    data.pa[p] += x.inv_apply_force(pa_a);
+                ia.sub_u_dinv_ut(&u[..nv], &dinv);
+                let w = dinv * uu;
+                let mut pa_a = pa;
+                for k in 0..nv {
+                    pa_a += u[k] * w[k];
                 }
+                pa_a
             }
-            JointType::Free => {}
+            // No DOF: the whole articulated inertia and bias force reach the parent.
+            (JointType::Fixed, _) => pa,
+            (JointType::Free, _) => continue,
+        };
+        if let Some(p) = body.parent {
+            let pa_a = pa_a + ia.apply(data.c[i]);
+            let x = &data.xup[i];
+            ia_head[p] += ia.transform_to_parent_with(x, &data.xup_rotation[i]);
+            data.pa[p] += x.inv_apply_force(pa_a);
         }
     }
     let a0 = base_acceleration(model);
@@ -172,20 +198,8 @@ pub fn aba_passes(
                 a.ang += data.s[i][0].ang * qdd;
                 data.a[i] = a;
             }
-            JointType::Universal { .. } | JointType::Ball { .. } => {
-                let nv = body.joint.nv();
-                let mut r = DVec3::ZERO;
-                for k in 0..nv {
-                    r[k] = data.uu[i][k] - data.u[i][k].dot_motion(a_prime);
-                }
-                let qdd = data.dinv[i] * r;
-                let mut a = a_prime;
-                for k in 0..nv {
-                    data.qdd[iv + k] = qdd[k];
-                    a.ang += data.s[i][k].ang * qdd[k];
-                }
-                data.a[i] = a;
-            }
+            JointType::Universal { .. } => multi_dof_acceleration::<2>(data, i, iv, a_prime),
+            JointType::Ball { .. } => multi_dof_acceleration::<3>(data, i, iv, a_prime),
             JointType::Fixed => data.a[i] = a_prime,
             JointType::Free => {
                 let f = ForceVec::new(
@@ -200,4 +214,41 @@ pub fn aba_passes(
             }
         }
     }
+}
+
+/// The column of a joint DOF about the coordinate axis `ax` (`S = [±e_k; 0]`): `U = I^A S`
+/// (± column k of `[M; Hᵀ]`), `Sᵀ U = M_kk` and `τ − Sᵀ p^A`.
+#[inline(always)]
+fn coordinate_column(
+    ia: &ArticulatedInertia,
+    ax: CoordAxis,
+    tau: f64,
+    pa: ForceVec,
+) -> (ForceVec, f64, f64) {
+    (
+        ForceVec::new(ia.m.col(ax.k) * ax.sign, ia.h.row(ax.k) * ax.sign),
+        ia.m.col(ax.k)[ax.k],
+        tau - ax.sign * pa.ang[ax.k],
+    )
+}
+
+/// Pass 3 for a joint of `N` rotational DOFs: `q̈ = D⁻¹(u − Uᵀ a')`, `a = a' + S q̈`.
+#[inline(always)]
+fn multi_dof_acceleration<const N: usize>(
+    data: &mut Data,
+    i: usize,
+    iv: usize,
+    a_prime: MotionVec,
+) {
+    let mut r = DVec3::ZERO;
+    for k in 0..N {
+        r[k] = data.uu[i][k] - data.u[i][k].dot_motion(a_prime);
+    }
+    let qdd = data.dinv[i] * r;
+    let mut a = a_prime;
+    for k in 0..N {
+        data.qdd[iv + k] = qdd[k];
+        a.ang += data.s[i][k].ang * qdd[k];
+    }
+    data.a[i] = a;
 }

@@ -107,7 +107,7 @@ impl AxisRotation {
     }
 
     /// `R A Rᵀ`: `A Rᵀ` mixes columns `i` and `j`, then `R` rows `i` and `j`.
-    #[inline]
+    #[inline(always)]
     pub fn conjugate(&self, a: &DMat3) -> DMat3 {
         match self.k {
             0 => conjugate::<1, 2>(self.c, self.s, a),
@@ -115,6 +115,50 @@ impl AxisRotation {
             _ => conjugate::<0, 1>(self.c, self.s, a),
         }
     }
+
+    /// `R A Rᵀ` for a symmetric `A`, of which only the upper triangle is read: the six
+    /// distinct entries (18 multiplications instead of 24), the result exactly symmetric.
+    #[inline(always)]
+    pub fn conjugate_symmetric(&self, a: &DMat3) -> DMat3 {
+        match self.k {
+            0 => conjugate_symmetric::<0, 1, 2>(self.c, self.s, a),
+            1 => conjugate_symmetric::<1, 2, 0>(self.c, self.s, a),
+            _ => conjugate_symmetric::<2, 0, 1>(self.c, self.s, a),
+        }
+    }
+}
+
+/// Entry `(r, c)` of a symmetric `A` read from its upper triangle.
+#[inline(always)]
+fn upper(a: &DMat3, r: usize, c: usize) -> f64 {
+    if r <= c { a.col(c)[r] } else { a.col(r)[c] }
+}
+
+/// `R A Rᵀ` for a symmetric `A` and the rotation `(c, s)` about axis `K` in the `I`–`J` plane,
+/// with the products of [`conjugate`] for one entry of each mirrored pair.
+#[inline(always)]
+fn conjugate_symmetric<const K: usize, const I: usize, const J: usize>(
+    c: f64,
+    s: f64,
+    a: &DMat3,
+) -> DMat3 {
+    let (aii, ajj, aij) = (upper(a, I, I), upper(a, J, J), upper(a, I, J));
+    let (aki, akj, akk) = (upper(a, K, I), upper(a, K, J), upper(a, K, K));
+    // `B = A Rᵀ` (its `I`, `J` block), then `R B`.
+    let (bii, bji) = (c * aii - s * aij, c * aij - s * ajj);
+    let (bij, bjj) = (s * aii + c * aij, s * aij + c * ajj);
+    let mut m = DMat3::ZERO;
+    let mut set = |r: usize, col: usize, v: f64| {
+        m.col_mut(col)[r] = v;
+        m.col_mut(r)[col] = v;
+    };
+    set(K, K, akk);
+    set(K, I, c * aki - s * akj);
+    set(K, J, s * aki + c * akj);
+    set(I, I, c * bii - s * bji);
+    set(J, J, s * bij + c * bjj);
+    set(I, J, c * bij - s * bjj);
+    m
 }
 
 /// `v` with components `I`, `J` rotated: `(c v_I − s v_J, s v_I + c v_J)`.
@@ -163,12 +207,23 @@ pub enum JointRotation {
 
 impl JointRotation {
     /// `Eᵀ A E` for the rotation `e` (= `Rᵀ`) of `Xup`: `R A Rᵀ`, through the factors when known.
-    #[inline]
+    #[inline(always)]
     pub fn conjugate(&self, e: &DMat3, a: &DMat3) -> DMat3 {
         match self {
             JointRotation::General => e.transpose() * *a * *e,
             JointRotation::One(r) => r.conjugate(a),
             JointRotation::Two(r1, r2) => r1.conjugate(&r2.conjugate(a)),
+        }
+    }
+
+    /// [`JointRotation::conjugate`] of a symmetric `A` (through the factors only its upper
+    /// triangle is read and the result is exactly symmetric).
+    #[inline(always)]
+    pub fn conjugate_symmetric(&self, e: &DMat3, a: &DMat3) -> DMat3 {
+        match self {
+            JointRotation::General => e.transpose() * *a * *e,
+            JointRotation::One(r) => r.conjugate_symmetric(a),
+            JointRotation::Two(r1, r2) => r1.conjugate_symmetric(&r2.conjugate_symmetric(a)),
         }
     }
 }
@@ -210,6 +265,10 @@ mod tests {
             assert!((r.apply_transpose(v) - g.transpose() * v).length() < 1e-14);
             assert!(close(r.mul_right(&a()), a() * g));
             assert!(close(r.conjugate(&a()), g * a() * g.transpose()));
+            let sym = a() + a().transpose();
+            let rs = r.conjugate_symmetric(&sym);
+            assert!(close(rs, g * sym * g.transpose()));
+            assert_eq!(rs, rs.transpose());
             let e = g.transpose();
             let r2 = AxisRotation::new(CoordAxis::of(DVec3::Y).unwrap(), -0.4);
             let g2 = DMat3::from_axis_angle(DVec3::Y, -0.4);

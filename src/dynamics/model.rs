@@ -212,9 +212,19 @@ impl Model {
     pub fn retract(&self, q: &[f64], z: &[f64], out: &mut [f64]) {
         for (i, b) in self.bodies.iter().enumerate() {
             let (iq, iv) = (self.q_idx[i], self.v_idx[i]);
-            let (nq, nv) = (b.joint.nq(), b.joint.nv());
-            b.joint
-                .retract(&q[iq..iq + nq], &z[iv..iv + nv], &mut out[iq..iq + nq]);
+            // Angle joints inline (the same sums as `JointType::retract`).
+            match b.joint {
+                JointType::Pin { .. } => out[iq] = q[iq] + z[iv],
+                JointType::Universal { .. } => {
+                    out[iq] = q[iq] + z[iv];
+                    out[iq + 1] = q[iq + 1] + z[iv + 1];
+                }
+                _ => {
+                    let (nq, nv) = (b.joint.nq(), b.joint.nv());
+                    b.joint
+                        .retract(&q[iq..iq + nq], &z[iv..iv + nv], &mut out[iq..iq + nq]);
+                }
+            }
         }
     }
 
@@ -223,6 +233,19 @@ impl Model {
     pub fn chart_rate(&self, q_stage: &[f64], z: &[f64], v: &[f64], zdot: &mut [f64]) {
         for (i, b) in self.bodies.iter().enumerate() {
             let (iq, iv) = (self.q_idx[i], self.v_idx[i]);
+            // Angle joints inline: their chart rate is the velocity.
+            match b.joint {
+                JointType::Pin { .. } => {
+                    zdot[iv] = v[iv];
+                    continue;
+                }
+                JointType::Universal { .. } => {
+                    zdot[iv] = v[iv];
+                    zdot[iv + 1] = v[iv + 1];
+                    continue;
+                }
+                _ => {}
+            }
             let (nq, nv) = (b.joint.nq(), b.joint.nv());
             b.joint.chart_rate(
                 &q_stage[iq..iq + nq],
@@ -247,6 +270,19 @@ impl Model {
     pub fn angles_near(&self, q: &[f64], reference: &[f64], out: &mut [f64]) {
         for (i, b) in self.bodies.iter().enumerate() {
             let (iq, iv) = (self.q_idx[i], self.v_idx[i]);
+            // Angle joints inline: their angles are their coordinates.
+            match b.joint {
+                JointType::Pin { .. } => {
+                    out[iv] = q[iq];
+                    continue;
+                }
+                JointType::Universal { .. } => {
+                    out[iv] = q[iq];
+                    out[iv + 1] = q[iq + 1];
+                    continue;
+                }
+                _ => {}
+            }
             let nv = b.joint.nv();
             b.joint.angles_near(
                 &q[iq..iq + b.joint.nq()],

@@ -421,6 +421,25 @@ fn integrate_stage(
 fn check_stage(model: &Model, state: &State, ws: &mut StepWorkspace) -> Result<(), StepError> {
     let t = state.time_s;
     let data = ws.kinematics_of(model, state);
+    // The common case first, without square roots: every body within bounds
+    // (`|v|² ≤ MAX_SPEED²`), where a NaN fails every comparison and a sum of the orientation's
+    // entries is finite only if all are; only a failing state is searched for its first
+    // culprit below.
+    let (max_speed2, r) = (MAX_SPEED * MAX_SPEED, MAX_EXTENT);
+    let within = (0..model.nbodies()).all(|i| {
+        let (p, vel, rot) = (data.pos[i], data.v[i], &data.rot[i]);
+        vel.ang.length_squared() <= max_speed2
+            && vel.lin.length_squared() <= max_speed2
+            && p.x.abs() <= r
+            && p.y.abs() <= r
+            && p.z.abs() <= r
+            && (rot.x_axis + rot.y_axis + rot.z_axis)
+                .element_sum()
+                .is_finite()
+    });
+    if within {
+        return Ok(());
+    }
     for i in 0..model.nbodies() {
         let (p, vel) = (data.pos[i], data.v[i]);
         let name = || model.bodies[i].name.clone();

@@ -388,28 +388,49 @@ impl ArticulatedInertia {
         }
     }
 
-    /// `I − (1/d) U Uᵀ` for a force vector `U` (the rank-one update of a 1-DOF joint in ABA).
+    /// `I − (1/d) U Uᵀ` for a force vector `U` (the rank-one update of a 1-DOF joint in ABA);
+    /// `M` and `L` stay exactly symmetric.
     #[inline]
     pub fn sub_outer(&mut self, u: ForceVec, inv_d: f64) {
-        let us = u.ang * inv_d;
-        self.m -= outer(us, u.ang);
-        self.h -= outer(us, u.lin);
-        self.l -= outer(u.lin * inv_d, u.lin);
+        self.sub_products(&[u * inv_d], &[u]);
+    }
+
+    /// `I − Σ_j W_j U_jᵀ` for force columns `W`, `U` whose sum is symmetric (`W = U D⁻¹` with a
+    /// symmetric `D`): `H` in full, the six distinct entries of `M` and `L` from their upper
+    /// triangles, mirrored so they stay exactly symmetric.
+    #[inline(always)]
+    pub fn sub_products<const N: usize>(&mut self, w: &[ForceVec; N], u: &[ForceVec; N]) {
+        for j in 0..N {
+            self.h -= outer(w[j].ang, u[j].lin);
+        }
+        let wa: [DVec3; N] = std::array::from_fn(|j| w[j].ang);
+        let ua: [DVec3; N] = std::array::from_fn(|j| u[j].ang);
+        let wl: [DVec3; N] = std::array::from_fn(|j| w[j].lin);
+        let ul: [DVec3; N] = std::array::from_fn(|j| u[j].lin);
+        sub_symmetric(&mut self.m, &wa, &ua);
+        sub_symmetric(&mut self.l, &wl, &ul);
     }
 
     /// `I − U D⁻¹ Uᵀ` for `n ≤ 3` force columns `U` and the inverse `D⁻¹` (n×n block of `dinv`).
     #[inline]
     pub fn sub_u_dinv_ut(&mut self, u: &[ForceVec], dinv: &DMat3) {
-        let n = u.len();
-        for j in 0..n {
-            // w = Σ_k U_k D⁻¹_kj
-            let mut w = ForceVec::ZERO;
-            for (k, uk) in u.iter().enumerate() {
-                w += *uk * dinv.col(j)[k];
-            }
-            self.m -= outer(w.ang, u[j].ang);
-            self.h -= outer(w.ang, u[j].lin);
-            self.l -= outer(w.lin, u[j].lin);
+        fn go<const N: usize>(ia: &mut ArticulatedInertia, u: &[ForceVec], dinv: &DMat3) {
+            let u: [ForceVec; N] = std::array::from_fn(|k| u[k]);
+            // w_j = Σ_k U_k D⁻¹_kj
+            let w: [ForceVec; N] = std::array::from_fn(|j| {
+                let mut wj = ForceVec::ZERO;
+                for (k, uk) in u.iter().enumerate() {
+                    wj += *uk * dinv.col(j)[k];
+                }
+                wj
+            });
+            ia.sub_products(&w, &u);
+        }
+        match u.len() {
+            0 => {}
+            1 => go::<1>(self, u, dinv),
+            2 => go::<2>(self, u, dinv),
+            _ => go::<3>(self, u, dinv),
         }
     }
 
@@ -423,28 +444,41 @@ impl ArticulatedInertia {
 
     /// [`ArticulatedInertia::transform_to_parent`] with `x`'s rotation also given as its
     /// coordinate-axis factors (`rotation`, from the kinematics): `EᵀAE = R A Rᵀ` per block
-    /// through them.
-    #[inline]
+    /// through them. `M` and `L` are symmetric, so only their six distinct entries are formed
+    /// (the result's `M` and `L` are exactly symmetric).
+    #[inline(always)]
     pub fn transform_to_parent_with(&self, x: &SpatialTransform, rotation: &JointRotation) -> Self {
         let e = x.rot;
-        let m1 = rotation.conjugate(&e, &self.m);
+        let m1 = rotation.conjugate_symmetric(&e, &self.m);
         let h1 = rotation.conjugate(&e, &self.h);
-        let l1 = rotation.conjugate(&e, &self.l);
-        // The products with R = [r]× as cross products: `R A` has columns `r × a_j` and
-        // `A R` columns `a_y r_z − a_z r_y, a_z r_x − a_x r_z, a_x r_y − a_y r_x`, the same
-        // bits as multiplying by `skew(r)` (its zero entries add nothing) at a third of the work.
+        let l1 = rotation.conjugate_symmetric(&e, &self.l);
+        // The products with R = [r]× as cross products: `R A` has columns `r × a_j`, and
+        // `(A R)_ij` is `a_i1 r_z − a_i2 r_y`, `a_i2 r_x − a_i0 r_z`, `a_i0 r_y − a_i1 r_x` for
+        // j = 0, 1, 2 (the products with `skew(r)` without its zero entries).
         let r = x.trans;
         let cross_cols =
             |a: DMat3| DMat3::from_cols(r.cross(a.x_axis), r.cross(a.y_axis), r.cross(a.z_axis));
         let rl = cross_cols(l1);
         let rh = cross_cols(h1.transpose());
-        let rlr = DMat3::from_cols(
-            rl.y_axis * r.z - rl.z_axis * r.y,
-            rl.z_axis * r.x - rl.x_axis * r.z,
-            rl.x_axis * r.y - rl.y_axis * r.x,
+        // `(R L R)_ij` from row i of `R L`, for the upper entries.
+        let rlr = |row: DVec3, j: usize| match j {
+            0 => row.y * r.z - row.z * r.y,
+            1 => row.z * r.x - row.x * r.z,
+            _ => row.x * r.y - row.y * r.x,
+        };
+        let rows = [rl.row(0), rl.row(1), rl.row(2)];
+        // `M_A = M' + R H'ᵀ + (R H'ᵀ)ᵀ − R L' R`.
+        let entry =
+            |i: usize, j: usize| m1.col(j)[i] + rh.col(j)[i] + rh.col(i)[j] - rlr(rows[i], j);
+        let (m00, m11, m22) = (entry(0, 0), entry(1, 1), entry(2, 2));
+        let (m01, m02, m12) = (entry(0, 1), entry(0, 2), entry(1, 2));
+        let m = DMat3::from_cols(
+            DVec3::new(m00, m01, m02),
+            DVec3::new(m01, m11, m12),
+            DVec3::new(m02, m12, m22),
         );
         Self {
-            m: m1 + rh + rh.transpose() - rlr,
+            m,
             h: h1 + rl,
             l: l1,
         }
@@ -461,6 +495,25 @@ impl ArticulatedInertia {
         let lin = linv * (f.lin - self.h.transpose() * ang);
         MotionVec { ang, lin }
     }
+}
+
+/// `A − Σ_j x_j y_jᵀ` for a symmetric result: the upper entries, mirrored.
+#[inline(always)]
+fn sub_symmetric<const N: usize>(a: &mut DMat3, x: &[DVec3; N], y: &[DVec3; N]) {
+    let entry = |r: usize, c: usize| {
+        let mut e = a.col(c)[r];
+        for j in 0..N {
+            e -= x[j][r] * y[j][c];
+        }
+        e
+    };
+    let (m00, m11, m22) = (entry(0, 0), entry(1, 1), entry(2, 2));
+    let (m01, m02, m12) = (entry(0, 1), entry(0, 2), entry(1, 2));
+    *a = DMat3::from_cols(
+        DVec3::new(m00, m01, m02),
+        DVec3::new(m01, m11, m12),
+        DVec3::new(m02, m12, m22),
+    );
 }
 
 impl Add for ArticulatedInertia {

@@ -16,7 +16,7 @@
 //! they only hold a corner where it touched and are capped by the friction cone.
 
 use crate::dynamics::data::Data;
-use crate::dynamics::spatial::{ArticulatedInertia, ForceVec};
+use crate::dynamics::spatial::{ArticulatedInertia, ForceVec, transpose_mul};
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 
@@ -208,19 +208,19 @@ impl ContactModel {
         load / (4.0 * self.corner_gains[i].0)
     }
 
-    /// Normal and tangential force on one corner at world point `x` with velocity `xd`.
-    /// Returns `(f_n, f_t, z)` or `None` when the corner is above the floor.
+    /// Normal and tangential force on one corner at world point `x` and signed height `z` (its
+    /// `n·x − h`) with velocity `xd`. Returns `(f_n, f_t, z)` or `None` when the corner is above
+    /// the floor.
     #[inline]
     fn corner_force(
         &self,
         link: usize,
-        x: DVec3,
+        (x, z): (DVec3, f64),
         xd: DVec3,
         anchor: Option<DVec3>,
     ) -> Option<(f64, DVec3, f64)> {
         let p = &self.params;
         let n = p.floor_normal;
-        let z = n.dot(x) - p.floor_height;
         if z >= 0.0 {
             return None;
         }
@@ -268,7 +268,11 @@ impl ContactModel {
         let rot = data.rot[i];
         let pos = data.pos[i];
         let (c, r) = self.bounds[i];
-        if n.dot(pos + rot * c) - p.floor_height > r {
+        // Heights through the floor normal in body coordinates: `z = n·pos − h + n_b·p` for a
+        // body point `p`, three products a corner instead of a rotation.
+        let n_body = transpose_mul(&rot, n);
+        let z_origin = n.dot(pos) - p.floor_height;
+        if z_origin + n_body.dot(c) > r {
             if UPDATE {
                 anchors.fill(None);
             }
@@ -279,14 +283,14 @@ impl ContactModel {
         let (k_c, c_c) = self.corner_gains[i];
         let (mut f_body, mut normal, mut depth, mut power) = (ForceVec::ZERO, 0.0, 0.0f64, 0.0);
         for (k, &cl) in self.corners[i].iter().enumerate() {
-            let x = pos + rot * cl;
-            let z = n.dot(x) - p.floor_height;
+            let z = z_origin + n_body.dot(cl);
             if z >= 0.0 {
                 if UPDATE {
                     anchors[k] = None;
                 }
                 continue;
             }
+            let x = pos + rot * cl;
             let xd = rot * (v.lin + v.ang.cross(cl));
             if UPDATE {
                 let on_floor = x - n * z;
@@ -306,7 +310,7 @@ impl ContactModel {
                     }
                 }
             }
-            if let Some((fnorm, ft, z)) = self.corner_force(i, x, xd, anchors[k]) {
+            if let Some((fnorm, ft, z)) = self.corner_force(i, (x, z), xd, anchors[k]) {
                 depth = depth.max(-z);
                 normal += fnorm;
                 power -= fnorm * n.dot(xd);
@@ -380,15 +384,17 @@ impl ContactModel {
         }
         for i in 0..self.corners.len() {
             let anchors = &mut state.anchors[i * 8..i * 8 + 8];
-            let mut ic = ArticulatedInertia::ZERO;
-            let h = implicit.as_ref().map(|(h, _)| *h);
-            let (f, fn_i, d, power) =
-                self.link_contact::<true>(data, i, anchors, h.map(|h| (h, &mut ic)));
-            if let Some((_, added)) = implicit.as_mut()
-                && ic != ArticulatedInertia::ZERO
-            {
-                added.push((i, ic));
-            }
+            let (f, fn_i, d, power) = match implicit.as_mut() {
+                Some((h, added)) => {
+                    let mut ic = ArticulatedInertia::ZERO;
+                    let out = self.link_contact::<true>(data, i, anchors, Some((*h, &mut ic)));
+                    if ic != ArticulatedInertia::ZERO {
+                        added.push((i, ic));
+                    }
+                    out
+                }
+                None => self.link_contact::<true>(data, i, anchors, None),
+            };
             let (c, _) = self.bounds[i];
             let v = data.v[i];
             sample.normal[i] = fn_i;
@@ -482,6 +488,10 @@ impl ContactStats {
     pub fn accumulate(&mut self, sample: &ContactSample, t: f64, dt: f64) {
         for i in 0..sample.normal.len() {
             let f = sample.normal[i];
+            if f == 0.0 && sample.depth[i] == 0.0 && sample.absorbed_power[i] == 0.0 {
+                // A link off the floor adds nothing (the same bits as adding its zeros).
+                continue;
+            }
             self.peak[i] = self.peak[i].max(f);
             self.impulse[i] += f * dt;
             self.max_depth[i] = self.max_depth[i].max(sample.depth[i]);

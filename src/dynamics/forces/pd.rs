@@ -52,7 +52,7 @@ impl PdTargets {
     }
 
     /// The torque (N·m) and velocity coefficient on DOF `d` at angle `theta`, rate `theta_dot`.
-    #[inline]
+    #[inline(always)]
     pub fn torque(&self, d: usize, theta: f64, theta_dot: f64) -> (f64, f64) {
         let (mut tau, kv) = pd_torque(
             self.kp[d],

@@ -167,11 +167,11 @@ impl FallRecorder {
         if monitor.contact.touchdown_s[p].is_some() {
             // Rebound: how high the pelvis box's lowest corner lifts off the floor after the
             // pelvis first touched it.
-            let lowest = body.boxes[p]
-                .corners()
-                .iter()
-                .map(|&c| (data.pos[p] + data.rot[p] * c).y)
-                .fold(f64::INFINITY, f64::min);
+            // A corner `c` is at height `pos.y + (row 1 of rot)·c`: the lowest is the centre's
+            // less the half extents along that row's magnitudes.
+            let b = &body.boxes[p];
+            let up = data.rot[p].row(1);
+            let lowest = data.pos[p].y + up.dot(b.center) - up.abs().dot(b.half);
             self.pelvis_rebound_m = self.pelvis_rebound_m.max(lowest - self.floor_height);
         }
         // Rest counts only once the push is over (a figure standing still before it is not
