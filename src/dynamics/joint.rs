@@ -127,6 +127,18 @@ impl JointType {
         }
     }
 
+    /// The DOFs of a joint whose coordinates are its angles (pin 1, universal 2; `None` for
+    /// the others): its retraction is `θ + z`, its chart rate `v` and its angles `θ`, DOF by DOF
+    /// (what [`crate::dynamics::model::Model`]'s per-joint loops take inline).
+    #[inline(always)]
+    pub const fn angle_dofs(&self) -> Option<usize> {
+        match self {
+            JointType::Pin { .. } => Some(1),
+            JointType::Universal { .. } => Some(2),
+            _ => None,
+        }
+    }
+
     /// True if every axis is unit length and a ball's axes are orthonormal.
     pub fn axes_valid(&self) -> bool {
         let unit = |a: DVec3| a.is_finite() && (a.length() - 1.0).abs() < 1e-9;

@@ -213,18 +213,16 @@ impl Model {
         for (i, b) in self.bodies.iter().enumerate() {
             let (iq, iv) = (self.q_idx[i], self.v_idx[i]);
             // Angle joints inline (the same sums as `JointType::retract`).
-            match b.joint {
-                JointType::Pin { .. } => out[iq] = q[iq] + z[iv],
-                JointType::Universal { .. } => {
-                    out[iq] = q[iq] + z[iv];
+            if let Some(n) = b.joint.angle_dofs() {
+                out[iq] = q[iq] + z[iv];
+                if n == 2 {
                     out[iq + 1] = q[iq + 1] + z[iv + 1];
                 }
-                _ => {
-                    let (nq, nv) = (b.joint.nq(), b.joint.nv());
-                    b.joint
-                        .retract(&q[iq..iq + nq], &z[iv..iv + nv], &mut out[iq..iq + nq]);
-                }
+                continue;
             }
+            let (nq, nv) = (b.joint.nq(), b.joint.nv());
+            b.joint
+                .retract(&q[iq..iq + nq], &z[iv..iv + nv], &mut out[iq..iq + nq]);
         }
     }
 
@@ -234,17 +232,12 @@ impl Model {
         for (i, b) in self.bodies.iter().enumerate() {
             let (iq, iv) = (self.q_idx[i], self.v_idx[i]);
             // Angle joints inline: their chart rate is the velocity.
-            match b.joint {
-                JointType::Pin { .. } => {
-                    zdot[iv] = v[iv];
-                    continue;
-                }
-                JointType::Universal { .. } => {
-                    zdot[iv] = v[iv];
+            if let Some(n) = b.joint.angle_dofs() {
+                zdot[iv] = v[iv];
+                if n == 2 {
                     zdot[iv + 1] = v[iv + 1];
-                    continue;
                 }
-                _ => {}
+                continue;
             }
             let (nq, nv) = (b.joint.nq(), b.joint.nv());
             b.joint.chart_rate(
@@ -271,17 +264,12 @@ impl Model {
         for (i, b) in self.bodies.iter().enumerate() {
             let (iq, iv) = (self.q_idx[i], self.v_idx[i]);
             // Angle joints inline: their angles are their coordinates.
-            match b.joint {
-                JointType::Pin { .. } => {
-                    out[iv] = q[iq];
-                    continue;
-                }
-                JointType::Universal { .. } => {
-                    out[iv] = q[iq];
+            if let Some(n) = b.joint.angle_dofs() {
+                out[iv] = q[iq];
+                if n == 2 {
                     out[iv + 1] = q[iq + 1];
-                    continue;
                 }
-                _ => {}
+                continue;
             }
             let nv = b.joint.nv();
             b.joint.angles_near(

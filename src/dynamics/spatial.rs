@@ -468,15 +468,7 @@ impl ArticulatedInertia {
         };
         let rows = [rl.row(0), rl.row(1), rl.row(2)];
         // `M_A = M' + R H'ᵀ + (R H'ᵀ)ᵀ − R L' R`.
-        let entry =
-            |i: usize, j: usize| m1.col(j)[i] + rh.col(j)[i] + rh.col(i)[j] - rlr(rows[i], j);
-        let (m00, m11, m22) = (entry(0, 0), entry(1, 1), entry(2, 2));
-        let (m01, m02, m12) = (entry(0, 1), entry(0, 2), entry(1, 2));
-        let m = DMat3::from_cols(
-            DVec3::new(m00, m01, m02),
-            DVec3::new(m01, m11, m12),
-            DVec3::new(m02, m12, m22),
-        );
+        let m = symmetric(|i, j| m1.col(j)[i] + rh.col(j)[i] + rh.col(i)[j] - rlr(rows[i], j));
         Self {
             m,
             h: h1 + rl,
@@ -500,20 +492,26 @@ impl ArticulatedInertia {
 /// `A − Σ_j x_j y_jᵀ` for a symmetric result: the upper entries, mirrored.
 #[inline(always)]
 fn sub_symmetric<const N: usize>(a: &mut DMat3, x: &[DVec3; N], y: &[DVec3; N]) {
-    let entry = |r: usize, c: usize| {
+    *a = symmetric(|r, c| {
         let mut e = a.col(c)[r];
         for j in 0..N {
             e -= x[j][r] * y[j][c];
         }
         e
-    };
+    });
+}
+
+/// The symmetric matrix whose entries on and above the diagonal are `entry(r, c)` (`r ≤ c`,
+/// six calls), mirrored below it.
+#[inline(always)]
+fn symmetric(entry: impl Fn(usize, usize) -> f64) -> DMat3 {
     let (m00, m11, m22) = (entry(0, 0), entry(1, 1), entry(2, 2));
     let (m01, m02, m12) = (entry(0, 1), entry(0, 2), entry(1, 2));
-    *a = DMat3::from_cols(
+    DMat3::from_cols(
         DVec3::new(m00, m01, m02),
         DVec3::new(m01, m11, m12),
         DVec3::new(m02, m12, m22),
-    );
+    )
 }
 
 impl Add for ArticulatedInertia {
