@@ -24,7 +24,7 @@ fn bench_generation(c: &mut Criterion) {
         ..GaConfig::default()
     };
     let mut count = InProcess {
-        batch: |g: &[Vec<f64>]| problem.evaluate(g),
+        batch: |g: &[Vec<f64>], refine: u32| problem.evaluate(g, refine),
     };
     let state = GaState::initial(cfg.clone(), bounds.clone(), &mut count).expect("GA");
     let genomes = state.population.clone();
@@ -39,13 +39,13 @@ fn bench_generation(c: &mut Criterion) {
             .build()
             .expect("pool");
         g.bench_function(format!("threads_{threads}"), |b| {
-            b.iter(|| pool.install(|| black_box(problem.evaluate(black_box(&genomes)))))
+            b.iter(|| pool.install(|| black_box(problem.evaluate(black_box(&genomes), 1))))
         });
     }
     g.finish();
     // The GA's own work per generation, with a free evaluation.
     let mut free = InProcess {
-        batch: |g: &[Vec<f64>]| g.iter().map(|x| Ok(x.iter().sum::<f64>())).collect(),
+        batch: |g: &[Vec<f64>], _: u32| g.iter().map(|x| Ok(x.iter().sum::<f64>())).collect(),
     };
     let base = GaState::initial(cfg, bounds, &mut free).expect("GA");
     c.bench_function("ga_step_operators_only_30x42", |b| {

@@ -18,7 +18,8 @@
 use marionette::evolve::fall_fitness::{stable_step_for, strength_kp_max};
 use marionette::evolve::{FallProblem, GaConfig, GaState, InProcess};
 use marionette::experiments::fall::Ranges;
-use marionette::experiments::fall::{SettledStart, ecs::run_parallel_from};
+use marionette::experiments::fall::SettledStart;
+use marionette::experiments::fall::ecs::{ReactionStart, run_parallel_reacting};
 use marionette::humanoid::ranges::{AgeGroup, RangeTable};
 
 fn env(name: &str) -> Option<f64> {
@@ -112,7 +113,7 @@ fn main() {
         ..GaConfig::default()
     };
     let mut free = InProcess {
-        batch: |g: &[Vec<f64>]| g.iter().map(|_| Ok(0.0)).collect(),
+        batch: |g: &[Vec<f64>], _: u32| g.iter().map(|_| Ok(0.0)).collect(),
     };
     let state = GaState::initial(cfg, bounds, &mut free).expect("GA");
     let edge = std::env::var("EDGE").is_ok();
@@ -138,8 +139,15 @@ fn main() {
         })
         .collect();
     let start = SettledStart::of(&problem.fall).ok();
+    // The stretch before the reaction, run once for all (as the GA does); NO_REACTION=1 runs
+    // every fall from its settled start instead (the same results).
+    let reaction = if std::env::var("NO_REACTION").is_ok() {
+        None
+    } else {
+        ReactionStart::of(&problem.fall, start.as_ref()).ok()
+    };
     let t0 = std::time::Instant::now();
-    let results = run_parallel_from(&configs, start.as_ref());
+    let results = run_parallel_reacting(&configs, start.as_ref(), reaction.as_ref());
     let wall = t0.elapsed().as_secs_f64();
     let mut steps = 0;
     let mut best = f64::INFINITY;

@@ -25,7 +25,7 @@ fn a_run_on_a_local_ray_cluster_matches_the_in_process_run_bit_for_bit() {
     };
     let bounds = p.bounds().unwrap();
     let mut local = InProcess {
-        batch: |g: &[Vec<f64>]| p.evaluate(g),
+        batch: |g: &[Vec<f64>], refine: u32| p.evaluate(g, refine),
     };
     let mut a = GaState::initial(cfg.clone(), bounds.clone(), &mut local).unwrap();
     while !a.done() {
@@ -46,4 +46,6 @@ fn a_run_on_a_local_ray_cluster_matches_the_in_process_run_bit_for_bit() {
         serde_json::to_string(&b).unwrap()
     );
     assert_eq!(b.evaluations, 8 + 2 * 6);
+    // The elite check's refined evaluations went through Ray too.
+    assert!(b.check_evaluations > 0);
 }

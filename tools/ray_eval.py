@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Evaluate marionette GA generations on a Ray cluster.
 
-This program speaks marionette's JSON-lines evaluation protocol (marionette-eval/1) on its own
+This program speaks marionette's JSON-lines evaluation protocol (marionette-eval/2) on its own
 standard input and output, exactly as `marionette eval --stdin` does, so the engine's GA uses it
 as an evaluator (scene field `evaluator: Command(["python3", "tools/ray_eval.py"])`) while the GA
 loop, its checkpoints and its bits stay in the engine. Behind it, each Ray actor holds one
@@ -27,7 +27,7 @@ import shutil
 import subprocess
 import sys
 
-PROTOCOL = "marionette-eval/1"
+PROTOCOL = "marionette-eval/2"
 
 
 def find_worker(given):

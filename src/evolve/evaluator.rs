@@ -5,10 +5,10 @@
 //! its bits stay in the engine.
 //!
 //! The protocol, one JSON object per line:
-//! 1. client → worker, once: `{"protocol": "marionette-eval/1", "problem": {…}}` (the problem,
+//! 1. client → worker, once: `{"protocol": "marionette-eval/2", "problem": {…}}` (the problem,
 //!    e.g. a [`FallProblem`](super::fall_fitness::FallProblem));
-//! 2. per generation, client → worker: `{"index": i, "genes": [x, …]}` for each genome, then
-//!    `{"evaluate": true}`;
+//! 2. per batch, client → worker: `{"index": i, "genes": [x, …], "refine": k}` for each genome
+//!    (`refine` as in [`Evaluator::evaluate`]; absent means 1), then `{"evaluate": true}`;
 //! 3. worker → client: `{"index": i, "damage": d}` or `{"index": i, "error": "why"}` for each,
 //!    then `{"done": n}`.
 //!
@@ -23,7 +23,9 @@ use serde::{Deserialize, Serialize};
 use super::genome::Genome;
 
 /// The protocol's name and version.
-pub const PROTOCOL: &str = "marionette-eval/1";
+/// Version 2 added `refine`; a version-1 worker would ignore it and answer at the problem's
+/// own resolution, so the version is checked.
+pub const PROTOCOL: &str = "marionette-eval/2";
 
 /// Why a run could not go on.
 #[derive(Debug, thiserror::Error)]
@@ -54,23 +56,33 @@ pub type Evaluation = Result<f64, String>;
 
 /// Computes the fitness of a generation's genomes, in order.
 pub trait Evaluator {
-    /// The damage of each genome of `generation` (same order and length as `genomes`).
+    /// The damage of each genome of `generation` (same order and length as `genomes`), the
+    /// problem resolved `refine` times finer than its own resolution (1: as posed; for a fall,
+    /// the time step divided by `refine`). The GA re-evaluates its elites at `refine = 2` to
+    /// check that their fitness is not an artefact of the resolution.
     fn evaluate(
         &mut self,
         generation: u64,
         genomes: &[Genome],
+        refine: u32,
     ) -> Result<Vec<Evaluation>, EvolveError>;
 }
 
 /// Evaluates in this process, in parallel on the current rayon pool.
-pub struct InProcess<F: Fn(&[Genome]) -> Vec<Evaluation>> {
-    /// Evaluates a batch (for falls: one World per genome, in parallel).
+pub struct InProcess<F: Fn(&[Genome], u32) -> Vec<Evaluation>> {
+    /// Evaluates a batch at a refinement (for falls: one World per genome, in parallel, at the
+    /// time step divided by the refinement).
     pub batch: F,
 }
 
-impl<F: Fn(&[Genome]) -> Vec<Evaluation>> Evaluator for InProcess<F> {
-    fn evaluate(&mut self, _: u64, genomes: &[Genome]) -> Result<Vec<Evaluation>, EvolveError> {
-        Ok((self.batch)(genomes))
+impl<F: Fn(&[Genome], u32) -> Vec<Evaluation>> Evaluator for InProcess<F> {
+    fn evaluate(
+        &mut self,
+        _: u64,
+        genomes: &[Genome],
+        refine: u32,
+    ) -> Result<Vec<Evaluation>, EvolveError> {
+        Ok((self.batch)(genomes, refine))
     }
 }
 
@@ -88,8 +100,23 @@ struct Header {
 #[derive(Serialize, Deserialize)]
 #[serde(untagged)]
 enum Request {
-    Genome { index: usize, genes: Vec<f64> },
-    Evaluate { evaluate: bool },
+    Genome {
+        index: usize,
+        genes: Vec<f64>,
+        #[serde(default = "unrefined", skip_serializing_if = "is_unrefined")]
+        refine: u32,
+    },
+    Evaluate {
+        evaluate: bool,
+    },
+}
+
+fn unrefined() -> u32 {
+    1
+}
+
+fn is_unrefined(k: &u32) -> bool {
+    *k == 1
 }
 
 #[derive(Serialize, Deserialize)]
@@ -143,11 +170,17 @@ impl JsonLines {
 }
 
 impl Evaluator for JsonLines {
-    fn evaluate(&mut self, _: u64, genomes: &[Genome]) -> Result<Vec<Evaluation>, EvolveError> {
+    fn evaluate(
+        &mut self,
+        _: u64,
+        genomes: &[Genome],
+        refine: u32,
+    ) -> Result<Vec<Evaluation>, EvolveError> {
         for (index, g) in genomes.iter().enumerate() {
             self.send(&Request::Genome {
                 index,
                 genes: g.clone(),
+                refine,
             })?;
         }
         self.send(&Request::Evaluate { evaluate: true })?;
@@ -201,9 +234,14 @@ impl Drop for JsonLines {
 /// Longest request line the worker accepts (bytes).
 pub const MAX_LINE: usize = 1 << 20;
 
+/// Largest refinement a worker accepts (a fall at 1/64 of its step already takes 64 times as
+/// long).
+pub const MAX_REFINE: u32 = 64;
+
 /// The worker side: reads the header, builds the evaluator of its problem with `make`, then
-/// answers batches until its input ends.
-pub fn serve<R: BufRead, W: Write, E: Fn(&[Genome]) -> Vec<Evaluation>>(
+/// answers batches until its input ends (a batch mixing refinements is evaluated per
+/// refinement).
+pub fn serve<R: BufRead, W: Write, E: Fn(&[Genome], u32) -> Vec<Evaluation>>(
     input: R,
     mut output: W,
     make: impl FnOnce(serde_json::Value) -> Result<E, String>,
@@ -222,7 +260,7 @@ pub fn serve<R: BufRead, W: Write, E: Fn(&[Genome]) -> Vec<Evaluation>>(
         )));
     }
     let eval = make(header.problem).map_err(|e| err(format!("problem: {e}")))?;
-    let mut batch: Vec<(usize, Genome)> = Vec::new();
+    let mut batch: Vec<(usize, Genome, u32)> = Vec::new();
     for (k, line) in lines.enumerate() {
         let line = line.map_err(|e| err(e.to_string()))?;
         if line.len() > MAX_LINE {
@@ -234,12 +272,35 @@ pub fn serve<R: BufRead, W: Write, E: Fn(&[Genome]) -> Vec<Evaluation>>(
         match serde_json::from_str::<Request>(&line)
             .map_err(|e| err(format!("line {}: {e}", k + 2)))?
         {
-            Request::Genome { index, genes } => batch.push((index, genes)),
+            Request::Genome {
+                index,
+                genes,
+                refine,
+            } => {
+                if !(1..=MAX_REFINE).contains(&refine) {
+                    return Err(err(format!(
+                        "line {}: refine must be 1..={MAX_REFINE}, found {refine}",
+                        k + 2
+                    )));
+                }
+                batch.push((index, genes, refine))
+            }
             Request::Evaluate { .. } => {
-                let genomes: Vec<Genome> = batch.iter().map(|(_, g)| g.clone()).collect();
-                let results = eval(&genomes);
+                let mut results: Vec<Option<Evaluation>> = vec![None; batch.len()];
+                let mut levels: Vec<u32> = batch.iter().map(|b| b.2).collect();
+                levels.sort_unstable();
+                levels.dedup();
+                for level in levels {
+                    let at: Vec<usize> =
+                        (0..batch.len()).filter(|&i| batch[i].2 == level).collect();
+                    let genomes: Vec<Genome> = at.iter().map(|&i| batch[i].1.clone()).collect();
+                    for (i, r) in at.into_iter().zip(eval(&genomes, level)) {
+                        results[i] = Some(r);
+                    }
+                }
                 let mut text = String::new();
-                for ((index, _), r) in batch.iter().zip(results) {
+                for ((index, _, _), r) in batch.iter().zip(results) {
+                    let r = r.unwrap_or_else(|| Err("not evaluated".into()));
                     let reply = match r {
                         Ok(damage) if damage.is_finite() => Reply::Damage {
                             index: *index,

@@ -14,9 +14,8 @@ use serde::{Deserialize, Serialize};
 
 use super::evaluator::Evaluation;
 use super::genome::{Bounds, Genome};
-use crate::experiments::fall::{
-    FallConfig, Ranges, SettledStart, SimError, ecs::run_parallel_from,
-};
+use crate::experiments::fall::ecs::{ReactionStart, run_parallel_reacting};
+use crate::experiments::fall::{FallConfig, Ranges, SettledStart, SimError};
 use crate::humanoid::fall21;
 use crate::humanoid::ranges::{AgeGroup, RangeTable};
 
@@ -36,21 +35,46 @@ pub struct FallProblem {
     pub settled: SettleCache,
 }
 
-/// The settled standing start of a problem's fall ([`SettledStart`]), computed at the first
-/// evaluation and kept for the next ones (settled anew if the fall has changed since). Not part
-/// of the problem: a clone starts empty and equality ignores it.
+/// The shared starts of a problem's fall, one pair per time step it is evaluated at (its own
+/// and the elite check's half of it): the settled standing body ([`SettledStart`]) and the fall
+/// run to its reaction time from it ([`ReactionStart`]), computed at the first evaluation and
+/// kept for the next ones (anew if the fall has changed since). Not part of the problem: a
+/// clone starts empty and equality ignores it.
 #[derive(Default)]
-pub struct SettleCache(std::sync::Mutex<Option<SettledStart>>);
+pub struct SettleCache(std::sync::Mutex<Vec<FallStarts>>);
+
+/// The starts of one fall: settled, and run to the reaction time when that succeeded.
+#[derive(Clone)]
+pub struct FallStarts {
+    /// The settled standing body.
+    pub settled: SettledStart,
+    /// The fall at its reaction time (`None` if it could not be run there: each evaluation then
+    /// runs from the settled start and reports why).
+    pub reaction: Option<ReactionStart>,
+}
+
+/// Fall steps a [`SettleCache`] keeps starts for (the oldest is dropped first).
+const SETTLE_CACHE_SIZE: usize = 4;
 
 impl SettleCache {
-    /// The settled start of `fall`, from the cache when it fits; `None` if the fall cannot be
-    /// built (each evaluation then reports why).
-    pub fn of(&self, fall: &FallConfig) -> Option<SettledStart> {
+    /// The starts of `fall`, from the cache when they fit; `None` if the fall cannot be built
+    /// (each evaluation then reports why).
+    pub fn of(&self, fall: &FallConfig) -> Option<FallStarts> {
         let mut c = self.0.lock().unwrap_or_else(|e| e.into_inner());
-        if !c.as_ref().is_some_and(|s| s.fits(fall)) {
-            *c = SettledStart::of(fall).ok();
+        if let Some(s) = c
+            .iter()
+            .find(|s| s.settled.fits(fall) && s.reaction.as_ref().is_none_or(|r| r.fits(fall)))
+        {
+            return Some(s.clone());
         }
-        c.clone()
+        let settled = SettledStart::of(fall).ok()?;
+        let reaction = ReactionStart::of(fall, Some(&settled)).ok();
+        let s = FallStarts { settled, reaction };
+        if c.len() >= SETTLE_CACHE_SIZE {
+            c.remove(0);
+        }
+        c.push(s.clone());
+        Some(s)
     }
 }
 
@@ -199,17 +223,45 @@ impl FallProblem {
         c
     }
 
-    /// The damage of every genome, each fall in its own World, in parallel; the standing body
-    /// is settled once for the whole run (the genes do not change how it stands; the same bits
-    /// as settling each fall).
-    pub fn evaluate(&self, genomes: &[Genome]) -> Vec<Evaluation> {
-        let configs: Vec<FallConfig> = genomes.iter().map(|g| self.config(g)).collect();
-        let start = self.settled.of(&self.fall);
-        run_parallel_from(&configs, start.as_ref())
-            .into_iter()
-            .map(|r| {
-                r.map(|f| f.damage)
-                    .map_err(|e: Arc<SimError>| e.to_string())
+    /// The damage of every genome, each fall in its own World, in parallel, at the problem's
+    /// time step divided by `refine` (1: the problem's own step); the standing body is settled
+    /// once per step for the whole run (the genes do not change how it stands; the same bits as
+    /// settling each fall).
+    pub fn evaluate(&self, genomes: &[Genome], refine: u32) -> Vec<Evaluation> {
+        let mut fall = self.fall.clone();
+        fall.dt_s /= f64::from(refine.max(1));
+        let genes = 2 * self.kp_max.len();
+        // Genomes of the wrong length (e.g. from a worker's input) are answered, not run.
+        let runnable: Vec<usize> = (0..genomes.len())
+            .filter(|&i| genomes[i].len() == genes)
+            .collect();
+        let configs: Vec<FallConfig> = runnable
+            .iter()
+            .map(|&i| {
+                let mut c = self.config(&genomes[i]);
+                c.dt_s = fall.dt_s;
+                c
+            })
+            .collect();
+        let start = self.settled.of(&fall);
+        let mut ran = run_parallel_reacting(
+            &configs,
+            start.as_ref().map(|s| &s.settled),
+            start.as_ref().and_then(|s| s.reaction.as_ref()),
+        )
+        .into_iter();
+        genomes
+            .iter()
+            .map(|g| {
+                if g.len() != genes {
+                    return Err(format!("a genome has {genes} genes, found {}", g.len()));
+                }
+                match ran.next() {
+                    Some(r) => r
+                        .map(|f| f.damage)
+                        .map_err(|e: Arc<SimError>| e.to_string()),
+                    None => Err("not evaluated".into()),
+                }
             })
             .collect()
     }

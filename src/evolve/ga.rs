@@ -9,7 +9,7 @@ use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64;
 use serde::{Deserialize, Serialize};
 
-use super::evaluator::{Evaluator, EvolveError};
+use super::evaluator::{Evaluation, Evaluator, EvolveError};
 use super::genome::{Bounds, Genome};
 use super::logbook::GenerationRecord;
 use super::operators::{better, polynomial_mutation, sbx, tournament};
@@ -35,6 +35,13 @@ pub struct GaConfig {
     pub mutation_eta: f64,
     /// Best individuals copied unchanged into the next generation (≥ 1 keeps the best).
     pub elites: usize,
+    /// The resolution check of the elites: before an individual passes on as one of the best
+    /// `max(elites, 1)` of its generation (and before it can be the run's best), it is
+    /// re-evaluated at twice the resolution (a fall at half its time step); if its fitness
+    /// moves by more than this fraction of itself, `|D(h/2) − D(h)| > tol · D(h)`, it won
+    /// through a simulation artefact and gets the worst fitness (logged as a failure), and the
+    /// next best is checked in turn. `None`: no check. Default 0.10 (issue 14's criterion).
+    pub elite_check_tolerance: Option<f64>,
     /// Seed of every random draw.
     pub seed: u64,
 }
@@ -50,6 +57,7 @@ impl Default for GaConfig {
             mutation_probability: None,
             mutation_eta: 20.0,
             elites: 2,
+            elite_check_tolerance: Some(0.10),
             seed: 1,
         }
     }
@@ -111,9 +119,24 @@ impl GaConfig {
                 return bad(f, format!("must be in [0, 1000], found {e}"));
             }
         }
+        if let Some(t) = self.elite_check_tolerance
+            && !(t.is_finite() && t >= 0.0)
+        {
+            return bad(
+                "elite_check_tolerance",
+                format!("must be a finite fraction ≥ 0 (or None), found {t}"),
+            );
+        }
         Ok(())
     }
 }
+
+/// How the failure log's entries of the elite check begin.
+pub const ELITE_CHECK: &str = "elite check";
+
+/// The refinement at which elites are checked ([`GaConfig::elite_check_tolerance`]): twice
+/// the resolution, a fall at half its time step.
+pub const ELITE_CHECK_REFINE: u32 = 2;
 
 /// The whole state of a run after a generation: what a checkpoint holds.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -126,14 +149,24 @@ pub struct GaState {
     pub generation: u64,
     /// Genomes.
     pub population: Vec<Genome>,
-    /// Damage of each (`None`: the evaluation failed).
+    /// Damage of each (`None`: the evaluation failed, or the elite check rejected it).
     pub fitness: Vec<Option<f64>>,
+    /// Whether each individual has passed the elite check (its fitness held at twice the
+    /// resolution); elites carry it into the next generation.
+    #[serde(default)]
+    pub checked: Vec<bool>,
     /// The best genome found so far and its damage.
     pub best: Option<(Genome, f64)>,
     /// The best genome of generation 0 (the unevolved "before").
     pub initial_best: Option<Genome>,
-    /// Evaluations so far.
+    /// Evaluations so far (at the problem's own resolution).
     pub evaluations: u64,
+    /// Re-evaluations of elites at twice the resolution so far ([`GaConfig::elite_check_tolerance`]).
+    #[serde(default)]
+    pub check_evaluations: u64,
+    /// Re-evaluations of elites in the current generation.
+    #[serde(default)]
+    pub generation_checks: u64,
     /// One record per generation so far.
     pub logbook: Vec<GenerationRecord>,
     /// Failed evaluations: (generation, index, why).
@@ -162,13 +195,25 @@ impl GaState {
             generation: 0,
             population: Vec::new(),
             fitness: Vec::new(),
+            checked: Vec::new(),
             best: None,
             initial_best: None,
             evaluations: 0,
+            check_evaluations: 0,
+            generation_checks: 0,
             logbook: Vec::new(),
             failures: Vec::new(),
         };
-        s.accept(population, None, evaluator)?;
+        let results = evaluator.evaluate(0, &population, 1)?;
+        s.receive(
+            Brood {
+                generation: 0,
+                elites: Vec::new(),
+                children: population,
+            },
+            results,
+        )?;
+        s.check_and_close(evaluator)?;
         s.initial_best = s.best.as_ref().map(|b| b.0.clone());
         Ok(s)
     }
@@ -193,15 +238,47 @@ impl GaState {
         idx
     }
 
-    /// Breeds and evaluates the next generation.
+    /// Breeds and evaluates the next generation: [`Self::breed`], its evaluation,
+    /// [`Self::receive`], the elite check ([`Self::unchecked_elites`], [`Self::receive_checks`])
+    /// and [`Self::close`]. A caller running several GAs can take the phases itself to evaluate
+    /// all their broods in one batch (the same bits).
     pub fn step(&mut self, evaluator: &mut dyn Evaluator) -> Result<(), EvolveError> {
+        let brood = self.breed();
+        let results = evaluator.evaluate(brood.generation, &brood.children, 1)?;
+        self.receive(brood, results)?;
+        self.check_and_close(evaluator)
+    }
+
+    /// The elite check by `evaluator`, then [`Self::close`].
+    fn check_and_close(&mut self, evaluator: &mut dyn Evaluator) -> Result<(), EvolveError> {
+        loop {
+            let todo = self.unchecked_elites();
+            if todo.is_empty() {
+                break;
+            }
+            let genomes: Vec<Genome> = todo.iter().map(|&i| self.population[i].clone()).collect();
+            let results = evaluator.evaluate(self.generation, &genomes, ELITE_CHECK_REFINE)?;
+            self.receive_checks(&todo, results)?;
+        }
+        self.close();
+        Ok(())
+    }
+
+    /// The next generation, bred but not evaluated: the elites (the best `elites`, unchanged,
+    /// with their fitness) and the children of tournament selection, SBX crossover and
+    /// polynomial mutation, every draw from the generator of (seed, generation).
+    pub fn breed(&self) -> Brood {
         let c = &self.config;
         let g = self.generation + 1;
         let mut rng = Pcg64::seed_from_u64(world_seed(c.seed, g));
         let rank = self.ranking();
-        let elites: Vec<(Genome, Option<f64>)> = rank[..c.elites]
+        let elites: Vec<Elite> = rank[..c.elites]
             .iter()
-            .map(|&i| (self.population[i].clone(), self.fitness[i]))
+            .map(|&i| Elite {
+                genome: self.population[i].clone(),
+                fitness: self.fitness[i],
+                checked: self.checked.get(i).copied().unwrap_or(false),
+            })
             .collect();
         let pm = c
             .mutation_probability
@@ -228,31 +305,35 @@ impl GaState {
                 children.push(y);
             }
         }
-        self.generation = g;
-        self.accept(children, Some(elites), evaluator)
+        Brood {
+            generation: g,
+            elites,
+            children,
+        }
     }
 
-    /// Evaluates `children`, forms the population (elites first) and logs the generation.
-    fn accept(
-        &mut self,
-        children: Vec<Genome>,
-        elites: Option<Vec<(Genome, Option<f64>)>>,
-        evaluator: &mut dyn Evaluator,
-    ) -> Result<(), EvolveError> {
-        let results = evaluator.evaluate(self.generation, &children)?;
-        if results.len() != children.len() {
+    /// Takes a brood and the evaluations of its children: the population (elites first) of the
+    /// brood's generation, failures logged. The generation is closed by [`Self::close`] after
+    /// the elite check.
+    pub fn receive(&mut self, brood: Brood, results: Vec<Evaluation>) -> Result<(), EvolveError> {
+        if results.len() != brood.children.len() {
             return Err(EvolveError::Evaluator(format!(
                 "{} results for {} genomes",
                 results.len(),
-                children.len()
+                brood.children.len()
             )));
         }
-        self.evaluations += children.len() as u64;
-        let (mut pop, mut fit): (Vec<Genome>, Vec<Option<f64>>) =
-            elites.unwrap_or_default().into_iter().unzip();
+        self.generation = brood.generation;
+        self.evaluations += brood.children.len() as u64;
+        self.generation_checks = 0;
+        let (mut pop, mut fit, mut checked) = (Vec::new(), Vec::new(), Vec::new());
+        for e in brood.elites {
+            pop.push(e.genome);
+            fit.push(e.fitness);
+            checked.push(e.checked);
+        }
         let offset = pop.len();
-        let failed_before = self.failures.len();
-        for (k, (genome, r)) in children.into_iter().zip(results).enumerate() {
+        for (k, (genome, r)) in brood.children.into_iter().zip(results).enumerate() {
             let f = match r {
                 Ok(d) if d.is_finite() => Some(d),
                 Ok(d) => {
@@ -267,9 +348,70 @@ impl GaState {
             };
             pop.push(genome);
             fit.push(f);
+            checked.push(false);
         }
         self.population = pop;
         self.fitness = fit;
+        self.checked = checked;
+        Ok(())
+    }
+
+    /// The individuals the elite check ([`GaConfig::elite_check_tolerance`]) has yet to
+    /// re-evaluate at [`ELITE_CHECK_REFINE`]: those among the best `max(elites, 1)` with a
+    /// fitness and not checked (empty when the check is off). Re-rank after
+    /// [`Self::receive_checks`]: a rejection brings the next one up.
+    pub fn unchecked_elites(&self) -> Vec<usize> {
+        if self.config.elite_check_tolerance.is_none() {
+            return Vec::new();
+        }
+        let k = self.config.elites.max(1).min(self.population.len());
+        self.ranking()[..k]
+            .iter()
+            .copied()
+            .filter(|&i| self.fitness[i].is_some() && !self.checked.get(i).copied().unwrap_or(true))
+            .collect()
+    }
+
+    /// Takes the refined evaluations of the individuals `todo` (from
+    /// [`Self::unchecked_elites`]): each is marked checked, and one whose fitness moved by more
+    /// than the tolerance, `|D_fine − D| > tol · |D|`, or whose re-evaluation failed, gets the
+    /// worst fitness and is logged with why.
+    pub fn receive_checks(
+        &mut self,
+        todo: &[usize],
+        results: Vec<Evaluation>,
+    ) -> Result<(), EvolveError> {
+        if results.len() != todo.len() {
+            return Err(EvolveError::Evaluator(format!(
+                "{} results for {} genomes",
+                results.len(),
+                todo.len()
+            )));
+        }
+        let tol = self.config.elite_check_tolerance.unwrap_or(f64::INFINITY);
+        self.check_evaluations += todo.len() as u64;
+        self.generation_checks += todo.len() as u64;
+        for (&i, r) in todo.iter().zip(results) {
+            self.checked[i] = true;
+            let d = self.fitness[i].unwrap_or(f64::NAN);
+            let why = match r {
+                Ok(fine) if fine.is_finite() && (fine - d).abs() <= tol * d.abs() => continue,
+                Ok(fine) => format!(
+                    "{ELITE_CHECK}: damage {d} at the problem's resolution, {fine} at \
+                     {ELITE_CHECK_REFINE}× it ({:+.1} %, tolerance {:.1} %)",
+                    100.0 * (fine - d) / d,
+                    100.0 * tol
+                ),
+                Err(e) => format!("{ELITE_CHECK}: at {ELITE_CHECK_REFINE}× the resolution: {e}"),
+            };
+            self.fitness[i] = None;
+            self.failures.push((self.generation, i, why));
+        }
+        Ok(())
+    }
+
+    /// Closes the generation: the best so far (never worse) and the logbook's record.
+    pub fn close(&mut self) {
         let before = self.best.as_ref().map(|b| b.1);
         if let Some(&i) = self.ranking().first()
             && let Some(f) = self.fitness[i]
@@ -277,17 +419,41 @@ impl GaState {
         {
             self.best = Some((self.population[i].clone(), f));
         }
+        let failed = self
+            .failures
+            .iter()
+            .rev()
+            .take_while(|f| f.0 == self.generation)
+            .count();
         self.logbook.push(GenerationRecord::of(
             (
                 self.generation,
                 self.evaluations,
-                self.failures.len() - failed_before,
+                failed,
+                self.generation_checks,
             ),
             &self.population,
             &self.fitness,
             &self.bounds,
             before,
         ));
-        Ok(())
     }
+}
+
+/// An elite passing unchanged into a brood.
+#[derive(Clone, Debug, PartialEq)]
+struct Elite {
+    genome: Genome,
+    fitness: Option<f64>,
+    checked: bool,
+}
+
+/// A generation bred by [`GaState::breed`], its children awaiting evaluation.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Brood {
+    /// The generation it becomes.
+    pub generation: u64,
+    elites: Vec<Elite>,
+    /// The genomes to evaluate, in order.
+    pub children: Vec<Genome>,
 }

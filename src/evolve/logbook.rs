@@ -30,8 +30,12 @@ pub struct GenerationRecord {
     /// Lowest damage of any generation so far (never rises).
     #[serde(with = "nan_as_null")]
     pub best_so_far: f64,
-    /// Evaluations that failed (unstable simulations) this generation.
+    /// Individuals of this generation given the worst fitness: evaluations that failed
+    /// (unstable simulations) and elites rejected by the elite check.
     pub failures: usize,
+    /// Re-evaluations of elites at twice the resolution this generation (the elite check).
+    #[serde(default)]
+    pub elite_checks: u64,
     /// Gene diversity: the mean over genes of the population's standard deviation divided by
     /// the gene's range.
     pub diversity: f64,
@@ -39,9 +43,9 @@ pub struct GenerationRecord {
 
 impl GenerationRecord {
     /// The figures of `population` with `fitness` (`None` = failed), of which `failures` failed
-    /// in this generation's evaluations.
+    /// in this generation's evaluations, with `elite_checks` re-evaluations by the elite check.
     pub fn of(
-        (generation, evaluations, failures): (u64, u64, usize),
+        (generation, evaluations, failures, elite_checks): (u64, u64, usize, u64),
         population: &[Genome],
         fitness: &[Option<f64>],
         bounds: &Bounds,
@@ -84,6 +88,7 @@ impl GenerationRecord {
             std,
             best_so_far,
             failures,
+            elite_checks,
             diversity: diversity(population, bounds),
         }
     }
@@ -114,7 +119,7 @@ pub fn diversity(population: &[Genome], bounds: &Bounds) -> f64 {
 
 /// The header of the CSV logbook.
 pub const CSV_HEADER: &str =
-    "generation,evaluations,best,mean,median,worst,std,best_so_far,failures,diversity";
+    "generation,evaluations,best,mean,median,worst,std,best_so_far,failures,elite_checks,diversity";
 
 /// The logbook as CSV (shortest round-trip decimals).
 pub fn to_csv(records: &[GenerationRecord]) -> String {
@@ -122,7 +127,7 @@ pub fn to_csv(records: &[GenerationRecord]) -> String {
     s.push('\n');
     for r in records {
         s.push_str(&format!(
-            "{},{},{},{},{},{},{},{},{},{}\n",
+            "{},{},{},{},{},{},{},{},{},{},{}\n",
             r.generation,
             r.evaluations,
             r.best,
@@ -132,6 +137,7 @@ pub fn to_csv(records: &[GenerationRecord]) -> String {
             r.std,
             r.best_so_far,
             r.failures,
+            r.elite_checks,
             r.diversity
         ));
     }

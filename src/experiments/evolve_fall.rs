@@ -7,7 +7,10 @@ use std::path::PathBuf;
 
 use serde::{Deserialize, Serialize};
 
-use crate::evolve::{Evaluator, EvolveError, FallProblem, GaConfig, GaState, checkpoint};
+use crate::evolve::ga::{Brood, ELITE_CHECK_REFINE};
+use crate::evolve::{
+    Evaluation, Evaluator, EvolveError, FallProblem, GaConfig, GaState, Genome, checkpoint,
+};
 use crate::experiments::fall::{FallConfig, FallResult, SimError, simulate_fall};
 use crate::humanoid::ranges::AgeGroup;
 
@@ -79,7 +82,10 @@ pub fn start(
 
 /// Advances every run to its last generation, one generation at a time for all, writing a
 /// checkpoint every `checkpointing.every` generations and at the end, and calling `progress`
-/// after each generation. `evaluator_of(run)` names the index of the run's evaluator.
+/// after each generation. `evaluator_of(run)` names the index of the run's evaluator. The
+/// broods of all runs sharing an evaluator are evaluated in one batch (and so are their elite
+/// checks), so the cores stay busy past the end of any one run's generation; every run gets
+/// the bits it would get alone ([`GaState::step`]).
 pub fn advance(
     runs: &mut [EvolutionRun],
     evaluators: &mut [Box<dyn Evaluator>],
@@ -87,17 +93,69 @@ pub fn advance(
     checkpointing: Option<&Checkpointing>,
     mut progress: impl FnMut(&[EvolutionRun]),
 ) -> Result<(), EvolveError> {
+    let owner: Vec<usize> = runs.iter().map(&evaluator_of).collect();
+    if let Some(&e) = owner.iter().find(|&&e| e >= evaluators.len()) {
+        return Err(EvolveError::Config {
+            field: "evaluators".into(),
+            message: format!("evaluator {e} of {}", evaluators.len()),
+        });
+    }
     loop {
-        let mut stepped = false;
-        for run in runs.iter_mut() {
-            if !run.state.done() {
-                let e = evaluator_of(run);
-                run.state.step(evaluators[e].as_mut())?;
-                stepped = true;
+        let active: Vec<usize> = (0..runs.len()).filter(|&i| !runs[i].state.done()).collect();
+        if active.is_empty() {
+            break;
+        }
+        let mut broods: Vec<(usize, Brood)> =
+            active.iter().map(|&i| (i, runs[i].state.breed())).collect();
+        let generation = broods.iter().map(|b| b.1.generation).max().unwrap_or(0);
+        let mut results: Vec<Vec<Evaluation>> = vec![Vec::new(); runs.len()];
+        for (e, evaluator) in evaluators.iter_mut().enumerate() {
+            let mine: Vec<&(usize, Brood)> = broods.iter().filter(|b| owner[b.0] == e).collect();
+            let genomes: Vec<Genome> = mine.iter().flat_map(|b| b.1.children.clone()).collect();
+            if genomes.is_empty() {
+                continue;
+            }
+            let mut all = evaluator.evaluate(generation, &genomes, 1)?.into_iter();
+            for (i, b) in mine {
+                results[*i] = all.by_ref().take(b.children.len()).collect();
             }
         }
-        if !stepped {
-            break;
+        for (i, brood) in broods.drain(..) {
+            runs[i]
+                .state
+                .receive(brood, std::mem::take(&mut results[i]))?;
+        }
+        // The elite checks, round by round, one batch per evaluator per round.
+        loop {
+            let todo: Vec<(usize, Vec<usize>)> = active
+                .iter()
+                .map(|&i| (i, runs[i].state.unchecked_elites()))
+                .filter(|t| !t.1.is_empty())
+                .collect();
+            if todo.is_empty() {
+                break;
+            }
+            for (e, evaluator) in evaluators.iter_mut().enumerate() {
+                let mine: Vec<&(usize, Vec<usize>)> =
+                    todo.iter().filter(|t| owner[t.0] == e).collect();
+                let genomes: Vec<Genome> = mine
+                    .iter()
+                    .flat_map(|(i, idx)| idx.iter().map(|&k| runs[*i].state.population[k].clone()))
+                    .collect();
+                if genomes.is_empty() {
+                    continue;
+                }
+                let mut all = evaluator
+                    .evaluate(generation, &genomes, ELITE_CHECK_REFINE)?
+                    .into_iter();
+                for (i, idx) in mine {
+                    let r: Vec<Evaluation> = all.by_ref().take(idx.len()).collect();
+                    runs[*i].state.receive_checks(idx, r)?;
+                }
+            }
+        }
+        for &i in &active {
+            runs[i].state.close();
         }
         progress(runs);
         let g = runs.iter().map(|r| r.state.generation).max().unwrap_or(0);

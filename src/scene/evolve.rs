@@ -15,6 +15,7 @@ use serde_json::json;
 use super::fall::{Controller, write_falls};
 use super::primitives::PrimitiveRender;
 use super::{SceneError, write_output};
+use crate::evolve::ga::ELITE_CHECK;
 use crate::evolve::{Evaluator, FallProblem, GaConfig, InProcess, JsonLines, checkpoint, logbook};
 use crate::experiments::evolve_fall::{
     Checkpointing, EvolutionRun, EvolveConfig, GroupOutcome, advance, best_falls, outcomes,
@@ -160,7 +161,7 @@ impl EvolveFallScene {
                     EvaluatorChoice::InProcess => {
                         let p = p.clone();
                         Ok(Box::new(InProcess {
-                            batch: move |g: &[Vec<f64>]| p.evaluate(g),
+                            batch: move |g: &[Vec<f64>], refine: u32| p.evaluate(g, refine),
                         }))
                     }
                     EvaluatorChoice::Command(argv) => {
@@ -477,7 +478,12 @@ pub fn run_evolve(
         "generations": config.ga.generations,
         "population": config.ga.population,
         "evaluations": runs.iter().map(|r| r.state.evaluations).sum::<u64>(),
-        "failed_evaluations": runs.iter().map(|r| r.state.failures.len()).sum::<usize>(),
+        "failed_evaluations": runs.iter().flat_map(|r| &r.state.failures).filter(|f| !f.2.starts_with(ELITE_CHECK)).count(),
+        "elite_check": {
+            "tolerance": config.ga.elite_check_tolerance,
+            "evaluations_at_half_step": runs.iter().map(|r| r.state.check_evaluations).sum::<u64>(),
+            "rejected": runs.iter().flat_map(|r| &r.state.failures).filter(|f| f.2.starts_with(ELITE_CHECK)).count(),
+        },
         "groups": groups.iter().map(group_json).collect::<Vec<_>>(),
         "ga_wall_time_s": ga_wall,
         "checkpoint": ck_dir.display().to_string(),

@@ -28,7 +28,7 @@ pub fn eval(args: Args) -> Result<()> {
     serve(input, output, |problem| {
         let p: FallProblem = serde_json::from_value(problem).map_err(|e| e.to_string())?;
         p.bounds().map_err(|e| e.to_string())?;
-        Ok(move |genomes: &[Vec<f64>]| p.evaluate(genomes))
+        Ok(move |genomes: &[Vec<f64>], refine: u32| p.evaluate(genomes, refine))
     })?;
     Ok(())
 }

@@ -11,8 +11,8 @@ use bevy_ecs::prelude::*;
 
 use super::{FallCharacter, FallConfig, FallController, FallRecorder, FallResult, SimError};
 use crate::ecs::physics::{
-    BodyState, PdController, PhysicsBody, PhysicsMonitor, PhysicsStatus, PhysicsWorkspace,
-    add_physics_systems,
+    BodyState, ExternalForces, FloorContact, JointLimits, PdController, PhysicsBody,
+    PhysicsMonitor, PhysicsStatus, PhysicsWorkspace, add_physics_systems,
 };
 use crate::ecs::{Clock, MotionSet, WorldPool, add_core_systems, configure_motion_sets};
 
@@ -77,6 +77,123 @@ pub fn fall_schedule() -> Schedule {
 /// Spawns one falling character into `world` and records its first frame. The World's
 /// [`Clock`] must step physics by the fall's `dt_s`.
 pub fn spawn_fall(world: &mut World, mut ch: FallCharacter) -> Result<Entity, SimError> {
+    check_clock(world, &ch)?;
+    let p = &mut ch.physics;
+    let b = &*p.body.body;
+    let data = p.workspace.kinematics_of(&b.model, &p.state);
+    ch.recorder.record(b, &p.state, data, &p.monitor);
+    if ch.recorder.finished(&p.state) {
+        p.status.stopped = true;
+    }
+    Ok(spawn_components(world, ch))
+}
+
+/// The character's components as one entity.
+fn spawn_components(world: &mut World, ch: FallCharacter) -> Entity {
+    world
+        .spawn((
+            ch.physics,
+            ch.pd,
+            ch.limits,
+            ch.contact,
+            ch.external,
+            ch.controller,
+            ch.recorder,
+        ))
+        .id()
+}
+
+/// The components of the falling character `e` of `world`, cloned.
+fn character_of(world: &World, e: Entity) -> Option<FallCharacter> {
+    Some(FallCharacter {
+        physics: crate::ecs::physics::PhysicsBundle {
+            body: world.get::<PhysicsBody>(e)?.clone(),
+            state: world.get::<BodyState>(e)?.clone(),
+            workspace: world.get::<PhysicsWorkspace>(e)?.clone(),
+            monitor: world.get::<PhysicsMonitor>(e)?.clone(),
+            status: world.get::<PhysicsStatus>(e)?.clone(),
+        },
+        pd: world.get::<PdController>(e)?.clone(),
+        limits: world.get::<JointLimits>(e)?.clone(),
+        contact: world.get::<FloorContact>(e)?.clone(),
+        external: world.get::<ExternalForces>(e)?.clone(),
+        controller: world.get::<FallController>(e)?.clone(),
+        recorder: world.get::<FallRecorder>(e)?.clone(),
+    })
+}
+
+/// A fall run in its World up to its reaction time (`control_start_s`): before it, the body
+/// stands, is pushed and is held by the stance gains, none of which depends on the reaction
+/// (key pose, k_p, k_v), so the falls of a GA's population share that stretch. Each fall
+/// continues from a copy of the whole World state (components and clock) with its own
+/// reaction: the same bits as running it from the start, without the 0.25 s (455 steps at
+/// 0.55 ms) before the reaction.
+#[derive(Clone, Debug)]
+pub struct ReactionStart {
+    /// The configuration it was run for, the reaction's fields normalised.
+    key: FallConfig,
+    /// The character assembled standing, before settling (the stability check of each
+    /// reaction's gains is made on it, as [`super::build_fall`] does).
+    standing: FallCharacter,
+    /// The character at the reaction time.
+    reacting: FallCharacter,
+    /// The World's clock at the reaction time.
+    clock: Clock,
+}
+
+impl ReactionStart {
+    /// Runs `cfg` in a World until its reaction time (the standing start taken from `settled`
+    /// where it fits).
+    pub fn of(cfg: &FallConfig, settled: Option<&super::SettledStart>) -> Result<Self, SimError> {
+        let standing = super::assemble(cfg)?;
+        let ch = super::build_fall_from(cfg, settled)?;
+        let mut world = World::new();
+        world.insert_resource(Clock::physics(cfg.dt_s));
+        let e = spawn_fall(&mut world, ch)?;
+        let mut schedule = fall_schedule();
+        // The controller switches in the first run whose state starts at or past the reaction
+        // time; stop just before that run.
+        while world
+            .get::<PhysicsStatus>(e)
+            .is_some_and(PhysicsStatus::running)
+            && world
+                .get::<BodyState>(e)
+                .is_some_and(|s| s.time_s < cfg.control_start_s)
+        {
+            schedule.run(&mut world);
+        }
+        let missing = || SimError::Config {
+            field: "world".into(),
+            message: "the fall's components went missing".into(),
+        };
+        Ok(Self {
+            key: super::reaction_key(cfg),
+            standing,
+            reacting: character_of(&world, e).ok_or_else(missing)?,
+            clock: *world.get_resource::<Clock>().ok_or_else(missing)?,
+        })
+    }
+
+    /// True when `cfg` differs from the configuration this start was run for in its reaction
+    /// (key pose, k_p, k_v) at most.
+    pub fn fits(&self, cfg: &FallConfig) -> bool {
+        self.key == super::reaction_key(cfg)
+    }
+
+    /// Spawns the fall of `cfg` (which must fit) at its reaction time into `world`, setting the
+    /// World's clock: its reaction validated and stability-checked as [`super::build_fall`]
+    /// does, the rest copied.
+    pub fn spawn(&self, world: &mut World, cfg: &FallConfig) -> Result<Entity, SimError> {
+        super::validate_reaction(cfg, self.standing.physics.body.body.dof_v.len())?;
+        super::check_stability(cfg, &self.standing)?;
+        let mut ch = self.reacting.clone();
+        ch.controller.key = super::key_targets(cfg);
+        world.insert_resource(self.clock);
+        Ok(spawn_components(world, ch))
+    }
+}
+
+fn check_clock(world: &World, ch: &FallCharacter) -> Result<(), SimError> {
     let dt = world.get_resource::<Clock>().map(|c| c.physics_dt());
     if dt != Some(ch.recorder.dt) {
         return Err(SimError::Config {
@@ -88,24 +205,7 @@ pub fn spawn_fall(world: &mut World, mut ch: FallCharacter) -> Result<Entity, Si
             ),
         });
     }
-    let p = &mut ch.physics;
-    let b = &*p.body.body;
-    let data = p.workspace.kinematics_of(&b.model, &p.state);
-    ch.recorder.record(b, &p.state, data, &p.monitor);
-    if ch.recorder.finished(&p.state) {
-        p.status.stopped = true;
-    }
-    Ok(world
-        .spawn((
-            ch.physics,
-            ch.pd,
-            ch.limits,
-            ch.contact,
-            ch.external,
-            ch.controller,
-            ch.recorder,
-        ))
-        .id())
+    Ok(())
 }
 
 /// A World holding the fall of `config` (validated and stability-checked), its clock ticking
@@ -170,9 +270,22 @@ pub fn run_parallel_from(
     configs: &[FallConfig],
     start: Option<&super::SettledStart>,
 ) -> Vec<Result<FallResult, Arc<SimError>>> {
+    run_parallel_reacting(configs, start, None)
+}
+
+/// [`run_parallel_from`] with every fall that fits `reaction` continued from it (see
+/// [`ReactionStart`]): the same results, without each fall's stretch before its reaction.
+pub fn run_parallel_reacting(
+    configs: &[FallConfig],
+    start: Option<&super::SettledStart>,
+    reaction: Option<&ReactionStart>,
+) -> Vec<Result<FallResult, Arc<SimError>>> {
     let pool = WorldPool::new(configs.len(), 0, |k, world| {
         world.insert_resource(Clock::physics(configs[k].dt_s));
-        let built = super::build_fall_from(&configs[k], start).and_then(|ch| spawn_fall(world, ch));
+        let built = match reaction {
+            Some(r) if r.fits(&configs[k]) => r.spawn(world, &configs[k]),
+            _ => super::build_fall_from(&configs[k], start).and_then(|ch| spawn_fall(world, ch)),
+        };
         if let Err(e) = built {
             world.insert_resource(NotBuilt(Arc::new(e)));
         }
@@ -193,4 +306,77 @@ pub fn run_parallel_from(
             }))
         })
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::experiments::fall::SettledStart;
+
+    /// The paper's elderly fall, stopped at rest, with reactions that differ per fall.
+    fn reactions() -> (FallConfig, Vec<FallConfig>) {
+        let base = FallConfig {
+            stop_at_rest: true,
+            duration_s: 1.5,
+            ..FallConfig::default()
+        };
+        let n = base.kp.len();
+        let configs = (0..4)
+            .map(|k| {
+                let mut c = base.clone();
+                for d in 0..n {
+                    c.key_pose_deg[d] += [0.0, 20.0, -15.0, 35.0][k] * ((d % 3) as f64 - 1.0);
+                    c.kp[d] *= [1.0, 0.3, 2.0, 0.05][k];
+                    c.kv[d] *= [1.0, 2.0, 0.5, 1.0][k];
+                }
+                c
+            })
+            .collect();
+        (base, configs)
+    }
+
+    #[test]
+    fn falls_continued_from_the_reaction_time_are_the_falls_run_from_the_start() {
+        let (base, mut configs) = reactions();
+        let settled = SettledStart::of(&base).unwrap();
+        let reaction = ReactionStart::of(&base, Some(&settled)).unwrap();
+        assert!(configs.iter().all(|c| reaction.fits(c)));
+        // The shared stretch ends at the reaction time, after the push began.
+        let t = reaction.reacting.physics.state.time_s;
+        assert!(t >= base.control_start_s && t < base.control_start_s + base.dt_s);
+        assert!(!reaction.reacting.controller.reacting);
+        // Two reactions it cannot take, refused as building them would refuse them.
+        let mut negative = configs[0].clone();
+        negative.kp[3] = -1.0;
+        let mut too_stiff = configs[0].clone();
+        too_stiff.kp.iter_mut().for_each(|k| *k = 1e9);
+        configs.extend([negative, too_stiff]);
+        let from_start = run_parallel_from(&configs, Some(&settled));
+        let continued = run_parallel_reacting(&configs, Some(&settled), Some(&reaction));
+        assert_eq!(from_start.len(), continued.len());
+        for (a, b) in from_start.iter().zip(&continued) {
+            match (a, b) {
+                (Ok(x), Ok(y)) => assert_eq!(x, y),
+                (Err(x), Err(y)) => assert_eq!(x.to_string(), y.to_string()),
+                _ => panic!("{a:?} against {b:?}"),
+            }
+        }
+        assert!(continued[..4].iter().all(|r| r.is_ok()));
+        assert!(
+            continued[4]
+                .as_ref()
+                .unwrap_err()
+                .to_string()
+                .contains("kp")
+        );
+        assert!(continued[5].is_err());
+        // A fall that differs before the reaction does not fit and runs from its start.
+        let mut pushed_harder = configs[0].clone();
+        pushed_harder.push.force_n *= 1.5;
+        assert!(!reaction.fits(&pushed_harder));
+        let alone = run_parallel_from(std::slice::from_ref(&pushed_harder), Some(&settled));
+        let mixed = run_parallel_reacting(&[pushed_harder], Some(&settled), Some(&reaction));
+        assert_eq!(alone[0].as_ref().unwrap(), mixed[0].as_ref().unwrap());
+        assert_ne!(alone[0].as_ref().unwrap(), from_start[0].as_ref().unwrap());
+    }
 }

@@ -86,26 +86,12 @@ fn validate(cfg: &FallConfig) -> Result<Resolved, SimError> {
     positive("gravity", cfg.gravity)?;
     let body = fall21_body(cfg.height_m, cfg.mass_kg, cfg.gravity)?;
     let n = body.dof_v.len();
-    for (f, v) in [
+    check_pose_and_gains(
+        n,
         ("stance_pose_deg", &cfg.stance_pose_deg),
-        ("stance_kp", &cfg.stance_kp),
-        ("stance_kv", &cfg.stance_kv),
-        ("key_pose_deg", &cfg.key_pose_deg),
-        ("kp", &cfg.kp),
-        ("kv", &cfg.kv),
-    ] {
-        check_len(f, v, n)?;
-    }
-    for (f, v) in [
-        ("stance_kp", &cfg.stance_kp),
-        ("stance_kv", &cfg.stance_kv),
-        ("kp", &cfg.kp),
-        ("kv", &cfg.kv),
-    ] {
-        if let Some(x) = v.iter().find(|x| **x < 0.0) {
-            return Err(cfg_err(f, format!("gains must be ≥ 0, found {x}")));
-        }
-    }
+        [("stance_kp", &cfg.stance_kp), ("stance_kv", &cfg.stance_kv)],
+    )?;
+    validate_reaction(cfg, n)?;
     positive("settle_max_s", cfg.settle_max_s)?;
     // Sizes are checked before anything is allocated or run.
     let steps = cfg.duration_s / cfg.dt_s;
@@ -246,6 +232,54 @@ fn validate(cfg: &FallConfig) -> Result<Resolved, SimError> {
         weights,
         ranges,
     })
+}
+
+/// Checks the reaction's fields of `cfg` (key pose, k_p, k_v: `n` finite values each, gains
+/// ≥ 0), the only fields in which falls sharing a [`ecs::ReactionStart`] differ.
+fn validate_reaction(cfg: &FallConfig, n: usize) -> Result<(), SimError> {
+    check_pose_and_gains(
+        n,
+        ("key_pose_deg", &cfg.key_pose_deg),
+        [("kp", &cfg.kp), ("kv", &cfg.kv)],
+    )
+}
+
+/// A pose and its two gains: `n` finite values each, the gains ≥ 0.
+fn check_pose_and_gains(
+    n: usize,
+    pose: (&str, &[f64]),
+    gains: [(&str, &[f64]); 2],
+) -> Result<(), SimError> {
+    check_len(pose.0, pose.1, n)?;
+    for (f, v) in gains {
+        check_len(f, v, n)?;
+    }
+    for (f, v) in gains {
+        if let Some(x) = v.iter().find(|x| **x < 0.0) {
+            return Err(cfg_err(f, format!("gains must be ≥ 0, found {x}")));
+        }
+    }
+    Ok(())
+}
+
+/// The reaction's PD targets of `cfg`: the key pose θ_d (rad) held with k_p and k_v, capped by
+/// the strength.
+fn key_targets(cfg: &FallConfig) -> PdTargets {
+    let rad = |v: &[f64]| v.iter().map(|x| x.to_radians()).collect::<Vec<_>>();
+    PdTargets::hold(rad(&cfg.key_pose_deg), cfg.kp.clone(), cfg.kv.clone())
+        .with_torque_limits(cfg.torque_limits_nm.clone().unwrap_or_default())
+}
+
+/// `cfg` with the reaction's fields (key pose, k_p, k_v) set to fixed values: what falls that
+/// may share a [`ecs::ReactionStart`] have in common.
+fn reaction_key(cfg: &FallConfig) -> FallConfig {
+    let base = FallConfig::default();
+    FallConfig {
+        key_pose_deg: base.key_pose_deg,
+        kp: base.kp,
+        kv: base.kv,
+        ..cfg.clone()
+    }
 }
 
 /// What a configuration names, resolved.
@@ -478,9 +512,8 @@ fn assemble(cfg: &FallConfig) -> Result<FallCharacter, SimError> {
     let q = standing_configuration(cfg, &body, &contact, &stance_pose);
     let strength = cfg.torque_limits_nm.clone().unwrap_or_default();
     let stance = PdTargets::hold(stance_pose, cfg.stance_kp.clone(), cfg.stance_kv.clone())
-        .with_torque_limits(strength.clone());
-    let key = PdTargets::hold(rad(&cfg.key_pose_deg), cfg.kp.clone(), cfg.kv.clone())
         .with_torque_limits(strength);
+    let key = key_targets(cfg);
     let limit_gains = match cfg.limits.limit_frequency_hz {
         Some(hz) => inverse_joint_inertia(&body.model, &q, &body.dof_v)
             .map_err(|e| cfg_err("body", e.to_string()))?
