@@ -105,25 +105,16 @@ pub fn advance(
         if active.is_empty() {
             break;
         }
-        let mut broods: Vec<(usize, Brood)> =
+        let broods: Vec<(usize, Brood)> =
             active.iter().map(|&i| (i, runs[i].state.breed())).collect();
         let generation = broods.iter().map(|b| b.1.generation).max().unwrap_or(0);
-        let mut results: Vec<Vec<Evaluation>> = vec![Vec::new(); runs.len()];
-        for (e, evaluator) in evaluators.iter_mut().enumerate() {
-            let mine: Vec<&(usize, Brood)> = broods.iter().filter(|b| owner[b.0] == e).collect();
-            let genomes: Vec<Genome> = mine.iter().flat_map(|b| b.1.children.clone()).collect();
-            if genomes.is_empty() {
-                continue;
-            }
-            let mut all = evaluator.evaluate(generation, &genomes, 1)?.into_iter();
-            for (i, b) in mine {
-                results[*i] = all.by_ref().take(b.children.len()).collect();
-            }
-        }
-        for (i, brood) in broods.drain(..) {
-            runs[i]
-                .state
-                .receive(brood, std::mem::take(&mut results[i]))?;
+        let parts: Vec<(usize, Vec<Genome>)> = broods
+            .iter()
+            .map(|(i, b)| (*i, b.children.clone()))
+            .collect();
+        let results = evaluate_by_owner(evaluators, &owner, generation, &parts, 1)?;
+        for ((i, brood), r) in broods.into_iter().zip(results) {
+            runs[i].state.receive(brood, r)?;
         }
         // The elite checks, round by round, one batch per evaluator per round.
         loop {
@@ -135,23 +126,17 @@ pub fn advance(
             if todo.is_empty() {
                 break;
             }
-            for (e, evaluator) in evaluators.iter_mut().enumerate() {
-                let mine: Vec<&(usize, Vec<usize>)> =
-                    todo.iter().filter(|t| owner[t.0] == e).collect();
-                let genomes: Vec<Genome> = mine
-                    .iter()
-                    .flat_map(|(i, idx)| idx.iter().map(|&k| runs[*i].state.population[k].clone()))
-                    .collect();
-                if genomes.is_empty() {
-                    continue;
-                }
-                let mut all = evaluator
-                    .evaluate(generation, &genomes, ELITE_CHECK_REFINE)?
-                    .into_iter();
-                for (i, idx) in mine {
-                    let r: Vec<Evaluation> = all.by_ref().take(idx.len()).collect();
-                    runs[*i].state.receive_checks(idx, r)?;
-                }
+            let parts: Vec<(usize, Vec<Genome>)> = todo
+                .iter()
+                .map(|(i, idx)| {
+                    let pop = &runs[*i].state.population;
+                    (*i, idx.iter().map(|&k| pop[k].clone()).collect())
+                })
+                .collect();
+            let results =
+                evaluate_by_owner(evaluators, &owner, generation, &parts, ELITE_CHECK_REFINE)?;
+            for ((i, idx), r) in todo.iter().zip(results) {
+                runs[*i].state.receive_checks(idx, r)?;
             }
         }
         for &i in &active {
@@ -167,6 +152,40 @@ pub fn advance(
         }
     }
     Ok(())
+}
+
+/// Evaluates `parts` (run index, genomes), all the parts of one evaluator (`owner[run]`) in one
+/// batch at `refine`; returns each part's evaluations, in the order of `parts`.
+fn evaluate_by_owner(
+    evaluators: &mut [Box<dyn Evaluator>],
+    owner: &[usize],
+    generation: u64,
+    parts: &[(usize, Vec<Genome>)],
+    refine: u32,
+) -> Result<Vec<Vec<Evaluation>>, EvolveError> {
+    let mut out: Vec<Vec<Evaluation>> = vec![Vec::new(); parts.len()];
+    for (e, evaluator) in evaluators.iter_mut().enumerate() {
+        let mine: Vec<usize> = (0..parts.len())
+            .filter(|&k| owner[parts[k].0] == e)
+            .collect();
+        let genomes: Vec<Genome> = mine.iter().flat_map(|&k| parts[k].1.clone()).collect();
+        if genomes.is_empty() {
+            continue;
+        }
+        let results = evaluator.evaluate(generation, &genomes, refine)?;
+        if results.len() != genomes.len() {
+            return Err(EvolveError::Evaluator(format!(
+                "{} results for {} genomes",
+                results.len(),
+                genomes.len()
+            )));
+        }
+        let mut all = results.into_iter();
+        for k in mine {
+            out[k] = all.by_ref().take(parts[k].1.len()).collect();
+        }
+    }
+    Ok(out)
 }
 
 /// The index of `problem`'s age group among `config.problems`.

@@ -434,9 +434,6 @@ pub struct SettledStart {
 fn settle_key(cfg: &FallConfig) -> FallConfig {
     let base = FallConfig::default();
     FallConfig {
-        key_pose_deg: base.key_pose_deg,
-        kp: base.kp,
-        kv: base.kv,
         control_start_s: base.control_start_s,
         push: base.push,
         duration_s: base.duration_s,
@@ -445,7 +442,7 @@ fn settle_key(cfg: &FallConfig) -> FallConfig {
         rest_kinetic_energy_j: base.rest_kinetic_energy_j,
         rest_hold_s: base.rest_hold_s,
         stop_at_rest: base.stop_at_rest,
-        ..cfg.clone()
+        ..reaction_key(cfg)
     }
 }
 
