@@ -1,6 +1,6 @@
 //! What the paper's GA costs: one generation of 30 chromosomes of the initial population (the
 //! elderly group's problem: 42 genes, falls stopped once the body rests), each fall in its own
-//! World, at the problem's step (0.55 ms, within the accuracy margin), the standing body settled once
+//! World, at the problem's step (0.70 ms, within the accuracy margin), the standing body settled once
 //! and kept across iterations as across a GA's generations, on a rayon pool of 1 and of 2
 //! threads. Falls per second give the paper's whole GA
 //! (30 × 500 = 15 000 falls for one age group) as 15 000 / rate; the ratio of the two rates is

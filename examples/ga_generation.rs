@@ -15,7 +15,7 @@
 //! body that holds its stance). Besides each fall, it prints the mean damage share per link over the falls and the link
 //! that carries the most damage in the best one.
 
-use marionette::evolve::fall_fitness::{stable_step_for, strength_kp_max};
+use marionette::evolve::fall_fitness::{STEP_MARGIN, stable_step_for, strength_kp_max};
 use marionette::evolve::{FallProblem, GaConfig, GaState, InProcess};
 use marionette::experiments::fall::Ranges;
 use marionette::experiments::fall::SettledStart;
@@ -75,12 +75,14 @@ fn main() {
     if let Some(g) = group_env("STRENGTH") {
         problem.fall.torque_limits_nm = Some(marionette::humanoid::strength::torque_limits(g));
         problem.kp_max = strength_kp_max(g, 1.0);
-        problem.fall.dt_s = stable_step_for(&problem.fall, &problem.kp_max).expect("step");
+        problem.fall.dt_s =
+            stable_step_for(&problem.fall, &problem.kp_max, STEP_MARGIN).expect("step");
     }
     if std::env::var("IMPLICIT_CONTACT_DAMPING").is_ok() {
         // The floor's damping taken implicitly: the step re-derived without its bound.
         problem.fall.contact.implicit_damping = true;
-        problem.fall.dt_s = stable_step_for(&problem.fall, &problem.kp_max).expect("step");
+        problem.fall.dt_s =
+            stable_step_for(&problem.fall, &problem.kp_max, STEP_MARGIN).expect("step");
     }
     if let Some(dt) = env("DT") {
         problem.fall.dt_s = dt;

@@ -47,6 +47,9 @@ fn default_seeds() -> Vec<u64> {
 fn default_kp_scale() -> f64 {
     1.0
 }
+fn default_step_margin() -> f64 {
+    crate::evolve::fall_fitness::STEP_MARGIN
+}
 fn default_every() -> u64 {
     10
 }
@@ -72,6 +75,12 @@ pub struct EvolveFallScene {
     /// for the age group's maximal torque).
     #[serde(default = "default_kp_scale")]
     pub kp_max_scale: f64,
+    /// The GA's time step as a fraction of the stability bound of the strongest genome, in
+    /// (0, 1] (default [`crate::evolve::fall_fitness::STEP_MARGIN`], 0.8): larger is faster
+    /// and less accurate; the elite check (`ga.elite_check_tolerance`) rejects individuals that
+    /// win through the step. Ignored when `fall` is given (it keeps its own `dt_s`).
+    #[serde(default = "default_step_margin")]
+    pub step_margin: f64,
     /// The fall every genome is tried on, per field (default: the paper's push of the age
     /// group at the GA's step, [`crate::evolve::fall_fitness::stable_step_for`]; its
     /// key pose and k_p are the genes). A fall given here takes the group's ranges and strength
@@ -119,6 +128,12 @@ impl EvolveFallScene {
                 self.kp_max_scale
             )));
         }
+        if !(self.step_margin.is_finite() && self.step_margin > 0.0 && self.step_margin <= 1.0) {
+            return Err(invalid(format!(
+                "step_margin must be in (0, 1], found {}",
+                self.step_margin
+            )));
+        }
         self.ga.validate().map_err(|e| invalid(e.to_string()))?;
         let falls = self.groups.len() as u64
             * self.seeds.len() as u64
@@ -133,14 +148,14 @@ impl EvolveFallScene {
             .groups
             .iter()
             .map(|&g| {
-                let mut p = FallProblem::paper(g);
+                // The step is derived from the strongest genome of the scaled k_p box.
+                let mut p = FallProblem::with_strength(g, self.kp_max_scale, self.step_margin);
                 if let Some(f) = &self.fall {
                     p.fall = f.clone();
                     p.fall.ranges = crate::experiments::fall::Ranges::Builtin(g);
                     p.fall.torque_limits_nm = Some(crate::humanoid::strength::torque_limits(g));
                     p.fall.stop_at_rest = true;
                 }
-                p.kp_max = crate::evolve::fall_fitness::strength_kp_max(g, self.kp_max_scale);
                 p.bounds().map_err(|e| invalid(e.to_string()))?;
                 Ok(p)
             })
@@ -503,4 +518,54 @@ pub fn run_evolve(
         });
     }
     Ok(report)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::evolve::fall_fitness::{STEP_MARGIN, stable_step_for, strength_kp_max};
+
+    fn scene(step_margin: f64, kp_max_scale: f64) -> EvolveFallScene {
+        EvolveFallScene {
+            format_version: 1,
+            name: "t".into(),
+            groups: vec![AgeGroup::Adult],
+            seeds: vec![1],
+            ga: GaConfig::default(),
+            kp_max_scale,
+            step_margin,
+            fall: None,
+            checkpoint_every: 10,
+            checkpoint_dir: None,
+            resume: None,
+            evaluator: EvaluatorChoice::InProcess,
+            render: PrimitiveRender::default(),
+        }
+    }
+
+    #[test]
+    fn the_step_follows_the_margin_and_the_strength_bound() {
+        let paper = FallProblem::paper(AgeGroup::Adult);
+        let default = scene(STEP_MARGIN, 1.0).config().unwrap();
+        assert_eq!(default.problems[0].fall.dt_s, paper.fall.dt_s);
+        // A smaller margin gives a smaller step, as `stable_step_for` derives it.
+        let half = scene(STEP_MARGIN / 2.0, 1.0).config().unwrap();
+        let expected = stable_step_for(&paper.fall, &paper.kp_max, STEP_MARGIN / 2.0).unwrap();
+        assert_eq!(half.problems[0].fall.dt_s, expected);
+        assert!(expected < paper.fall.dt_s);
+        // Stronger genomes are stiffer: the step is re-derived from the scaled k_p bound and is
+        // no larger than the paper's.
+        let strong = scene(STEP_MARGIN, 4.0).config().unwrap();
+        let p = &strong.problems[0];
+        assert_eq!(p.kp_max, strength_kp_max(AgeGroup::Adult, 4.0));
+        assert_eq!(
+            p.fall.dt_s,
+            stable_step_for(&paper.fall, &p.kp_max, STEP_MARGIN).unwrap()
+        );
+        assert!(p.fall.dt_s <= paper.fall.dt_s);
+        for bad in [0.0, -0.5, 1.5, f64::NAN] {
+            let e = scene(bad, 1.0).config().unwrap_err().to_string();
+            assert!(e.contains("step_margin must be in (0, 1]"), "{e}");
+        }
+    }
 }
