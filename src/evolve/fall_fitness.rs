@@ -128,7 +128,7 @@ pub fn strength_kp_max(group: AgeGroup, scale: f64) -> Vec<f64> {
 }
 
 /// The GA's step is the largest multiple of `1 / STEP_QUANTA_PER_S` seconds (50 µs) within
-/// [`STEP_MARGIN`] of the stability bound.
+/// the margin of the stability bound ([`stable_step_for`]).
 pub const STEP_QUANTA_PER_S: f64 = 20_000.0;
 /// The fraction of the stability bound the GA's step may take: 0.8 (0.70 ms on the paper's
 /// falls, bound 0.92 ms), an accuracy margin, not only a stability one. Near its bound
@@ -139,11 +139,11 @@ pub const STEP_QUANTA_PER_S: f64 = 20_000.0;
 /// 5,848 N; 5,876 N at a quarter). With the elite check (`GaConfig::elite_check_tolerance`:
 /// an elite whose damage moves by more than 10 % at half the step is rejected), 40-generation
 /// runs of both groups over seeds 1–5 rejected 9 of 460 checked elites at 0.65 (0.55 ms),
-/// 5 of 461 at 0.8 (0.70 ms) and 21 of 456 at 0.9 (0.80 ms), whose extra checks and rejected
-/// lines ate its fewer steps (GA wall time 96.1 s, 70.7 s, 74.7 s); every reported best fall
-/// held within 1 % at half the step at 0.8 except the adult's generation 0 (+6.1 %). 0.8 is
-/// the largest margin at which winning through the step stays as rare as at 0.65. The scene
-/// field `step_margin` sets another. Taking the floor's damping implicitly
+/// 5 of 461 at 0.8 (0.70 ms) and 21 of 456 at 0.9 (0.80 ms), GA wall time 96.1 s, 70.7 s and
+/// 74.7 s (at 0.9 the rejections cost more than the fewer steps save); every reported best
+/// fall held within 1 % at half the step at 0.8 except the adult's generation 0 (+6.1 %). Of
+/// the margins tried, 0.8 is the largest at which winning through the step stays as rare as at
+/// 0.65. The scene field `step_margin` sets another. Taking the floor's damping implicitly
 /// ([`ContactParams::implicit_damping`]) lifts the bound to 1.85 ms (the heel pad's damper no
 /// longer narrows it), but evolved falls then win through the step: in 20-generation runs at
 /// 0.9 ms (0.49 of that bound) the best evolved adult of seed 3 had +15.7 % damage at half the

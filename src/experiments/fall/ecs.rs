@@ -126,8 +126,8 @@ fn character_of(world: &World, e: Entity) -> Option<FallCharacter> {
 /// stands, is pushed and is held by the stance gains, none of which depends on the reaction
 /// (key pose, k_p, k_v), so the falls of a GA's population share that stretch. Each fall
 /// continues from a copy of the whole World state (components and clock) with its own
-/// reaction: the same bits as running it from the start, without the 0.25 s (455 steps at
-/// 0.55 ms) before the reaction.
+/// reaction: the same bits as running it from the start, without the 0.25 s (some 360 steps at
+/// the GA's 0.70 ms) before the reaction.
 #[derive(Clone, Debug)]
 pub struct ReactionStart {
     /// The configuration it was run for, the reaction's fields normalised.
