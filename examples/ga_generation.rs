@@ -12,11 +12,14 @@
 //! `IMPLICIT_CONTACT_DAMPING=1` takes the floor's normal damping implicitly and re-derives the
 //! step without its bound (before `DT`).
 //! `KEY=stance` replaces every θ_d gene by the stance pose (random k_p only: the fall of a
-//! body that holds its stance). Besides each fall, it prints the mean damage share per link over the falls and the link
+//! body that holds its stance). `GENOMES_FROM=<dir>` takes the genomes from the population of
+//! the run of `GROUP` and `SEED` in that folder's `checkpoint.json` (an evolved population,
+//! whose falls last longer than the initial one's) instead of the initial population. Besides each fall, it prints the mean damage share per link over the falls and the link
 //! that carries the most damage in the best one.
 
 use marionette::evolve::fall_fitness::{STEP_MARGIN, stable_step_for, strength_kp_max};
-use marionette::evolve::{FallProblem, GaConfig, GaState, InProcess};
+use marionette::evolve::{FallProblem, GaConfig, GaState, InProcess, checkpoint};
+use marionette::experiments::evolve_fall::EvolutionRun;
 use marionette::experiments::fall::Ranges;
 use marionette::experiments::fall::SettledStart;
 use marionette::experiments::fall::ecs::{ReactionStart, run_parallel_reacting};
@@ -117,7 +120,19 @@ fn main() {
     let mut free = InProcess {
         batch: |g: &[Vec<f64>], _: u32| g.iter().map(|_| Ok(0.0)).collect(),
     };
-    let state = GaState::initial(cfg, bounds, &mut free).expect("GA");
+    let mut state = GaState::initial(cfg, bounds, &mut free).expect("GA");
+    if let Ok(dir) = std::env::var("GENOMES_FROM") {
+        let runs: Vec<EvolutionRun> =
+            checkpoint::load(std::path::Path::new(&dir)).expect("GENOMES_FROM: a checkpoint");
+        let seed = state.config.seed;
+        let run = runs
+            .into_iter()
+            .find(|r| r.problem.age_group == group && r.state.config.seed == seed)
+            .unwrap_or_else(|| panic!("GENOMES_FROM: no run of {group:?}, seed {seed}"));
+        eprintln!("generation {} of {dir}", run.state.generation);
+        state.population = run.state.population;
+        assert!(n <= state.population.len(), "N: at most the population");
+    }
     let edge = std::env::var("EDGE").is_ok();
     let stance_key = std::env::var("KEY").as_deref() == Ok("stance");
     let nd = problem.kp_max.len();

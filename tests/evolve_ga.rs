@@ -65,7 +65,46 @@ fn the_ga_minimises_and_elitism_never_loses_the_best() {
     }
     let last = s.logbook.last().unwrap().best_so_far;
     assert!(last < 0.01 * first, "best {first} → {last}");
-    assert_eq!(s.evaluations, 20 + 60 * 18);
+    // Every child was evaluated or inherited the fitness of an identical parent.
+    assert_eq!(s.evaluations + s.inherited, 20 + 60 * 18);
+    assert!(s.inherited > 0, "no child was a copy in 60 generations");
+}
+
+#[test]
+fn a_copy_of_a_parent_inherits_its_fitness_and_only_changed_children_are_evaluated() {
+    // A deterministic evaluation that counts the genomes it is given.
+    let seen = std::sync::Arc::new(std::sync::atomic::AtomicU64::new(0));
+    let counted = seen.clone();
+    let mut e = InProcess {
+        batch: move |g: &[Genome], _: u32| {
+            counted.fetch_add(g.len() as u64, std::sync::atomic::Ordering::Relaxed);
+            par_map(g, sphere)
+        },
+    };
+    let mut s = GaState::initial(ga(40, 5), sphere_bounds(), &mut e).unwrap();
+    while !s.done() {
+        s.step(&mut e).unwrap();
+        // Inherited or evaluated, every fitness is the genome's own, to the bit.
+        for (g, f) in s.population.iter().zip(&s.fitness) {
+            assert_eq!(f.map(f64::to_bits), sphere(g).ok().map(f64::to_bits));
+        }
+    }
+    let seen = seen.load(std::sync::atomic::Ordering::Relaxed);
+    assert_eq!(seen, s.evaluations + s.check_evaluations);
+    assert!(s.inherited > 0);
+    assert_eq!(s.evaluations + s.inherited, 20 + 40 * 18);
+    // Without crossover and mutation every child is a copy: nothing is evaluated after
+    // generation 0.
+    let cfg = GaConfig {
+        crossover_probability: 0.0,
+        mutation_probability: Some(0.0),
+        ..ga(5, 5)
+    };
+    let s = run_to_end(
+        GaState::initial(cfg, sphere_bounds(), &mut e).unwrap(),
+        &mut sphere_eval(),
+    );
+    assert_eq!((s.evaluations, s.inherited), (20, 5 * 18));
 }
 
 /// The sphere with a resolution artefact: a narrow basin around x = (−3, …) where the coarse
@@ -505,16 +544,26 @@ fn runs_advanced_together_get_the_bits_of_each_run_alone_in_one_batch_per_round(
             serde_json::to_string(alone).unwrap()
         );
     }
-    // The elderly evaluator saw one batch of the three runs' children (10 each) per
-    // generation, the adult one one of 10; the checks came in batches too.
+    // The elderly evaluator saw one batch of the three runs' children per generation (10
+    // each, less the copies that inherit a fitness), the adult one one of its run's; the
+    // checks came in batches too.
     let elderly = logs[0].lock().unwrap().clone();
     let adult = logs[1].lock().unwrap().clone();
-    assert_eq!(elderly.iter().filter(|b| *b == &(1, 30)).count(), 15);
-    assert!(
-        elderly.iter().all(|b| b.0 == 2 || *b == (1, 30)),
-        "{elderly:?}"
-    );
-    assert_eq!(adult.iter().filter(|b| *b == &(1, 10)).count(), 15);
+    let children = |log: &[(u32, usize)]| {
+        let b: Vec<usize> = log.iter().filter(|b| b.0 == 1).map(|b| b.1).collect();
+        (b.len(), b.iter().sum::<usize>() as u64)
+    };
+    let evaluated = |adult: bool| {
+        alone
+            .iter()
+            .zip(&runs)
+            .filter(|(_, r)| (r.problem.age_group == AgeGroup::Adult) == adult)
+            .map(|(s, _)| s.evaluations - 12)
+            .sum::<u64>()
+    };
+    assert_eq!(children(&elderly), (15, evaluated(false)));
+    assert_eq!(children(&adult), (15, evaluated(true)));
+    assert!(elderly.iter().all(|b| b.0 == 1 || b.0 == 2), "{elderly:?}");
     let checks: u64 = alone.iter().map(|s| s.check_evaluations).sum::<u64>()
         - runs
             .iter()

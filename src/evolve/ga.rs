@@ -3,7 +3,11 @@
 //! polynomial mutation. Every random draw of generation `g` comes from a generator seeded by the
 //! run's seed and `g` ([`crate::ecs::world_seed`]); evaluations draw nothing, so a run is the
 //! same bits whatever evaluates it and however many threads it uses, and a resumed run continues
-//! exactly.
+//! exactly. As in the textbook loop (e.g. DEAP's `eaSimple`, which evaluates only the individuals
+//! whose fitness crossover or mutation invalidated), a child that is gene for gene a copy of an
+//! evaluated parent (copied without crossover, no gene mutated) inherits its fitness instead of
+//! being simulated again: an evaluation draws nothing and depends on the genome alone, so the
+//! run is the same bits as one that re-evaluates it.
 
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64;
@@ -161,6 +165,10 @@ pub struct GaState {
     pub initial_best: Option<Genome>,
     /// Evaluations so far (at the problem's own resolution).
     pub evaluations: u64,
+    /// Children that were copies of an evaluated parent and inherited its fitness (and elite
+    /// check) instead of an evaluation, so far.
+    #[serde(default)]
+    pub inherited: u64,
     /// Re-evaluations of elites at twice the resolution so far ([`GaConfig::elite_check_tolerance`]).
     #[serde(default)]
     pub check_evaluations: u64,
@@ -199,6 +207,7 @@ impl GaState {
             best: None,
             initial_best: None,
             evaluations: 0,
+            inherited: 0,
             check_evaluations: 0,
             generation_checks: 0,
             logbook: Vec::new(),
@@ -209,6 +218,7 @@ impl GaState {
             Brood {
                 generation: 0,
                 elites: Vec::new(),
+                inherited: vec![None; population.len()],
                 children: population,
             },
             results,
@@ -244,7 +254,12 @@ impl GaState {
     /// all their broods in one batch (the same bits).
     pub fn step(&mut self, evaluator: &mut dyn Evaluator) -> Result<(), EvolveError> {
         let brood = self.breed();
-        let results = evaluator.evaluate(brood.generation, &brood.children, 1)?;
+        let todo = brood.to_evaluate();
+        let results = if todo.is_empty() {
+            Vec::new()
+        } else {
+            evaluator.evaluate(brood.generation, &todo, 1)?
+        };
         self.receive(brood, results)?;
         self.check_and_close(evaluator)
     }
@@ -266,7 +281,9 @@ impl GaState {
 
     /// The next generation, bred but not evaluated: the elites (the best `elites`, unchanged,
     /// with their fitness) and the children of tournament selection, SBX crossover and
-    /// polynomial mutation, every draw from the generator of (seed, generation).
+    /// polynomial mutation, every draw from the generator of (seed, generation). A child
+    /// identical to an individual of this generation that has a fitness inherits it and its
+    /// elite check ([`Brood::to_evaluate`] leaves it out).
     pub fn breed(&self) -> Brood {
         let c = &self.config;
         let g = self.generation + 1;
@@ -305,26 +322,43 @@ impl GaState {
                 children.push(y);
             }
         }
+        // Copies are found by the genes' bits: an evaluation depends on nothing else.
+        let key = |x: &Genome| x.iter().map(|v| v.to_bits()).collect::<Vec<u64>>();
+        let mut known = std::collections::HashMap::new();
+        for (i, x) in self.population.iter().enumerate() {
+            if let Some(f) = self.fitness[i] {
+                let checked = self.checked.get(i).copied().unwrap_or(false);
+                known.entry(key(x)).or_insert((f, checked));
+            }
+        }
+        let inherited = children
+            .iter()
+            .map(|x| known.get(&key(x)).copied())
+            .collect();
         Brood {
             generation: g,
             elites,
             children,
+            inherited,
         }
     }
 
-    /// Takes a brood and the evaluations of its children: the population (elites first) of the
-    /// brood's generation, failures logged. The generation is closed by [`Self::close`] after
-    /// the elite check.
+    /// Takes a brood and the evaluations of its children to evaluate
+    /// ([`Brood::to_evaluate`], in order): the population (elites first) of the brood's
+    /// generation, failures logged. The generation is closed by [`Self::close`] after the elite
+    /// check.
     pub fn receive(&mut self, brood: Brood, results: Vec<Evaluation>) -> Result<(), EvolveError> {
-        if results.len() != brood.children.len() {
+        let copies = brood.inherited.iter().filter(|k| k.is_some()).count();
+        let expected = brood.children.len() - copies;
+        if results.len() != expected {
             return Err(EvolveError::Evaluator(format!(
-                "{} results for {} genomes",
+                "{} results for {expected} genomes",
                 results.len(),
-                brood.children.len()
             )));
         }
         self.generation = brood.generation;
-        self.evaluations += brood.children.len() as u64;
+        self.evaluations += expected as u64;
+        self.inherited += copies as u64;
         self.generation_checks = 0;
         let (mut pop, mut fit, mut checked) = (Vec::new(), Vec::new(), Vec::new());
         for e in brood.elites {
@@ -333,7 +367,17 @@ impl GaState {
             checked.push(e.checked);
         }
         let offset = pop.len();
-        for (k, (genome, r)) in brood.children.into_iter().zip(results).enumerate() {
+        let mut results = results.into_iter();
+        for (k, (genome, known)) in brood.children.into_iter().zip(brood.inherited).enumerate() {
+            if let Some((f, was_checked)) = known {
+                pop.push(genome);
+                fit.push(Some(f));
+                checked.push(was_checked);
+                continue;
+            }
+            let r = results
+                .next()
+                .ok_or_else(|| EvolveError::Evaluator("fewer results than genomes".into()))?;
             let f = match r {
                 Ok(d) if d.is_finite() => Some(d),
                 Ok(d) => {
@@ -454,6 +498,27 @@ pub struct Brood {
     /// The generation it becomes.
     pub generation: u64,
     elites: Vec<Elite>,
-    /// The genomes to evaluate, in order.
+    /// The children's genomes, in order.
     pub children: Vec<Genome>,
+    /// Per child, the fitness and elite check it inherits from an identical individual of the
+    /// parent generation (`None`: it is to be evaluated).
+    inherited: Vec<Option<(f64, bool)>>,
+}
+
+impl Brood {
+    /// The children that need an evaluation (those that are not copies of an evaluated
+    /// parent), in order: what [`GaState::receive`] takes the results of.
+    pub fn to_evaluate(&self) -> Vec<Genome> {
+        self.children
+            .iter()
+            .zip(&self.inherited)
+            .filter(|(_, k)| k.is_none())
+            .map(|(x, _)| x.clone())
+            .collect()
+    }
+
+    /// Children that inherit a parent's fitness.
+    pub fn copies(&self) -> usize {
+        self.inherited.iter().filter(|k| k.is_some()).count()
+    }
 }

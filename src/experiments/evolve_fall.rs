@@ -108,10 +108,8 @@ pub fn advance(
         let broods: Vec<(usize, Brood)> =
             active.iter().map(|&i| (i, runs[i].state.breed())).collect();
         let generation = broods.iter().map(|b| b.1.generation).max().unwrap_or(0);
-        let parts: Vec<(usize, Vec<Genome>)> = broods
-            .iter()
-            .map(|(i, b)| (*i, b.children.clone()))
-            .collect();
+        let parts: Vec<(usize, Vec<Genome>)> =
+            broods.iter().map(|(i, b)| (*i, b.to_evaluate())).collect();
         let results = evaluate_by_owner(evaluators, &owner, generation, &parts, 1)?;
         for ((i, brood), r) in broods.into_iter().zip(results) {
             runs[i].state.receive(brood, r)?;

@@ -493,6 +493,7 @@ pub fn run_evolve(
         "generations": config.ga.generations,
         "population": config.ga.population,
         "evaluations": runs.iter().map(|r| r.state.evaluations).sum::<u64>(),
+        "inherited_fitness": runs.iter().map(|r| r.state.inherited).sum::<u64>(),
         "failed_evaluations": runs.iter().flat_map(|r| &r.state.failures).filter(|f| !f.2.starts_with(ELITE_CHECK)).count(),
         "elite_check": {
             "tolerance": config.ga.elite_check_tolerance,
