@@ -2,10 +2,10 @@
 //! elderly group's problem: 42 genes, falls stopped once the body rests), each fall in its own
 //! World, at the problem's step (0.70 ms, within the accuracy margin), the standing body settled once
 //! and kept across iterations as across a GA's generations, on a rayon pool of 1 and of 2
-//! threads. Falls per second give the paper's whole GA
-//! (30 × 500 = 15 000 falls for one age group) as 15 000 / rate; the ratio of the two rates is
-//! the parallel efficiency × 2. Also one GA step alone (selection, crossover, mutation) without
-//! evaluation.
+//! threads. The ratio of the two rates is the parallel efficiency × 2. These are initial
+//! genomes, whose falls rest sooner than evolved ones: 15 000 / rate understates the paper's
+//! whole GA, which `benches/evolve_run.rs` times itself. Also one GA step alone (selection,
+//! crossover, mutation) without evaluation.
 //! Run: `cargo bench --bench evolve`.
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
