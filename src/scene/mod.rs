@@ -184,7 +184,8 @@ impl Scene {
 
 /// Sets fields of `scene` from `path=value` assignments. The path names fields from the scene's
 /// top (`clip.end_s`, `render.gif_fps`); the value is JSON-like (`2.5`, `true`, `null`,
-/// `"text"`, `[1, 2]`) or a bare word taken as text (`humanoid24`).
+/// `"text"`, `[1, 2]`) or a bare word taken as text (`humanoid24`), also inside a list
+/// (`[elderly, adult]`, as the scene files write such lists).
 pub fn apply_overrides(scene: &Scene, assignments: &[String]) -> Result<Scene, SceneError> {
     if assignments.is_empty() {
         return Ok(scene.clone());
@@ -198,8 +199,7 @@ pub fn apply_overrides(scene: &Scene, assignments: &[String]) -> Result<Scene, S
         let (path, raw) = a
             .split_once('=')
             .ok_or_else(|| err("expected field.path=value".into()))?;
-        let new: serde_json::Value = serde_json::from_str(raw)
-            .unwrap_or_else(|_| serde_json::Value::String(raw.to_string()));
+        let new = override_value(raw);
         // The top level is the scene kind: {"Show": {...}}.
         let mut cur = value
             .as_object_mut()
@@ -254,6 +254,43 @@ pub fn apply_overrides(scene: &Scene, assignments: &[String]) -> Result<Scene, S
         assignment: assignments.join(" "),
         message: e.to_string(),
     })
+}
+
+/// The value of an override: JSON if it parses, else a list `[a, b, …]` whose items are
+/// values in turn (so bare words may stand in it), else the text itself.
+fn override_value(raw: &str) -> serde_json::Value {
+    if let Ok(v) = serde_json::from_str(raw) {
+        return v;
+    }
+    let text = || serde_json::Value::String(raw.to_string());
+    let t = raw.trim();
+    let Some(inner) = t.strip_prefix('[').and_then(|r| r.strip_suffix(']')) else {
+        return text();
+    };
+    // Split at the commas outside brackets, braces and quotes.
+    let (mut items, mut depth, mut quoted, mut start) = (Vec::new(), 0i32, false, 0);
+    let mut prev = ' ';
+    for (i, c) in inner.char_indices() {
+        match c {
+            '"' if prev != '\\' => quoted = !quoted,
+            '[' | '{' if !quoted => depth += 1,
+            ']' | '}' if !quoted => depth -= 1,
+            ',' if !quoted && depth == 0 => {
+                items.push(&inner[start..i]);
+                start = i + 1;
+            }
+            _ => {}
+        }
+        prev = c;
+    }
+    if depth != 0 || quoted {
+        return text();
+    }
+    items.push(&inner[start..]);
+    if items.iter().any(|s| s.trim().is_empty()) {
+        return text();
+    }
+    serde_json::Value::Array(items.iter().map(|s| override_value(s.trim())).collect())
 }
 
 /// Longest scene name, characters.
@@ -462,6 +499,26 @@ mod tests {
         assert_eq!(sh.clip.end_s, Some(1.5));
         assert!(!sh.render.gif);
         assert_eq!(sh.name, "other");
+    }
+
+    #[test]
+    fn an_override_list_may_hold_bare_words() {
+        use serde_json::json;
+        assert_eq!(
+            override_value("[elderly, adult]"),
+            json!(["elderly", "adult"])
+        );
+        assert_eq!(override_value("[elderly]"), json!(["elderly"]));
+        assert_eq!(override_value("[1, x, \"a, b\"]"), json!([1, "x", "a, b"]));
+        assert_eq!(
+            override_value("[[a, 1], {\"k\": 2}]"),
+            json!([["a", 1], {"k": 2}])
+        );
+        // JSON stays JSON; what is no list stays text.
+        assert_eq!(override_value("[1, 2]"), json!([1, 2]));
+        assert_eq!(override_value("humanoid24"), json!("humanoid24"));
+        assert_eq!(override_value("[a, ]"), json!("[a, ]"));
+        assert_eq!(override_value("[a, [b]"), json!("[a, [b]"));
     }
 
     #[test]
