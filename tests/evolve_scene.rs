@@ -137,8 +137,11 @@ fn a_resumed_evolution_ends_where_an_uninterrupted_one_does() {
         "--set",
         &file,
     ]);
-    // The file carries the step it was evolved at; the Fall scene takes it.
+    // The file carries the step it was evolved at; the Fall scene takes it. It names the
+    // group it was evolved for, and the report says so.
     let fall = report(&replay);
+    assert_eq!(fall["controller_evolved_for"], "adult");
+    assert_eq!(fall["age_group"], "adult");
     assert_eq!(
         fall["dt_s"].as_f64(),
         Some(FallProblem::paper(AgeGroup::Adult).fall.dt_s)
@@ -156,6 +159,27 @@ fn a_resumed_evolution_ends_where_an_uninterrupted_one_does() {
         (replayed - evolved).abs() <= 1e-9 * evolved,
         "replayed {replayed} N vs evolved {evolved} N"
     );
+    // Run on the other figure only, the fall says whose controller it is running.
+    let other = marionette(&[
+        "run",
+        "scenes/fall.ron",
+        "--out",
+        &s(&replay),
+        "--set",
+        "age_group=elderly",
+        "--set",
+        "compare_with=null",
+        "--set",
+        "render.gif=false",
+        "--set",
+        &file,
+    ]);
+    let note = String::from_utf8_lossy(&other.stderr);
+    assert!(
+        note.contains("evolved for the adult figure") && note.contains("--set age_group=adult"),
+        "{note}"
+    );
+    assert_eq!(report(&replay)["controller_evolved_for"], "adult");
     std::fs::remove_dir_all(&replay).ok();
     // A scene step that contradicts the controller's is refused, naming the way out.
     let out = Command::new(env!("CARGO_BIN_EXE_marionette"))

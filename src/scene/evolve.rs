@@ -283,13 +283,19 @@ fn controller_ron(problem: &FallProblem, genes: &[f64]) -> Result<String, SceneE
         start_s: Some(problem.fall.control_start_s),
         dt_s: Some(problem.fall.dt_s),
         contact_implicit_damping: Some(problem.fall.contact.implicit_damping),
+        evolved_for: Some(problem.age_group),
     };
     let text = ron::ser::to_string_pretty(&controller, ron::ser::PrettyConfig::default())
         .map_err(|e| invalid(format!("controller file: {e}")))?;
     Ok(format!(
         "// The evolved key pose and stiffness, for a Fall scene's controller_file. Evolved at \
          dt = {dt} s (dt_s), the step a Fall scene replays it at, with the floor's damping \
-         taken {mode} (contact_implicit_damping).\n{text}\n",
+         taken {mode} (contact_implicit_damping), for the {group} figure (evolved_for: a Fall \
+         scene of that age_group replays its evolved damage).\n{text}\n",
+        group = match problem.age_group {
+            AgeGroup::Elderly => "elderly",
+            AgeGroup::Adult => "adult",
+        },
         dt = problem.fall.dt_s,
         mode = if problem.fall.contact.implicit_damping {
             "implicitly"

@@ -86,6 +86,11 @@ pub struct Controller {
     /// A scene's own `controller` block overrides the file's; left out everywhere, the scene's
     /// `contact` decides.
     pub contact_implicit_damping: Option<bool>,
+    /// The age group whose fall this controller was evolved on (an evolution writes it): that
+    /// group's fall replays its evolved damage. The report names it beside each group
+    /// simulated (`controller_evolved_for`), and a fall of another group only is noted on
+    /// standard error.
+    pub evolved_for: Option<AgeGroup>,
 }
 
 /// A pushed fall: an elderly or adult figure with given PD settings, pushed.
@@ -193,6 +198,28 @@ impl FallScene {
         }
     }
 
+    /// The controller file, read, if the scene names one.
+    fn controller_from_file(&self, base: &Path) -> Result<Option<Controller>, SceneError> {
+        let Some(f) = &self.controller_file else {
+            return Ok(None);
+        };
+        let path = resolve_path(f, base);
+        let text = crate::io::read_text(&path)?;
+        Ok(Some(crate::io::parse_ron::<Controller>(
+            &text,
+            &path.display().to_string(),
+        )?))
+    }
+
+    /// The age group the controller was evolved for: the scene's `controller` block's, else
+    /// the file's.
+    pub fn controller_evolved_for(&self, base: &Path) -> Result<Option<AgeGroup>, SceneError> {
+        Ok(self
+            .controller
+            .evolved_for
+            .or(self.controller_from_file(base)?.and_then(|c| c.evolved_for)))
+    }
+
     /// The simulation configuration: the paper's experiment for the age group, with this
     /// scene's settings.
     pub fn config(&self, base: &Path) -> Result<FallConfig, SceneError> {
@@ -207,17 +234,7 @@ impl FallScene {
         c.mass_kg = self.body.mass_kg;
         c.contact = self.contact;
         let names = fall21().dof_names();
-        let from_file = match &self.controller_file {
-            Some(f) => {
-                let path = resolve_path(f, base);
-                let text = crate::io::read_text(&path)?;
-                Some(crate::io::parse_ron::<Controller>(
-                    &text,
-                    &path.display().to_string(),
-                )?)
-            }
-            None => None,
-        };
+        let from_file = self.controller_from_file(base)?;
         for ctrl in from_file.iter().chain(std::iter::once(&self.controller)) {
             override_per_dof(
                 "key_pose_deg",
@@ -406,8 +423,23 @@ pub fn run_fall(
         },
         &out.join("head_height.png"),
     )?;
+    let evolved_for = scene.controller_evolved_for(base)?;
+    if let Some(e) = evolved_for
+        && groups.iter().all(|(g, _)| *g != e)
+    {
+        eprintln!(
+            "note: the controller was evolved for the {} figure; this fall runs it on the {} \
+             figure (--set age_group={} replays its evolved damage)",
+            group_name(e),
+            group_name(scene.age_group),
+            group_name(e)
+        );
+    }
     let mut report = fall_report(&results[0], sim_wall);
     report["age_group"] = json!(scene.age_group);
+    if let Some(e) = evolved_for {
+        report["controller_evolved_for"] = json!(e);
+    }
     report["damage_weights"] = json!(config.damage_weights);
     if let (Some(r), Some((g, _))) = (results.get(1), groups.get(1)) {
         let mut other = fall_report(r, sim_wall);
