@@ -123,20 +123,23 @@ fn a_resumed_evolution_ends_where_an_uninterrupted_one_does() {
         "controller_file=\"{}\"",
         a.join("best_adult.controller.ron").display()
     );
-    marionette(&[
-        "run",
-        "scenes/fall.ron",
-        "--out",
-        &s(&replay),
-        "--set",
-        "age_group=adult",
-        "--set",
-        "compare_with=null",
-        "--set",
-        "render.gif=false",
-        "--set",
-        &file,
-    ]);
+    let replay_on = |group: &str| {
+        marionette(&[
+            "run",
+            "scenes/fall.ron",
+            "--out",
+            &s(&replay),
+            "--set",
+            &format!("age_group={group}"),
+            "--set",
+            "compare_with=null",
+            "--set",
+            "render.gif=false",
+            "--set",
+            &file,
+        ])
+    };
+    replay_on("adult");
     // The file carries the step it was evolved at; the Fall scene takes it. It names the
     // group it was evolved for, and the report says so.
     let fall = report(&replay);
@@ -160,20 +163,7 @@ fn a_resumed_evolution_ends_where_an_uninterrupted_one_does() {
         "replayed {replayed} N vs evolved {evolved} N"
     );
     // Run on the other figure only, the fall says whose controller it is running.
-    let other = marionette(&[
-        "run",
-        "scenes/fall.ron",
-        "--out",
-        &s(&replay),
-        "--set",
-        "age_group=elderly",
-        "--set",
-        "compare_with=null",
-        "--set",
-        "render.gif=false",
-        "--set",
-        &file,
-    ]);
+    let other = replay_on("elderly");
     let note = String::from_utf8_lossy(&other.stderr);
     assert!(
         note.contains("evolved for the adult figure") && note.contains("--set age_group=adult"),
