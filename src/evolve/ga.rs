@@ -328,7 +328,11 @@ impl GaState {
         for (i, x) in self.population.iter().enumerate() {
             if let Some(f) = self.fitness[i] {
                 let checked = self.checked.get(i).copied().unwrap_or(false);
-                known.entry(key(x)).or_insert((f, checked));
+                // The same genes have the same damage; checked if any copy was.
+                known
+                    .entry(key(x))
+                    .and_modify(|k: &mut (f64, bool)| k.1 |= checked)
+                    .or_insert((f, checked));
             }
         }
         let inherited = children
@@ -348,7 +352,7 @@ impl GaState {
     /// generation, failures logged. The generation is closed by [`Self::close`] after the elite
     /// check.
     pub fn receive(&mut self, brood: Brood, results: Vec<Evaluation>) -> Result<(), EvolveError> {
-        let copies = brood.inherited.iter().filter(|k| k.is_some()).count();
+        let copies = brood.copies();
         let expected = brood.children.len() - copies;
         if results.len() != expected {
             return Err(EvolveError::Evaluator(format!(
