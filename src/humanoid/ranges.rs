@@ -36,6 +36,16 @@ pub enum AgeGroup {
     Adult,
 }
 
+impl AgeGroup {
+    /// The group's name as scenes and files write it (`elderly`, `adult`).
+    pub fn name(self) -> &'static str {
+        match self {
+            AgeGroup::Elderly => "elderly",
+            AgeGroup::Adult => "adult",
+        }
+    }
+}
+
 /// Errors reading a range table.
 #[derive(Debug, thiserror::Error)]
 pub enum RangeError {

@@ -104,13 +104,6 @@ pub struct EvolveFallScene {
     pub render: PrimitiveRender,
 }
 
-fn group_name(g: AgeGroup) -> &'static str {
-    match g {
-        AgeGroup::Elderly => "elderly",
-        AgeGroup::Adult => "adult",
-    }
-}
-
 fn invalid(m: String) -> SceneError {
     SceneError::Invalid(m)
 }
@@ -292,10 +285,7 @@ fn controller_ron(problem: &FallProblem, genes: &[f64]) -> Result<String, SceneE
          dt = {dt} s (dt_s), the step a Fall scene replays it at, with the floor's damping \
          taken {mode} (contact_implicit_damping), for the {group} figure (evolved_for: a Fall \
          scene of that age_group replays its evolved damage).\n{text}\n",
-        group = match problem.age_group {
-            AgeGroup::Elderly => "elderly",
-            AgeGroup::Adult => "adult",
-        },
+        group = problem.age_group.name(),
         dt = problem.fall.dt_s,
         mode = if problem.fall.contact.implicit_damping {
             "implicitly"
@@ -374,7 +364,7 @@ pub fn run_evolve(
     for r in &runs {
         let stem = format!(
             "logbook_{}_seed{}",
-            group_name(r.problem.age_group),
+            r.problem.age_group.name(),
             r.state.config.seed
         );
         write_output(
@@ -396,7 +386,7 @@ pub fn run_evolve(
             .collect();
         let len = rs.iter().map(|r| r.state.logbook.len()).min().unwrap_or(0);
         series.push(Series {
-            name: format!("{}: mean of {} seeds", group_name(g.age_group), rs.len()),
+            name: format!("{}: mean of {} seeds", g.age_group.name(), rs.len()),
             points: (0..len)
                 .map(|k| {
                     let m = rs
@@ -432,7 +422,7 @@ pub fn run_evolve(
             })
             .ok_or_else(|| invalid("no run".into()))?;
         let (before, after) = best_falls(best)?;
-        let name = group_name(g.age_group);
+        let name = g.age_group.name();
         let cfg = |genes: Option<&Vec<f64>>| {
             genes.map_or_else(|| best.problem.fall.clone(), |g| best.problem.config(g))
         };

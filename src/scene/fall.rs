@@ -87,9 +87,8 @@ pub struct Controller {
     /// `contact` decides.
     pub contact_implicit_damping: Option<bool>,
     /// The age group whose fall this controller was evolved on (an evolution writes it): that
-    /// group's fall replays its evolved damage. The report names it beside each group
-    /// simulated (`controller_evolved_for`), and a fall of another group only is noted on
-    /// standard error.
+    /// group's fall replays its evolved damage. The report names it
+    /// (`controller_evolved_for`), and a fall of other groups only is noted on standard error.
     pub evolved_for: Option<AgeGroup>,
 }
 
@@ -211,18 +210,15 @@ impl FallScene {
         )?))
     }
 
-    /// The age group the controller was evolved for: the scene's `controller` block's, else
-    /// the file's.
-    pub fn controller_evolved_for(&self, base: &Path) -> Result<Option<AgeGroup>, SceneError> {
-        Ok(self
-            .controller
-            .evolved_for
-            .or(self.controller_from_file(base)?.and_then(|c| c.evolved_for)))
-    }
-
     /// The simulation configuration: the paper's experiment for the age group, with this
     /// scene's settings.
     pub fn config(&self, base: &Path) -> Result<FallConfig, SceneError> {
+        Ok(self.configure(base)?.0)
+    }
+
+    /// [`Self::config`] and the age group the controller was evolved for (the scene's
+    /// `controller` block's, else the file's), the file read once.
+    fn configure(&self, base: &Path) -> Result<(FallConfig, Option<AgeGroup>), SceneError> {
         let mut c = FallConfig::paper(self.age_group);
         if let Some(f) = &self.ranges_file {
             c.ranges = Ranges::Table(RangeTable::load(&resolve_path(f, base))?);
@@ -269,7 +265,11 @@ impl FallScene {
             }
             c.damage_weights.insert(link.clone(), *w);
         }
-        Ok(c)
+        let evolved_for = self
+            .controller
+            .evolved_for
+            .or(from_file.and_then(|f| f.evolved_for));
+        Ok((c, evolved_for))
     }
 }
 
@@ -366,7 +366,7 @@ pub fn run_fall(
     base: &Path,
     out: &Path,
 ) -> Result<serde_json::Value, SceneError> {
-    let config = scene.config(base)?;
+    let (config, evolved_for) = scene.configure(base)?;
     let mut groups = vec![(scene.age_group, config.clone())];
     if let Some(other) = scene.compare_with {
         let mut c = config.clone();
@@ -392,9 +392,9 @@ pub fn run_fall(
             let file = if k == 0 {
                 "fall".to_string()
             } else {
-                format!("fall_{}", group_name(*g))
+                format!("fall_{}", g.name())
             };
-            (file, format!("{} ({})", scene.name, group_name(*g)), r)
+            (file, format!("{} ({})", scene.name, g.name()), r)
         })
         .collect();
     write_falls(&named, &scene.render, out)?;
@@ -408,7 +408,7 @@ pub fn run_fall(
                 .iter()
                 .zip(&groups)
                 .map(|(r, (g, _))| Series {
-                    name: group_name(*g).into(),
+                    name: g.name().into(),
                     points: r
                         .frames
                         .iter()
@@ -423,16 +423,15 @@ pub fn run_fall(
         },
         &out.join("head_height.png"),
     )?;
-    let evolved_for = scene.controller_evolved_for(base)?;
     if let Some(e) = evolved_for
         && groups.iter().all(|(g, _)| *g != e)
     {
         eprintln!(
             "note: the controller was evolved for the {} figure; this fall runs it on the {} \
              figure (--set age_group={} replays its evolved damage)",
-            group_name(e),
-            group_name(scene.age_group),
-            group_name(e)
+            e.name(),
+            scene.age_group.name(),
+            e.name()
         );
     }
     let mut report = fall_report(&results[0], sim_wall);
@@ -447,11 +446,4 @@ pub fn run_fall(
         report["compared"] = other;
     }
     Ok(report)
-}
-
-fn group_name(g: AgeGroup) -> &'static str {
-    match g {
-        AgeGroup::Elderly => "elderly",
-        AgeGroup::Adult => "adult",
-    }
 }
