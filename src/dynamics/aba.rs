@@ -41,6 +41,7 @@ pub fn aba<'d>(
 /// products): the linearisation of a force taken implicitly, `J q̈ = a_b − ā_b` being the
 /// body's acceleration due to `q̈`. It enters as `I^A_b += I_c`, `p^A_b −= I_c ā_b`
 /// ([`ContactParams::implicit_damping`](super::forces::contact::ContactParams::implicit_damping)).
+#[inline(always)]
 pub fn aba_passes(
     model: &Model,
     data: &mut Data,
@@ -51,22 +52,43 @@ pub fn aba_passes(
 ) {
     let n = model.nbodies();
     debug_assert_eq!(f_ext.len(), n);
-    data.ia.copy_from_slice(&model.inertia_blocks);
+    // Every per-body buffer as a slice of length n (the compiler then knows each body index
+    // is in bounds).
+    let Data {
+        xup,
+        xup_rotation,
+        s,
+        v,
+        c,
+        a,
+        ia,
+        pa,
+        u,
+        dinv,
+        uu,
+        qdd,
+        ..
+    } = data;
+    let (xups, rots, ss, vs, cs) = (&xup[..n], &xup_rotation[..n], &s[..n], &v[..n], &c[..n]);
+    let (accs, ias, pas) = (&mut a[..n], &mut ia[..n], &mut pa[..n]);
+    let (us, dinvs, uus, qdds) = (&mut u[..n], &mut dinv[..n], &mut uu[..n], &mut qdd[..]);
+    let f_ext = &f_ext[..n];
+    ias.copy_from_slice(&model.inertia_blocks);
     for i in 0..n {
         let inertia = &model.bodies[i].inertia;
-        let vi = data.v[i];
-        data.pa[i] = vi.cross_force(inertia.apply(vi)) - f_ext[i];
+        let vi = vs[i];
+        pas[i] = vi.cross_force(inertia.apply(vi)) - f_ext[i];
     }
     if !implicit.is_empty() {
         // ā: the accelerations at q̈ = 0, parents first (pass 3 overwrites `a`).
         let a0 = base_acceleration(model);
         for i in 0..n {
-            let a_parent = model.bodies[i].parent.map_or(a0, |p| data.a[p]);
-            data.a[i] = data.xup[i].apply_motion(a_parent) + data.c[i];
+            let a_parent = model.bodies[i].parent.map_or(a0, |p| accs[p]);
+            accs[i] = xups[i].apply_motion(a_parent) + cs[i];
         }
         for (b, ic) in implicit {
-            data.ia[*b] += *ic;
-            data.pa[*b] -= ic.apply(data.a[*b]);
+            ias[*b] += *ic;
+            pas[*b] -= ic.apply(accs[*b]);
         }
     }
     for i in (0..n).rev() {
@@ -74,9 +96,9 @@ pub fn aba_passes(
         let iv = model.v_idx[i];
         // Parents come before their children: the parent's entries lie below `i`, and the
         // body's own articulated inertia is updated in place to `I^a` (no copies).
-        let (ia_head, ia_tail) = data.ia.split_at_mut(i);
+        let (ia_head, ia_tail) = ias.split_at_mut(i);
         let ia = &mut ia_tail[0];
-        let pa = data.pa[i];
+        let pa = pas[i];
         let arm = |k: usize| armature.map_or(0.0, |a| a[iv + k]);
         let has_parent = body.parent.is_some();
         // `p^a − I^a c`: the bias force the body passes on (before the inertia's product).
@@ -88,16 +110,16 @@ pub fn aba_passes(
                 let (u, d, uu) = match axes {
                     JointAxes::One(ax) => coordinate_column(ia, ax, tau[iv], pa),
                     _ => {
-                        let a = data.s[i][0].ang;
+                        let a = ss[i][0].ang;
                         let u = ia.apply_angular(a);
                         (u, a.dot(u.ang), tau[iv] - a.dot(pa.ang))
                     }
                 };
                 let d = d + arm(0);
                 let dinv = 1.0 / d;
-                data.u[i][0] = u;
-                data.dinv[i].x_axis.x = dinv;
-                data.uu[i].x = uu;
+                us[i][0] = u;
+                dinvs[i].x_axis.x = dinv;
+                uus[i].x = uu;
                 if !has_parent {
                     continue;
                 }
@@ -107,7 +129,7 @@ pub fn aba_passes(
             (JointType::Universal { .. }, JointAxes::Two(_, a2)) => {
                 // The second column is the coordinate axis `a2` itself (taken as in a pin),
                 // the first `R₂ᵀ a₁` (from the kinematics); `D` is 2×2.
-                let b = data.s[i][0].ang;
+                let b = ss[i][0].ang;
                 let u0 = ia.apply_angular(b);
                 let (u1, d11, uu1) = coordinate_column(ia, a2, tau[iv + 1], pa);
                 let d00 = b.dot(u0.ang) + arm(0);
@@ -121,10 +143,10 @@ pub fn aba_passes(
                     DVec3::Z,
                 );
                 let u = [u0, u1];
-                data.u[i][0] = u0;
-                data.u[i][1] = u1;
-                data.dinv[i] = dinv;
-                data.uu[i] = DVec3::new(uu0, uu1, 0.0);
+                us[i][0] = u0;
+                us[i][1] = u1;
+                dinvs[i] = dinv;
+                uus[i] = DVec3::new(uu0, uu1, 0.0);
                 if !has_parent {
                     continue;
                 }
@@ -142,13 +164,13 @@ pub fn aba_passes(
                 let mut d = DMat3::IDENTITY;
                 let mut uu = DVec3::ZERO;
                 for k in 0..nv {
-                    let a = data.s[i][k].ang;
+                    let a = ss[i][k].ang;
                     u[k] = ia.apply_angular(a);
                     uu[k] = tau[iv + k] - a.dot(pa.ang);
                 }
                 for r in 0..nv {
                     for k in 0..nv {
-                        let mut e = data.s[i][r].ang.dot(u[k].ang);
+                        let mut e = ss[i][r].ang.dot(u[k].ang);
                         if r == k {
                             e += arm(k);
                         }
@@ -156,9 +178,9 @@ pub fn aba_passes(
                     }
                 }
                 let dinv = d.inverse();
-                data.u[i] = u;
-                data.dinv[i] = dinv;
-                data.uu[i] = uu;
+                us[i] = u;
+                dinvs[i] = dinv;
+                uus[i] = uu;
                 if !has_parent {
                     continue;
                 }
@@ -175,10 +197,10 @@ pub fn aba_passes(
             (JointType::Free, _) => continue,
         };
         if let Some(p) = body.parent {
-            let pa_a = pa_a + ia.apply(data.c[i]);
-            let x = &data.xup[i];
-            ia_head[p] += ia.transform_to_parent_with(x, &data.xup_rotation[i]);
-            data.pa[p] += x.inv_apply_force(pa_a);
+            let pa_a = pa_a + ia.apply(cs[i]);
+            let x = &xups[i];
+            ia_head[p] += ia.transform_to_parent_with(x, &rots[i]);
+            pas[p] += x.inv_apply_force(pa_a);
         }
     }
     let a0 = base_acceleration(model);
@@ -186,31 +208,43 @@ pub fn aba_passes(
         let body = &model.bodies[i];
         let iv = model.v_idx[i];
         let a_parent = match body.parent {
-            Some(p) => data.a[p],
+            Some(p) => accs[p],
             None => a0,
         };
-        let a_prime = data.xup[i].apply_motion(a_parent) + data.c[i];
+        let a_prime = xups[i].apply_motion(a_parent) + cs[i];
         match body.joint {
             JointType::Pin { .. } => {
-                let qdd = data.dinv[i].x_axis.x * (data.uu[i].x - data.u[i][0].dot_motion(a_prime));
-                data.qdd[iv] = qdd;
+                let qdd = dinvs[i].x_axis.x * (uus[i].x - us[i][0].dot_motion(a_prime));
+                qdds[iv] = qdd;
                 let mut a = a_prime;
-                a.ang += data.s[i][0].ang * qdd;
-                data.a[i] = a;
+                a.ang += ss[i][0].ang * qdd;
+                accs[i] = a;
             }
-            JointType::Universal { .. } => multi_dof_acceleration::<2>(data, i, iv, a_prime),
-            JointType::Ball { .. } => multi_dof_acceleration::<3>(data, i, iv, a_prime),
-            JointType::Fixed => data.a[i] = a_prime,
+            JointType::Universal { .. } => {
+                accs[i] = multi_dof_acceleration::<2>(
+                    (&us[i], &dinvs[i], uus[i], &ss[i]),
+                    a_prime,
+                    &mut qdds[iv..iv + 2],
+                )
+            }
+            JointType::Ball { .. } => {
+                accs[i] = multi_dof_acceleration::<3>(
+                    (&us[i], &dinvs[i], uus[i], &ss[i]),
+                    a_prime,
+                    &mut qdds[iv..iv + 3],
+                )
+            }
+            JointType::Fixed => accs[i] = a_prime,
             JointType::Free => {
                 let f = ForceVec::new(
                     DVec3::new(tau[iv], tau[iv + 1], tau[iv + 2]),
                     DVec3::new(tau[iv + 3], tau[iv + 4], tau[iv + 5]),
-                ) - data.pa[i];
-                let a = data.ia[i].solve(f);
+                ) - pas[i];
+                let a = ias[i].solve(f);
                 let qdd = a - a_prime;
-                data.qdd[iv..iv + 3].copy_from_slice(&qdd.ang.to_array());
-                data.qdd[iv + 3..iv + 6].copy_from_slice(&qdd.lin.to_array());
-                data.a[i] = a;
+                qdds[iv..iv + 3].copy_from_slice(&qdd.ang.to_array());
+                qdds[iv + 3..iv + 6].copy_from_slice(&qdd.lin.to_array());
+                accs[i] = a;
             }
         }
     }
@@ -235,20 +269,19 @@ fn coordinate_column(
 /// Pass 3 for a joint of `N` rotational DOFs: `q̈ = D⁻¹(u − Uᵀ a')`, `a = a' + S q̈`.
 #[inline(always)]
 fn multi_dof_acceleration<const N: usize>(
-    data: &mut Data,
-    i: usize,
-    iv: usize,
+    (u, dinv, uu, s): (&[ForceVec; 3], &DMat3, DVec3, &[MotionVec; 3]),
     a_prime: MotionVec,
-) {
+    qdd: &mut [f64],
+) -> MotionVec {
     let mut r = DVec3::ZERO;
     for k in 0..N {
-        r[k] = data.uu[i][k] - data.u[i][k].dot_motion(a_prime);
+        r[k] = uu[k] - u[k].dot_motion(a_prime);
     }
-    let qdd = data.dinv[i] * r;
+    let qdd_n = *dinv * r;
     let mut a = a_prime;
     for k in 0..N {
-        data.qdd[iv + k] = qdd[k];
-        a.ang += data.s[i][k].ang * qdd[k];
+        qdd[k] = qdd_n[k];
+        a.ang += s[k].ang * qdd_n[k];
     }
-    data.a[i] = a;
+    a
 }

@@ -78,6 +78,7 @@ impl IntegratorWorkspace {
 }
 
 /// Advances `(q, v)` from time `t` by `h` seconds with `scheme`.
+#[inline(always)]
 pub fn step<D: Dynamics>(
     scheme: Integrator,
     model: &Model,
@@ -136,6 +137,7 @@ pub fn rk4_step<D: Dynamics>(
 
 /// One semi-implicit Euler step: `v ← v + h q̈(q, v)`, then `q ← q ⊞ h ż(q, v)`; with
 /// `implicit = Some(h)` the joint damping is taken implicitly in `q̈`.
+#[inline(always)]
 pub fn semi_implicit_euler_step<D: Dynamics>(
     model: &Model,
     ws: &mut IntegratorWorkspace,

@@ -241,7 +241,7 @@ impl JointType {
     /// axes (`axes`, from the model): the same `X_J`, `v_J`, `c_J` and `S` from the factors'
     /// sines and cosines, without general 3×3 products, and the factors themselves. Joints
     /// without that structure (`JointAxes::General`) take [`JointType::jcalc`].
-    #[inline]
+    #[inline(always)]
     pub fn jcalc_axes(
         &self,
         axes: JointAxes,
@@ -294,7 +294,7 @@ impl JointType {
 
     /// The retraction `q ⊞ z`: pin/universal `θ + z`; ball `Q·exp(A z)`; free
     /// `[p + z_lin; Q·exp(z_ang)]` (`z_lin` a world displacement, `z_ang` a body rotation vector).
-    #[inline]
+    #[inline(always)]
     pub fn retract(&self, q: &[f64], z: &[f64], out: &mut [f64]) {
         match self {
             JointType::Pin { .. } => out[0] = q[0] + z[0],
@@ -323,7 +323,7 @@ impl JointType {
     /// The rate `ż` of the chart coordinates `z` (with `q_stage = q₀ ⊞ z`) under velocity `v`:
     /// angles `ż = v`; ball `ż = Aᵀ dexp⁻¹(Az, Av)`; free `ż_ang = dexp⁻¹(z_ang, ω)`,
     /// `ż_lin = R(q_stage) v_lin`. Integrating `ż` in the chart keeps Runge–Kutta at full order.
-    #[inline]
+    #[inline(always)]
     pub fn chart_rate(&self, q_stage: &[f64], z: &[f64], v: &[f64], zdot: &mut [f64]) {
         match self {
             JointType::Pin { .. } => zdot[0] = v[0],
@@ -351,7 +351,7 @@ impl JointType {
 
     /// The joint's anatomical angles (rad), one per velocity DOF: pin/universal `θ`; ball the
     /// rotation vector's components on its DOF axes (`Aᵀ log Q`); free: zeros.
-    #[inline]
+    #[inline(always)]
     pub fn angles(&self, q: &[f64], out: &mut [f64]) {
         match self {
             JointType::Pin { .. } => out[0] = q[0],
@@ -372,7 +372,7 @@ impl JointType {
     /// representative of the same rotation nearest `reference` (`v` or `v − 2π v̂`): a rotation
     /// tracked through |θ| = π (an arm swung overhead) reads on without the principal branch's
     /// jump to the opposite side. The other joints read as [`JointType::angles`].
-    #[inline]
+    #[inline(always)]
     pub fn angles_near(&self, q: &[f64], reference: &[f64], out: &mut [f64]) {
         self.angles(q, out);
         if matches!(self, JointType::Ball { .. }) {

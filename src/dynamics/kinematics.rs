@@ -8,20 +8,31 @@ use super::model::Model;
 use super::spatial::{MotionVec, SpatialTransform};
 
 /// Fills `data.xup, s, v, c, rot, pos` for configuration `q` (size nq) and velocity `v` (size nv).
-#[inline]
+#[inline(always)]
 pub fn kinematics(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) {
     debug_assert_eq!(q.len(), model.nq);
     debug_assert_eq!(v.len(), model.nv);
-    for (i, body) in model.bodies.iter().enumerate() {
+    // Every per-body buffer as a slice of length n (each body index is then known in bounds).
+    let n = model.nbodies();
+    let Data {
+        xup,
+        xup_rotation,
+        s,
+        v: vel,
+        c,
+        rot,
+        pos,
+        ..
+    } = data;
+    let (xups, rots, ss) = (&mut xup[..n], &mut xup_rotation[..n], &mut s[..n]);
+    let (vs, cs) = (&mut vel[..n], &mut c[..n]);
+    let (world_rot, world_pos) = (&mut rot[..n], &mut pos[..n]);
+    for (i, body) in model.bodies[..n].iter().enumerate() {
         let (iq, iv) = (model.q_idx[i], model.v_idx[i]);
         let j = &body.joint;
         let axes = model.joint_axes[i];
-        let (xj, vj, cj, rotation) = j.jcalc_axes(
-            axes,
-            &q[iq..iq + j.nq()],
-            &v[iv..iv + j.nv()],
-            &mut data.s[i],
-        );
+        let (xj, vj, cj, rotation) =
+            j.jcalc_axes(axes, &q[iq..iq + j.nq()], &v[iv..iv + j.nv()], &mut ss[i]);
         let xup = match rotation {
             // `X_tree` is a pure translation and `X_J` a pure rotation: `X_J X_tree` is
             // `rot(E_J)` with the tree's translation.
@@ -31,26 +42,26 @@ pub fn kinematics(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) {
                 trans: body.x_tree.trans,
             },
         };
-        data.xup[i] = xup;
-        data.xup_rotation[i] = rotation;
+        xups[i] = xup;
+        rots[i] = rotation;
         match body.parent {
             Some(p) => {
-                let vi = xup.apply_motion(data.v[p]) + vj;
-                data.v[i] = vi;
-                data.c[i] = cj + vi.cross_motion(vj);
-                let rp = data.rot[p];
-                data.rot[i] = match rotation {
+                let vi = xup.apply_motion(vs[p]) + vj;
+                vs[i] = vi;
+                cs[i] = cj + vi.cross_motion(vj);
+                let rp = world_rot[p];
+                world_rot[i] = match rotation {
                     JointRotation::General => rp * xup.rot.transpose(),
                     JointRotation::One(r) => r.mul_right(&rp),
                     JointRotation::Two(r1, r2) => r2.mul_right(&r1.mul_right(&rp)),
                 };
-                data.pos[i] = data.pos[p] + rp * xup.trans;
+                world_pos[i] = world_pos[p] + rp * xup.trans;
             }
             None => {
-                data.v[i] = vj;
-                data.c[i] = cj + vj.cross_motion(vj);
-                data.rot[i] = xup.rot.transpose();
-                data.pos[i] = xup.trans;
+                vs[i] = vj;
+                cs[i] = cj + vj.cross_motion(vj);
+                world_rot[i] = xup.rot.transpose();
+                world_pos[i] = xup.trans;
             }
         }
     }

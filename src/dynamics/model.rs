@@ -209,6 +209,7 @@ impl Model {
     }
 
     /// `out = q ⊞ z` joint by joint (see [`JointType::retract`]); `z` has size nv.
+    #[inline(always)]
     pub fn retract(&self, q: &[f64], z: &[f64], out: &mut [f64]) {
         for (i, b) in self.bodies.iter().enumerate() {
             let (iq, iv) = (self.q_idx[i], self.v_idx[i]);
@@ -228,6 +229,7 @@ impl Model {
 
     /// The chart rate `ż` at `q_stage = q₀ ⊞ z` under velocity `v` (see
     /// [`JointType::chart_rate`]); all vectors but `q_stage` have size nv.
+    #[inline(always)]
     pub fn chart_rate(&self, q_stage: &[f64], z: &[f64], v: &[f64], zdot: &mut [f64]) {
         for (i, b) in self.bodies.iter().enumerate() {
             let (iq, iv) = (self.q_idx[i], self.v_idx[i]);
@@ -250,6 +252,7 @@ impl Model {
     }
 
     /// The anatomical angle of every velocity DOF (rad; zeros for a free joint), size nv.
+    #[inline(always)]
     pub fn angles(&self, q: &[f64], out: &mut [f64]) {
         for (i, b) in self.bodies.iter().enumerate() {
             let (iq, iv) = (self.q_idx[i], self.v_idx[i]);
@@ -260,6 +263,7 @@ impl Model {
 
     /// The angles as [`Model::angles`], every ball joint read nearest `reference` (size nv; see
     /// [`JointType::angles_near`]).
+    #[inline(always)]
     pub fn angles_near(&self, q: &[f64], reference: &[f64], out: &mut [f64]) {
         for (i, b) in self.bodies.iter().enumerate() {
             let (iq, iv) = (self.q_idx[i], self.v_idx[i]);

@@ -412,7 +412,7 @@ impl ArticulatedInertia {
     }
 
     /// `I − U D⁻¹ Uᵀ` for `n ≤ 3` force columns `U` and the inverse `D⁻¹` (n×n block of `dinv`).
-    #[inline]
+    #[inline(always)]
     pub fn sub_u_dinv_ut(&mut self, u: &[ForceVec], dinv: &DMat3) {
         fn go<const N: usize>(ia: &mut ArticulatedInertia, u: &[ForceVec], dinv: &DMat3) {
             let u: [ForceVec; N] = std::array::from_fn(|k| u[k]);
@@ -478,7 +478,7 @@ impl ArticulatedInertia {
 
     /// Solves `I a = f` for a symmetric positive definite `I` by the Schur complement of `L`:
     /// `(M − H L⁻¹ Hᵀ) ω = n − H L⁻¹ f_lin`, `v = L⁻¹(f_lin − Hᵀ ω)`.
-    #[inline]
+    #[inline(always)]
     pub fn solve(&self, f: ForceVec) -> MotionVec {
         let linv = self.l.inverse();
         let hl = self.h * linv;

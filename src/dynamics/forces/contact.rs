@@ -211,7 +211,7 @@ impl ContactModel {
     /// Normal and tangential force on one corner at world point `x` and signed height `z` (its
     /// `n·x − h`) with velocity `xd`. Returns `(f_n, f_t, z)` or `None` when the corner is above
     /// the floor.
-    #[inline]
+    #[inline(always)]
     fn corner_force(
         &self,
         link: usize,
@@ -255,7 +255,7 @@ impl ContactModel {
     /// ic))` each pushing corner's normal damper is taken implicitly over a step `h`
     /// ([`ContactParams::implicit_damping`]): `ic` (body coordinates) gains `h c j jᵀ`,
     /// `j = [p × n; n]` the floor normal as a unit force at the corner `p`.
-    #[inline]
+    #[inline(always)]
     fn link_contact<const UPDATE: bool>(
         &self,
         data: &Data,
@@ -369,6 +369,7 @@ impl ContactModel {
     /// ([`ContactParams::implicit_damping`]): `added` is cleared, then holds per touching link
     /// its implicit inertia `Σ h c j jᵀ` (body coordinates) for
     /// [`aba_passes`](crate::dynamics::aba::aba_passes); `f_ext` gets the forces at the state.
+    #[inline(always)]
     pub fn update_and_apply_implicit(
         &self,
         data: &Data,
@@ -485,6 +486,7 @@ impl ContactStats {
     }
 
     /// Accounts for one step of `dt` seconds starting at time `t` (s) whose start saw `sample`.
+    #[inline(always)]
     pub fn accumulate(&mut self, sample: &ContactSample, t: f64, dt: f64) {
         for i in 0..sample.normal.len() {
             let f = sample.normal[i];

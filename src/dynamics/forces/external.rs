@@ -94,7 +94,7 @@ impl ExternalForce {
 }
 
 /// Adds every force of `forces` active at time `t` (s) to `f_ext` (body coordinates).
-#[inline]
+#[inline(always)]
 pub fn apply_external(data: &Data, forces: &[ExternalForce], t: f64, f_ext: &mut [ForceVec]) {
     for f in forces {
         if f.active(t) {
