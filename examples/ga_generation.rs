@@ -2,7 +2,8 @@
 //! population (seed 1), each fall in its own World on the current rayon pool; prints each fall's
 //! damage, steps, rest time, worst range excursion and penetration so a change can be checked
 //! for identical bits. Deterministic instruction counts:
-//! `RAYON_NUM_THREADS=1 valgrind --tool=callgrind target/release/examples/ga_generation 8`.
+//! `MARIONETTE_PORTABLE=1 RAYON_NUM_THREADS=1 valgrind --tool=callgrind target/release/examples/ga_generation 8`
+//! (the portable copy of the step: valgrind cannot decode some instructions of the AVX2 copy).
 //! Optional environment: `GROUP=adult`, `DT=<s>` (time step), `SEED=<k>` (the GA seed), and
 //! to find what makes the age groups' first generations differ, the other group's joint
 //! ranges (`RANGES=adult|elderly`: θ_d bounds and the simulated ranges) or strength
