@@ -14,6 +14,7 @@ pub mod bevy;
 pub mod bvh;
 pub mod choreo;
 pub mod clips;
+pub mod cpu;
 pub mod dynamics;
 pub mod ecs;
 #[cfg(feature = "editor")]

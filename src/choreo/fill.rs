@@ -536,7 +536,7 @@ const DP_COLUMNS: usize = 32;
 #[inline]
 fn min_plus(d: &[f64], c: &[f32]) -> f64 {
     #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") {
+    if crate::cpu::has_avx2() {
         // SAFETY: the processor supports AVX2 (checked just above).
         return unsafe { min_plus_avx2(d, c) };
     }
