@@ -4,7 +4,8 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::{DQuat, DVec3};
-use marionette::dynamics::{Data, ForceVec, aba};
+use marionette::dynamics::aba_lanes::{LaneData, LaneInput, aba_passes_lanes};
+use marionette::dynamics::{Data, ForceVec, aba, aba_passes, kinematics};
 use marionette::humanoid::body::fall21_body;
 use std::hint::black_box;
 
@@ -50,6 +51,36 @@ fn bench_aba(c: &mut Criterion) {
                 black_box(&f_ext),
             );
             black_box(qdd[6])
+        })
+    });
+    // Passes 2 and 3 only (kinematics done once beforehand), four bodies: one by one, and in
+    // the lanes of one vector call.
+    let mut datas: Vec<Data> = (0..4).map(|_| Data::new(model)).collect();
+    for d in &mut datas {
+        kinematics(model, d, &q, &v);
+    }
+    c.bench_function("aba_passes_fall21_x4_one_by_one", |b| {
+        b.iter(|| {
+            for d in &mut datas {
+                aba_passes(model, d, black_box(&tau), black_box(&f_ext), None, &[]);
+            }
+            black_box(datas[3].qdd[6])
+        })
+    });
+    let mut lanes = LaneData::new(model);
+    c.bench_function("aba_passes_fall21_x4_lanes", |b| {
+        b.iter(|| {
+            let mut bodies: Vec<LaneInput> = datas
+                .iter_mut()
+                .map(|data| LaneInput {
+                    data,
+                    tau: black_box(&tau[..]),
+                    f_ext: black_box(&f_ext[..]),
+                    armature: None,
+                })
+                .collect();
+            aba_passes_lanes(model, &mut lanes, &mut bodies);
+            black_box(datas[3].qdd[6])
         })
     });
 }

@@ -63,6 +63,12 @@ pub struct IntegratorWorkspace {
 }
 
 impl IntegratorWorkspace {
+    /// The buffer semi-implicit Euler takes its acceleration `q̈` from (size nv).
+    #[inline(always)]
+    pub fn acceleration_mut(&mut self) -> &mut [f64] {
+        &mut self.kv[0]
+    }
+
     /// Allocates buffers for `model`.
     pub fn new(model: &Model) -> Self {
         let nv = model.nv;
@@ -147,8 +153,21 @@ pub fn semi_implicit_euler_step<D: Dynamics>(
     h: f64,
     (q, v): (&mut [f64], &mut [f64]),
 ) -> Result<(), D::Error> {
-    let nv = model.nv;
     dynamics.acceleration(t, q, v, implicit, &mut ws.kv[0])?;
+    semi_implicit_euler_advance(model, ws, h, (q, v));
+    Ok(())
+}
+
+/// The update of [`semi_implicit_euler_step`] once its acceleration `q̈` is in
+/// [`IntegratorWorkspace::acceleration_mut`]: `v ← v + h q̈`, then `q ← q ⊞ h ż(q, v)`.
+#[inline(always)]
+pub fn semi_implicit_euler_advance(
+    model: &Model,
+    ws: &mut IntegratorWorkspace,
+    h: f64,
+    (q, v): (&mut [f64], &mut [f64]),
+) {
+    let nv = model.nv;
     for k in 0..nv {
         v[k] += h * ws.kv[0][k];
     }
@@ -159,5 +178,4 @@ pub fn semi_implicit_euler_step<D: Dynamics>(
     }
     ws.q_stage.copy_from_slice(q);
     model.retract(&ws.q_stage, &ws.z, q);
-    Ok(())
 }

@@ -14,6 +14,7 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod aba;
+pub mod aba_lanes;
 pub mod axis_rotation;
 pub mod crba;
 pub mod data;
@@ -22,6 +23,7 @@ pub mod forces;
 pub mod integrator;
 pub mod joint;
 pub mod kinematics;
+pub mod lanes;
 pub mod model;
 pub mod pipeline;
 pub mod rnea;

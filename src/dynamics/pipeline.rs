@@ -17,6 +17,7 @@
 //! A force whose parameters are absent (`None`, or no external forces) is simply not felt.
 
 use super::aba::aba_passes;
+use super::aba_lanes::{LaneData, LaneInput, lanes_inline};
 use super::data::Data;
 use super::forces::contact::{ContactModel, ContactSample, ContactState, ContactStats};
 use super::forces::external::{ExternalForce, apply_external};
@@ -548,74 +549,233 @@ impl Dynamics for Evaluation<'_> {
         implicit_dt: Option<f64>,
         qdd: &mut [f64],
     ) -> Result<(), StepError> {
-        let model = self.model;
-        let forces = self.forces;
-        let ws = &mut *self.ws;
-        let at_start = ws.step_start_ready;
-        // The implicit contact damping belongs to the step-start evaluation only.
-        if !at_start {
-            ws.implicit.clear();
-        }
-        let (start_angles, start_pd) = (
-            at_start && ws.step_start_angles,
-            at_start && ws.step_start_pd,
+        let arm = prepare(
+            self.model,
+            self.forces,
+            self.anchors,
+            self.ws,
+            t,
+            q,
+            v,
+            implicit_dt,
         );
-        ws.step_start_angles = false;
-        ws.step_start_pd = false;
-        if at_start {
-            // First evaluation of the step: the contact stage computed kinematics and contact
-            // forces at exactly this state (and the limits stage its angles and PD torques).
-            ws.step_start_ready = false;
-        } else {
-            kinematics(model, &mut ws.data, q, v);
-            ws.f_ext.fill(ForceVec::ZERO);
-            if let Some(cm) = forces.contact {
-                cm.apply(&ws.data, self.anchors, &mut ws.f_ext, &mut ws.normal);
-            }
+        let ws = &mut *self.ws;
+        let arm = arm.then_some(&ws.armature[..]);
+        aba_passes(
+            self.model,
+            &mut ws.data,
+            &ws.tau,
+            &ws.f_ext,
+            arm,
+            &ws.implicit,
+        );
+        finish(self.model, ws, t, qdd)
+    }
+}
+
+/// The force evaluation before the ABA: kinematics and contact forces (unless the step-start
+/// stages left them), external forces, angles, PD and joint-model torques and, with
+/// `implicit_dt = Some(h)`, the armature `h·d`; returns whether the armature applies.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn prepare(
+    model: &Model,
+    forces: &Forces,
+    anchors: &ContactState,
+    ws: &mut EvalScratch,
+    t: f64,
+    q: &[f64],
+    v: &[f64],
+    implicit_dt: Option<f64>,
+) -> bool {
+    let at_start = ws.step_start_ready;
+    // The implicit contact damping belongs to the step-start evaluation only.
+    if !at_start {
+        ws.implicit.clear();
+    }
+    let (start_angles, start_pd) = (
+        at_start && ws.step_start_angles,
+        at_start && ws.step_start_pd,
+    );
+    ws.step_start_angles = false;
+    ws.step_start_pd = false;
+    if at_start {
+        // First evaluation of the step: the contact stage computed kinematics and contact
+        // forces at exactly this state (and the limits stage its angles and PD torques).
+        ws.step_start_ready = false;
+    } else {
+        kinematics(model, &mut ws.data, q, v);
+        ws.f_ext.fill(ForceVec::ZERO);
+        if let Some(cm) = forces.contact {
+            cm.apply(&ws.data, anchors, &mut ws.f_ext, &mut ws.normal);
         }
-        apply_external(&ws.data, forces.external, t, &mut ws.f_ext);
-        if (forces.pd.is_some() || forces.limits.is_some()) && !start_angles {
-            read_angles(model, forces, q, &mut ws.reference, &mut ws.angles);
+    }
+    apply_external(&ws.data, forces.external, t, &mut ws.f_ext);
+    if (forces.pd.is_some() || forces.limits.is_some()) && !start_angles {
+        read_angles(model, forces, q, &mut ws.reference, &mut ws.angles);
+    }
+    for (d, &k) in forces.dofs.iter().enumerate() {
+        let (th, thd) = (ws.angles[k], v[k]);
+        let (mut tau, mut damp) = (0.0, 0.0);
+        if start_pd {
+            (tau, damp) = ws.pd_start[d];
+        } else if let Some(pd) = forces.pd {
+            (tau, damp) = pd.torque(d, th, thd);
         }
-        for (d, &k) in forces.dofs.iter().enumerate() {
-            let (th, thd) = (ws.angles[k], v[k]);
-            let (mut tau, mut damp) = (0.0, 0.0);
-            if start_pd {
-                (tau, damp) = ws.pd_start[d];
-            } else if let Some(pd) = forces.pd {
-                (tau, damp) = pd.torque(d, th, thd);
-            }
-            if let Some(l) = forces.limits {
-                let (t2, d2) = l.torque(d, th, thd);
-                tau += t2;
-                damp += d2;
-            }
-            ws.tau[k] = tau;
-            ws.damping[k] = damp;
+        if let Some(l) = forces.limits {
+            let (t2, d2) = l.torque(d, th, thd);
+            tau += t2;
+            damp += d2;
         }
-        let arm = match implicit_dt {
-            Some(h) => {
-                for k in 0..ws.armature.len() {
-                    ws.armature[k] = h * ws.damping[k];
-                }
-                Some(&ws.armature[..])
+        ws.tau[k] = tau;
+        ws.damping[k] = damp;
+    }
+    match implicit_dt {
+        Some(h) => {
+            for k in 0..ws.armature.len() {
+                ws.armature[k] = h * ws.damping[k];
             }
-            None => None,
-        };
-        aba_passes(model, &mut ws.data, &ws.tau, &ws.f_ext, arm, &ws.implicit);
-        qdd.copy_from_slice(&ws.data.qdd);
-        if let Some(k) = qdd.iter().position(|x| !x.is_finite()) {
-            let b = (0..model.nbodies())
-                .rev()
-                .find(|&b| model.v_idx[b] <= k)
-                .unwrap_or(0);
-            return Err(StepError::NonFinite {
-                time_s: t,
-                body: model.bodies[b].name.clone(),
-                quantity: "joint acceleration".into(),
-            });
+            true
         }
-        Ok(())
+        None => false,
+    }
+}
+
+/// The force evaluation after the ABA: `q̈` from the data into `qdd`, a non-finite one an
+/// error with the time and body.
+#[inline(always)]
+fn finish(model: &Model, ws: &EvalScratch, t: f64, qdd: &mut [f64]) -> Result<(), StepError> {
+    qdd.copy_from_slice(&ws.data.qdd);
+    if let Some(k) = qdd.iter().position(|x| !x.is_finite()) {
+        let b = (0..model.nbodies())
+            .rev()
+            .find(|&b| model.v_idx[b] <= k)
+            .unwrap_or(0);
+        return Err(StepError::NonFinite {
+            time_s: t,
+            body: model.bodies[b].name.clone(),
+            quantity: "joint acceleration".into(),
+        });
+    }
+    Ok(())
+}
+
+/// One body of [`step_lanes`]: the forces it feels, its state, buffers and monitor, and the
+/// result of its latest step.
+#[derive(Debug)]
+pub struct LaneBody<'a> {
+    /// The forces.
+    pub forces: Forces<'a>,
+    /// The state.
+    pub state: &'a mut State,
+    /// The buffers.
+    pub ws: &'a mut StepWorkspace,
+    /// The monitor.
+    pub monitor: &'a mut StepMonitor,
+    /// The outcome of the latest step of this body.
+    pub result: Result<(), StepError>,
+}
+
+/// One step of `settings.dt` seconds for each body of `bodies` (all of `model`): the same
+/// stages as [`step`], every body's state, monitor and result the bits [`step`] gives it
+/// alone, with the articulated-body algorithm of [`LANES`] bodies at a time in the lanes of
+/// one vector computation ([`crate::dynamics::aba_lanes`]). That holds for semi-implicit
+/// Euler with the floor's damping explicit; any other scheme steps each body by [`step`].
+/// A body whose step fails keeps its error in `result` and the others go on.
+pub fn step_lanes(
+    model: &Model,
+    settings: StepSettings,
+    bodies: &mut [LaneBody],
+    lanes: &mut LaneData,
+) {
+    #[cfg(target_arch = "x86_64")]
+    if crate::cpu::has_avx2() {
+        // SAFETY: the processor supports AVX2 (detected at run time just above).
+        return unsafe { step_lanes_avx2(model, settings, bodies, lanes) };
+    }
+    step_lanes_stages(model, settings, bodies, lanes)
+}
+
+/// [`step_lanes_stages`] compiled for AVX2.
+///
+/// # Safety
+/// The processor must support AVX2 ([`crate::cpu::has_avx2`]).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn step_lanes_avx2(
+    model: &Model,
+    settings: StepSettings,
+    bodies: &mut [LaneBody],
+    lanes: &mut LaneData,
+) {
+    step_lanes_stages(model, settings, bodies, lanes)
+}
+
+/// The stages of [`step_lanes`].
+#[inline(always)]
+fn step_lanes_stages(
+    model: &Model,
+    settings: StepSettings,
+    bodies: &mut [LaneBody],
+    lanes: &mut LaneData,
+) {
+    let implicit_damping = match settings.integrator {
+        Integrator::SemiImplicitEuler { implicit_damping } => implicit_damping,
+        Integrator::Rk4 => true,
+    };
+    let explicit_contact = bodies
+        .iter()
+        .all(|b| b.forces.contact.is_none_or(|c| !c.params.implicit_damping));
+    if matches!(settings.integrator, Integrator::Rk4) || !explicit_contact || bodies.len() < 2 {
+        for b in bodies.iter_mut() {
+            b.result = step_stages(model, settings, &b.forces, b.state, b.ws, b.monitor);
+        }
+        return;
+    }
+    let h = settings.dt;
+    let implicit_dt = implicit_damping.then_some(h);
+    for b in bodies.iter_mut() {
+        let (forces, state, ws, monitor) = (&b.forces, &mut *b.state, &mut *b.ws, &mut *b.monitor);
+        position_stage(model, state, ws);
+        limits_stage(model, forces, state, ws, monitor, h);
+        contact_stage(forces, settings, state, ws, monitor);
+        // The integrate stage: its one evaluation's forces here, its ABA in the lanes below.
+        ws.eval.kinematics_at_step = None;
+        let (t, q, v) = (state.time_s, &state.q, &state.v);
+        prepare(
+            model,
+            forces,
+            &state.anchors,
+            &mut ws.eval,
+            t,
+            q,
+            v,
+            implicit_dt,
+        );
+    }
+    lanes_inline(
+        model,
+        lanes,
+        bodies.iter_mut().map(|b| {
+            let e = &mut b.ws.eval;
+            LaneInput {
+                data: &mut e.data,
+                tau: &e.tau,
+                f_ext: &e.f_ext,
+                armature: implicit_damping.then_some(&e.armature[..]),
+            }
+        }),
+    );
+    for b in bodies.iter_mut() {
+        let (state, ws) = (&mut *b.state, &mut *b.ws);
+        let StepWorkspace { eval, iws } = ws;
+        b.result = finish(model, eval, state.time_s, iws.acceleration_mut());
+        if b.result.is_ok() {
+            integrator::semi_implicit_euler_advance(model, iws, h, (&mut state.q, &mut state.v));
+            state.steps += 1;
+            state.time_s = state.steps as f64 * h;
+            b.result = check_stage(model, state, ws);
+        }
     }
 }
 
@@ -850,5 +1010,89 @@ mod tests {
             touched > 0,
             "no link but the feet touched the floor in 1.2 s"
         );
+    }
+
+    #[test]
+    fn bodies_stepped_in_lanes_have_the_bits_of_bodies_stepped_alone() {
+        // Five pushed fall21 figures with different PD targets and gains (a group of four
+        // lanes and one body with three empty lanes), stepped by `step_lanes` and each alone by
+        // `step`: the same states at every step and the same monitors; with joint damping
+        // taken implicitly (the fall's scheme) and explicitly.
+        use crate::experiments::fall::{FallConfig, build_fall};
+        let ch = build_fall(&FallConfig::paper(
+            crate::humanoid::ranges::AgeGroup::Elderly,
+        ))
+        .expect("the paper's fall builds");
+        let body = &ch.physics.body.body;
+        let model = &body.model;
+        let nd = body.dof_v.len();
+        let pds: Vec<PdTargets> = (0..5)
+            .map(|b| {
+                let mut pd = ch.pd.0.clone();
+                for d in 0..nd {
+                    let x = (b * nd + d) as f64;
+                    pd.target[d] += 0.3 * (0.7 * x).sin();
+                    pd.kp[d] *= 0.5 + 0.25 * b as f64;
+                }
+                pd
+            })
+            .collect();
+        let forces_of = |pd| Forces {
+            dofs: &body.dof_v,
+            pd: Some(pd),
+            limits: Some(&ch.limits.0),
+            contact: Some(&*ch.contact.0),
+            external: &ch.external.0,
+        };
+        for implicit_damping in [true, false] {
+            let settings = StepSettings {
+                integrator: Integrator::SemiImplicitEuler { implicit_damping },
+                dt: 5e-4,
+            };
+            let fresh = || {
+                (0..5)
+                    .map(|_| {
+                        (
+                            ch.physics.state.0.clone(),
+                            StepWorkspace::new(model),
+                            StepMonitor::new(body.link_names.len(), nd),
+                        )
+                    })
+                    .collect::<Vec<_>>()
+            };
+            let (mut alone, mut laned) = (fresh(), fresh());
+            let mut lanes = LaneData::new(model);
+            for n in 0..2400 {
+                for (b, (state, ws, monitor)) in alone.iter_mut().enumerate() {
+                    step(model, settings, &forces_of(&pds[b]), state, ws, monitor).unwrap();
+                }
+                let mut bodies: Vec<LaneBody> = laned
+                    .iter_mut()
+                    .zip(&pds)
+                    .map(|((state, ws, monitor), pd)| LaneBody {
+                        forces: forces_of(pd),
+                        state,
+                        ws,
+                        monitor,
+                        result: Ok(()),
+                    })
+                    .collect();
+                step_lanes(model, settings, &mut bodies, &mut lanes);
+                assert!(bodies.iter().all(|b| b.result.is_ok()), "step {n}");
+                drop(bodies);
+                let bits = |s: &State| -> Vec<u64> {
+                    s.q.iter().chain(&s.v).map(|x| x.to_bits()).collect()
+                };
+                for b in 0..5 {
+                    assert_eq!(bits(&alone[b].0), bits(&laned[b].0), "body {b}, step {n}");
+                }
+            }
+            for b in 0..5 {
+                assert_eq!(alone[b].0, laned[b].0);
+                assert_eq!(alone[b].2, laned[b].2, "monitor of body {b}");
+            }
+            // The bodies fell differently.
+            assert_ne!(alone[0].0.q, alone[4].0.q);
+        }
     }
 }

@@ -19,13 +19,14 @@ use super::character::RootAssist;
 use super::clock::Clock;
 use super::motion::{Character, JointState, Recorder, SkeletonRef};
 use super::sets::{MotionSet, configure_motion_sets};
+use crate::dynamics::aba_lanes::LaneData;
 use crate::dynamics::forces::contact::ContactModel;
 use crate::dynamics::forces::external::ExternalForce;
 use crate::dynamics::forces::limits::JointRanges;
 use crate::dynamics::forces::pd::PdTargets;
 use crate::dynamics::integrator::Integrator;
 use crate::dynamics::pipeline::{
-    self, Forces, State, StepError, StepMonitor, StepSettings, StepWorkspace,
+    self, Forces, LaneBody, State, StepError, StepMonitor, StepSettings, StepWorkspace,
 };
 use crate::humanoid::body::HumanBody;
 
@@ -167,21 +168,44 @@ type StepQuery<'a> = (
 /// Steps every running body by the clock's substeps of `tick / substeps` seconds; an error
 /// stops that body (recorded in its [`PhysicsStatus`]) and no other.
 ///
-/// A character's [`RootAssist`] joins its external forces for the tick.
+/// A character's [`RootAssist`] joins its external forces for the tick. Bodies of one model
+/// integrated by semi-implicit Euler step together through [`pipeline::step_lanes`] (their
+/// articulated-body algorithm [`LANES`](crate::dynamics::lanes::LANES) at a time in vector
+/// lanes), each to the bits it has
+/// stepped alone.
 pub fn step_bodies(
     clock: Res<Clock>,
     mut scratch: Local<Vec<ExternalForce>>,
+    mut lanes: Local<Vec<(Arc<HumanBody>, LaneData)>>,
     mut q: Query<StepQuery>,
 ) {
     let dt = clock.physics_dt();
-    for (body, mut state, pd, limits, contact, external, mut ws, mut monitor, mut status, assist) in
-        &mut q
-    {
+    let mut together = Vec::new();
+    for item in &mut q {
+        let (
+            body,
+            mut state,
+            pd,
+            limits,
+            contact,
+            external,
+            mut ws,
+            mut monitor,
+            mut status,
+            assist,
+        ) = item;
         if !status.running() {
             continue;
         }
+        let assisted = assist.and_then(RootAssist::external);
+        if assisted.is_none() && matches!(body.integrator, Integrator::SemiImplicitEuler { .. }) {
+            together.push((
+                body, state, pd, limits, contact, external, ws, monitor, status,
+            ));
+            continue;
+        }
         let mut external = external.map_or(&[][..], |e| &e.0[..]);
-        if let Some(f) = assist.and_then(RootAssist::external) {
+        if let Some(f) = assisted {
             scratch.clear();
             scratch.extend_from_slice(external);
             scratch.push(f);
@@ -209,6 +233,57 @@ pub fn step_bodies(
             ) {
                 status.error = Some(Arc::new(e));
                 break;
+            }
+        }
+    }
+    // The bodies of one model and scheme, in query order.
+    while let Some(first) = together.first() {
+        let (human, integrator) = (first.0.body.clone(), first.0.integrator);
+        let (mut group, rest): (Vec<_>, Vec<_>) = together
+            .into_iter()
+            .partition(|b| Arc::ptr_eq(&b.0.body, &human) && b.0.integrator == integrator);
+        together = rest;
+        let model = &human.model;
+        let k = match lanes.iter().position(|(h, _)| Arc::ptr_eq(h, &human)) {
+            Some(k) => k,
+            None => {
+                lanes.push((human.clone(), LaneData::new(model)));
+                lanes.len() - 1
+            }
+        };
+        let lane_data = &mut lanes[k].1;
+        let settings = StepSettings { integrator, dt };
+        for _ in 0..clock.substeps {
+            let mut bodies: Vec<LaneBody> = group
+                .iter_mut()
+                .filter(|b| b.8.running())
+                .map(
+                    |(body, state, pd, limits, contact, external, ws, monitor, _)| LaneBody {
+                        forces: Forces {
+                            dofs: &body.body.dof_v,
+                            pd: pd.map(|p| &p.0),
+                            limits: limits.map(|l| &l.0),
+                            contact: contact.map(|c| &*c.0),
+                            external: external.map_or(&[][..], |e| &e.0[..]),
+                        },
+                        state: &mut state.0,
+                        ws: &mut ws.0,
+                        monitor: &mut monitor.0,
+                        result: Ok(()),
+                    },
+                )
+                .collect();
+            if bodies.is_empty() {
+                break;
+            }
+            pipeline::step_lanes(model, settings, &mut bodies, lane_data);
+            let errors: Vec<Option<StepError>> =
+                bodies.into_iter().map(|b| b.result.err()).collect();
+            let mut errors = errors.into_iter();
+            for b in group.iter_mut().filter(|b| b.8.running()) {
+                if let Some(Some(e)) = errors.next() {
+                    b.8.error = Some(Arc::new(e));
+                }
             }
         }
     }

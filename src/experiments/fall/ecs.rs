@@ -10,6 +10,7 @@ use std::sync::Arc;
 use bevy_ecs::prelude::*;
 
 use super::{FallCharacter, FallConfig, FallController, FallRecorder, FallResult, SimError};
+use crate::dynamics::lanes::LANES;
 use crate::ecs::physics::{
     BodyState, ExternalForces, FloorContact, JointLimits, PdController, PhysicsBody,
     PhysicsMonitor, PhysicsStatus, PhysicsWorkspace, add_physics_systems,
@@ -253,13 +254,18 @@ pub fn fall_results(world: &mut World) -> Vec<Result<FallResult, Arc<SimError>>>
     out.into_iter().map(|(_, r)| r).collect()
 }
 
-/// Why a World of a pool holds no fall.
+/// The falls a World of a pool holds, in input order: each one's input index and its entity,
+/// or why it was not built.
 #[derive(Resource)]
-struct NotBuilt(Arc<SimError>);
+struct Pack(Vec<(usize, Result<Entity, Arc<SimError>>)>);
 
-/// Simulates each configuration in its own World of a [`WorldPool`], in parallel on the
-/// current rayon pool; the results are in input order and do not depend on the number of
-/// threads.
+/// Simulates the configurations in the Worlds of a [`WorldPool`], in parallel on the current
+/// rayon pool; the results are in input order and do not depend on the number of threads.
+///
+/// Falls that share their time step (and their start, see [`run_parallel_reacting`]) share a
+/// World, up to [`LANES`] of them, so that the engine's step takes their articulated-body
+/// algorithm in vector lanes ([`crate::ecs::physics::step_bodies`]); each fall has the bits it
+/// has alone in its World.
 pub fn run_parallel(configs: &[FallConfig]) -> Vec<Result<FallResult, Arc<SimError>>> {
     run_parallel_from(configs, None)
 }
@@ -273,6 +279,37 @@ pub fn run_parallel_from(
     run_parallel_reacting(configs, start, None)
 }
 
+/// The packs of falls that share a World: input indices, at most [`LANES`] per pack, falls of
+/// one pack sharing their time step and whether they continue from the reaction start; the
+/// packs of a kind as many as their falls need, rounded up to a multiple of the threads, and
+/// the falls spread evenly over them.
+fn packs(configs: &[FallConfig], reacts: impl Fn(usize) -> bool) -> Vec<Vec<usize>> {
+    let mut kinds: Vec<((u64, bool), Vec<usize>)> = Vec::new();
+    for (k, c) in configs.iter().enumerate() {
+        let key = (c.dt_s.to_bits(), reacts(k));
+        match kinds.iter_mut().find(|(kk, _)| *kk == key) {
+            Some((_, v)) => v.push(k),
+            None => kinds.push((key, vec![k])),
+        }
+    }
+    let threads = rayon::current_num_threads().max(1);
+    let mut out = Vec::new();
+    for (_, members) in kinds {
+        let needed = members.len().div_ceil(LANES);
+        let count = needed
+            .div_ceil(threads)
+            .saturating_mul(threads)
+            .min(members.len());
+        let (base, extra) = (members.len() / count, members.len() % count);
+        let mut it = members.into_iter();
+        for p in 0..count {
+            let size = base + usize::from(p < extra);
+            out.push(it.by_ref().take(size).collect());
+        }
+    }
+    out
+}
+
 /// [`run_parallel_from`] with every fall that fits `reaction` continued from it (see
 /// [`ReactionStart`]): the same results, without each fall's stretch before its reaction.
 pub fn run_parallel_reacting(
@@ -280,32 +317,64 @@ pub fn run_parallel_reacting(
     start: Option<&super::SettledStart>,
     reaction: Option<&ReactionStart>,
 ) -> Vec<Result<FallResult, Arc<SimError>>> {
-    let pool = WorldPool::new(configs.len(), 0, |k, world| {
-        world.insert_resource(Clock::physics(configs[k].dt_s));
-        let built = match reaction {
-            Some(r) if r.fits(&configs[k]) => r.spawn(world, &configs[k]),
-            _ => super::build_fall_from(&configs[k], start).and_then(|ch| spawn_fall(world, ch)),
-        };
-        if let Err(e) = built {
-            world.insert_resource(NotBuilt(Arc::new(e)));
+    let fits = |k: usize| reaction.is_some_and(|r| r.fits(&configs[k]));
+    let packs = packs(configs, fits);
+    let pool = WorldPool::new(packs.len(), 0, |w, world| {
+        let mut pack = Vec::with_capacity(packs[w].len());
+        for &k in &packs[w] {
+            world.insert_resource(Clock::physics(configs[k].dt_s));
+            let built = match reaction {
+                Some(r) if fits(k) => r.spawn(world, &configs[k]),
+                _ => {
+                    super::build_fall_from(&configs[k], start).and_then(|ch| spawn_fall(world, ch))
+                }
+            };
+            pack.push((k, built.map_err(Arc::new)));
         }
+        world.insert_resource(Pack(pack));
         Ok::<(), std::convert::Infallible>(())
     });
     let mut pool = match pool {
         Ok(p) => p,
         Err(never) => match never {},
     };
-    pool.run(|w| {
-        if let Some(e) = w.get_resource::<NotBuilt>() {
-            return Err(e.0.clone());
-        }
-        run_fall_world(w).pop().unwrap_or_else(|| {
-            Err(Arc::new(SimError::Config {
-                field: "world".into(),
-                message: "no character".into(),
-            }))
+    let ran = pool.run(|w| {
+        let results = run_fall_world(w);
+        let Some(pack) = w.remove_resource::<Pack>() else {
+            return Vec::new();
+        };
+        // `run_fall_world` answers the built falls in spawn order.
+        let mut results = results.into_iter();
+        pack.0
+            .into_iter()
+            .map(|(k, built)| {
+                let r = match built {
+                    Ok(_) => results.next().unwrap_or_else(|| {
+                        Err(Arc::new(SimError::Config {
+                            field: "world".into(),
+                            message: "a fall's character went missing".into(),
+                        }))
+                    }),
+                    Err(e) => Err(e),
+                };
+                (k, r)
+            })
+            .collect::<Vec<_>>()
+    });
+    let mut out: Vec<Option<Result<FallResult, Arc<SimError>>>> = vec![None; configs.len()];
+    for (k, r) in ran.into_iter().flatten() {
+        out[k] = Some(r);
+    }
+    out.into_iter()
+        .map(|r| {
+            r.unwrap_or_else(|| {
+                Err(Arc::new(SimError::Config {
+                    field: "world".into(),
+                    message: "a fall was not run".into(),
+                }))
+            })
         })
-    })
+        .collect()
 }
 
 #[cfg(test)]
