@@ -1,5 +1,6 @@
 //! One GA evaluation for profiling: the first `N` genomes (default 8) of an age group's initial
-//! population (seed 1), each fall in its own World on the current rayon pool; prints each fall's
+//! population (seed 1), in the parallel Worlds of the fall pool (up to four falls at a time in each)
+//! on the current rayon pool; prints each fall's
 //! damage, steps, rest time, worst range excursion and penetration so a change can be checked
 //! for identical bits. Deterministic instruction counts:
 //! `MARIONETTE_PORTABLE=1 RAYON_NUM_THREADS=1 valgrind --tool=callgrind target/release/examples/ga_generation 8`

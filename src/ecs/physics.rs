@@ -239,10 +239,16 @@ pub fn step_bodies(
     // The bodies of one model and scheme, in query order.
     while let Some(first) = together.first() {
         let (human, integrator) = (first.0.body.clone(), first.0.integrator);
-        let (mut group, rest): (Vec<_>, Vec<_>) = together
-            .into_iter()
-            .partition(|b| Arc::ptr_eq(&b.0.body, &human) && b.0.integrator == integrator);
-        together = rest;
+        let same = |b: &(&PhysicsBody, _, _, _, _, _, _, _, _)| {
+            Arc::ptr_eq(&b.0.body, &human) && b.0.integrator == integrator
+        };
+        let mut group = if together.iter().all(&same) {
+            std::mem::take(&mut together)
+        } else {
+            let (group, rest): (Vec<_>, Vec<_>) = together.into_iter().partition(|b| same(b));
+            together = rest;
+            group
+        };
         let model = &human.model;
         let k = match lanes.iter().position(|(h, _)| Arc::ptr_eq(h, &human)) {
             Some(k) => k,
@@ -277,6 +283,9 @@ pub fn step_bodies(
                 break;
             }
             pipeline::step_lanes(model, settings, &mut bodies, lane_data);
+            if bodies.iter().all(|b| b.result.is_ok()) {
+                continue;
+            }
             let errors: Vec<Option<StepError>> =
                 bodies.into_iter().map(|b| b.result.err()).collect();
             let mut errors = errors.into_iter();

@@ -70,7 +70,7 @@ pub trait Evaluator {
 
 /// Evaluates in this process, in parallel on the current rayon pool.
 pub struct InProcess<F: Fn(&[Genome], u32) -> Vec<Evaluation>> {
-    /// Evaluates a batch at a refinement (for falls: one World per genome, in parallel, at the
+    /// Evaluates a batch at a refinement (for falls: in parallel Worlds, each fall to the bits it has alone, at the
     /// time step divided by the refinement).
     pub batch: F,
 }

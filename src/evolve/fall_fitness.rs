@@ -235,7 +235,8 @@ impl FallProblem {
         c
     }
 
-    /// The damage of every genome, each fall in its own World, in parallel, at the problem's
+    /// The damage of every genome, the falls in parallel Worlds (up to four at a time in each,
+    /// [`run_parallel_reacting`]), at the problem's
     /// time step divided by `refine` (1: the problem's own step); the standing body is settled
     /// once per step for the whole run (the genes do not change how it stands; the same bits as
     /// settling each fall).

@@ -29,7 +29,8 @@ use crate::render::{Plot, Series, plot};
 /// Who evaluates the generations.
 #[derive(Clone, Debug, PartialEq, Default, Serialize, Deserialize)]
 pub enum EvaluatorChoice {
-    /// In this process, one World per fall, in parallel with rayon.
+    /// In this process, in parallel with rayon (a World per thread, up to four falls at a time
+    /// in it).
     #[default]
     InProcess,
     /// A JSON-lines worker started with this command line, e.g.

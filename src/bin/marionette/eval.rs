@@ -1,7 +1,7 @@
 //! `marionette eval --stdin`: a fitness worker speaking the JSON-lines protocol of
 //! `marionette::evolve::evaluator` on standard input and output (a header with the problem,
 //! then batches of genomes; one result line per genome keyed by index). Each batch is evaluated
-//! in parallel on all cores, each fall in its own World.
+//! in parallel on all cores (a World per core, up to four falls at a time in each).
 
 use std::io::{BufReader, BufWriter};
 

@@ -1,11 +1,15 @@
 //! The pushed fall in a World: a falling character is the physics components of
 //! [`crate::ecs::physics`] (stepped by the engine's physics systems) plus the paper's
 //! [`FallController`] (in [`MotionSet::Control`]) and a [`FallRecorder`] (in
-//! [`MotionSet::Record`]), which stops the body once its run is over. One World per fall runs
-//! with the World's [`Clock`] ticking one physics step; many run in parallel in a
-//! [`WorldPool`], to the same bits on any number of threads.
+//! [`MotionSet::Record`]), which stops the body once its run is over. A World runs its falls
+//! with its [`Clock`] ticking one physics step. Many falls run in parallel in a [`WorldPool`]
+//! of one World per thread, each holding up to [`LANES`] falls at a time (their
+//! articulated-body algorithms then share vector lanes, [`crate::ecs::physics::step_bodies`])
+//! and taking the next fall of the batch as one finishes; every fall has the bits it has alone
+//! in its own World, on any number of threads.
 
 use std::sync::Arc;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 use bevy_ecs::prelude::*;
 
@@ -185,11 +189,23 @@ impl ReactionStart {
     /// World's clock: its reaction validated and stability-checked as [`super::build_fall`]
     /// does, the rest copied.
     pub fn spawn(&self, world: &mut World, cfg: &FallConfig) -> Result<Entity, SimError> {
+        world.insert_resource(self.clock);
+        self.spawn_keeping_clock(world, cfg)
+    }
+
+    /// [`Self::spawn`] into a World whose clock already steps physics by the fall's step
+    /// (e.g. one running other falls), leaving the clock as it is: a body's time is its own
+    /// state's.
+    pub fn spawn_keeping_clock(
+        &self,
+        world: &mut World,
+        cfg: &FallConfig,
+    ) -> Result<Entity, SimError> {
         super::validate_reaction(cfg, self.standing.physics.body.body.dof_v.len())?;
         super::check_stability(cfg, &self.standing)?;
         let mut ch = self.reacting.clone();
         ch.controller.key = super::key_targets(cfg);
-        world.insert_resource(self.clock);
+        check_clock(world, &ch)?;
         Ok(spawn_components(world, ch))
     }
 }
@@ -243,29 +259,62 @@ pub fn fall_results(world: &mut World) -> Vec<Result<FallResult, Arc<SimError>>>
     let mut out: Vec<(Entity, Result<FallResult, Arc<SimError>>)> = q
         .iter(world)
         .map(|(e, body, state, monitor, recorder, status)| {
-            let r = match &status.error {
-                Some(err) => Err(Arc::new(SimError::Step((**err).clone()))),
-                None => Ok(recorder.result(&body.body, state, monitor)),
-            };
-            (e, r)
+            (e, result_of(body, state, monitor, recorder, status))
         })
         .collect();
     out.sort_by_key(|(e, _)| e.index());
     out.into_iter().map(|(_, r)| r).collect()
 }
 
-/// The falls a World of a pool holds, in input order: each one's input index and its entity,
-/// or why it was not built.
-#[derive(Resource)]
-struct Pack(Vec<(usize, Result<Entity, Arc<SimError>>)>);
+/// The result of one falling body from its components.
+fn result_of(
+    body: &PhysicsBody,
+    state: &BodyState,
+    monitor: &PhysicsMonitor,
+    recorder: &FallRecorder,
+    status: &PhysicsStatus,
+) -> Result<FallResult, Arc<SimError>> {
+    match &status.error {
+        Some(err) => Err(Arc::new(SimError::Step((**err).clone()))),
+        None => Ok(recorder.result(&body.body, state, monitor)),
+    }
+}
+
+/// The result of the falling body `e` of `world` once it no longer runs (finished or failed),
+/// the body then despawned; `None` while it runs.
+fn take_finished(world: &mut World, e: Entity) -> Option<Result<FallResult, Arc<SimError>>> {
+    let r = {
+        let status = world.get::<PhysicsStatus>(e)?;
+        if status.running() {
+            return None;
+        }
+        let parts = (
+            world.get::<PhysicsBody>(e),
+            world.get::<BodyState>(e),
+            world.get::<PhysicsMonitor>(e),
+            world.get::<FallRecorder>(e),
+        );
+        match parts {
+            (Some(body), Some(state), Some(monitor), Some(recorder)) => {
+                result_of(body, state, monitor, recorder, status)
+            }
+            _ => Err(Arc::new(SimError::Config {
+                field: "world".into(),
+                message: "a fall's components went missing".into(),
+            })),
+        }
+    };
+    world.despawn(e);
+    Some(r)
+}
 
 /// Simulates the configurations in the Worlds of a [`WorldPool`], in parallel on the current
 /// rayon pool; the results are in input order and do not depend on the number of threads.
 ///
-/// Falls that share their time step (and their start, see [`run_parallel_reacting`]) share a
-/// World, up to [`LANES`] of them, so that the engine's step takes their articulated-body
-/// algorithm in vector lanes ([`crate::ecs::physics::step_bodies`]); each fall has the bits it
-/// has alone in its World.
+/// One World per thread runs up to [`LANES`] falls at a time (of one time step and start, see
+/// [`run_parallel_reacting`]), so that the engine's step takes their articulated-body
+/// algorithm in vector lanes ([`crate::ecs::physics::step_bodies`]), and takes the next fall
+/// of the batch as one finishes; each fall has the bits it has alone in its own World.
 pub fn run_parallel(configs: &[FallConfig]) -> Vec<Result<FallResult, Arc<SimError>>> {
     run_parallel_from(configs, None)
 }
@@ -279,37 +328,6 @@ pub fn run_parallel_from(
     run_parallel_reacting(configs, start, None)
 }
 
-/// The packs of falls that share a World: input indices, at most [`LANES`] per pack, falls of
-/// one pack sharing their time step and whether they continue from the reaction start; the
-/// packs of a kind as many as their falls need, rounded up to a multiple of the threads, and
-/// the falls spread evenly over them.
-fn packs(configs: &[FallConfig], reacts: impl Fn(usize) -> bool) -> Vec<Vec<usize>> {
-    let mut kinds: Vec<((u64, bool), Vec<usize>)> = Vec::new();
-    for (k, c) in configs.iter().enumerate() {
-        let key = (c.dt_s.to_bits(), reacts(k));
-        match kinds.iter_mut().find(|(kk, _)| *kk == key) {
-            Some((_, v)) => v.push(k),
-            None => kinds.push((key, vec![k])),
-        }
-    }
-    let threads = rayon::current_num_threads().max(1);
-    let mut out = Vec::new();
-    for (_, members) in kinds {
-        let needed = members.len().div_ceil(LANES);
-        let count = needed
-            .div_ceil(threads)
-            .saturating_mul(threads)
-            .min(members.len());
-        let (base, extra) = (members.len() / count, members.len() % count);
-        let mut it = members.into_iter();
-        for p in 0..count {
-            let size = base + usize::from(p < extra);
-            out.push(it.by_ref().take(size).collect());
-        }
-    }
-    out
-}
-
 /// [`run_parallel_from`] with every fall that fits `reaction` continued from it (see
 /// [`ReactionStart`]): the same results, without each fall's stretch before its reaction.
 pub fn run_parallel_reacting(
@@ -318,52 +336,39 @@ pub fn run_parallel_reacting(
     reaction: Option<&ReactionStart>,
 ) -> Vec<Result<FallResult, Arc<SimError>>> {
     let fits = |k: usize| reaction.is_some_and(|r| r.fits(&configs[k]));
-    let packs = packs(configs, fits);
-    let pool = WorldPool::new(packs.len(), 0, |w, world| {
-        let mut pack = Vec::with_capacity(packs[w].len());
-        for &k in &packs[w] {
-            world.insert_resource(Clock::physics(configs[k].dt_s));
-            let built = match reaction {
-                Some(r) if fits(k) => r.spawn(world, &configs[k]),
-                _ => {
-                    super::build_fall_from(&configs[k], start).and_then(|ch| spawn_fall(world, ch))
-                }
-            };
-            pack.push((k, built.map_err(Arc::new)));
+    // Falls of one time step and start share Worlds (one clock); usually there is one kind.
+    let mut kinds: Vec<((u64, bool), Vec<usize>)> = Vec::new();
+    for (k, c) in configs.iter().enumerate() {
+        let key = (c.dt_s.to_bits(), fits(k));
+        match kinds.iter_mut().find(|(kk, _)| *kk == key) {
+            Some((_, v)) => v.push(k),
+            None => kinds.push((key, vec![k])),
         }
-        world.insert_resource(Pack(pack));
-        Ok::<(), std::convert::Infallible>(())
-    });
-    let mut pool = match pool {
-        Ok(p) => p,
-        Err(never) => match never {},
-    };
-    let ran = pool.run(|w| {
-        let results = run_fall_world(w);
-        let Some(pack) = w.remove_resource::<Pack>() else {
-            return Vec::new();
-        };
-        // `run_fall_world` answers the built falls in spawn order.
-        let mut results = results.into_iter();
-        pack.0
-            .into_iter()
-            .map(|(k, built)| {
-                let r = match built {
-                    Ok(_) => results.next().unwrap_or_else(|| {
-                        Err(Arc::new(SimError::Config {
-                            field: "world".into(),
-                            message: "a fall's character went missing".into(),
-                        }))
-                    }),
-                    Err(e) => Err(e),
-                };
-                (k, r)
-            })
-            .collect::<Vec<_>>()
-    });
+    }
     let mut out: Vec<Option<Result<FallResult, Arc<SimError>>>> = vec![None; configs.len()];
-    for (k, r) in ran.into_iter().flatten() {
-        out[k] = Some(r);
+    for ((_, reacting), members) in kinds {
+        let dt = configs[members[0]].dt_s;
+        let workers = rayon::current_num_threads().clamp(1, members.len());
+        let pool = WorldPool::new(workers, 0, |_, world| {
+            world.insert_resource(Clock::physics(dt));
+            Ok::<(), std::convert::Infallible>(())
+        });
+        let mut pool = match pool {
+            Ok(p) => p,
+            Err(never) => match never {},
+        };
+        let next = AtomicUsize::new(0);
+        let spawn = |world: &mut World, k: usize| match reaction {
+            Some(r) if reacting => r.spawn_keeping_clock(world, &configs[k]),
+            _ => super::build_fall_from(&configs[k], start).and_then(|ch| spawn_fall(world, ch)),
+        };
+        for (k, r) in pool
+            .run(|w| run_queue(w, &members, &next, &spawn))
+            .into_iter()
+            .flatten()
+        {
+            out[k] = Some(r);
+        }
     }
     out.into_iter()
         .map(|r| {
@@ -375,6 +380,47 @@ pub fn run_parallel_reacting(
             })
         })
         .collect()
+}
+
+/// Runs falls of `members` in `world`, up to [`LANES`] at a time, each next one taken from
+/// the shared counter `next` as a fall finishes (so the Worlds of a pool stay busy until the
+/// queue is empty); returns each fall's input index and result. A fall's result does not
+/// depend on which World or with which others it ran.
+fn run_queue(
+    world: &mut World,
+    members: &[usize],
+    next: &AtomicUsize,
+    spawn: &(impl Fn(&mut World, usize) -> Result<Entity, SimError> + Sync),
+) -> Vec<(usize, Result<FallResult, Arc<SimError>>)> {
+    let mut schedule = fall_schedule();
+    let mut live: Vec<(usize, Entity)> = Vec::with_capacity(LANES);
+    let mut out = Vec::new();
+    loop {
+        while live.len() < LANES {
+            let Some(&k) = members.get(next.fetch_add(1, Ordering::Relaxed)) else {
+                break;
+            };
+            match spawn(world, k) {
+                Ok(e) => live.push((k, e)),
+                Err(e) => out.push((k, Err(Arc::new(e)))),
+            }
+        }
+        if live.is_empty() {
+            return out;
+        }
+        let before = live.len();
+        live.retain(|&(k, e)| match take_finished(world, e) {
+            Some(r) => {
+                out.push((k, r));
+                false
+            }
+            None => true,
+        });
+        // A finished fall frees its lane for the next before the World steps again.
+        if live.len() == before {
+            schedule.run(world);
+        }
+    }
 }
 
 #[cfg(test)]
@@ -447,5 +493,51 @@ mod tests {
         let mixed = run_parallel_reacting(&[pushed_harder], Some(&settled), Some(&reaction));
         assert_eq!(alone[0].as_ref().unwrap(), mixed[0].as_ref().unwrap());
         assert_ne!(alone[0].as_ref().unwrap(), from_start[0].as_ref().unwrap());
+    }
+
+    #[test]
+    fn falls_that_share_worlds_have_the_results_of_falls_alone() {
+        // Seven falls (more than the lanes of one World; reactions that rest at different
+        // times, one that cannot be built) through the pool on 1 and 2 threads, against each
+        // fall alone in its own World: the same results, in input order.
+        let (_, mut configs) = reactions();
+        let mut more = configs.clone();
+        for (k, c) in more.iter_mut().enumerate().take(2) {
+            c.key_pose_deg
+                .iter_mut()
+                .for_each(|x| *x = -*x * (k as f64 + 0.5));
+        }
+        configs.extend(more.into_iter().take(2));
+        let mut negative = configs[0].clone();
+        negative.kp[3] = -1.0;
+        configs.insert(2, negative);
+        let alone: Vec<_> = configs
+            .iter()
+            .map(|c| build_fall_world(c).map(|mut w| run_fall_world(&mut w).remove(0)))
+            .collect();
+        for threads in [1, 2] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let shared = pool.install(|| run_parallel(&configs));
+            assert_eq!(shared.len(), configs.len());
+            for (k, (a, b)) in alone.iter().zip(&shared).enumerate() {
+                match (a, b) {
+                    (Ok(Ok(x)), Ok(y)) => assert_eq!(x, y, "fall {k} on {threads} threads"),
+                    (Err(x), Err(y)) => assert_eq!(x.to_string(), y.to_string()),
+                    _ => panic!("fall {k}: {a:?} against {b:?}"),
+                }
+            }
+        }
+        let steps: Vec<u64> = alone
+            .iter()
+            .filter_map(|r| r.as_ref().ok()?.as_ref().ok().map(|f| f.steps))
+            .collect();
+        assert_eq!(steps.len(), 6);
+        assert!(
+            steps.iter().any(|&s| s != steps[0]),
+            "every fall as long: {steps:?}"
+        );
     }
 }
