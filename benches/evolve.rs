@@ -1,6 +1,6 @@
 //! What the paper's GA costs: one generation of 30 chromosomes of the initial population (the
-//! elderly group's problem: 42 genes, falls stopped once the body rests), each fall in its own
-//! World, at the problem's step (0.70 ms, within the accuracy margin), the standing body settled once
+//! elderly group's problem: 42 genes, falls stopped once the body rests) in the fall pool's
+//! parallel Worlds (up to four falls at a time in each), at the problem's step (0.70 ms, within the accuracy margin), the standing body settled once
 //! and kept across iterations as across a GA's generations, on a rayon pool of 1 and of 2
 //! threads. The ratio of the two rates is the parallel efficiency × 2. These are initial
 //! genomes, whose falls rest sooner than evolved ones: 15 000 / rate understates the paper's

@@ -1,4 +1,5 @@
-//! 64 pushed falls (3 s each) as parallel Worlds on a rayon pool of 1 and of 2 threads:
+//! 64 pushed falls (3 s each) in parallel Worlds (up to four falls at a time in each) on a rayon
+//! pool of 1 and of 2 threads:
 //! throughput in falls per second.
 //! Run: `cargo bench --bench falls_parallel`.
 
