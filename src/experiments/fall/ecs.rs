@@ -5,11 +5,10 @@
 //! with its [`Clock`] ticking one physics step. Many falls run in parallel in a [`WorldPool`]
 //! of one World per thread, each holding up to [`LANES`] falls at a time (their
 //! articulated-body algorithms then share vector lanes, [`crate::ecs::physics::step_bodies`])
-//! and taking the next fall of the batch as one finishes; every fall has the bits it has alone
-//! in its own World, on any number of threads.
+//! and taking the next fall as one finishes, from its own share of the batch and then from the
+//! others'; every fall has the bits it has alone in its own World, on any number of threads.
 
-use std::sync::Arc;
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex};
 
 use bevy_ecs::prelude::*;
 
@@ -19,7 +18,7 @@ use crate::ecs::physics::{
     BodyState, ExternalForces, FloorContact, JointLimits, PdController, PhysicsBody,
     PhysicsMonitor, PhysicsStatus, PhysicsWorkspace, add_physics_systems,
 };
-use crate::ecs::{Clock, MotionSet, WorldPool, add_core_systems, configure_motion_sets};
+use crate::ecs::{Clock, MotionSet, WorldPool, WorldSeed, add_core_systems, configure_motion_sets};
 
 /// The paper's controller: the key pose becomes the PD target at the reaction time.
 pub fn fall_control_system(
@@ -314,7 +313,8 @@ fn take_finished(world: &mut World, e: Entity) -> Option<Result<FallResult, Arc<
 /// One World per thread runs up to [`LANES`] falls at a time (of one time step and start, see
 /// [`run_parallel_reacting`]), so that the engine's step takes their articulated-body
 /// algorithm in vector lanes ([`crate::ecs::physics::step_bodies`]), and takes the next fall
-/// of the batch as one finishes; each fall has the bits it has alone in its own World.
+/// as one finishes, from its own share of the batch and then from the others'; each fall has
+/// the bits it has alone in its own World.
 pub fn run_parallel(configs: &[FallConfig]) -> Vec<Result<FallResult, Arc<SimError>>> {
     run_parallel_from(configs, None)
 }
@@ -357,13 +357,16 @@ pub fn run_parallel_reacting(
             Ok(p) => p,
             Err(never) => match never {},
         };
-        let next = AtomicUsize::new(0);
+        let queue = FallQueue::new(members.len(), workers);
         let spawn = |world: &mut World, k: usize| match reaction {
             Some(r) if reacting => r.spawn_keeping_clock(world, &configs[k]),
             _ => super::build_fall_from(&configs[k], start).and_then(|ch| spawn_fall(world, ch)),
         };
         for (k, r) in pool
-            .run(|w| run_queue(w, &members, &next, &spawn))
+            .run(|w| {
+                let own = w.get_resource::<WorldSeed>().map_or(0, |s| s.index);
+                run_queue(w, &members, &|| queue.take(own), &spawn)
+            })
             .into_iter()
             .flatten()
         {
@@ -382,14 +385,57 @@ pub fn run_parallel_reacting(
         .collect()
 }
 
-/// Runs falls of `members` in `world`, up to [`LANES`] at a time, each next one taken from
-/// the shared counter `next` as a fall finishes (so the Worlds of a pool stay busy until the
-/// queue is empty); returns each fall's input index and result. A fall's result does not
+/// The falls of a batch shared among the Worlds of a pool: each World has its own share (the
+/// batch split into as many near-equal runs as Worlds, so equal falls end together) and takes
+/// from its front; a World whose share is done takes from the back of the share with the most
+/// left, so none waits while another still has falls to start.
+struct FallQueue {
+    /// Per World, the positions of its share not yet started.
+    shares: Vec<Mutex<std::ops::Range<usize>>>,
+}
+
+impl FallQueue {
+    /// `n` falls over `workers` Worlds.
+    fn new(n: usize, workers: usize) -> Self {
+        let workers = workers.max(1);
+        let (base, extra) = (n / workers, n % workers);
+        let mut start = 0;
+        let shares = (0..workers)
+            .map(|w| {
+                let len = base + usize::from(w < extra);
+                let r = start..start + len;
+                start += len;
+                Mutex::new(r)
+            })
+            .collect();
+        Self { shares }
+    }
+
+    /// The next fall position for World `own`, if any is left.
+    fn take(&self, own: usize) -> Option<usize> {
+        fn lock(
+            m: &Mutex<std::ops::Range<usize>>,
+        ) -> std::sync::MutexGuard<'_, std::ops::Range<usize>> {
+            m.lock().unwrap_or_else(|e| e.into_inner())
+        }
+        if let Some(m) = self.shares.get(own)
+            && let Some(k) = lock(m).next()
+        {
+            return Some(k);
+        }
+        let longest = self.shares.iter().max_by_key(|m| lock(m).len())?;
+        lock(longest).next_back()
+    }
+}
+
+/// Runs falls of `members` in `world`, up to [`LANES`] at a time, the position of each next
+/// one in `members` from `take` as a fall finishes (so the Worlds of a pool stay busy while
+/// falls are left); returns each fall's input index and result. A fall's result does not
 /// depend on which World or with which others it ran.
 fn run_queue(
     world: &mut World,
     members: &[usize],
-    next: &AtomicUsize,
+    take: &impl Fn() -> Option<usize>,
     spawn: &(impl Fn(&mut World, usize) -> Result<Entity, SimError> + Sync),
 ) -> Vec<(usize, Result<FallResult, Arc<SimError>>)> {
     let mut schedule = fall_schedule();
@@ -397,7 +443,7 @@ fn run_queue(
     let mut out = Vec::new();
     loop {
         while live.len() < LANES {
-            let Some(&k) = members.get(next.fetch_add(1, Ordering::Relaxed)) else {
+            let Some(&k) = take().and_then(|j| members.get(j)) else {
                 break;
             };
             match spawn(world, k) {
