@@ -23,6 +23,8 @@
 //! fall21 (15 links, 21 DOF) is the falling paper's body ([`fall21_body`]); humanoid24 (17
 //! links, 24 DOF, the motor-primitive model) gets a body the same way ([`humanoid24_body`]).
 
+use std::sync::{Arc, Mutex, Weak};
+
 use crate::dynamics::forces::contact::LinkBox;
 use crate::dynamics::joint::JointType;
 use crate::dynamics::model::{Body, Model, ModelError};
@@ -153,6 +155,29 @@ fn rod(m: f64, len: f64, r: f64, p0: DVec3, dir: DVec3) -> Inertia {
 /// `(0, −g, 0)`.
 pub fn fall21_body(height: f64, mass: f64, g: f64) -> Result<HumanBody, HumanError> {
     human_body(&figure::fall21(), height, mass, g)
+}
+
+/// The fall21 human of [`fall21_body`], shared: while any holder keeps it, every call with the
+/// same `height` (m), `mass` (kg) and `g` returns that same body (equal parameters build equal
+/// bodies), so characters built one by one share one body, as the engine's step needs to
+/// take their articulated-body algorithms together in vector lanes
+/// ([`crate::ecs::physics::step_bodies`]).
+pub fn shared_fall21_body(height: f64, mass: f64, g: f64) -> Result<Arc<HumanBody>, HumanError> {
+    type Key = (u64, u64, u64);
+    static SHARED: Mutex<Vec<(Key, Weak<HumanBody>)>> = Mutex::new(Vec::new());
+    let key = (height.to_bits(), mass.to_bits(), g.to_bits());
+    let mut shared = SHARED.lock().unwrap_or_else(|e| e.into_inner());
+    shared.retain(|(_, w)| w.strong_count() > 0);
+    if let Some(body) = shared
+        .iter()
+        .find(|(k, _)| *k == key)
+        .and_then(|(_, w)| w.upgrade())
+    {
+        return Ok(body);
+    }
+    let body = Arc::new(fall21_body(height, mass, g)?);
+    shared.push((key, Arc::downgrade(&body)));
+    Ok(body)
 }
 
 /// Builds the humanoid24 human (the motor-primitive model) of standing height `height` (m) and

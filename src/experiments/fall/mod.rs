@@ -38,7 +38,7 @@ use crate::dynamics::stability::{
     DofStiffness, StiffestMode, inverse_joint_inertia, scheme_name, stiffest_mode,
 };
 use crate::ecs::physics::{ExternalForces, FloorContact, JointLimits, PdController, PhysicsBundle};
-use crate::humanoid::body::{HumanBody, fall21_body};
+use crate::humanoid::body::{HumanBody, shared_fall21_body};
 use crate::humanoid::ranges::RangeTable;
 use crate::humanoid::tissue;
 
@@ -84,7 +84,7 @@ fn validate(cfg: &FallConfig) -> Result<Resolved, SimError> {
     positive("duration_s", cfg.duration_s)?;
     positive("record_hz", cfg.record_hz)?;
     positive("gravity", cfg.gravity)?;
-    let body = fall21_body(cfg.height_m, cfg.mass_kg, cfg.gravity)?;
+    let body = shared_fall21_body(cfg.height_m, cfg.mass_kg, cfg.gravity)?;
     let n = body.dof_v.len();
     check_pose_and_gains(
         n,
@@ -284,7 +284,7 @@ fn reaction_key(cfg: &FallConfig) -> FallConfig {
 
 /// What a configuration names, resolved.
 struct Resolved {
-    body: HumanBody,
+    body: Arc<HumanBody>,
     push_link: usize,
     weights: Vec<f64>,
     ranges: Vec<(f64, f64)>,
@@ -520,7 +520,6 @@ fn assemble(cfg: &FallConfig) -> Result<FallCharacter, SimError> {
         None => Vec::new(),
     };
     let nv = body.model.nv;
-    let body = Arc::new(body);
     Ok(FallCharacter {
         physics: PhysicsBundle::new(body, cfg.integrator, q),
         pd: PdController(stance.clone()),
