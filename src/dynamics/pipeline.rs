@@ -56,6 +56,13 @@ impl State {
             steps: 0,
         }
     }
+
+    /// Counts one step of `dt` seconds: the time becomes `steps · dt`.
+    #[inline(always)]
+    fn count_step(&mut self, dt: f64) {
+        self.steps += 1;
+        self.time_s = self.steps as f64 * dt;
+    }
 }
 
 /// The forces a body feels, all optional: PD control and the joint model act on the DOFs
@@ -459,8 +466,7 @@ fn integrate_stage(
         settings.dt,
         (&mut state.q, &mut state.v),
     )?;
-    state.steps += 1;
-    state.time_s = state.steps as f64 * settings.dt;
+    state.count_step(settings.dt);
     Ok(())
 }
 
@@ -719,19 +725,23 @@ fn step_lanes_stages(
     bodies: &mut [LaneBody],
     lanes: &mut LaneData,
 ) {
-    let implicit_damping = match settings.integrator {
-        Integrator::SemiImplicitEuler { implicit_damping } => implicit_damping,
-        Integrator::Rk4 => true,
-    };
     let explicit_contact = bodies
         .iter()
         .all(|b| b.forces.contact.is_none_or(|c| !c.params.implicit_damping));
-    if matches!(settings.integrator, Integrator::Rk4) || !explicit_contact || bodies.len() < 2 {
-        for b in bodies.iter_mut() {
-            b.result = step_stages(model, settings, &b.forces, b.state, b.ws, b.monitor);
+    let implicit_damping = match settings.integrator {
+        Integrator::SemiImplicitEuler { implicit_damping }
+            if explicit_contact && bodies.len() > 1 =>
+        {
+            implicit_damping
         }
-        return;
-    }
+        // RK4, the floor's damping taken implicitly or a body alone: each by `step`.
+        _ => {
+            for b in bodies.iter_mut() {
+                b.result = step_stages(model, settings, &b.forces, b.state, b.ws, b.monitor);
+            }
+            return;
+        }
+    };
     let h = settings.dt;
     let implicit_dt = implicit_damping.then_some(h);
     for b in bodies.iter_mut() {
@@ -772,8 +782,7 @@ fn step_lanes_stages(
         b.result = finish(model, eval, state.time_s, iws.acceleration_mut());
         if b.result.is_ok() {
             integrator::semi_implicit_euler_advance(model, iws, h, (&mut state.q, &mut state.v));
-            state.steps += 1;
-            state.time_s = state.steps as f64 * h;
+            state.count_step(h);
             b.result = check_stage(model, state, ws);
         }
     }

@@ -171,8 +171,7 @@ type StepQuery<'a> = (
 /// A character's [`RootAssist`] joins its external forces for the tick. Bodies of one model
 /// integrated by semi-implicit Euler step together through [`pipeline::step_lanes`] (their
 /// articulated-body algorithm [`LANES`](crate::dynamics::lanes::LANES) at a time in vector
-/// lanes), each to the bits it has
-/// stepped alone.
+/// lanes), each to the bits it has stepped alone.
 pub fn step_bodies(
     clock: Res<Clock>,
     mut scratch: Local<Vec<ExternalForce>>,
@@ -250,6 +249,8 @@ pub fn step_bodies(
             group
         };
         let model = &human.model;
+        // Lane buffers per body, dropped with the last character of that body.
+        lanes.retain(|(h, _)| Arc::strong_count(h) > 1);
         let k = match lanes.iter().position(|(h, _)| Arc::ptr_eq(h, &human)) {
             Some(k) => k,
             None => {
