@@ -57,7 +57,14 @@ impl AxisRotation {
     /// The rotation by `theta` (rad) about the signed axis `axis`.
     #[inline]
     pub fn new(axis: CoordAxis, theta: f64) -> Self {
-        let (s, c) = theta.sin_cos();
+        let (s, c) = super::trig::sin_cos(theta);
+        Self::from_sin_cos(axis, s, c)
+    }
+
+    /// The rotation about the signed axis `axis` by the angle whose sine and cosine are `s`, `c`
+    /// ([`trig::sin_cos_at`](super::trig::sin_cos_at) of a configuration).
+    #[inline(always)]
+    pub fn from_sin_cos(axis: CoordAxis, s: f64, c: f64) -> Self {
         Self {
             k: axis.k,
             c,

@@ -38,6 +38,9 @@ pub struct Data {
     pub f: Vec<ForceVec>,
     /// Composite inertias of the composite-rigid-body algorithm.
     pub ic: Vec<ArticulatedInertia>,
+    /// `sin q` and `cos q` entry by entry (size nq), filled by
+    /// [`kinematics`](super::kinematics::kinematics) at the model's `axis_angles` only.
+    pub q_sin_cos: (Vec<f64>, Vec<f64>),
     /// World orientation of each body (body → world rotation).
     pub rot: Vec<DMat3>,
     /// World position of each body origin (m).
@@ -73,6 +76,7 @@ impl Data {
             uu: vec![DVec3::ZERO; n],
             f: vec![ForceVec::ZERO; n],
             ic: vec![ArticulatedInertia::ZERO; n],
+            q_sin_cos: (vec![0.0; model.nq], vec![0.0; model.nq]),
             rot: vec![DMat3::IDENTITY; n],
             pos: vec![DVec3::ZERO; n],
             qdd: vec![0.0; nv],

@@ -239,19 +239,21 @@ impl JointType {
 
     /// [`JointType::jcalc`] for a joint whose rotation factors into rotations about coordinate
     /// axes (`axes`, from the model): the same `X_J`, `v_J`, `c_J` and `S` from the factors'
-    /// sines and cosines, without general 3×3 products, and the factors themselves. Joints
-    /// without that structure (`JointAxes::General`) take [`JointType::jcalc`].
+    /// sines and cosines (`sin_q`, `cos_q`: those of the joint's `q`, from
+    /// [`trig::sin_cos_at`](super::trig::sin_cos_at)), without general 3×3 products, and the
+    /// factors themselves. Joints without that structure (`JointAxes::General`) take
+    /// [`JointType::jcalc`].
     #[inline(always)]
     pub fn jcalc_axes(
         &self,
         axes: JointAxes,
-        q: &[f64],
+        (q, sin_q, cos_q): (&[f64], &[f64], &[f64]),
         qd: &[f64],
         s: &mut [MotionVec; 3],
     ) -> (SpatialTransform, MotionVec, MotionVec, JointRotation) {
         match (self, axes) {
             (JointType::Pin { axis }, JointAxes::One(a)) => {
-                let r = AxisRotation::new(a, q[0]);
+                let r = AxisRotation::from_sin_cos(a, sin_q[0], cos_q[0]);
                 s[0] = MotionVec::new(*axis, DVec3::ZERO);
                 let e = r.matrix().transpose();
                 (
@@ -262,8 +264,8 @@ impl JointType {
                 )
             }
             (JointType::Universal { axis1, axis2 }, JointAxes::Two(a1, a2)) => {
-                let r1 = AxisRotation::new(a1, q[0]);
-                let r2 = AxisRotation::new(a2, q[1]);
+                let r1 = AxisRotation::from_sin_cos(a1, sin_q[0], cos_q[0]);
+                let r2 = AxisRotation::from_sin_cos(a2, sin_q[1], cos_q[1]);
                 let b = r2.apply_transpose(*axis1);
                 s[0] = MotionVec::new(b, DVec3::ZERO);
                 s[1] = MotionVec::new(*axis2, DVec3::ZERO);

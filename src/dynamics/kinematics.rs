@@ -22,8 +22,10 @@ pub fn kinematics(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) {
         c,
         rot,
         pos,
+        q_sin_cos: (q_sin, q_cos),
         ..
     } = data;
+    super::trig::sin_cos_at(q, &model.axis_angles, q_sin, q_cos);
     let (xups, rots, ss) = (&mut xup[..n], &mut xup_rotation[..n], &mut s[..n]);
     let (vs, cs) = (&mut vel[..n], &mut c[..n]);
     let (world_rot, world_pos) = (&mut rot[..n], &mut pos[..n]);
@@ -31,8 +33,13 @@ pub fn kinematics(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) {
         let (iq, iv) = (model.q_idx[i], model.v_idx[i]);
         let j = &body.joint;
         let axes = model.joint_axes[i];
-        let (xj, vj, cj, rotation) =
-            j.jcalc_axes(axes, &q[iq..iq + j.nq()], &v[iv..iv + j.nv()], &mut ss[i]);
+        let jq = iq..iq + j.nq();
+        let (xj, vj, cj, rotation) = j.jcalc_axes(
+            axes,
+            (&q[jq.clone()], &q_sin[jq.clone()], &q_cos[jq]),
+            &v[iv..iv + j.nv()],
+            &mut ss[i],
+        );
         let xup = match rotation {
             // `X_tree` is a pure translation and `X_J` a pure rotation: `X_J X_tree` is
             // `rot(E_J)` with the tree's translation.

@@ -29,6 +29,7 @@ pub mod pipeline;
 pub mod rnea;
 pub mod spatial;
 pub mod stability;
+pub mod trig;
 
 pub use aba::{aba, aba_passes};
 pub use crba::{crba, forward_dynamics_crba};

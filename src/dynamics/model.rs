@@ -96,6 +96,9 @@ pub struct Model {
     /// from `bodies` at construction (the kinematics and the ABA take the cheaper products where
     /// it does).
     pub joint_axes: Vec<JointAxes>,
+    /// The entries of `q` that are angles of such coordinate-axis joints (one per pin, two per
+    /// universal), whose sines and cosines the kinematics takes four at a time.
+    pub axis_angles: Vec<usize>,
 }
 
 /// The coordinate-axis structure of body `b`'s joint rotation: a pin or universal joint whose
@@ -174,10 +177,20 @@ impl Model {
             nv += b.joint.nv();
         }
         let inertia_blocks = bodies.iter().map(|b| b.inertia.to_blocks()).collect();
-        let joint_axes = bodies.iter().map(joint_axes).collect();
+        let joint_axes: Vec<JointAxes> = bodies.iter().map(joint_axes).collect();
+        let axis_angles = joint_axes
+            .iter()
+            .zip(&q_idx)
+            .flat_map(|(axes, &iq)| match axes {
+                JointAxes::General => iq..iq,
+                JointAxes::One(_) => iq..iq + 1,
+                JointAxes::Two(..) => iq..iq + 2,
+            })
+            .collect();
         Ok(Self {
             inertia_blocks,
             joint_axes,
+            axis_angles,
             bodies,
             gravity,
             q_idx,
