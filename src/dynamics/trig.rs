@@ -15,7 +15,8 @@
 /// Angles up to this magnitude (rad) take the polynomial; larger ones the C library.
 pub const REDUCED_LIMIT: f64 = 1.0e6;
 
-use super::lanes::{F4, LANES};
+/// Angles evaluated together: four, the `f64` width of AVX2.
+const LANES: usize = 4;
 
 // π/2 in three parts (Cephes' DP1..DP3 doubled).
 const PIO2_1: f64 = 1.5707963109016418;
@@ -56,21 +57,27 @@ fn zip4<T: Copy, U: Copy, V>(a: [T; LANES], b: [U; LANES], f: impl Fn(T, U) -> V
 /// `(sin x, cos x)` of four angles (rad), lane by lane.
 #[inline(always)]
 pub fn sin_cos4(x: [f64; LANES]) -> ([f64; LANES], [f64; LANES]) {
-    let xa = F4(map4(x, f64::abs));
+    let xa = map4(x, f64::abs);
     // `y`, the nearest integer to `|x|·2/π` (ties to even), through `+ 2⁵² − 2⁵²`, exact below
     // 2⁵¹; the sum also holds `y mod 4` in its low mantissa bits.
-    let t = xa * TWO_OVER_PI + TWO_52;
-    let y = t - TWO_52;
-    let r = ((xa - y * PIO2_1) - y * PIO2_2) - y * PIO2_3;
-    let r2 = r * r;
-    let horner =
-        |p: &[f64; 6]| ((((r2 * p[5] + p[4]) * r2 + p[3]) * r2 + p[2]) * r2 + p[1]) * r2 + p[0];
-    let s = r + r * r2 * horner(&S);
-    let c = (F4::splat(1.0) - r2 * 0.5) + r2 * r2 * horner(&C);
-    let q = map4(t.0, |v| v.to_bits() & 3);
+    let t = map4(xa, |a| a * TWO_OVER_PI + TWO_52);
+    let y = map4(t, |t| t - TWO_52);
+    let r = zip4(xa, y, |a, y| ((a - y * PIO2_1) - y * PIO2_2) - y * PIO2_3);
+    let poly = |p: &[f64; 6]| {
+        map4(r, |r| {
+            let z = r * r;
+            ((((z * p[5] + p[4]) * z + p[3]) * z + p[2]) * z + p[1]) * z + p[0]
+        })
+    };
+    let s = zip4(r, poly(&S), |r, p| r + r * (r * r) * p);
+    let c = zip4(r, poly(&C), |r, p| {
+        let z = r * r;
+        (1.0 - z * 0.5) + z * z * p
+    });
+    let q = map4(t, |v| v.to_bits() & 3);
     // Odd quadrants swap sine and cosine: a lane's mask is all ones there.
     let swap = map4(q, |q| 0u64.wrapping_sub(q & 1));
-    let (sb, cb) = (map4(s.0, f64::to_bits), map4(c.0, f64::to_bits));
+    let (sb, cb) = (map4(s, f64::to_bits), map4(c, f64::to_bits));
     let pick = |a: [u64; LANES], b: [u64; LANES]| {
         zip4(zip4(a, b, |a, b| (a, b)), swap, |(a, b), m| {
             (a & !m) | (b & m)
@@ -83,7 +90,7 @@ pub fn sin_cos4(x: [f64; LANES]) -> ([f64; LANES], [f64; LANES]) {
     let cos_sign = map4(q, |q| (((q + 1) >> 1) & 1) << 63);
     let sin = map4(zip4(sv, sin_sign, |v, m| v ^ m), f64::from_bits);
     let cos = map4(zip4(cv, cos_sign, |v, m| v ^ m), f64::from_bits);
-    let near = map4(xa.0, |a| a <= REDUCED_LIMIT);
+    let near = map4(xa, |a| a <= REDUCED_LIMIT);
     if near[0] & near[1] & near[2] & near[3] {
         (sin, cos)
     } else {
