@@ -137,10 +137,17 @@ impl FallRecorder {
         }
         let model = &body.model;
         let t = state.time_s;
-        let mut ke = 0.0;
-        for i in 0..model.nbodies() {
-            ke += model.bodies[i].inertia.kinetic_energy(data.v[i]);
-        }
+        // The kinetic energy `Σ ½ vᵢᵀ Iᵢ vᵢ` (J), each term at least zero (rounding can leave a
+        // resting body's a hair below it): whole up to the push, whose maximum is reported;
+        // after it only as far as the rest test needs, since a partial sum of such terms that
+        // reaches the threshold stays there.
+        let terms = || {
+            (0..model.nbodies()).map(|i| {
+                let k = model.bodies[i].inertia.kinetic_energy(data.v[i]);
+                if k < 0.0 { 0.0 } else { k }
+            })
+        };
+        let whole = (t <= self.push_start).then(|| terms().fold(0.0, |sum, k| sum + k));
         // The monitor's sample is the floor at the start of the step that just ended.
         let step_start = t - self.dt;
         if step_start < self.push_start {
@@ -154,7 +161,7 @@ impl FallRecorder {
             let b = &mut self.before_push;
             b.min_foot_force_n = b.min_foot_force_n.min(feet);
             b.max_foot_force_n = b.max_foot_force_n.max(feet);
-            if t <= self.push_start {
+            if let Some(ke) = whole {
                 b.max_kinetic_energy_j = b.max_kinetic_energy_j.max(ke);
             }
         }
@@ -176,7 +183,12 @@ impl FallRecorder {
         }
         // Rest counts only once the push is over (a figure standing still before it is not
         // "at rest" on the floor).
-        if ke < self.rest_energy && t >= self.rest_after {
+        let at_rest = t >= self.rest_after
+            && match whole {
+                Some(ke) => ke < self.rest_energy,
+                None => below(terms(), self.rest_energy),
+            };
+        if at_rest {
             self.rest_since.get_or_insert(t);
         } else {
             self.rest_since = None;
@@ -296,5 +308,49 @@ impl FallRecorder {
             torque_saturation: strength,
             peak_torques,
         }
+    }
+}
+
+/// Whether the sum of the nonnegative `terms` (in order) stays below `limit`, adding only until
+/// it does not: the same answer as comparing the whole sum, since floating-point partial sums
+/// of nonnegative terms never decrease. A NaN term answers false.
+fn below(terms: impl Iterator<Item = f64>, limit: f64) -> bool {
+    let mut sum = 0.0;
+    for k in terms {
+        sum += k;
+        let still_below = sum < limit;
+        if !still_below {
+            return false;
+        }
+    }
+    true
+}
+
+#[cfg(test)]
+mod tests {
+    use super::below;
+
+    /// Stopping at the limit answers as the whole sum does: over terms spanning twenty orders
+    /// of magnitude, limits placed at, just above and just below every partial sum.
+    #[test]
+    fn below_answers_as_the_whole_sum_does() {
+        let terms: Vec<f64> = (0..24)
+            .map(|i| {
+                let x = ((i * 7919) % 97) as f64 / 97.0;
+                x * 10f64.powi((i % 21) - 10)
+            })
+            .collect();
+        let mut partial = 0.0;
+        let mut limits = vec![0.0, f64::INFINITY, f64::MIN_POSITIVE];
+        for &k in &terms {
+            partial += k;
+            limits.extend([partial, partial.next_up(), partial.next_down()]);
+        }
+        let whole: f64 = terms.iter().fold(0.0, |s, k| s + k);
+        for limit in limits {
+            assert_eq!(below(terms.iter().copied(), limit), whole < limit, "{limit}");
+        }
+        assert!(below(std::iter::empty(), 1.0));
+        assert!(!below([0.1, f64::NAN, 0.1].into_iter(), 1.0));
     }
 }
