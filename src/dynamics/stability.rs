@@ -78,44 +78,87 @@ pub fn stiffest_mode(
     contact: Option<&ContactModel>,
     dofs: &[DofStiffness],
 ) -> Result<Option<StiffestMode>, super::crba::NotPositiveDefinite> {
-    let mut worst: Option<StiffestMode> = None;
-    let mut consider = |bound: f64, what: &dyn Fn() -> String, body: usize, omega, zeta| {
-        if worst.as_ref().is_none_or(|w| bound < w.bound_s) {
-            worst = Some(StiffestMode {
-                bound_s: bound,
-                what: what(),
-                body,
-                omega,
-                zeta,
-            });
-        }
-    };
-    // Contact damping taken implicitly in semi-implicit Euler leaves the undamped bound 2/ω.
-    let implicit_damping = contact.is_some_and(|cm| {
-        cm.params.implicit_damping && matches!(integrator, Integrator::SemiImplicitEuler { .. })
-    });
-    if let Some(cm) = contact {
-        for i in 0..model.nbodies() {
-            let (omega, zeta) = cm.link_frequency(i, &model.bodies[i].inertia);
-            let zeta = if implicit_damping { 0.0 } else { zeta };
-            let bound = stable_step(integrator, omega, zeta);
-            consider(bound, &|| "contact".to_string(), i, omega, zeta);
-        }
-    }
-    let vs: Vec<usize> = dofs.iter().map(|d| d.v).collect();
-    let ws = inverse_joint_inertia(model, q, &vs)?;
-    for (d, &w) in dofs.iter().zip(&ws) {
-        let omega = (d.stiffness * w).sqrt();
-        let zeta = if omega > 0.0 {
-            d.damping * w / (2.0 * omega)
-        } else {
-            0.0
-        };
-        let bound = stable_step(integrator, omega, zeta);
-        consider(bound, &|| format!("joint {}", d.name), d.body, omega, zeta);
-    }
-    Ok(worst)
+    Ok(StiffnessBasis::new(model, q, integrator, contact)?.stiffest_mode(dofs))
 }
+
+/// What [`stiffest_mode`] finds that does not depend on the DOFs' gains, for checking many
+/// gains at one configuration (the reactions of a GA batch): the stiffest contact mode and
+/// `(H⁻¹)_jj` of every velocity index at `q`. [`StiffnessBasis::stiffest_mode`] then gives
+/// [`stiffest_mode`]'s answer, bit for bit.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StiffnessBasis {
+    /// The scheme the bounds are for.
+    integrator: Integrator,
+    /// The contact mode with the smallest bound (the first such link), if any link has contact.
+    contact: Option<StiffestMode>,
+    /// `(H⁻¹)_jj` (1/(kg·m²) for a revolute DOF) for every velocity index `j`.
+    inverse_inertia: Vec<f64>,
+}
+
+impl StiffnessBasis {
+    /// The contact modes of every link and the inverse joint inertia at `q`.
+    pub fn new(
+        model: &Model,
+        q: &[f64],
+        integrator: Integrator,
+        contact: Option<&ContactModel>,
+    ) -> Result<Self, super::crba::NotPositiveDefinite> {
+        // Contact damping taken implicitly in semi-implicit Euler leaves the undamped bound 2/ω.
+        let implicit_damping = contact.is_some_and(|cm| {
+            cm.params.implicit_damping && matches!(integrator, Integrator::SemiImplicitEuler { .. })
+        });
+        let mut worst: Option<StiffestMode> = None;
+        if let Some(cm) = contact {
+            for i in 0..model.nbodies() {
+                let (omega, zeta) = cm.link_frequency(i, &model.bodies[i].inertia);
+                let zeta = if implicit_damping { 0.0 } else { zeta };
+                let bound = stable_step(integrator, omega, zeta);
+                if worst.as_ref().is_none_or(|w| bound < w.bound_s) {
+                    worst = Some(StiffestMode {
+                        bound_s: bound,
+                        what: "contact".to_string(),
+                        body: i,
+                        omega,
+                        zeta,
+                    });
+                }
+            }
+        }
+        let all: Vec<usize> = (0..model.nv).collect();
+        Ok(Self {
+            integrator,
+            contact: worst,
+            inverse_inertia: inverse_joint_inertia(model, q, &all)?,
+        })
+    }
+
+    /// The stiffest mode with the DOF stiffnesses `dofs` (their `v` within the model's): the
+    /// contact mode unless a DOF's bound is smaller (the first such DOF).
+    pub fn stiffest_mode(&self, dofs: &[DofStiffness]) -> Option<StiffestMode> {
+        let mut worst = self.contact.clone();
+        for d in dofs {
+            let w = self.inverse_inertia[d.v];
+            let omega = (d.stiffness * w).sqrt();
+            let zeta = if omega > 0.0 {
+                d.damping * w / (2.0 * omega)
+            } else {
+                0.0
+            };
+            let bound = stable_step(self.integrator, omega, zeta);
+            if worst.as_ref().is_none_or(|m| bound < m.bound_s) {
+                worst = Some(StiffestMode {
+                    bound_s: bound,
+                    what: format!("joint {}", d.name),
+                    body: d.body,
+                    omega,
+                    zeta,
+                });
+            }
+        }
+        worst
+    }
+}
+
 /// The inverse effective inertia `(H⁻¹)_jj` (1/(kg·m²) for a revolute DOF) of each velocity
 /// index `j` of `vs` at configuration `q`, with `H` the joint-space inertia of the free tree
 /// (CRBA): the DOF's `ω² = k (H⁻¹)_jj` under a spring `k`.

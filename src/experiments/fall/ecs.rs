@@ -14,6 +14,7 @@ use bevy_ecs::prelude::*;
 
 use super::{FallCharacter, FallConfig, FallController, FallRecorder, FallResult, SimError};
 use crate::dynamics::lanes::LANES;
+use crate::dynamics::stability::StiffnessBasis;
 use crate::ecs::physics::{
     BodyState, ExternalForces, FloorContact, JointLimits, PdController, PhysicsBody,
     PhysicsMonitor, PhysicsStatus, PhysicsWorkspace, add_physics_systems,
@@ -139,6 +140,9 @@ pub struct ReactionStart {
     /// The character assembled standing, before settling (the stability check of each
     /// reaction's gains is made on it, as [`super::build_fall`] does).
     standing: FallCharacter,
+    /// What the stability check of every reaction finds on `standing` independently of the
+    /// gains, found once (the error's message if it failed).
+    stiffness: Result<StiffnessBasis, String>,
     /// The character at the reaction time.
     reacting: FallCharacter,
     /// The World's clock at the reaction time.
@@ -172,6 +176,7 @@ impl ReactionStart {
         };
         Ok(Self {
             key: super::reaction_key(cfg),
+            stiffness: super::stiffness_basis(cfg, &standing),
             standing,
             reacting: character_of(&world, e).ok_or_else(missing)?,
             clock: *world.get_resource::<Clock>().ok_or_else(missing)?,
@@ -201,7 +206,7 @@ impl ReactionStart {
         cfg: &FallConfig,
     ) -> Result<Entity, SimError> {
         super::validate_reaction(cfg, self.standing.physics.body.body.dof_v.len())?;
-        super::check_stability(cfg, &self.standing)?;
+        super::check_stability_with(cfg, &self.standing, &self.stiffness)?;
         let mut ch = self.reacting.clone();
         ch.controller.key = super::key_targets(cfg);
         check_clock(world, &ch)?;

@@ -35,7 +35,7 @@ use crate::dynamics::forces::pd::PdTargets;
 use crate::dynamics::kinematics::kinematics;
 use crate::dynamics::pipeline::{self, Forces, StepSettings};
 use crate::dynamics::stability::{
-    DofStiffness, StiffestMode, inverse_joint_inertia, scheme_name, stiffest_mode,
+    DofStiffness, StiffestMode, StiffnessBasis, inverse_joint_inertia, scheme_name,
 };
 use crate::ecs::physics::{ExternalForces, FloorContact, JointLimits, PdController, PhysicsBundle};
 use crate::humanoid::body::{HumanBody, shared_fall21_body};
@@ -344,8 +344,20 @@ fn standing_configuration(
 /// stiffness is its larger PD gain plus the limit spring; its damping is taken explicitly
 /// unless the scheme takes it implicitly.
 pub fn check_stability(cfg: &FallConfig, ch: &FallCharacter) -> Result<(), SimError> {
+    check_stability_with(cfg, ch, &stiffness_basis(cfg, ch))
+}
+
+/// [`check_stability`] with the part that does not depend on the gains already found
+/// ([`stiffness_basis`] of the same character and configuration but for its gains): the same
+/// answer, bit for bit.
+pub(crate) fn check_stability_with(
+    cfg: &FallConfig,
+    ch: &FallCharacter,
+    basis: &Result<StiffnessBasis, String>,
+) -> Result<(), SimError> {
     let body = &*ch.physics.body.body;
-    match stiffest_mode_of(cfg, ch)? {
+    let basis = basis.as_ref().map_err(|e| cfg_err("body", e.clone()))?;
+    match basis.stiffest_mode(&dof_stiffness(cfg, ch)) {
         Some(m) if cfg.dt_s > m.bound_s => Err(SimError::Unstable {
             what: m.what,
             body: body.link_names[m.body].clone(),
@@ -364,14 +376,30 @@ pub fn check_stability(cfg: &FallConfig, ch: &FallCharacter) -> Result<(), SimEr
 /// nothing is stiff.
 pub fn stiffest_mode_of_config(cfg: &FallConfig) -> Result<Option<StiffestMode>, SimError> {
     let ch = assemble(cfg)?;
-    stiffest_mode_of(cfg, &ch)
+    let basis = stiffness_basis(cfg, &ch).map_err(|e| cfg_err("body", e))?;
+    Ok(basis.stiffest_mode(&dof_stiffness(cfg, &ch)))
 }
 
-/// The stiffest mode of the character `ch` of `cfg` at its current configuration.
-fn stiffest_mode_of(
+/// What the stability check of the character `ch` of `cfg` at its current configuration finds
+/// independently of the gains (contact modes, inverse joint inertia); the error's message if its
+/// joint-space inertia is not positive definite.
+pub(crate) fn stiffness_basis(
     cfg: &FallConfig,
     ch: &FallCharacter,
-) -> Result<Option<StiffestMode>, SimError> {
+) -> Result<StiffnessBasis, String> {
+    let body = &*ch.physics.body.body;
+    StiffnessBasis::new(
+        &body.model,
+        &ch.physics.state.q,
+        cfg.integrator,
+        Some(&ch.contact.0),
+    )
+    .map_err(|e| e.to_string())
+}
+
+/// Each DOF's stiffness for the stability check: its larger PD gain plus its limit spring, its
+/// damping explicit unless the scheme takes it implicitly.
+fn dof_stiffness(cfg: &FallConfig, ch: &FallCharacter) -> Vec<DofStiffness> {
     let body = &*ch.physics.body.body;
     let implicit = matches!(
         cfg.integrator,
@@ -380,8 +408,7 @@ fn stiffest_mode_of(
         }
     );
     let l = &ch.limits.0;
-    let dofs: Vec<DofStiffness> = body
-        .dof_v
+    body.dof_v
         .iter()
         .enumerate()
         .map(|(d, &k)| {
@@ -398,15 +425,7 @@ fn stiffest_mode_of(
                 },
             }
         })
-        .collect();
-    stiffest_mode(
-        &body.model,
-        &ch.physics.state.q,
-        cfg.integrator,
-        Some(&ch.contact.0),
-        &dofs,
-    )
-    .map_err(|e| cfg_err("body", e.to_string()))
+        .collect()
 }
 
 /// Validates `cfg`, builds the body standing on the floor with its controller, push and

@@ -348,7 +348,11 @@ mod tests {
         }
         let whole: f64 = terms.iter().fold(0.0, |s, k| s + k);
         for limit in limits {
-            assert_eq!(below(terms.iter().copied(), limit), whole < limit, "{limit}");
+            assert_eq!(
+                below(terms.iter().copied(), limit),
+                whole < limit,
+                "{limit}"
+            );
         }
         assert!(below(std::iter::empty(), 1.0));
         assert!(!below([0.1, f64::NAN, 0.1].into_iter(), 1.0));
