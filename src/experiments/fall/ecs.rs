@@ -13,6 +13,7 @@ use std::sync::{Arc, Mutex};
 use bevy_ecs::prelude::*;
 
 use super::{FallCharacter, FallConfig, FallController, FallRecorder, FallResult, SimError};
+use crate::dynamics::crba::NotPositiveDefinite;
 use crate::dynamics::lanes::LANES;
 use crate::dynamics::stability::StiffnessBasis;
 use crate::ecs::physics::{
@@ -141,8 +142,8 @@ pub struct ReactionStart {
     /// reaction's gains is made on it, as [`super::build_fall`] does).
     standing: FallCharacter,
     /// What the stability check of every reaction finds on `standing` independently of the
-    /// gains, found once (the error's message if it failed).
-    stiffness: Result<StiffnessBasis, String>,
+    /// gains, found once (or why it could not be).
+    stiffness: Result<StiffnessBasis, NotPositiveDefinite>,
     /// The character at the reaction time.
     reacting: FallCharacter,
     /// The World's clock at the reaction time.

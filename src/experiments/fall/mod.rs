@@ -27,6 +27,7 @@ use std::sync::Arc;
 
 use glam::{DQuat, DVec3};
 
+use crate::dynamics::crba::NotPositiveDefinite;
 use crate::dynamics::data::Data;
 use crate::dynamics::equilibrium::{BalanceSettings, balance_base, holding_torques};
 use crate::dynamics::forces::contact::ContactModel;
@@ -353,10 +354,10 @@ pub fn check_stability(cfg: &FallConfig, ch: &FallCharacter) -> Result<(), SimEr
 pub(crate) fn check_stability_with(
     cfg: &FallConfig,
     ch: &FallCharacter,
-    basis: &Result<StiffnessBasis, String>,
+    basis: &Result<StiffnessBasis, NotPositiveDefinite>,
 ) -> Result<(), SimError> {
     let body = &*ch.physics.body.body;
-    let basis = basis.as_ref().map_err(|e| cfg_err("body", e.clone()))?;
+    let basis = basis.as_ref().map_err(|e| cfg_err("body", e.to_string()))?;
     match basis.stiffest_mode(&dof_stiffness(cfg, ch)) {
         Some(m) if cfg.dt_s > m.bound_s => Err(SimError::Unstable {
             what: m.what,
@@ -376,17 +377,17 @@ pub(crate) fn check_stability_with(
 /// nothing is stiff.
 pub fn stiffest_mode_of_config(cfg: &FallConfig) -> Result<Option<StiffestMode>, SimError> {
     let ch = assemble(cfg)?;
-    let basis = stiffness_basis(cfg, &ch).map_err(|e| cfg_err("body", e))?;
+    let basis = stiffness_basis(cfg, &ch).map_err(|e| cfg_err("body", e.to_string()))?;
     Ok(basis.stiffest_mode(&dof_stiffness(cfg, &ch)))
 }
 
 /// What the stability check of the character `ch` of `cfg` at its current configuration finds
-/// independently of the gains (contact modes, inverse joint inertia); the error's message if its
+/// independently of the gains (contact modes, inverse joint inertia); an error if its
 /// joint-space inertia is not positive definite.
 pub(crate) fn stiffness_basis(
     cfg: &FallConfig,
     ch: &FallCharacter,
-) -> Result<StiffnessBasis, String> {
+) -> Result<StiffnessBasis, NotPositiveDefinite> {
     let body = &*ch.physics.body.body;
     StiffnessBasis::new(
         &body.model,
@@ -394,7 +395,6 @@ pub(crate) fn stiffness_basis(
         cfg.integrator,
         Some(&ch.contact.0),
     )
-    .map_err(|e| e.to_string())
 }
 
 /// Each DOF's stiffness for the stability check: its larger PD gain plus its limit spring, its
