@@ -209,7 +209,7 @@ impl FeetOnFloor {
 /// Lowest height along the floor normal of the contact corners of `link` posed by `data`.
 fn lowest_corner(contact: &ContactModel, data: &Data, link: usize) -> f64 {
     let n = contact.params.floor_normal;
-    contact.corners[link]
+    contact.corners()[link]
         .iter()
         .map(|&c| n.dot(data.pos[link] + data.rot[link] * c))
         .fold(f64::INFINITY, f64::min)
@@ -428,7 +428,7 @@ pub fn spawn_physical_character(
     let mut params = settings.contact;
     let probe = ContactModel::new(&body.boxes, &masses, &gains, params);
     let lowest = probe
-        .corners
+        .corners()
         .iter()
         .enumerate()
         .flat_map(|(i, cs)| cs.iter().map(move |&c| (i, c)))

@@ -135,8 +135,9 @@ impl ContactState {
 /// The contact geometry of a body: its boxes' corners and the per-link gains.
 #[derive(Clone, Debug)]
 pub struct ContactModel {
-    /// Corners of each link's box, link frame.
-    pub corners: Vec<[DVec3; 8]>,
+    /// Corners of each link's box, link frame, in [`LinkBox::corners`]' order (two values per
+    /// axis, which the contact stage relies on; hence private: [`ContactModel::corners`]).
+    corners: Vec<[DVec3; 8]>,
     /// Box centre (link frame) and bounding radius per link, for a quick rejection.
     pub bounds: Vec<(DVec3, f64)>,
     /// Link masses (kg), for the tangential gains.
@@ -149,8 +150,9 @@ pub struct ContactModel {
 }
 
 /// What the contact stage saw at one step start, per link: normal force (N), deepest corner
-/// penetration (m), the power the normal forces take out of the body (W, `−Σ f_n ż`) and the
-/// vertical velocity of the box centre (m/s); and the deepest penetration of any link (m).
+/// penetration (m), the power the normal forces take out of the body (W, `−Σ f_n ż`) and, where
+/// the floor pushes, the vertical velocity of the box centre (m/s); and the deepest penetration
+/// of any link (m).
 #[derive(Clone, Debug, PartialEq, Default)]
 pub struct ContactSample {
     /// Normal force per link (N).
@@ -159,7 +161,8 @@ pub struct ContactSample {
     pub depth: Vec<f64>,
     /// Power absorbed by the normal contact per link (W).
     pub absorbed_power: Vec<f64>,
-    /// Velocity of each box centre along the floor normal (m/s).
+    /// Velocity of each box centre along the floor normal (m/s) for the links the floor
+    /// pushes (`normal > 0`, what a touchdown records); 0 for the others.
     pub center_normal_velocity: Vec<f64>,
     /// Deepest penetration of any link (m).
     pub penetration: f64,
@@ -203,39 +206,33 @@ impl ContactModel {
         }
     }
 
+    /// The corners of each link's box in the link frame (m), in [`LinkBox::corners`]' order.
+    pub fn corners(&self) -> &[[DVec3; 8]] {
+        &self.corners
+    }
+
     /// The static sink (m) of link `i` carrying `load` newtons flat on its four lower corners.
     pub fn static_sink(&self, i: usize, load: f64) -> f64 {
         load / (4.0 * self.corner_gains[i].0)
     }
 
-    /// Normal and tangential force on one corner at world point `x` and signed height `z` (its
-    /// `n·x − h`) with velocity `xd`. Returns `(f_n, f_t, z)` or `None` when the corner is above
-    /// the floor.
+    /// Normal and tangential force on one corner below the floor with velocity `xd`, its
+    /// velocity along the floor normal `zd = n·ẋ` and its friction spring's stretch
+    /// `stretch = (x − a)_t` (zero without an anchor), for link `link`'s mass and the corner's
+    /// normal force `fnorm`: `f_t = −k_t m stretch − c_t m ẋ_t`, clipped to `|f_t| ≤ μ f_n`.
     #[inline(always)]
-    fn corner_force(
+    fn tangential_force(
         &self,
         link: usize,
-        (x, z): (DVec3, f64),
         xd: DVec3,
-        anchor: Option<DVec3>,
-    ) -> Option<(f64, DVec3, f64)> {
+        zd: f64,
+        stretch: DVec3,
+        fnorm: f64,
+    ) -> DVec3 {
         let p = &self.params;
         let n = p.floor_normal;
-        if z >= 0.0 {
-            return None;
-        }
         let m = self.masses[link];
-        let (k, c) = self.corner_gains[link];
-        let zd = n.dot(xd);
-        let fnorm = (-k * z - c * zd).max(0.0);
         let vt = xd - n * zd;
-        let stretch = match anchor {
-            Some(a) => {
-                let d = x - a;
-                d - n * n.dot(d)
-            }
-            None => DVec3::ZERO,
-        };
         let mut ft =
             -stretch * (p.tangential_stiffness_per_kg * m) - vt * (p.tangential_damping_per_kg * m);
         let cap = p.friction * fnorm;
@@ -243,7 +240,7 @@ impl ContactModel {
         if l2 > cap * cap {
             ft *= cap / l2.sqrt();
         }
-        Some((fnorm, ft, z))
+        ft
     }
 
     /// The contact force of link `i` (body coordinates), its total normal force (N) and its
@@ -282,8 +279,19 @@ impl ContactModel {
         let m = self.masses[i];
         let (k_c, c_c) = self.corner_gains[i];
         let (mut f_body, mut normal, mut depth, mut power) = (ForceVec::ZERO, 0.0, 0.0f64, 0.0);
-        for (k, &cl) in self.corners[i].iter().enumerate() {
-            let z = z_origin + n_body.dot(cl);
+        // A box's corners take two values per axis (`LinkBox::corners`): their products with
+        // the normal once per axis, summed as `n_b·p` sums them.
+        let cs = &self.corners[i];
+        let px = [n_body.x * cs[0].x, n_body.x * cs[1].x];
+        let py = [n_body.y * cs[0].y, n_body.y * cs[2].y];
+        let pz = [n_body.z * cs[0].z, n_body.z * cs[4].z];
+        // The friction spring's stretch `(x − a)_t` toward anchor `a`.
+        let stretch_to = |x: DVec3, a: DVec3| {
+            let d = x - a;
+            d - n * n.dot(d)
+        };
+        for (k, &cl) in cs.iter().enumerate() {
+            let z = z_origin + ((px[k & 1] + py[(k >> 1) & 1]) + pz[k >> 2]);
             if z >= 0.0 {
                 if UPDATE {
                     anchors[k] = None;
@@ -292,37 +300,44 @@ impl ContactModel {
             }
             let x = pos + rot * cl;
             let xd = rot * (v.lin + v.ang.cross(cl));
-            if UPDATE {
-                let on_floor = x - n * z;
-                match anchors[k] {
-                    None => anchors[k] = Some(on_floor),
-                    Some(a) => {
-                        let zd = n.dot(xd);
-                        let fnorm = (-k_c * z - c_c * zd).max(0.0);
-                        let d = x - a;
-                        let stretch = d - n * n.dot(d);
-                        let max_stretch = p.friction * fnorm / (p.tangential_stiffness_per_kg * m);
-                        let s = stretch.length();
-                        if s > max_stretch {
-                            let keep = if s > 0.0 { max_stretch / s } else { 0.0 };
-                            anchors[k] = Some(on_floor - stretch * keep);
-                        }
+            let zd = n.dot(xd);
+            let fnorm = (-k_c * z - c_c * zd).max(0.0);
+            let stretch = match anchors[k] {
+                Some(a) if UPDATE => {
+                    let stretch = stretch_to(x, a);
+                    let max_stretch = p.friction * fnorm / (p.tangential_stiffness_per_kg * m);
+                    let s = stretch.length();
+                    if s > max_stretch {
+                        // Slip: the anchor is dragged to the cone's edge.
+                        let keep = if s > 0.0 { max_stretch / s } else { 0.0 };
+                        let a = (x - n * z) - stretch * keep;
+                        anchors[k] = Some(a);
+                        stretch_to(x, a)
+                    } else {
+                        stretch
                     }
                 }
-            }
-            if let Some((fnorm, ft, z)) = self.corner_force(i, (x, z), xd, anchors[k]) {
-                depth = depth.max(-z);
-                normal += fnorm;
-                power -= fnorm * n.dot(xd);
-                let f_world = n * fnorm + ft;
-                f_body += ForceVec::at_point(rot.transpose() * f_world, cl);
-                if let Some((h, ic)) = implicit.as_mut()
-                    && fnorm > 0.0
-                {
-                    // I + h c j jᵀ.
-                    let j = ForceVec::at_point(rot.transpose() * n, cl);
-                    ic.sub_outer(j, -*h * c_c);
+                Some(a) => stretch_to(x, a),
+                None if UPDATE => {
+                    // A new contact anchors where it touches.
+                    let a = x - n * z;
+                    anchors[k] = Some(a);
+                    stretch_to(x, a)
                 }
+                None => DVec3::ZERO,
+            };
+            let ft = self.tangential_force(i, xd, zd, stretch, fnorm);
+            depth = depth.max(-z);
+            normal += fnorm;
+            power -= fnorm * zd;
+            let f_world = n * fnorm + ft;
+            f_body += ForceVec::at_point(rot.transpose() * f_world, cl);
+            if let Some((h, ic)) = implicit.as_mut()
+                && fnorm > 0.0
+            {
+                // I + h c j jᵀ.
+                let j = ForceVec::at_point(rot.transpose() * n, cl);
+                ic.sub_outer(j, -*h * c_c);
             }
         }
         (f_body, normal, depth, power)
@@ -396,12 +411,17 @@ impl ContactModel {
                 }
                 None => self.link_contact::<true>(data, i, anchors, None),
             };
-            let (c, _) = self.bounds[i];
-            let v = data.v[i];
             sample.normal[i] = fn_i;
             sample.depth[i] = d;
             sample.absorbed_power[i] = power;
-            sample.center_normal_velocity[i] = n.dot(data.rot[i] * (v.lin + v.ang.cross(c)));
+            // Only a link the floor pushes can touch down (`ContactStats::accumulate`).
+            sample.center_normal_velocity[i] = if fn_i > 0.0 {
+                let (c, _) = self.bounds[i];
+                let v = data.v[i];
+                n.dot(data.rot[i] * (v.lin + v.ang.cross(c)))
+            } else {
+                0.0
+            };
             deepest = deepest.max(d);
             f_ext[i] += f;
         }

@@ -324,7 +324,7 @@ fn standing_configuration(
     kinematics(&body.model, &mut data, &q, &zeros);
     let n_up = cfg.contact.floor_normal;
     let mut lowest = f64::INFINITY;
-    for (i, corners) in contact.corners.iter().enumerate() {
+    for (i, corners) in contact.corners().iter().enumerate() {
         for &cl in corners {
             lowest = lowest.min(n_up.dot(data.pos[i] + data.rot[i] * cl));
         }
