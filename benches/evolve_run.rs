@@ -1,7 +1,8 @@
 //! The paper's whole GA for one age group, the unit of issue 14's speed aim: the elderly
 //! problem, seed 1, 30 chromosomes × 500 generations as `scenes/evolve_fall.ron` runs it (two
 //! elites kept, children that copy an evaluated parent inheriting its fitness, the elites
-//! checked at half the step), evaluated in process on a rayon pool of 2 threads. Unlike the
+//! checked at half the step), evaluated in process on a rayon pool of 2 threads as the scene
+//! does ([`InProcessFalls`]: the next generation's falls run alongside each elite check). Unlike the
 //! generation bench of `benches/evolve.rs` (the initial population), it includes the evolved
 //! generations, whose falls last longer before they rest. Each iteration starts from a fresh
 //! problem (the standing body settled once, as in a run). One iteration takes about 1.5 min, so
@@ -9,7 +10,7 @@
 //! Run: `cargo bench --bench evolve_run`.
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use marionette::evolve::{FallProblem, GaConfig, GaState, InProcess};
+use marionette::evolve::{FallProblem, GaConfig, GaState, InProcessFalls};
 use marionette::humanoid::ranges::AgeGroup;
 use std::hint::black_box;
 use std::time::Duration;
@@ -22,9 +23,7 @@ fn paper_ga(seed: u64) -> GaState {
         seed,
         ..GaConfig::default()
     };
-    let mut e = InProcess {
-        batch: |g: &[Vec<f64>], refine: u32| problem.evaluate(g, refine),
-    };
+    let mut e = InProcessFalls::new(problem);
     let mut s = GaState::initial(cfg, bounds, &mut e).expect("GA");
     while !s.done() {
         s.step(&mut e).expect("GA step");

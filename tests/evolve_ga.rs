@@ -1,13 +1,15 @@
 //! The genetic algorithm: it optimises, elitism never loses the best, the same seed gives the
 //! same logbook on 1 and 2 threads, a resumed run continues to the same bits, the JSON-lines
 //! worker gives the same fitness as in-process evaluation, and a run with diverging individuals
-//! (refused before they run, or blowing up mid-fall) completes with them logged.
+//! (refused before they run, or blowing up mid-fall) completes with them logged; running the
+//! next generation's falls alongside the elite checks changes no bit.
 
 use std::process::Command;
 
 use marionette::evolve::evaluator::{Evaluation, par_map};
 use marionette::evolve::{
-    Bounds, Evaluator, FallProblem, GaConfig, GaState, Genome, InProcess, JsonLines, checkpoint,
+    Bounds, Evaluator, FallProblem, GaConfig, GaState, Genome, InProcess, InProcessFalls,
+    JsonLines, checkpoint,
 };
 use marionette::humanoid::ranges::AgeGroup;
 
@@ -577,4 +579,76 @@ fn runs_advanced_together_get_the_bits_of_each_run_alone_in_one_batch_per_round(
         .sum();
     assert!(checks > 0);
     assert_eq!(batched as u64, checks);
+}
+
+/// The in-process fall evaluator runs the next generation's falls alongside each round of elite
+/// checks and gives them up when a check is rejected: the same bits as evaluating one batch
+/// after the other, on one thread and two, for a run alone and for runs advanced together
+/// sharing the evaluator. A strict tolerance makes some checks fail, so both the look-ahead
+/// taken and the look-ahead given up are exercised.
+#[test]
+fn running_the_next_generation_alongside_the_elite_checks_changes_no_bit() {
+    use marionette::experiments::evolve_fall::{EvolutionRun, advance};
+    let p = small_fall_problem();
+    let cfg = |seed| GaConfig {
+        population: 6,
+        generations: 4,
+        seed,
+        elite_check_tolerance: Some(0.002),
+        ..GaConfig::default()
+    };
+    let plain = |seed| {
+        let mut e = fall_eval(&p);
+        let s = GaState::initial(cfg(seed), p.bounds().unwrap(), &mut e).unwrap();
+        run_to_end(s, &mut e)
+    };
+    let expected = [plain(21), plain(22)];
+    let rejected: usize = expected.iter().map(|s| s.failures.len()).sum();
+    let checks: u64 = expected.iter().map(|s| s.check_evaluations).sum();
+    assert!(
+        rejected > 0 && (rejected as u64) < checks,
+        "{rejected} of {checks} checks rejected: the test needs both outcomes"
+    );
+    for threads in [1, 2] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            // Each run alone.
+            for (seed, want) in [21, 22].into_iter().zip(&expected) {
+                let mut e = InProcessFalls::new(p.clone());
+                let s = GaState::initial(cfg(seed), p.bounds().unwrap(), &mut e).unwrap();
+                let s = run_to_end(s, &mut e);
+                assert_eq!(
+                    serde_json::to_string(&s).unwrap(),
+                    serde_json::to_string(want).unwrap(),
+                    "seed {seed} on {threads} thread(s)"
+                );
+                assert!(
+                    e.answered_ahead > 0,
+                    "seed {seed}: no generation looked ahead"
+                );
+            }
+            // Both runs advanced together, their checks and look-ahead in one batch.
+            let mut shared: Vec<Box<dyn Evaluator>> =
+                vec![Box::new(InProcessFalls::new(p.clone()))];
+            let mut runs: Vec<EvolutionRun> = [21, 22]
+                .into_iter()
+                .map(|seed| EvolutionRun {
+                    problem: p.clone(),
+                    state: GaState::initial(cfg(seed), p.bounds().unwrap(), shared[0].as_mut())
+                        .unwrap(),
+                })
+                .collect();
+            advance(&mut runs, &mut shared, |_| 0, None, |_| {}).unwrap();
+            for (r, want) in runs.iter().zip(&expected) {
+                assert_eq!(
+                    serde_json::to_string(&r.state).unwrap(),
+                    serde_json::to_string(want).unwrap(),
+                    "advanced together on {threads} thread(s)"
+                );
+            }
+        });
+    }
 }

@@ -16,10 +16,12 @@
 
 use std::io::{BufRead, BufReader, Write};
 use std::process::{Child, ChildStdin, ChildStdout, Command, Stdio};
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use super::fall_fitness::FallProblem;
 use super::genome::Genome;
 
 /// The protocol's name and version.
@@ -66,6 +68,25 @@ pub trait Evaluator {
         genomes: &[Genome],
         refine: u32,
     ) -> Result<Vec<Evaluation>, EvolveError>;
+
+    /// The elite checks of `generation`: [`Self::evaluate`] of `checks` at `refine`. Meanwhile
+    /// an evaluator may start on `ahead`, the children the next generation evaluates (at
+    /// refinement 1) if the checks change nothing, which `wanted` tells from the checks'
+    /// evaluations; it then answers that next [`Self::evaluate`] from what it found, if the
+    /// genomes asked for are `ahead`'s bit for bit. An evaluation depends on nothing but its
+    /// genome and refinement, so this changes when results are computed, never what they are.
+    /// The default evaluates the checks only.
+    fn evaluate_checks(
+        &mut self,
+        generation: u64,
+        checks: &[Genome],
+        refine: u32,
+        ahead: &[Genome],
+        wanted: &(dyn Fn(&[Evaluation]) -> bool + Sync),
+    ) -> Result<Vec<Evaluation>, EvolveError> {
+        let _ = (ahead, wanted);
+        self.evaluate(generation, checks, refine)
+    }
 }
 
 /// Evaluates in this process, in parallel on the current rayon pool.
@@ -83,6 +104,90 @@ impl<F: Fn(&[Genome], u32) -> Vec<Evaluation>> Evaluator for InProcess<F> {
         refine: u32,
     ) -> Result<Vec<Evaluation>, EvolveError> {
         Ok((self.batch)(genomes, refine))
+    }
+}
+
+/// Evaluates a [`FallProblem`] in this process (its falls in parallel Worlds on the current
+/// rayon pool), overlapping each round of elite checks with the next generation
+/// ([`Evaluator::evaluate_checks`]): a check is a single fall that occupies one thread, so the
+/// next generation's falls run on the others meanwhile and are given up as soon as a check
+/// changes the next generation.
+pub struct InProcessFalls {
+    /// The problem.
+    pub problem: FallProblem,
+    /// Batches answered from the look-ahead so far (generations whose falls ran alongside
+    /// their parents' elite checks).
+    pub answered_ahead: u64,
+    /// The genomes evaluated ahead and their evaluations, for the next [`Evaluator::evaluate`].
+    ahead: Option<(Vec<Genome>, Vec<Evaluation>)>,
+}
+
+impl InProcessFalls {
+    /// Evaluates `problem`.
+    pub fn new(problem: FallProblem) -> Self {
+        Self {
+            problem,
+            answered_ahead: 0,
+            ahead: None,
+        }
+    }
+}
+
+/// True if `a` and `b` are the same genomes bit for bit.
+fn same_genomes(a: &[Genome], b: &[Genome]) -> bool {
+    a.len() == b.len()
+        && a.iter().zip(b).all(|(x, y)| {
+            x.len() == y.len() && x.iter().zip(y).all(|(u, v)| u.to_bits() == v.to_bits())
+        })
+}
+
+impl Evaluator for InProcessFalls {
+    fn evaluate(
+        &mut self,
+        _: u64,
+        genomes: &[Genome],
+        refine: u32,
+    ) -> Result<Vec<Evaluation>, EvolveError> {
+        if let Some((g, r)) = self.ahead.take()
+            && refine == 1
+            && same_genomes(&g, genomes)
+        {
+            self.answered_ahead += 1;
+            return Ok(r);
+        }
+        Ok(self.problem.evaluate(genomes, refine))
+    }
+
+    fn evaluate_checks(
+        &mut self,
+        _: u64,
+        checks: &[Genome],
+        refine: u32,
+        ahead: &[Genome],
+        wanted: &(dyn Fn(&[Evaluation]) -> bool + Sync),
+    ) -> Result<Vec<Evaluation>, EvolveError> {
+        self.ahead = None;
+        let p = &self.problem;
+        if ahead.is_empty() {
+            return Ok(p.evaluate(checks, refine));
+        }
+        let stop = AtomicBool::new(false);
+        let (done, next) = rayon::join(
+            || {
+                let r = p.evaluate(checks, refine);
+                if !wanted(&r) {
+                    stop.store(true, Ordering::Relaxed);
+                }
+                r
+            },
+            || p.evaluate_until(ahead, 1, &stop),
+        );
+        if let Some(next) = next
+            && wanted(&done)
+        {
+            self.ahead = Some((ahead.to_vec(), next));
+        }
+        Ok(done)
     }
 }
 

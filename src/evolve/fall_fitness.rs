@@ -9,12 +9,13 @@
 //! Genes, in order: `θ_d` (rad) of DOF 0..21, then `k_p` (N·m/rad) of DOF 0..21.
 
 use std::sync::Arc;
+use std::sync::atomic::AtomicBool;
 
 use serde::{Deserialize, Serialize};
 
 use super::evaluator::Evaluation;
 use super::genome::{Bounds, Genome};
-use crate::experiments::fall::ecs::{ReactionStart, run_parallel_reacting};
+use crate::experiments::fall::ecs::{ReactionStart, run_parallel_until};
 use crate::experiments::fall::{FallConfig, Ranges, SettledStart, SimError};
 use crate::humanoid::fall21;
 use crate::humanoid::ranges::{AgeGroup, RangeTable};
@@ -236,11 +237,22 @@ impl FallProblem {
     }
 
     /// The damage of every genome, the falls in parallel Worlds (up to four at a time in each,
-    /// [`run_parallel_reacting`]), at the problem's
+    /// [`run_parallel_reacting`](crate::experiments::fall::ecs::run_parallel_reacting)), at the problem's
     /// time step divided by `refine` (1: the problem's own step); the standing body is settled
     /// once per step for the whole run (the genes do not change how it stands; the same bits as
     /// settling each fall).
     pub fn evaluate(&self, genomes: &[Genome], refine: u32) -> Vec<Evaluation> {
+        self.evaluate_until(genomes, refine, &AtomicBool::new(false))
+            .expect("never stopped")
+    }
+
+    /// [`Self::evaluate`] that gives up as soon as `stop` is set (`None` then).
+    pub fn evaluate_until(
+        &self,
+        genomes: &[Genome],
+        refine: u32,
+        stop: &AtomicBool,
+    ) -> Option<Vec<Evaluation>> {
         let mut fall = self.fall.clone();
         fall.dt_s /= f64::from(refine.max(1));
         let genes = 2 * self.kp_max.len();
@@ -257,13 +269,14 @@ impl FallProblem {
             })
             .collect();
         let start = self.settled.of(&fall);
-        let mut ran = run_parallel_reacting(
+        let mut ran = run_parallel_until(
             &configs,
             start.as_ref().map(|s| &s.settled),
             start.as_ref().and_then(|s| s.reaction.as_ref()),
-        )
+            stop,
+        )?
         .into_iter();
-        genomes
+        let out = genomes
             .iter()
             .map(|g| {
                 if g.len() != genes {
@@ -276,6 +289,7 @@ impl FallProblem {
                     None => Err("not evaluated".into()),
                 }
             })
-            .collect()
+            .collect();
+        Some(out)
     }
 }

@@ -272,7 +272,17 @@ impl GaState {
                 break;
             }
             let genomes: Vec<Genome> = todo.iter().map(|&i| self.population[i].clone()).collect();
-            let results = evaluator.evaluate(self.generation, &genomes, ELITE_CHECK_REFINE)?;
+            let ahead = self
+                .brood_if_checks_hold(&todo)
+                .map_or_else(Vec::new, |b| b.to_evaluate());
+            let wanted = |r: &[Evaluation]| self.checks_hold(&todo, r);
+            let results = evaluator.evaluate_checks(
+                self.generation,
+                &genomes,
+                ELITE_CHECK_REFINE,
+                &ahead,
+                &wanted,
+            )?;
             self.receive_checks(&todo, results)?;
         }
         self.close();
@@ -285,6 +295,40 @@ impl GaState {
     /// identical to an individual of this generation that has a fitness inherits it and its
     /// elite check ([`Brood::to_evaluate`] leaves it out).
     pub fn breed(&self) -> Brood {
+        self.breed_with(&self.checked)
+    }
+
+    /// The brood of the next generation if the elite checks of `todo` (from
+    /// [`Self::unchecked_elites`]) all hold: [`Self::breed`] with them checked, as it will be
+    /// after [`Self::receive_checks`] and [`Self::close`] (`None` when this generation is the
+    /// run's last). What an evaluator may work on while the checks run
+    /// ([`Evaluator::evaluate_checks`]).
+    pub fn brood_if_checks_hold(&self, todo: &[usize]) -> Option<Brood> {
+        if self.generation >= self.config.generations {
+            return None;
+        }
+        let mut checked = self.checked.clone();
+        for &i in todo {
+            if let Some(c) = checked.get_mut(i) {
+                *c = true;
+            }
+        }
+        Some(self.breed_with(&checked))
+    }
+
+    /// True if the checks' `results` of `todo` all hold, as [`Self::receive_checks`] judges
+    /// them (then they leave the ranking, and so the next brood, unchanged).
+    pub fn checks_hold(&self, todo: &[usize], results: &[Evaluation]) -> bool {
+        let tol = self.config.elite_check_tolerance.unwrap_or(f64::INFINITY);
+        results.len() == todo.len()
+            && todo.iter().zip(results).all(|(&i, r)| {
+                let d = self.fitness.get(i).copied().flatten().unwrap_or(f64::NAN);
+                check_holds(d, r, tol)
+            })
+    }
+
+    /// [`Self::breed`] with the elite-check flags `checked`.
+    fn breed_with(&self, checked: &[bool]) -> Brood {
         let c = &self.config;
         let g = self.generation + 1;
         let mut rng = Pcg64::seed_from_u64(world_seed(c.seed, g));
@@ -294,7 +338,7 @@ impl GaState {
             .map(|&i| Elite {
                 genome: self.population[i].clone(),
                 fitness: self.fitness[i],
-                checked: self.checked.get(i).copied().unwrap_or(false),
+                checked: checked.get(i).copied().unwrap_or(false),
             })
             .collect();
         let pm = c
@@ -327,7 +371,7 @@ impl GaState {
         let mut known = std::collections::HashMap::new();
         for (i, x) in self.population.iter().enumerate() {
             if let Some(f) = self.fitness[i] {
-                let checked = self.checked.get(i).copied().unwrap_or(false);
+                let checked = checked.get(i).copied().unwrap_or(false);
                 // The same genes have the same damage; checked if any copy was.
                 known
                     .entry(key(x))
@@ -442,8 +486,10 @@ impl GaState {
         for (&i, r) in todo.iter().zip(results) {
             self.checked[i] = true;
             let d = self.fitness[i].unwrap_or(f64::NAN);
+            if check_holds(d, &r, tol) {
+                continue;
+            }
             let why = match r {
-                Ok(fine) if fine.is_finite() && (fine - d).abs() <= tol * d.abs() => continue,
                 Ok(fine) => format!(
                     "{ELITE_CHECK}: damage {d} at the problem's resolution, {fine} at \
                      {ELITE_CHECK_REFINE}× it ({:+.1} %, tolerance {:.1} %)",
@@ -486,6 +532,12 @@ impl GaState {
             before,
         ));
     }
+}
+
+/// Whether an elite check holds: the re-evaluation `r` of an individual of damage `d` is finite
+/// and within `|D_fine − D| ≤ tol · |D|`.
+fn check_holds(d: f64, r: &Evaluation, tol: f64) -> bool {
+    matches!(r, Ok(fine) if fine.is_finite() && (fine - d).abs() <= tol * d.abs())
 }
 
 /// An elite passing unchanged into a brood.

@@ -13,7 +13,7 @@ pub mod genome;
 pub mod logbook;
 pub mod operators;
 
-pub use evaluator::{Evaluation, Evaluator, EvolveError, InProcess, JsonLines};
+pub use evaluator::{Evaluation, Evaluator, EvolveError, InProcess, InProcessFalls, JsonLines};
 pub use fall_fitness::FallProblem;
 pub use ga::{GaConfig, GaState};
 pub use genome::{Bounds, Genome};

@@ -131,8 +131,24 @@ pub fn advance(
                     (*i, idx.iter().map(|&k| pop[k].clone()).collect())
                 })
                 .collect();
-            let results =
-                evaluate_by_owner(evaluators, &owner, generation, &parts, ELITE_CHECK_REFINE)?;
+            // What each run evaluates next if its checks hold, in the order the next
+            // generation's batch asks for it (a run that ends here asks for nothing).
+            let ahead: Vec<(usize, Vec<Genome>)> = active
+                .iter()
+                .filter_map(|&i| {
+                    let idx = todo.iter().find(|t| t.0 == i).map_or(&[][..], |t| &t.1[..]);
+                    let brood = runs[i].state.brood_if_checks_hold(idx)?;
+                    Some((i, brood.to_evaluate()))
+                })
+                .collect();
+            let results = evaluate_checks_by_owner(
+                evaluators,
+                &owner,
+                generation,
+                &parts,
+                &ahead,
+                &|k, r| runs[todo[k].0].state.checks_hold(&todo[k].1, r),
+            )?;
             for ((i, idx), r) in todo.iter().zip(results) {
                 runs[*i].state.receive_checks(idx, r)?;
             }
@@ -171,6 +187,59 @@ fn evaluate_by_owner(
             continue;
         }
         let results = evaluator.evaluate(generation, &genomes, refine)?;
+        if results.len() != genomes.len() {
+            return Err(EvolveError::Evaluator(format!(
+                "{} results for {} genomes",
+                results.len(),
+                genomes.len()
+            )));
+        }
+        let mut all = results.into_iter();
+        for k in mine {
+            out[k] = all.by_ref().take(parts[k].1.len()).collect();
+        }
+    }
+    Ok(out)
+}
+
+/// The elite checks `parts` (run index, genomes) at [`ELITE_CHECK_REFINE`], all the parts of
+/// one evaluator in one batch as [`evaluate_by_owner`] does, each evaluator given its runs' part
+/// of `ahead` (run index, the genomes its next generation evaluates if its checks hold) to work
+/// on meanwhile ([`Evaluator::evaluate_checks`]); `holds(k, results)` tells whether the checks
+/// of part `k` hold.
+fn evaluate_checks_by_owner(
+    evaluators: &mut [Box<dyn Evaluator>],
+    owner: &[usize],
+    generation: u64,
+    parts: &[(usize, Vec<Genome>)],
+    ahead: &[(usize, Vec<Genome>)],
+    holds: &(dyn Fn(usize, &[Evaluation]) -> bool + Sync),
+) -> Result<Vec<Vec<Evaluation>>, EvolveError> {
+    let mut out: Vec<Vec<Evaluation>> = vec![Vec::new(); parts.len()];
+    for (e, evaluator) in evaluators.iter_mut().enumerate() {
+        let mine: Vec<usize> = (0..parts.len())
+            .filter(|&k| owner[parts[k].0] == e)
+            .collect();
+        let genomes: Vec<Genome> = mine.iter().flat_map(|&k| parts[k].1.clone()).collect();
+        if genomes.is_empty() {
+            continue;
+        }
+        let next: Vec<Genome> = ahead
+            .iter()
+            .filter(|a| owner[a.0] == e)
+            .flat_map(|a| a.1.clone())
+            .collect();
+        let wanted = |results: &[Evaluation]| {
+            let mut rest = results;
+            mine.iter().all(|&k| {
+                let n = parts[k].1.len().min(rest.len());
+                let (part, tail) = rest.split_at(n);
+                rest = tail;
+                n == parts[k].1.len() && holds(k, part)
+            })
+        };
+        let results =
+            evaluator.evaluate_checks(generation, &genomes, ELITE_CHECK_REFINE, &next, &wanted)?;
         if results.len() != genomes.len() {
             return Err(EvolveError::Evaluator(format!(
                 "{} results for {} genomes",

@@ -16,7 +16,9 @@ use super::fall::{Controller, write_falls};
 use super::primitives::PrimitiveRender;
 use super::{SceneError, write_output};
 use crate::evolve::ga::ELITE_CHECK;
-use crate::evolve::{Evaluator, FallProblem, GaConfig, InProcess, JsonLines, checkpoint, logbook};
+use crate::evolve::{
+    Evaluator, FallProblem, GaConfig, InProcessFalls, JsonLines, checkpoint, logbook,
+};
 use crate::experiments::evolve_fall::{
     Checkpointing, EvolutionRun, EvolveConfig, GroupOutcome, advance, best_falls, outcomes,
     problem_index, start,
@@ -167,12 +169,7 @@ impl EvolveFallScene {
             .iter()
             .map(|p| -> Result<Box<dyn Evaluator>, SceneError> {
                 match &self.evaluator {
-                    EvaluatorChoice::InProcess => {
-                        let p = p.clone();
-                        Ok(Box::new(InProcess {
-                            batch: move |g: &[Vec<f64>], refine: u32| p.evaluate(g, refine),
-                        }))
-                    }
+                    EvaluatorChoice::InProcess => Ok(Box::new(InProcessFalls::new(p.clone()))),
                     EvaluatorChoice::Command(argv) => {
                         let (prog, args) = argv
                             .split_first()

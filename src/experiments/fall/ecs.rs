@@ -8,6 +8,7 @@
 //! and taking the next fall as one finishes, from its own share of the batch and then from the
 //! others'; every fall has the bits it has alone in its own World, on any number of threads.
 
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 
 use bevy_ecs::prelude::*;
@@ -341,6 +342,17 @@ pub fn run_parallel_reacting(
     start: Option<&super::SettledStart>,
     reaction: Option<&ReactionStart>,
 ) -> Vec<Result<FallResult, Arc<SimError>>> {
+    run_parallel_until(configs, start, reaction, &AtomicBool::new(false)).expect("never stopped")
+}
+
+/// [`run_parallel_reacting`] that gives up as soon as `stop` is set (checked before every
+/// step of every World): `None` then, else every fall's result.
+pub fn run_parallel_until(
+    configs: &[FallConfig],
+    start: Option<&super::SettledStart>,
+    reaction: Option<&ReactionStart>,
+    stop: &AtomicBool,
+) -> Option<Vec<Result<FallResult, Arc<SimError>>>> {
     let fits = |k: usize| reaction.is_some_and(|r| r.fits(&configs[k]));
     // Falls of one time step and start share Worlds (one clock); usually there is one kind.
     let mut kinds: Vec<((u64, bool), Vec<usize>)> = Vec::new();
@@ -371,15 +383,19 @@ pub fn run_parallel_reacting(
         for (k, r) in pool
             .run(|w| {
                 let own = w.get_resource::<WorldSeed>().map_or(0, |s| s.index);
-                run_queue(w, &members, &|| queue.take(own), &spawn)
+                run_queue(w, &members, &|| queue.take(own), &spawn, stop)
             })
             .into_iter()
             .flatten()
         {
             out[k] = Some(r);
         }
+        if stop.load(Ordering::Relaxed) {
+            return None;
+        }
     }
-    out.into_iter()
+    let out = out
+        .into_iter()
         .map(|r| {
             r.unwrap_or_else(|| {
                 Err(Arc::new(SimError::Config {
@@ -388,7 +404,8 @@ pub fn run_parallel_reacting(
                 }))
             })
         })
-        .collect()
+        .collect();
+    Some(out)
 }
 
 /// The falls of a batch shared among the Worlds of a pool: each World has its own share (the
@@ -443,11 +460,16 @@ fn run_queue(
     members: &[usize],
     take: &impl Fn() -> Option<usize>,
     spawn: &(impl Fn(&mut World, usize) -> Result<Entity, SimError> + Sync),
+    stop: &AtomicBool,
 ) -> Vec<(usize, Result<FallResult, Arc<SimError>>)> {
     let mut schedule = fall_schedule();
     let mut live: Vec<(usize, Entity)> = Vec::with_capacity(LANES);
     let mut out = Vec::new();
     loop {
+        if stop.load(Ordering::Relaxed) {
+            // Given up: what is left in the World is dropped with it.
+            return out;
+        }
         while live.len() < LANES {
             let Some(&k) = take().and_then(|j| members.get(j)) else {
                 break;
