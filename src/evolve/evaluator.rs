@@ -73,9 +73,9 @@ pub trait Evaluator {
     /// an evaluator may start on `ahead`, the children the next generation evaluates (at
     /// refinement 1) if the checks change nothing, which `wanted` tells from the checks'
     /// evaluations; it then answers that next [`Self::evaluate`] from what it found, if the
-    /// genomes asked for are `ahead`'s bit for bit. An evaluation depends on nothing but its
-    /// genome and refinement, so this changes when results are computed, never what they are.
-    /// The default evaluates the checks only.
+    /// genomes asked for are `ahead`'s bit for bit. Only an evaluator whose results depend on
+    /// nothing but the genome and the refinement (as a fall's do) may look ahead: it changes
+    /// when results are computed, never what they are. The default evaluates the checks only.
     fn evaluate_checks(
         &mut self,
         generation: u64,

@@ -110,7 +110,7 @@ pub fn advance(
         let generation = broods.iter().map(|b| b.1.generation).max().unwrap_or(0);
         let parts: Vec<(usize, Vec<Genome>)> =
             broods.iter().map(|(i, b)| (*i, b.to_evaluate())).collect();
-        let results = evaluate_by_owner(evaluators, &owner, generation, &parts, 1)?;
+        let results = evaluate_by_owner(evaluators, &owner, generation, &parts, Batch::Children)?;
         for ((i, brood), r) in broods.into_iter().zip(results) {
             runs[i].state.receive(brood, r)?;
         }
@@ -141,14 +141,13 @@ pub fn advance(
                     Some((i, brood.to_evaluate()))
                 })
                 .collect();
-            let results = evaluate_checks_by_owner(
-                evaluators,
-                &owner,
-                generation,
-                &parts,
-                &ahead,
-                &|k, r| runs[todo[k].0].state.checks_hold(&todo[k].1, r),
-            )?;
+            let holds =
+                |k: usize, r: &[Evaluation]| runs[todo[k].0].state.checks_hold(&todo[k].1, r);
+            let checks = Batch::Checks {
+                ahead: &ahead,
+                holds: &holds,
+            };
+            let results = evaluate_by_owner(evaluators, &owner, generation, &parts, checks)?;
             for ((i, idx), r) in todo.iter().zip(results) {
                 runs[*i].state.receive_checks(idx, r)?;
             }
@@ -168,14 +167,27 @@ pub fn advance(
     Ok(())
 }
 
+/// What [`evaluate_by_owner`] evaluates: a generation's children at the problems' own
+/// resolution, or elite checks at [`ELITE_CHECK_REFINE`] with `ahead` (run index, the genomes
+/// its next generation evaluates if its checks hold) for the evaluators to work on meanwhile
+/// ([`Evaluator::evaluate_checks`]) and `holds(k, results)` telling whether the checks of part
+/// `k` hold.
+enum Batch<'a> {
+    Children,
+    Checks {
+        ahead: &'a [(usize, Vec<Genome>)],
+        holds: &'a (dyn Fn(usize, &[Evaluation]) -> bool + Sync),
+    },
+}
+
 /// Evaluates `parts` (run index, genomes), all the parts of one evaluator (`owner[run]`) in one
-/// batch at `refine`; returns each part's evaluations, in the order of `parts`.
+/// batch; returns each part's evaluations, in the order of `parts`.
 fn evaluate_by_owner(
     evaluators: &mut [Box<dyn Evaluator>],
     owner: &[usize],
     generation: u64,
     parts: &[(usize, Vec<Genome>)],
-    refine: u32,
+    batch: Batch,
 ) -> Result<Vec<Vec<Evaluation>>, EvolveError> {
     let mut out: Vec<Vec<Evaluation>> = vec![Vec::new(); parts.len()];
     for (e, evaluator) in evaluators.iter_mut().enumerate() {
@@ -186,60 +198,32 @@ fn evaluate_by_owner(
         if genomes.is_empty() {
             continue;
         }
-        let results = evaluator.evaluate(generation, &genomes, refine)?;
-        if results.len() != genomes.len() {
-            return Err(EvolveError::Evaluator(format!(
-                "{} results for {} genomes",
-                results.len(),
-                genomes.len()
-            )));
-        }
-        let mut all = results.into_iter();
-        for k in mine {
-            out[k] = all.by_ref().take(parts[k].1.len()).collect();
-        }
-    }
-    Ok(out)
-}
-
-/// The elite checks `parts` (run index, genomes) at [`ELITE_CHECK_REFINE`], all the parts of
-/// one evaluator in one batch as [`evaluate_by_owner`] does, each evaluator given its runs' part
-/// of `ahead` (run index, the genomes its next generation evaluates if its checks hold) to work
-/// on meanwhile ([`Evaluator::evaluate_checks`]); `holds(k, results)` tells whether the checks
-/// of part `k` hold.
-fn evaluate_checks_by_owner(
-    evaluators: &mut [Box<dyn Evaluator>],
-    owner: &[usize],
-    generation: u64,
-    parts: &[(usize, Vec<Genome>)],
-    ahead: &[(usize, Vec<Genome>)],
-    holds: &(dyn Fn(usize, &[Evaluation]) -> bool + Sync),
-) -> Result<Vec<Vec<Evaluation>>, EvolveError> {
-    let mut out: Vec<Vec<Evaluation>> = vec![Vec::new(); parts.len()];
-    for (e, evaluator) in evaluators.iter_mut().enumerate() {
-        let mine: Vec<usize> = (0..parts.len())
-            .filter(|&k| owner[parts[k].0] == e)
-            .collect();
-        let genomes: Vec<Genome> = mine.iter().flat_map(|&k| parts[k].1.clone()).collect();
-        if genomes.is_empty() {
-            continue;
-        }
-        let next: Vec<Genome> = ahead
-            .iter()
-            .filter(|a| owner[a.0] == e)
-            .flat_map(|a| a.1.clone())
-            .collect();
-        let wanted = |results: &[Evaluation]| {
-            let mut rest = results;
-            mine.iter().all(|&k| {
-                let n = parts[k].1.len().min(rest.len());
-                let (part, tail) = rest.split_at(n);
-                rest = tail;
-                n == parts[k].1.len() && holds(k, part)
-            })
+        let results = match batch {
+            Batch::Children => evaluator.evaluate(generation, &genomes, 1)?,
+            Batch::Checks { ahead, holds } => {
+                let next: Vec<Genome> = ahead
+                    .iter()
+                    .filter(|a| owner[a.0] == e)
+                    .flat_map(|a| a.1.clone())
+                    .collect();
+                let wanted = |results: &[Evaluation]| {
+                    let mut rest = results;
+                    mine.iter().all(|&k| {
+                        let n = parts[k].1.len().min(rest.len());
+                        let (part, tail) = rest.split_at(n);
+                        rest = tail;
+                        n == parts[k].1.len() && holds(k, part)
+                    })
+                };
+                evaluator.evaluate_checks(
+                    generation,
+                    &genomes,
+                    ELITE_CHECK_REFINE,
+                    &next,
+                    &wanted,
+                )?
+            }
         };
-        let results =
-            evaluator.evaluate_checks(generation, &genomes, ELITE_CHECK_REFINE, &next, &wanted)?;
         if results.len() != genomes.len() {
             return Err(EvolveError::Evaluator(format!(
                 "{} results for {} genomes",
