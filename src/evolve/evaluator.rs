@@ -69,6 +69,12 @@ pub trait Evaluator {
         refine: u32,
     ) -> Result<Vec<Evaluation>, EvolveError>;
 
+    /// Whether [`Self::evaluate_checks`] works on its `ahead` genomes (else the GA does not
+    /// breed them for it). The default: no.
+    fn looks_ahead(&self) -> bool {
+        false
+    }
+
     /// The elite checks of `generation`: [`Self::evaluate`] of `checks` at `refine`. Meanwhile
     /// an evaluator may start on `ahead`, the children the next generation evaluates (at
     /// refinement 1) if the checks change nothing, which `wanted` tells from the checks'
@@ -156,6 +162,10 @@ impl Evaluator for InProcessFalls {
             return Ok(r);
         }
         Ok(self.problem.evaluate(genomes, refine))
+    }
+
+    fn looks_ahead(&self) -> bool {
+        true
     }
 
     fn evaluate_checks(

@@ -135,6 +135,7 @@ pub fn advance(
             // generation's batch asks for it (a run that ends here asks for nothing).
             let ahead: Vec<(usize, Vec<Genome>)> = active
                 .iter()
+                .filter(|&&i| evaluators[owner[i]].looks_ahead())
                 .filter_map(|&i| {
                     let idx = todo.iter().find(|t| t.0 == i).map_or(&[][..], |t| &t.1[..]);
                     let brood = runs[i].state.brood_if_checks_hold(idx)?;
