@@ -93,7 +93,8 @@ pub struct EvolveFallScene {
     /// Generations between checkpoints.
     #[serde(default = "default_every")]
     pub checkpoint_every: u64,
-    /// Folder of the checkpoint (default `out/<name>.checkpoint`).
+    /// Folder of the checkpoint (default: beside the output folder, `<out>.checkpoint`; for
+    /// the default output `out/<name>/`, `out/<name>.checkpoint`).
     #[serde(default)]
     pub checkpoint_dir: Option<String>,
     /// Continue from the checkpoint in this folder (`marionette run … --resume DIR`).
@@ -293,21 +294,33 @@ fn controller_ron(problem: &FallProblem, genes: &[f64]) -> Result<String, SceneE
     ))
 }
 
-/// Runs an [`EvolveFallScene`]; returns the report.
+/// The default checkpoint folder of a run into `out_dir`: beside it, `<out_dir>.checkpoint`
+/// (`out/<name>.checkpoint` if `out_dir` has no folder name of its own, e.g. `.`).
+pub fn default_checkpoint_dir(scene: &EvolveFallScene, out_dir: &Path) -> PathBuf {
+    match out_dir.file_name() {
+        Some(name) => {
+            let mut name = name.to_os_string();
+            name.push(".checkpoint");
+            out_dir.with_file_name(name)
+        }
+        None => PathBuf::from(format!("out/{}.checkpoint", scene.name)),
+    }
+}
+
+/// Runs an [`EvolveFallScene`] whose outputs are written into `out` (the staging folder of the
+/// output folder `out_dir`, [`super::run`]); returns the report.
 pub fn run_evolve(
     scene: &EvolveFallScene,
     _base: &Path,
     out: &Path,
+    out_dir: &Path,
 ) -> Result<serde_json::Value, SceneError> {
     let config = scene.config()?;
     let mut evaluators = scene.evaluators(&config)?;
-    let ck_dir = PathBuf::from(
-        scene
-            .resume
-            .clone()
-            .or_else(|| scene.checkpoint_dir.clone())
-            .unwrap_or_else(|| format!("out/{}.checkpoint", scene.name)),
-    );
+    let ck_dir = match scene.resume.as_ref().or(scene.checkpoint_dir.as_ref()) {
+        Some(dir) => PathBuf::from(dir),
+        None => default_checkpoint_dir(scene, out_dir),
+    };
     let started = Instant::now();
     let mut runs: Vec<EvolutionRun> = match &scene.resume {
         Some(_) => {
@@ -536,6 +549,16 @@ mod tests {
             evaluator: EvaluatorChoice::InProcess,
             render: PrimitiveRender::default(),
         }
+    }
+
+    #[test]
+    fn the_checkpoint_sits_beside_the_output_folder() {
+        let s = scene(STEP_MARGIN, 1.0);
+        let ck = |out: &str| default_checkpoint_dir(&s, Path::new(out));
+        assert_eq!(ck("out/t"), PathBuf::from("out/t.checkpoint"));
+        assert_eq!(ck("out/t/"), PathBuf::from("out/t.checkpoint"));
+        assert_eq!(ck("/tmp/quick"), PathBuf::from("/tmp/quick.checkpoint"));
+        assert_eq!(ck("."), PathBuf::from("out/t.checkpoint"));
     }
 
     #[test]

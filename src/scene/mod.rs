@@ -425,7 +425,7 @@ pub fn run(scene: &Scene, base: &Path, out_dir: &Path) -> Result<serde_json::Val
         Scene::JumpingKneeKick(s) => run_jumping_knee_kick(s, base, tmp)?,
         Scene::Fall(s) => run_fall(s, base, tmp)?,
         Scene::ActiveKneeKick(s) => run_active_knee_kick(s, base, tmp)?,
-        Scene::EvolveFall(s) => run_evolve(s, base, tmp)?,
+        Scene::EvolveFall(s) => run_evolve(s, base, tmp, out_dir)?,
         Scene::Dance(s) => run_dance(s, base, tmp)?,
     };
     if let Some(o) = report.as_object_mut() {
