@@ -119,8 +119,8 @@ impl<F: Fn(&[Genome], u32) -> Vec<Evaluation>> Evaluator for InProcess<F> {
 /// next generation's falls run on the others meanwhile and are given up as soon as a check
 /// changes the next generation.
 pub struct InProcessFalls {
-    /// The problem.
-    pub problem: FallProblem,
+    /// The problem (private: what was evaluated ahead holds for it alone).
+    problem: FallProblem,
     /// Batches answered from the look-ahead so far (generations whose falls ran alongside
     /// their parents' elite checks).
     pub answered_ahead: u64,
@@ -136,6 +136,11 @@ impl InProcessFalls {
             answered_ahead: 0,
             ahead: None,
         }
+    }
+
+    /// The problem.
+    pub fn problem(&self) -> &FallProblem {
+        &self.problem
     }
 }
 
