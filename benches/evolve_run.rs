@@ -2,9 +2,9 @@
 //! problem, seed 1, 30 chromosomes × 500 generations as `scenes/evolve_fall.ron` runs it (two
 //! elites kept, children that copy an evaluated parent inheriting its fitness, the elites
 //! checked at half the step), evaluated in process on a rayon pool of 2 threads as the scene
-//! does ([`InProcessFalls`]: the next generation's falls run alongside each elite check). Unlike the
-//! generation bench of `benches/evolve.rs` (the initial population), it includes the evolved
-//! generations, whose falls last longer before they rest. Each iteration starts from a fresh
+//! does ([`InProcessFalls`]: the next generation's falls run alongside each elite check).
+//! Unlike the generation bench of `benches/evolve.rs` (the initial population), it includes
+//! the evolved generations, whose falls last longer before they rest. Each iteration starts from a fresh
 //! problem (the standing body settled once, as in a run). One iteration takes about 1.5 min, so
 //! the 10 samples take about 15–20 minutes.
 //! Run: `cargo bench --bench evolve_run`.

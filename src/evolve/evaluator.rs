@@ -187,18 +187,19 @@ impl Evaluator for InProcessFalls {
             return Ok(p.evaluate(checks, refine));
         }
         let stop = AtomicBool::new(false);
-        let (done, next) = rayon::join(
+        let ((done, hold), next) = rayon::join(
             || {
                 let r = p.evaluate(checks, refine);
-                if !wanted(&r) {
+                let hold = wanted(&r);
+                if !hold {
                     stop.store(true, Ordering::Relaxed);
                 }
-                r
+                (r, hold)
             },
             || p.evaluate_until(ahead, 1, &stop),
         );
         if let Some(next) = next
-            && wanted(&done)
+            && hold
         {
             self.ahead = Some((ahead.to_vec(), next));
         }

@@ -237,10 +237,10 @@ impl FallProblem {
     }
 
     /// The damage of every genome, the falls in parallel Worlds (up to four at a time in each,
-    /// [`run_parallel_reacting`](crate::experiments::fall::ecs::run_parallel_reacting)), at the problem's
-    /// time step divided by `refine` (1: the problem's own step); the standing body is settled
-    /// once per step for the whole run (the genes do not change how it stands; the same bits as
-    /// settling each fall).
+    /// [`run_parallel_reacting`](crate::experiments::fall::ecs::run_parallel_reacting)), at
+    /// the problem's time step divided by `refine` (1: the problem's own step); the standing
+    /// body is settled once per step for the whole run (the genes do not change how it stands;
+    /// the same bits as settling each fall).
     pub fn evaluate(&self, genomes: &[Genome], refine: u32) -> Vec<Evaluation> {
         self.evaluate_until(genomes, refine, &AtomicBool::new(false))
             .expect("never stopped")
