@@ -119,6 +119,40 @@ pub fn plot(plot: &Plot, path: &Path) -> Result<(), RenderError> {
     write(path, &bytes)
 }
 
+/// The label of tick `v` on an axis of counts: the whole number it is (within rounding of the
+/// tick arithmetic), nothing between two whole numbers.
+fn whole_label(v: f64) -> String {
+    let r = v.round();
+    if (v - r).abs() <= 1e-9 * r.abs().max(1.0) {
+        // `+ 0.0` turns a −0 into 0.
+        format!("{}", r + 0.0)
+    } else {
+        String::new()
+    }
+}
+
+/// The decimals that tell apart the ticks of an axis spanning `span`: its labelled ticks are
+/// at least a tenth of the span apart, at 1, 2 or 5 times a power of ten.
+fn decimals_for(span: f64) -> usize {
+    if !(span > 0.0 && span.is_finite()) {
+        return 0;
+    }
+    (-(span / 10.0).log10().floor()).clamp(0.0, 9.0) as usize
+}
+
+/// Tick `v` with `decimals` decimals (no "−0").
+fn fixed_label(v: f64, decimals: usize) -> String {
+    let s = format!("{v:.decimals$}");
+    if s.trim_start_matches('-')
+        .chars()
+        .all(|c| c == '0' || c == '.')
+    {
+        s.trim_start_matches('-').to_string()
+    } else {
+        s
+    }
+}
+
 fn plot_err<E: std::fmt::Display>(e: E) -> RenderError {
     RenderError::Encode(format!("plot: {e}"))
 }
@@ -267,9 +301,23 @@ fn draw<DB: DrawingBackend>(
         .y_label_area_size(84 * k)
         .build_cartesian_2d(x.0..x.1, y.0..y.1)
         .map_err(plot_err)?;
-    chart
-        .configure_mesh()
-        .x_desc(plot.x_label.as_str())
+    // An axis of counts (generations, bars, frames: every x whole) is labelled with whole
+    // numbers only; otherwise each axis with the decimals its tick spacing needs (no "5000.0").
+    let counts =
+        pts().all(|p| p.0.fract() == 0.0) && plot.markers.iter().all(|m| m.0.fract() == 0.0);
+    let (dx, dy) = (decimals_for(x.1 - x.0), decimals_for(y.1 - y.0));
+    let x_labels = |v: &f64| {
+        if counts {
+            whole_label(*v)
+        } else {
+            fixed_label(*v, dx)
+        }
+    };
+    let y_labels = |v: &f64| fixed_label(*v, dy);
+    let mut mesh = chart.configure_mesh();
+    mesh.x_label_formatter(&x_labels)
+        .y_label_formatter(&y_labels);
+    mesh.x_desc(plot.x_label.as_str())
         .y_desc(plot.y_label.as_str())
         .axis_desc_style(font(19))
         .label_style(font(16))
@@ -395,6 +443,88 @@ mod tests {
             pos,
             SeriesLabelPosition::UpperLeft | SeriesLabelPosition::LowerRight
         ));
+    }
+
+    /// The tick labels of an SVG plot (the text of its `<text>` elements that parse as numbers).
+    fn numeric_labels(plot_: &Plot, name: &str) -> Vec<String> {
+        let path =
+            std::env::temp_dir().join(format!("marionette-{}-{name}.svg", std::process::id()));
+        plot(plot_, &path).unwrap();
+        let svg = std::fs::read_to_string(&path).unwrap();
+        let _ = std::fs::remove_file(&path);
+        svg.split("<text")
+            .skip(1)
+            .filter_map(|t| {
+                let s = t.split_once('>')?.1.split_once('<')?.0.trim();
+                s.parse::<f64>().is_ok().then(|| s.to_string())
+            })
+            .collect()
+    }
+
+    #[test]
+    fn an_axis_of_counts_is_labelled_with_whole_numbers() {
+        assert_eq!(whole_label(4.000_000_000_000_001), "4");
+        assert_eq!(whole_label(-0.0), "0");
+        assert_eq!(whole_label(2.5), "");
+        assert_eq!(
+            (
+                decimals_for(20_000.0),
+                decimals_for(3.0),
+                decimals_for(0.02)
+            ),
+            (0, 1, 3)
+        );
+        assert_eq!(fixed_label(-0.0001, 2), "0.00");
+        assert_eq!(fixed_label(0.25, 1), "0.2");
+        // Fitness over 20 generations: whole generations on the x axis.
+        let gens = Plot {
+            series: vec![Series {
+                name: "best".into(),
+                points: (0..=20)
+                    .map(|g| (g as f64, 1000.0 - 3.0 * g as f64))
+                    .collect(),
+            }],
+            ..Plot::default()
+        };
+        let labels = numeric_labels(&gens, "counts");
+        // The damages are near 1000: every label from 0 to 20 is a generation's.
+        let x: Vec<&String> = labels
+            .iter()
+            .filter(|l| (0.0..=20.0).contains(&l.parse::<f64>().unwrap()))
+            .collect();
+        assert!(x.iter().any(|l| *l == "10"), "{labels:?}");
+        assert!(x.iter().all(|l| !l.contains('.')), "{labels:?}");
+        // Over 2 generations the ticks between whole ones are left blank.
+        let short = Plot {
+            series: vec![Series {
+                name: "best".into(),
+                points: vec![(0.0, 5.0), (1.0, 4.0), (2.0, 3.5)],
+            }],
+            ..Plot::default()
+        };
+        let labels = numeric_labels(&short, "short");
+        for g in ["0", "1", "2"] {
+            assert!(labels.iter().any(|l| l == g), "{g} in {labels:?}");
+        }
+        let x = labels
+            .iter()
+            .filter(|l| (0.0..=2.0).contains(&l.parse::<f64>().unwrap()));
+        assert!(x.clone().all(|l| !l.contains('.')), "{labels:?}");
+        // Time in seconds keeps its fractions.
+        let time = Plot {
+            series: vec![Series {
+                name: "height".into(),
+                points: (0..=30).map(|k| (k as f64 * 0.1, 100.0)).collect(),
+            }],
+            ..Plot::default()
+        };
+        // The heights are near 100: every label below 3 is a time's.
+        let labels = numeric_labels(&time, "time");
+        let fractions = labels.iter().filter(|l| {
+            let v = l.parse::<f64>().unwrap();
+            v > 0.0 && v < 3.0 && v.fract() != 0.0
+        });
+        assert!(fractions.count() >= 2, "{labels:?}");
     }
 
     #[test]
