@@ -631,8 +631,11 @@ fn running_the_next_generation_alongside_the_elite_checks_changes_no_bit() {
                 );
             }
             // Both runs advanced together, their checks and look-ahead in one batch.
-            let mut shared: Vec<Box<dyn Evaluator>> =
-                vec![Box::new(InProcessFalls::new(p.clone()))];
+            let ahead = std::sync::Arc::new(std::sync::atomic::AtomicU64::new(0));
+            let mut shared: Vec<Box<dyn Evaluator>> = vec![Box::new(Publishing {
+                inner: InProcessFalls::new(p.clone()),
+                answered_ahead: ahead.clone(),
+            })];
             let mut runs: Vec<EvolutionRun> = [21, 22]
                 .into_iter()
                 .map(|seed| EvolutionRun {
@@ -649,6 +652,58 @@ fn running_the_next_generation_alongside_the_elite_checks_changes_no_bit() {
                     "advanced together on {threads} thread(s)"
                 );
             }
+            assert!(
+                ahead.load(std::sync::atomic::Ordering::Relaxed) > 0,
+                "advanced together: no generation looked ahead"
+            );
         });
+    }
+}
+
+/// [`InProcessFalls`] behind the `dyn Evaluator` that [`advance`] takes, publishing how many
+/// generations it answered ahead.
+struct Publishing {
+    inner: InProcessFalls,
+    answered_ahead: std::sync::Arc<std::sync::atomic::AtomicU64>,
+}
+
+impl Publishing {
+    fn publish(&self) {
+        self.answered_ahead.store(
+            self.inner.answered_ahead,
+            std::sync::atomic::Ordering::Relaxed,
+        );
+    }
+}
+
+impl Evaluator for Publishing {
+    fn evaluate(
+        &mut self,
+        generation: u64,
+        genomes: &[Genome],
+        refine: u32,
+    ) -> Result<Vec<Evaluation>, marionette::evolve::EvolveError> {
+        let r = self.inner.evaluate(generation, genomes, refine);
+        self.publish();
+        r
+    }
+
+    fn looks_ahead(&self) -> bool {
+        self.inner.looks_ahead()
+    }
+
+    fn evaluate_checks(
+        &mut self,
+        generation: u64,
+        checks: &[Genome],
+        refine: u32,
+        ahead: &[Genome],
+        wanted: &(dyn Fn(&[Evaluation]) -> bool + Sync),
+    ) -> Result<Vec<Evaluation>, marionette::evolve::EvolveError> {
+        let r = self
+            .inner
+            .evaluate_checks(generation, checks, refine, ahead, wanted);
+        self.publish();
+        r
     }
 }
