@@ -191,15 +191,17 @@ fn passes(
     let (accs, ias, pas) = (&mut a[..n], &mut ia[..n], &mut pa[..n]);
     let (us, dinvs, uus) = (&mut u[..n], &mut dinv[..n], &mut uu[..n]);
     // Lanes whose joint structure differs (not bodies of one model) are each taken alone.
-    let uniform = (0..n).all(|i| {
+    // (A loop, not `all`: an iterator adaptor left out of line would run without AVX2.)
+    let mut uniform = true;
+    for (i, rot) in rots.iter_mut().enumerate() {
         match Rotation4::gather(std::array::from_fn(|l| &data[l].xup_rotation[i])) {
-            Some(r) => {
-                rots[i] = r;
-                true
+            Some(r) => *rot = r,
+            None => {
+                uniform = false;
+                break;
             }
-            None => false,
         }
-    });
+    }
     if !uniform {
         for (l, d) in data.into_iter().enumerate() {
             aba_passes(model, d, tau[l], f_ext[l], armature[l], &[]);

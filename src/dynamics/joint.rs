@@ -182,7 +182,7 @@ impl JointType {
 
     /// `jcalc`: returns `(X_J, v_J, c_J)` and writes the motion-subspace columns into `s`
     /// (unused for a free joint, whose `S` is the 6×6 identity).
-    #[inline]
+    #[inline(always)]
     pub fn jcalc(
         &self,
         q: &[f64],

@@ -587,13 +587,13 @@ impl Inertia4 {
     /// `I −= U D⁻¹ Uᵀ` for `N` columns ([`ArticulatedInertia::sub_u_dinv_ut`]).
     #[inline(always)]
     pub fn sub_u_dinv_ut<const N: usize>(&mut self, u: &[Force4; N], dinv: &M3) {
-        let w: [Force4; N] = std::array::from_fn(|j| {
-            let mut wj = Force4::ZERO;
+        // Loops, not `array::from_fn`: its closure left out of line would run without AVX2.
+        let mut w = [Force4::ZERO; N];
+        for (j, wj) in w.iter_mut().enumerate() {
             for (k, uk) in u.iter().enumerate() {
-                wj += *uk * dinv.col(j).get(k);
+                *wj += *uk * dinv.col(j).get(k);
             }
-            wj
-        });
+        }
         self.sub_products(&w, u);
     }
 
@@ -606,10 +606,8 @@ impl Inertia4 {
         let h1 = rotation.conjugate(e, &self.h);
         let l1 = rotation.conjugate_symmetric(e, &self.l);
         let r = x.trans;
-        let cross_cols =
-            |a: M3| M3::from_cols(r.cross(a.x_axis), r.cross(a.y_axis), r.cross(a.z_axis));
-        let rl = cross_cols(l1);
-        let rh = cross_cols(h1.transpose());
+        let rl = cross_cols(r, l1);
+        let rh = cross_cols(r, h1.transpose());
         let rlr = |row: V3, j: usize| match j {
             0 => row.y * r.z - row.z * r.y,
             1 => row.z * r.x - row.x * r.z,
@@ -657,6 +655,13 @@ fn sub_symmetric<const N: usize>(a: &mut M3, x: &[V3; N], y: &[V3; N]) {
         }
         e
     });
+}
+
+/// `[r]× A`, column by column (a function, not a closure: inlined into the AVX2 step, where
+/// a closure left out of line ran without AVX2).
+#[inline(always)]
+fn cross_cols(r: V3, a: M3) -> M3 {
+    M3::from_cols(r.cross(a.x_axis), r.cross(a.y_axis), r.cross(a.z_axis))
 }
 
 /// The symmetric matrix of the upper entries `entry(r, c)`, `r ≤ c`.
