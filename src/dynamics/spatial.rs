@@ -414,17 +414,20 @@ impl ArticulatedInertia {
     /// `I − U D⁻¹ Uᵀ` for `n ≤ 3` force columns `U` and the inverse `D⁻¹` (n×n block of `dinv`).
     #[inline(always)]
     pub fn sub_u_dinv_ut(&mut self, u: &[ForceVec], dinv: &DMat3) {
+        // Inlined, with loops rather than `array::from_fn`: out of line, the physics step's
+        // AVX2 copy would call it compiled without AVX2.
+        #[inline(always)]
         fn go<const N: usize>(ia: &mut ArticulatedInertia, u: &[ForceVec], dinv: &DMat3) {
-            let u: [ForceVec; N] = std::array::from_fn(|k| u[k]);
+            let mut cols = [ForceVec::ZERO; N];
+            cols.copy_from_slice(&u[..N]);
             // w_j = Σ_k U_k D⁻¹_kj
-            let w: [ForceVec; N] = std::array::from_fn(|j| {
-                let mut wj = ForceVec::ZERO;
-                for (k, uk) in u.iter().enumerate() {
-                    wj += *uk * dinv.col(j)[k];
+            let mut w = [ForceVec::ZERO; N];
+            for (j, wj) in w.iter_mut().enumerate() {
+                for (k, uk) in cols.iter().enumerate() {
+                    *wj += *uk * dinv.col(j)[k];
                 }
-                wj
-            });
-            ia.sub_products(&w, &u);
+            }
+            ia.sub_products(&w, &cols);
         }
         match u.len() {
             0 => {}
