@@ -688,16 +688,12 @@ impl Evaluator for Publishing {
         r
     }
 
-    fn looks_ahead(&self) -> bool {
-        self.inner.looks_ahead()
-    }
-
     fn evaluate_checks(
         &mut self,
         generation: u64,
         checks: &[Genome],
         refine: u32,
-        ahead: &[Genome],
+        ahead: &dyn Fn() -> Vec<Genome>,
         wanted: &(dyn Fn(&[Evaluation]) -> bool + Sync),
     ) -> Result<Vec<Evaluation>, marionette::evolve::EvolveError> {
         let r = self

@@ -69,25 +69,20 @@ pub trait Evaluator {
         refine: u32,
     ) -> Result<Vec<Evaluation>, EvolveError>;
 
-    /// Whether [`Self::evaluate_checks`] works on its `ahead` genomes (else the GA does not
-    /// breed them for it). The default: no.
-    fn looks_ahead(&self) -> bool {
-        false
-    }
-
     /// The elite checks of `generation`: [`Self::evaluate`] of `checks` at `refine`. Meanwhile
-    /// an evaluator may start on `ahead`, the children the next generation evaluates (at
-    /// refinement 1) if the checks change nothing, which `wanted` tells from the checks'
-    /// evaluations; it then answers that next [`Self::evaluate`] from what it found, if the
-    /// genomes asked for are `ahead`'s bit for bit. Only an evaluator whose results depend on
-    /// nothing but the genome and the refinement (as a fall's do) may look ahead: it changes
-    /// when results are computed, never what they are. The default evaluates the checks only.
+    /// an evaluator may start on `ahead()`, the children the next generation evaluates (at
+    /// refinement 1) if the checks change nothing (bred only when called), which `wanted`
+    /// tells from the checks' evaluations; it then answers that next [`Self::evaluate`] from
+    /// what it found, if the genomes asked for are those bit for bit. Only an evaluator whose
+    /// results depend on nothing but the genome and the refinement (as a fall's do) may look
+    /// ahead: it changes when results are computed, never what they are. The default
+    /// evaluates the checks only (and breeds nothing).
     fn evaluate_checks(
         &mut self,
         generation: u64,
         checks: &[Genome],
         refine: u32,
-        ahead: &[Genome],
+        ahead: &dyn Fn() -> Vec<Genome>,
         wanted: &(dyn Fn(&[Evaluation]) -> bool + Sync),
     ) -> Result<Vec<Evaluation>, EvolveError> {
         let _ = (ahead, wanted);
@@ -169,20 +164,17 @@ impl Evaluator for InProcessFalls {
         Ok(self.problem.evaluate(genomes, refine))
     }
 
-    fn looks_ahead(&self) -> bool {
-        true
-    }
-
     fn evaluate_checks(
         &mut self,
         _: u64,
         checks: &[Genome],
         refine: u32,
-        ahead: &[Genome],
+        ahead: &dyn Fn() -> Vec<Genome>,
         wanted: &(dyn Fn(&[Evaluation]) -> bool + Sync),
     ) -> Result<Vec<Evaluation>, EvolveError> {
         self.ahead = None;
         let p = &self.problem;
+        let ahead = ahead();
         if ahead.is_empty() {
             return Ok(p.evaluate(checks, refine));
         }
@@ -196,12 +188,12 @@ impl Evaluator for InProcessFalls {
                 }
                 (r, hold)
             },
-            || p.evaluate_until(ahead, 1, &stop),
+            || p.evaluate_until(&ahead, 1, &stop),
         );
         if let Some(next) = next
             && hold
         {
-            self.ahead = Some((ahead.to_vec(), next));
+            self.ahead = Some((ahead, next));
         }
         Ok(done)
     }

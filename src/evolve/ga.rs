@@ -272,12 +272,10 @@ impl GaState {
                 break;
             }
             let genomes: Vec<Genome> = todo.iter().map(|&i| self.population[i].clone()).collect();
-            // The next brood, bred only for an evaluator that works on it.
-            let ahead = if evaluator.looks_ahead() {
+            // The next brood, bred only if the evaluator asks for it.
+            let ahead = || {
                 self.brood_if_checks_hold(&todo)
                     .map_or_else(Vec::new, |b| b.to_evaluate())
-            } else {
-                Vec::new()
             };
             let wanted = |r: &[Evaluation]| self.checks_hold(&todo, r);
             let results = evaluator.evaluate_checks(

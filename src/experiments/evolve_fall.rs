@@ -131,17 +131,21 @@ pub fn advance(
                     (*i, idx.iter().map(|&k| pop[k].clone()).collect())
                 })
                 .collect();
-            // What each run evaluates next if its checks hold, in the order the next
-            // generation's batch asks for it (a run that ends here asks for nothing).
-            let ahead: Vec<(usize, Vec<Genome>)> = active
-                .iter()
-                .filter(|&&i| evaluators[owner[i]].looks_ahead())
-                .filter_map(|&i| {
-                    let idx = todo.iter().find(|t| t.0 == i).map_or(&[][..], |t| &t.1[..]);
-                    let brood = runs[i].state.brood_if_checks_hold(idx)?;
-                    Some((i, brood.to_evaluate()))
-                })
-                .collect();
+            // What the runs of evaluator `e` evaluate next if their checks hold, in the order
+            // the next generation's batch asks for it (a run that ends here asks for nothing),
+            // bred only if that evaluator asks.
+            let ahead = |e: usize| -> Vec<Genome> {
+                active
+                    .iter()
+                    .filter(|&&i| owner[i] == e)
+                    .filter_map(|&i| {
+                        let idx = todo.iter().find(|t| t.0 == i).map_or(&[][..], |t| &t.1[..]);
+                        let brood = runs[i].state.brood_if_checks_hold(idx)?;
+                        Some(brood.to_evaluate())
+                    })
+                    .flatten()
+                    .collect()
+            };
             let holds =
                 |k: usize, r: &[Evaluation]| runs[todo[k].0].state.checks_hold(&todo[k].1, r);
             let checks = Batch::Checks {
@@ -169,14 +173,14 @@ pub fn advance(
 }
 
 /// What [`evaluate_by_owner`] evaluates: a generation's children at the problems' own
-/// resolution, or elite checks at [`ELITE_CHECK_REFINE`] with `ahead` (run index, the genomes
-/// its next generation evaluates if its checks hold) for the evaluators to work on meanwhile
-/// ([`Evaluator::evaluate_checks`]) and `holds(k, results)` telling whether the checks of part
-/// `k` hold.
+/// resolution, or elite checks at [`ELITE_CHECK_REFINE`] with `ahead(e)` (the genomes the runs
+/// of evaluator `e` evaluate next if their checks hold, bred when called) for the evaluators to
+/// work on meanwhile ([`Evaluator::evaluate_checks`]) and `holds(k, results)` telling whether
+/// the checks of part `k` hold.
 enum Batch<'a> {
     Children,
     Checks {
-        ahead: &'a [(usize, Vec<Genome>)],
+        ahead: &'a dyn Fn(usize) -> Vec<Genome>,
         holds: &'a (dyn Fn(usize, &[Evaluation]) -> bool + Sync),
     },
 }
@@ -202,11 +206,7 @@ fn evaluate_by_owner(
         let results = match batch {
             Batch::Children => evaluator.evaluate(generation, &genomes, 1)?,
             Batch::Checks { ahead, holds } => {
-                let next: Vec<Genome> = ahead
-                    .iter()
-                    .filter(|a| owner[a.0] == e)
-                    .flat_map(|a| a.1.clone())
-                    .collect();
+                let next = || ahead(e);
                 let wanted = |results: &[Evaluation]| {
                     let mut rest = results;
                     mine.iter().all(|&k| {
