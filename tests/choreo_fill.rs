@@ -71,8 +71,9 @@ fn a_fill_keeps_its_pins_and_assembles_into_a_dance_as_long_as_its_bars() {
     let n = db.segments.len();
     let p = FillParams::default();
     let pins = Pins::from([(2, 7), (3, 8), (9, n - 1), (13, 0)]);
-    let f = fill(&db, 16, &pins, &p).unwrap();
-    assert_eq!(f, fill_dijkstra(&db, 16, &pins, &p).unwrap());
+    let music: Vec<f64> = (0..16).map(|k| (k % 4) as f64 / 3.0).collect();
+    let f = fill(&db, &music, &pins, &p).unwrap();
+    assert_eq!(f, fill_dijkstra(&db, &music, &pins, &p).unwrap());
     assert_eq!(f.segments.len(), 16);
     assert_eq!(f.connections.len(), 15);
     for (&bar, &s) in &pins {
@@ -104,9 +105,10 @@ fn pins_past_the_end_or_to_missing_segments_are_refused() {
     let db = generated_database(4, 2, 4).unwrap();
     let n = db.segments.len();
     let p = FillParams::default();
-    let e = fill(&db, 8, &Pins::from([(8, 0)]), &p).unwrap_err();
+    let music = [0.5; 8];
+    let e = fill(&db, &music, &Pins::from([(8, 0)]), &p).unwrap_err();
     assert_eq!(e.to_string(), "pin on bar 8: the song has 8 bars (0 to 7)");
-    let e = fill(&db, 8, &Pins::from([(1, n)]), &p).unwrap_err();
+    let e = fill(&db, &music, &Pins::from([(1, n)]), &p).unwrap_err();
     assert!(
         e.to_string()
             .contains(&format!("segment {n} does not exist")),
@@ -117,7 +119,9 @@ fn pins_past_the_end_or_to_missing_segments_are_refused() {
         ..db.clone()
     };
     assert_eq!(
-        fill(&empty, 8, &Pins::new(), &p).unwrap_err().to_string(),
+        fill(&empty, &music, &Pins::new(), &p)
+            .unwrap_err()
+            .to_string(),
         "the dance database has no segments to fill bars with"
     );
 }
@@ -140,4 +144,64 @@ fn fig5_on_the_shared_dance_database() {
     };
     let o = run(&db, &DanceFillConfig::default()).unwrap();
     check_fig5(&o, "shared dance database");
+}
+
+/// The music term (issue 34): at κ = 0 the fill is the paper's; at the default κ the filled
+/// bars' motion intensity follows the music (Spearman ≥ 0.6 on a song whose loudness rises and
+/// falls), the music term's mismatch falls, and the DP still agrees with Dijkstra.
+#[test]
+fn the_music_term_makes_the_fill_follow_the_music_and_zero_is_the_paper_s_fill() {
+    use marionette::choreo::metrics::spearman;
+    use marionette::choreo::relevance::{motion_intensity, percentile_ranks};
+    let db = generated_database(21, 6, 8).unwrap();
+    let n = db.segments.len();
+    let bars = 24;
+    // A song louder and quieter in turn, every bar's level distinct.
+    let loudness: Vec<f64> = (0..bars)
+        .map(|k| (k as f64 * 0.7).sin() + 0.01 * k as f64)
+        .collect();
+    let music = percentile_ranks(&loudness);
+    let pins = Pins::from([(3, 5 % n), (17, 11 % n)]);
+    let paper = fill(&db, &music, &pins, &FillParams::paper()).unwrap();
+    let zero = FillParams {
+        intensity_weight: 0.0,
+        ..FillParams::default()
+    };
+    assert_eq!(paper, fill(&db, &music, &pins, &zero).unwrap());
+    // The paper's fill does not look at the music: any music gives the same path.
+    let flat = vec![0.5; bars];
+    assert_eq!(
+        paper.segments,
+        fill(&db, &flat, &pins, &FillParams::paper())
+            .unwrap()
+            .segments
+    );
+    let p = FillParams::default();
+    let follow = fill(&db, &music, &pins, &p).unwrap();
+    assert_eq!(follow, fill_dijkstra(&db, &music, &pins, &p).unwrap());
+    let motion = motion_intensity(&db);
+    let rho = |f: &[usize]| spearman(&music, &f.iter().map(|&s| motion[s]).collect::<Vec<_>>());
+    let (r0, r1) = (rho(&paper.segments), rho(&follow.segments));
+    eprintln!(
+        "Spearman {r0:.3} -> {r1:.3}; mismatch {:.3} -> {:.3}; seam cost {:.4} -> {:.4}",
+        paper.intensity_mismatch, follow.intensity_mismatch, paper.total_cost, follow.total_cost
+    );
+    assert!(r1 >= 0.6 && r1 > r0, "Spearman {r0} -> {r1}");
+    assert!(follow.intensity_mismatch < paper.intensity_mismatch);
+    // The paper's fill is the cheapest in seam cost; following the music costs some of it.
+    assert!(paper.total_cost <= follow.total_cost);
+    for (&bar, &s) in &pins {
+        assert_eq!(follow.segments[bar], s);
+    }
+    // Bad music ranks and κ are refused, naming the bar.
+    let mut bad = music.clone();
+    bad[4] = 1.5;
+    let e = fill(&db, &bad, &pins, &p).unwrap_err().to_string();
+    assert!(e.contains("bar 4") && e.contains("1.5"), "{e}");
+    let neg = FillParams {
+        intensity_weight: -1.0,
+        ..FillParams::default()
+    };
+    let e = fill(&db, &music, &pins, &neg).unwrap_err().to_string();
+    assert!(e.contains("intensity_weight"), "{e}");
 }

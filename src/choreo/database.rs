@@ -138,8 +138,9 @@ fn is_manifest(p: &Path) -> bool {
         .is_some_and(|t| crate::io::parse_ron::<Manifest>(&t, "").is_ok())
 }
 
-/// A clip on humanoid24: a BVH mapped with the detected mapping and retargeted, or a keyframed
-/// .ron clip, set on its floor ([`grounded`]).
+/// A clip on humanoid24: a BVH mapped with the detected mapping, retargeted and played on
+/// humanoid24's own proportions with its root path scaled by the ratio of the leg lengths
+/// ([`crate::mapping::onto_model`]), or a keyframed .ron clip; set on its floor ([`grounded`]).
 pub fn load_model_clip(path: &Path) -> Result<ModelClip, SegmentError> {
     load_unground(path).map(grounded)
 }
@@ -178,7 +179,11 @@ fn load_unground(path: &Path) -> Result<ModelClip, SegmentError> {
     let (bvh, _warnings) = crate::bvh::parse_file(path).map_err(|e| load(e.into()))?;
     let clip = crate::skeleton::Clip::from_bvh(&bvh, None).map_err(|e| load(e.into()))?;
     let mapping = crate::mapping::Mapping::detect_clip(&clip).map_err(|e| load(e.into()))?;
-    crate::mapping::retarget(&clip, &mapping, &humanoid24()).map_err(|e| load(e.into()))
+    let model = humanoid24();
+    let mapped = crate::mapping::retarget(&clip, &mapping, &model).map_err(|e| load(e.into()))?;
+    // The source's angles on humanoid24 itself, the root path scaled with the legs, so that
+    // every segment is measured and danced on the one figure it is played on.
+    Ok(crate::mapping::onto_model(&mapped, &model))
 }
 
 /// What one source clip gave the database.

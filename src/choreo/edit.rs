@@ -400,7 +400,7 @@ impl Edit {
         Ok(fill_with_table(
             &self.db,
             &table,
-            self.state.bars.len(),
+            &self.music,
             &self.state.pins,
             &self.state.fill,
         )?)

@@ -17,16 +17,38 @@
 //!   in contact as [`crate::analysis::ground_contacts`] finds it (within its threshold of the
 //!   height it rests at above the dance's floor, so the mapped ankle that stands 8–12 cm up
 //!   counts) and its vertical speed under [`CONTACT_VERTICAL_SPEED_M_S`] (not lifting or
-//!   landing).
+//!   landing). A dance and its source segments all stand on the floor y = 0, so they are
+//!   measured against it and against the rest heights of the model standing on it
+//!   ([`foot_skating_on_floor`], [`crate::analysis::ground_contacts_against`]): estimated per
+//!   motion, a floor found a few centimetres off or an ankle resting on tiptoe would change
+//!   what counts as contact from one motion to the next.
 //! - **Transition cost**: Σ C over the seams of the fill, and the mean S.
+//! - **Foot penetration** (against the floor y = 0 the database stands on): the deepest foot
+//!   point, the fraction of frames with a foot point under [`PENETRATION_M`], and in the
+//!   frames where a foot is in contact (as for skating, against that floor) the largest
+//!   |sole height| of that foot, a foot's sole height being the lowest of its points' heights
+//!   less their heights in the model's rest pose standing on the floor
+//!   ([`super::feet::rest_sole_heights`]: the toe's 0, the ankle's about 6 cm).
+//! - **Intensity correlation**: Spearman's ρ between the music intensity of the bars and the
+//!   motion intensity of their segments: the Pearson correlation of their ranks (ties sharing
+//!   their mean rank), in [−1, 1].
+//! - **Sources**: the same skating and beat alignment of the segments a dance uses, each played
+//!   alone at its own timing in its clip (its bar of the clip, at the dance's frame rate, by the
+//!   same sampling as the dance) against its own beat grid (the clip's counts: four to a bar),
+//!   so that the dance is held against what its material does.
 
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 
-use super::dance::Dance;
+use super::dance::{Dance, DanceParams, assemble};
+use super::database::Database;
 use super::fill::Fill;
-use super::segments::speed_curve;
-use crate::analysis::{ContactConfig, clip_contacts_and_feet};
+use super::music::Bar;
+use super::segments::{BEATS_PER_BAR, speed_curve};
+use crate::analysis::{
+    ContactConfig, ContactReference, Contacts, clip_contacts_and_feet, ground_contacts_against,
+    point_tracks,
+};
 use crate::humanoid::ModelClip;
 
 /// σ of the beat alignment score: 3 frames at 60 fps, seconds.
@@ -83,10 +105,157 @@ pub struct DanceMetrics {
     pub foot_skating_m_s: f64,
     /// Fraction of foot-point samples in contact.
     pub foot_contact_fraction: f64,
+    /// How far the feet go into the floor.
+    pub foot_penetration: FootPenetration,
     /// Σ C over the seams.
     pub transition_cost: f64,
     /// Mean connection score S over the seams (0 without seams).
     pub mean_connection_s: f64,
+}
+
+/// A foot point under this height counts as in the floor, metres (−1 cm).
+pub const PENETRATION_M: f64 = -0.01;
+
+/// How far a motion's feet go into the floor y = 0 (module docs).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct FootPenetration {
+    /// The lowest height of a foot point over the motion, metres (negative: in the floor).
+    pub deepest_m: f64,
+    /// Fraction of frames in which some foot point is under [`PENETRATION_M`].
+    pub frames_below_fraction: f64,
+    /// The largest |sole height| of a foot in contact, metres.
+    pub contact_sole_max_m: f64,
+    /// Frames × feet in contact.
+    pub contact_foot_frames: usize,
+}
+
+/// The foot penetration of a clip against the floor y = 0 (module docs); zeros for a clip
+/// without feet.
+pub fn foot_penetration(clip: &ModelClip) -> FootPenetration {
+    let n = clip.frame_count();
+    let Some((contacts, feet)) = floor_contacts(clip) else {
+        return FootPenetration::default();
+    };
+    if n == 0 {
+        return FootPenetration::default();
+    }
+    let rest = super::feet::rest_sole_heights(clip);
+    let mut out = FootPenetration {
+        deepest_m: f64::INFINITY,
+        ..FootPenetration::default()
+    };
+    let mut below = 0usize;
+    for (f, (left, right)) in feet[0].iter().zip(&feet[1]).enumerate().take(n) {
+        let mut lowest = f64::INFINITY;
+        for (side, spans) in [&contacts.left, &contacts.right].into_iter().enumerate() {
+            let pts = if side == 0 { left } else { right };
+            lowest = pts.iter().map(|p| p.y).fold(lowest, f64::min);
+            let t = f as f64 * clip.frame_time;
+            if spans
+                .iter()
+                .any(|s| t >= s.start_s - 1e-9 && t < s.end_s - 1e-9)
+            {
+                let sole = pts
+                    .iter()
+                    .zip(&rest[side])
+                    .map(|(p, r)| p.y - r)
+                    .fold(f64::INFINITY, f64::min);
+                out.contact_sole_max_m = out.contact_sole_max_m.max(sole.abs());
+                out.contact_foot_frames += 1;
+            }
+        }
+        out.deepest_m = out.deepest_m.min(lowest);
+        if lowest < PENETRATION_M {
+            below += 1;
+        }
+    }
+    out.frames_below_fraction = below as f64 / n as f64;
+    out
+}
+
+/// Spearman's rank correlation of `a` and `b` (module docs); 0 when either is constant or
+/// they hold fewer than two pairs.
+pub fn spearman(a: &[f64], b: &[f64]) -> f64 {
+    let n = a.len().min(b.len());
+    if n < 2 {
+        return 0.0;
+    }
+    let (ra, rb) = (
+        super::relevance::percentile_ranks(&a[..n]),
+        super::relevance::percentile_ranks(&b[..n]),
+    );
+    let mean = |r: &[f64]| r.iter().sum::<f64>() / n as f64;
+    let (ma, mb) = (mean(&ra), mean(&rb));
+    let (mut sab, mut saa, mut sbb) = (0.0, 0.0, 0.0);
+    for (x, y) in ra.iter().zip(&rb) {
+        sab += (x - ma) * (y - mb);
+        saa += (x - ma) * (x - ma);
+        sbb += (y - mb) * (y - mb);
+    }
+    if saa <= 0.0 || sbb <= 0.0 {
+        0.0
+    } else {
+        sab / (saa * sbb).sqrt()
+    }
+}
+
+/// What the segments of a dance do alone (module docs): skating and beat alignment.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct SourceMetrics {
+    /// Mean horizontal speed of the foot points in contact, over every segment's contact
+    /// samples, m/s.
+    pub foot_skating_m_s: f64,
+    /// Mean over the segments of their beat alignment score against their own counts.
+    pub beat_alignment_score: f64,
+    /// Segments measured.
+    pub segments: usize,
+}
+
+/// The metrics of database segments `segments` each played alone at its own timing at `fps`
+/// frames per second (module docs); a segment too short to assemble at that rate is left out.
+pub fn source_metrics(db: &Database, segments: &[usize], fps: f64) -> SourceMetrics {
+    let params = DanceParams {
+        fps,
+        seam_frames: 0,
+    };
+    let (mut skate_sum, mut skate_n, mut bas_sum, mut count) = (0.0, 0.0, 0.0, 0usize);
+    for &s in segments {
+        let Some(seg) = db.segments.get(s) else {
+            continue;
+        };
+        let len = seg.end_s - seg.start_s;
+        let bar = Bar {
+            start_s: 0.0,
+            end_s: len,
+            rms: 0.0,
+            rms_db: f64::NEG_INFINITY,
+        };
+        let Ok(alone) = assemble(db, &[s], std::slice::from_ref(&bar), &params) else {
+            continue;
+        };
+        let (skating, contact) = foot_skating_on_floor(&alone.clip);
+        let samples = contact * alone.clip.frame_count() as f64;
+        skate_sum += skating * samples;
+        skate_n += samples;
+        let counts: Vec<f64> = (0..=BEATS_PER_BAR)
+            .map(|k| k as f64 * len / BEATS_PER_BAR as f64)
+            .collect();
+        bas_sum += beat_alignment_score(&motion_beats(&alone.clip), &counts, BAS_SIGMA_S);
+        count += 1;
+    }
+    SourceMetrics {
+        foot_skating_m_s: if skate_n > 0.0 {
+            skate_sum / skate_n
+        } else {
+            0.0
+        },
+        beat_alignment_score: if count > 0 {
+            bas_sum / count as f64
+        } else {
+            0.0
+        },
+        segments: count,
+    }
 }
 
 /// The motion beats of a clip (module docs), seconds from its first frame.
@@ -173,14 +342,53 @@ pub fn seam_jerk(dance: &Dance) -> (Jerk, Jerk) {
 }
 
 /// Foot skating of a clip: (mean horizontal speed in contact m/s, contact fraction of the
-/// foot points' frames) (module docs).
+/// foot points' frames) (module docs), the floor and rest heights estimated from the clip.
 pub fn foot_skating(clip: &ModelClip) -> (f64, f64) {
     let c = clip.to_clip();
-    let n = c.frame_count();
-    let config = ContactConfig::default();
-    let Some((contacts, feet)) = clip_contacts_and_feet(&c, &config) else {
-        return (0.0, 0.0);
+    match clip_contacts_and_feet(&c, &ContactConfig::default()) {
+        Some((contacts, feet)) => skating(clip, &contacts, &feet),
+        None => (0.0, 0.0),
+    }
+}
+
+/// [`foot_skating`] against the floor y = 0 and the rest heights of the model standing on it
+/// ([`super::feet::rest_sole_heights`]): the measure of a dance and of its source segments,
+/// which all stand on that floor, so that one floor and one standard judge them all.
+pub fn foot_skating_on_floor(clip: &ModelClip) -> (f64, f64) {
+    match floor_contacts(clip) {
+        Some((contacts, feet)) => skating(clip, &contacts, &feet),
+        None => (0.0, 0.0),
+    }
+}
+
+/// The contacts of `clip`'s feet against the floor y = 0 and the model's standing rest heights
+/// ([`ground_contacts_against`]), and the foot points' tracks; `None` without feet.
+pub fn floor_contacts(clip: &ModelClip) -> Option<(Contacts, [Vec<Vec<DVec3>>; 2])> {
+    let c = clip.to_clip();
+    let [lf, rf] = crate::analysis::foot_points(&c.skeleton);
+    if lf.is_empty() || rf.is_empty() {
+        return None;
+    }
+    let feet = [point_tracks(&c, &lf), point_tracks(&c, &rf)];
+    let reference = ContactReference {
+        floor_y_m: 0.0,
+        rest_heights_m: super::feet::rest_sole_heights(clip)
+            .map(|v| v.into_iter().map(Some).collect()),
     };
+    let contacts = ground_contacts_against(
+        &feet[0],
+        &feet[1],
+        &[],
+        clip.frame_time,
+        &ContactConfig::default(),
+        &reference,
+    );
+    Some((contacts, feet))
+}
+
+/// Skating of the foot tracks `feet` under `contacts` (module docs).
+fn skating(clip: &ModelClip, contacts: &Contacts, feet: &[Vec<Vec<DVec3>>; 2]) -> (f64, f64) {
+    let n = clip.frame_count();
     if n < 2 {
         return (0.0, 0.0);
     }
@@ -220,7 +428,7 @@ pub fn dance_metrics(dance: &Dance, beats_s: &[f64], fill: &Fill) -> DanceMetric
         .collect();
     let motion = motion_beats(&dance.clip);
     let (seam, inside) = seam_jerk(dance);
-    let (skating, contact) = foot_skating(&dance.clip);
+    let (skating, contact) = foot_skating_on_floor(&dance.clip);
     let seams = fill.connections.len();
     DanceMetrics {
         beat_alignment_score: beat_alignment_score(&motion, &music, BAS_SIGMA_S),
@@ -230,6 +438,7 @@ pub fn dance_metrics(dance: &Dance, beats_s: &[f64], fill: &Fill) -> DanceMetric
         inside_jerk: inside,
         foot_skating_m_s: skating,
         foot_contact_fraction: contact,
+        foot_penetration: foot_penetration(&dance.clip),
         transition_cost: fill.total_cost,
         mean_connection_s: if seams > 0 {
             fill.connections.iter().map(|c| c.s).sum::<f64>() / seams as f64

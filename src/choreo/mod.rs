@@ -15,6 +15,7 @@
 //!   dynamic programme that gives the same path);
 //! - [`dance`]: the chosen segments assembled at the song's bar timing, root carried on, seams
 //!   rewritten by cubic interpolation;
+//! - [`feet`]: the dance's planted feet put on the floor and held still by leg IK;
 //! - [`metrics`]: beat alignment score, seam jerk, foot skating, transition cost of a dance;
 //! - [`augment`]: a larger database from a real one by mirror images and time offsets;
 //! - [`relevance`]: rel(q, m), music intensity against motion intensity, both as percentile ranks;
@@ -29,6 +30,7 @@ pub mod database;
 pub mod edit;
 pub mod eros;
 pub mod features;
+pub mod feet;
 pub mod fill;
 pub mod metrics;
 pub mod music;

@@ -266,6 +266,10 @@ pub struct TransitionTable {
     pub min_cost: f64,
     /// The smallest cost off the diagonal (a ≠ b); +∞ for a single segment.
     pub min_cost_off_diagonal: f64,
+    /// The cost of a good seam in this database: the mean over segments a of their cheapest
+    /// transition to another segment, (1/n) Σ_a min_{b ≠ a} C(a → b) (min_b C(a → b) for a
+    /// single segment). The fill's music term is weighed in these units.
+    pub typical_cost: f64,
 }
 
 impl TransitionTable {
@@ -350,15 +354,22 @@ impl TransitionTable {
             });
         let mut min_cost = f64::INFINITY;
         let mut min_cost_off_diagonal = f64::INFINITY;
+        let mut best_sum = 0.0;
         for a in 0..n {
+            let mut best = f64::INFINITY;
             for b in 0..n {
                 let c = f64::from(cost[a * n + b]);
                 min_cost = min_cost.min(c);
+                if a != b || n == 1 {
+                    best = best.min(c);
+                }
                 if a != b {
                     min_cost_off_diagonal = min_cost_off_diagonal.min(c);
                 }
             }
+            best_sum += best;
         }
+        let typical_cost = if n > 0 { best_sum / n as f64 } else { 0.0 };
         TransitionTable {
             n,
             beta_sum,
@@ -366,6 +377,7 @@ impl TransitionTable {
             cost_to,
             min_cost,
             min_cost_off_diagonal,
+            typical_cost,
         }
     }
 

@@ -14,11 +14,10 @@ use glam::DVec3;
 
 use super::EditorError;
 use super::scene::DanceFile;
-use crate::choreo::dance::assemble;
 use crate::choreo::edit::Edit;
 use crate::choreo::fill::Fill;
 use crate::humanoid::{Model, ModelClip, humanoid24};
-use crate::scene::{load_dance, scene_pins, song_timed_bvh};
+use crate::scene::{load_dance, perform, scene_pins, song_timed_bvh};
 
 /// The song the edit dances to.
 #[derive(Debug, Clone)]
@@ -193,12 +192,13 @@ impl Session {
 
     fn dance(&mut self) -> Result<crate::choreo::dance::Dance, EditorError> {
         let segments = self.generate()?.segments.clone();
-        Ok(assemble(
+        let (d, _) = perform(
+            self.file.scene(),
             self.edit.database(),
             &segments,
             self.edit.bars(),
-            &self.file.scene().dance,
-        )?)
+        )?;
+        Ok(d)
     }
 
     /// The whole dance of the current pins as the `motion.bvh` that `marionette run` writes

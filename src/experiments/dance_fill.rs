@@ -23,7 +23,7 @@ use serde::{Deserialize, Serialize};
 use crate::choreo::dance::{DanceError, DanceParams, assemble};
 use crate::choreo::database::{BuildParams, DATABASE_VERSION, Database, Source};
 use crate::choreo::eros::eros_weights;
-use crate::choreo::fill::{Fill, FillError, FillParams, Pins, check, fill_with_table};
+use crate::choreo::fill::{FillError, FillParams, Pins, check, fill_with_table};
 use crate::choreo::metrics::seam_jerk;
 use crate::choreo::music::Bar;
 use crate::choreo::segments::{Beat, SegmentError, TempoSource, cut_segments};
@@ -75,7 +75,7 @@ impl Default for DanceFillConfig {
             pin_sets: 40,
             pins_per_set: 3,
             bar_s: 2.0,
-            fill: FillParams::default(),
+            fill: FillParams::paper(),
             dance: DanceParams::default(),
             seed: 1,
         }
@@ -258,7 +258,7 @@ pub fn run(db: &Database, cfg: &DanceFillConfig) -> Result<DanceFillOutcome, Dan
         for (i, s) in STRATEGIES.iter().enumerate() {
             let segments = match s {
                 Strategy::ConnectionAware => {
-                    fill_with_table(db, &table, cfg.bars, &pins, &cfg.fill)?.segments
+                    fill_with_table(db, &table, &music, &pins, &cfg.fill)?.segments
                 }
                 Strategy::Random => {
                     blind_fill(cfg.bars, &pins, n, cfg.fill.no_adjacent_repeat, |_, _| {
@@ -324,19 +324,14 @@ fn trial(
         .windows(2)
         .map(|w| connection(&db.segments[w[0]], &db.segments[w[1]], &cfg.fill.transition))
         .collect();
-    let fill = Fill {
-        segments: segments.to_vec(),
-        total_cost: connections.iter().map(|c| c.cost).sum(),
-        connections,
-    };
-    let seams = fill.connections.len().max(1) as f64;
+    let seams = connections.len().max(1) as f64;
     Ok(Trial {
-        segments: fill.segments.clone(),
+        segments: segments.to_vec(),
         seam_jerk_mean: seam.mean_rad_s3,
         seam_jerk_peak: seam.peak_rad_s3,
         inside_jerk_mean: inside.mean_rad_s3,
-        mean_s: fill.connections.iter().map(|c| c.s).sum::<f64>() / seams,
-        total_cost: fill.total_cost,
+        mean_s: connections.iter().map(|c| c.s).sum::<f64>() / seams,
+        total_cost: connections.iter().map(|c| c.cost).sum(),
     })
 }
 

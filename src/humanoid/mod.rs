@@ -10,6 +10,7 @@
 //!
 //! - [`humanoid24`]: the 24-DOF model of the motor-primitive paper (SPEC §1).
 //! - [`ModelClip`]: a motion on a model (DOF angles plus root motion).
+//! - [`leg_ik`]: two-bone inverse kinematics of a leg (the ankle put at a point).
 //! - [`fall21`]: the 21-DOF, 15-link model of the falling paper (SPEC §3), with age-dependent
 //!   joint ranges in [`ranges`].
 
@@ -18,6 +19,7 @@ pub mod body;
 mod definition;
 pub mod export;
 mod joint_angles;
+pub mod leg_ik;
 mod model_clip;
 pub mod ranges;
 pub mod strength;

@@ -349,3 +349,108 @@ fn height_of(model: &Model) -> f64 {
     let lo = pts.iter().map(|p| p.y).fold(f64::MAX, f64::min);
     hi - lo
 }
+
+/// Leg length of a model at rest, metres: the mean over the sides that have them of the height
+/// of the `…_hip` joint above the lowest point at or below its `…_ankle` joint (the ankle, its
+/// End Site, any joint under it); `None` for a model without hips and ankles.
+pub fn leg_length(model: &Model) -> Option<f64> {
+    let skeleton = model.skeleton();
+    let pts = skeleton.rest_points();
+    let parents = skeleton.point_parents();
+    let mut lengths = vec![];
+    for side in ["left_", "right_"] {
+        let (Some(hip), Some(ankle)) = (
+            model.joint_index(&format!("{side}hip")),
+            model.joint_index(&format!("{side}ankle")),
+        ) else {
+            continue;
+        };
+        // Points at or below the ankle: parents come before children, so one pass marks them.
+        let mut below = vec![false; pts.len()];
+        for p in 0..pts.len() {
+            below[p] = p == ankle || parents[p].is_some_and(|q| below[q]);
+        }
+        let lowest = (0..pts.len())
+            .filter(|&p| below[p])
+            .map(|p| pts[p].y)
+            .fold(f64::INFINITY, f64::min);
+        lengths.push(pts[hip].y - lowest);
+    }
+    (!lengths.is_empty()).then(|| lengths.iter().sum::<f64>() / lengths.len() as f64)
+}
+
+/// `clip` played on `target`, a model with the same joints and DOFs as `clip.model` (e.g. the
+/// source-proportioned copy [`retarget`] returns, played on the model itself): the DOF angles
+/// and the root orientation as they are, the root translation scaled by s = L_target / L_clip,
+/// the ratio of the two models' leg lengths at rest ([`leg_length`]): t' = s·t. A dancer 1.53 m
+/// tall put on legs of a 1.65 m figure keeps her pelvis at her own height and so stands in the
+/// floor; scaled, the pelvis rides as high above the feet, and the steps are as long, in
+/// proportion to the legs. Without legs on either model the translation is kept (s = 1).
+pub fn onto_model(clip: &ModelClip, target: &Model) -> ModelClip {
+    let s = match (leg_length(target), leg_length(&clip.model)) {
+        (Some(t), Some(c)) if t > 0.0 && c > 0.0 => t / c,
+        _ => 1.0,
+    };
+    ModelClip {
+        model: target.clone(),
+        frame_time: clip.frame_time,
+        root_translation: clip.root_translation.iter().map(|t| *t * s).collect(),
+        root_rotation: clip.root_rotation.clone(),
+        angles: clip.angles.clone(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::humanoid::humanoid24;
+
+    #[test]
+    fn leg_length_of_humanoid24_is_its_hip_height_and_scales_with_it() {
+        let m = humanoid24();
+        let l = leg_length(&m).unwrap();
+        // Hip centre at 0.530 H above the sole (the toe End Site is at the floor at rest).
+        assert!((l / m.height - 0.530).abs() < 0.01, "{l} of {}", m.height);
+        let small = m.scaled_to_height(1.53);
+        assert!((leg_length(&small).unwrap() / l - 1.53 / m.height).abs() < 1e-12);
+    }
+
+    #[test]
+    fn onto_a_taller_model_the_root_path_scales_with_the_legs() {
+        let target = humanoid24();
+        let source = target.scaled_to_height(1.53);
+        let d = target.dofs.len();
+        let n = 10;
+        let clip = ModelClip {
+            model: source.clone(),
+            frame_time: 0.1,
+            root_translation: (0..n)
+                .map(|f| DVec3::new(0.1 * f as f64, 0.8, -0.05 * f as f64))
+                .collect(),
+            root_rotation: vec![DQuat::IDENTITY; n],
+            angles: (0..n * d).map(|i| 0.01 * i as f64).collect(),
+        };
+        let out = onto_model(&clip, &target);
+        let s = target.height / 1.53;
+        for (a, b) in clip.root_translation.iter().zip(&out.root_translation) {
+            assert!((*b - *a * s).length() < 1e-12);
+        }
+        assert_eq!(out.angles, clip.angles);
+        assert_eq!(out.model, target);
+        // Standing straight with its sole on the floor on the source, so it does on the target.
+        let stand = |m: &Model| {
+            leg_length(m).unwrap()
+                + (m.skeleton().rest_points()[0].y
+                    - m.skeleton().rest_points()[m.joint_index("left_hip").unwrap()].y)
+        };
+        let still = ModelClip {
+            root_translation: vec![DVec3::new(0.0, stand(&source), 0.0)],
+            root_rotation: vec![DQuat::IDENTITY],
+            angles: vec![0.0; d],
+            ..clip
+        };
+        let on = onto_model(&still, &target);
+        let sole = on.foot_heights()[0][0];
+        assert!(sole.abs() < 1e-9, "sole at {sole} m");
+    }
+}

@@ -20,6 +20,7 @@ use super::{SceneError, write_output};
 use crate::choreo::authored::{AuthoredDance, generate};
 use crate::choreo::dance::{self, DanceParams};
 use crate::choreo::database::{BuildParams, Database, Manifest};
+use crate::choreo::feet::{PlantParams, Planting, plant_feet};
 use crate::choreo::fill::{self, FillParams, Pins};
 use crate::choreo::metrics;
 use crate::choreo::music::synth::{SynthSong, synthesize};
@@ -119,6 +120,9 @@ pub struct DanceScene {
     /// How the dance is assembled.
     #[serde(default)]
     pub dance: DanceParams,
+    /// How the assembled dance's feet are put on the floor ([`crate::choreo::feet`]).
+    #[serde(default)]
+    pub feet: PlantParams,
     /// The relevance-feedback search of eqs. (1)–(4) that `marionette edit` runs on this scene
     /// (`marionette run` does not search: it fills the unpinned bars).
     #[serde(default)]
@@ -391,6 +395,20 @@ fn resolve_pins(pins: &[Pin], db: &Database) -> Result<Pins, SceneError> {
     Ok(out)
 }
 
+/// The dance of `segments` (one per bar of `bars`) as `scene` makes it, for `marionette run`
+/// and the editor alike: assembled at the bars' timing ([`dance::assemble`]), then its feet put
+/// on the floor ([`plant_feet`]).
+pub fn perform(
+    scene: &DanceScene,
+    db: &Database,
+    segments: &[usize],
+    bars: &[Bar],
+) -> Result<(dance::Dance, Planting), SceneError> {
+    let mut d = dance::assemble(db, segments, bars, &scene.dance)?;
+    let planting = plant_feet(&mut d.clip, &scene.feet);
+    Ok((d, planting))
+}
+
 /// Runs a [`DanceScene`] (module docs). Returns the report.
 pub fn run_dance(
     scene: &DanceScene,
@@ -411,9 +429,14 @@ pub fn run_dance(
     } = load_dance(scene, base)?;
     let bars = &bars[..];
     let bars_n = bars.len();
-    let filled = fill::fill(&db, bars_n, &pins, &scene.fill)?;
-    let d = dance::assemble(&db, &filled.segments, bars, &scene.dance)?;
+    let music_rank = relevance::music_intensity(bars);
+    let filled = fill::fill(&db, &music_rank, &pins, &scene.fill)?;
+    let (d, planting) = perform(scene, &db, &filled.segments, bars)?;
     let m = metrics::dance_metrics(&d, &analysis.beats_s, &filled);
+    let sources = metrics::source_metrics(&db, &filled.segments, 1.0 / d.clip.frame_time);
+    let motion_rank_db = relevance::motion_intensity(&db);
+    let motion_rank: Vec<f64> = filled.segments.iter().map(|&s| motion_rank_db[s]).collect();
+    let intensity_spearman = metrics::spearman(&music_rank, &motion_rank);
 
     // motion.bvh at the song's timing: the first frame held from t = 0 to the first bar.
     let (bvh, lead) = song_timed_bvh(&d);
@@ -462,9 +485,6 @@ pub fn run_dance(
             &out.join("motion.gif"),
         )?;
     }
-    let music_rank = relevance::music_intensity(bars);
-    let motion_rank_db = relevance::motion_intensity(&db);
-    let motion_rank: Vec<f64> = filled.segments.iter().map(|&s| motion_rank_db[s]).collect();
     plot(
         &Plot {
             title: format!("{}: music and motion intensity per bar", scene.name),
@@ -548,6 +568,16 @@ pub fn run_dance(
         })).collect::<Vec<_>>(),
         "pins": pins.iter().map(|(b, s)| json!({"bar": b, "segment": s})).collect::<Vec<_>>(),
         "no_adjacent_repeat": scene.fill.no_adjacent_repeat,
+        "fill_intensity_weight": scene.fill.intensity_weight,
+        "feet": {
+            "planted": scene.feet.enabled,
+            "locked": scene.feet.lock,
+            "contact_spans": planting.spans,
+            "contact_spans_locked": planting.locked,
+            "leg_frames_moved": planting.leg_frames,
+            "max_correction_m": planting.max_correction_m,
+            "max_residual_m": planting.max_residual_m,
+        },
         "per_bar": per_bar,
         "seams": seams,
         "metrics": {
@@ -560,6 +590,20 @@ pub fn run_dance(
             "inside_jerk_mean_rad_s3": m.inside_jerk.mean_rad_s3,
             "foot_skating_m_s": m.foot_skating_m_s,
             "foot_contact_fraction": m.foot_contact_fraction,
+            "foot_penetration": {
+                "deepest_m": m.foot_penetration.deepest_m,
+                "frames_below_1cm_fraction": m.foot_penetration.frames_below_fraction,
+                "contact_sole_max_m": m.foot_penetration.contact_sole_max_m,
+            },
+            "intensity_spearman": intensity_spearman,
+            "intensity_mismatch": filled.intensity_mismatch,
+            "sources": {
+                "what": "the segments danced, each alone at its own timing in its clip, at the \
+                    dance's frame rate, against its own counts",
+                "segments": sources.segments,
+                "foot_skating_m_s": sources.foot_skating_m_s,
+                "beat_alignment_score": sources.beat_alignment_score,
+            },
             "transition_cost": m.transition_cost,
             "mean_connection_s": m.mean_connection_s,
         },

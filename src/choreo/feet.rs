@@ -1,0 +1,538 @@
+//! Feet on the floor: an assembled dance's planted feet put on the floor (y = 0) and held still,
+//! by two-bone leg inverse kinematics ([`crate::humanoid::leg_ik`]), the pelvis left where the
+//! dance puts it.
+//!
+//! Segments from different clips, time-resized to the song's bars and joined at seams, put the
+//! feet a little in or above the floor and let a planted foot slide where its sources did not.
+//! This puts them back, per leg:
+//!
+//! - **Sole height.** A foot point's sole height is its height minus its height in the model's
+//!   rest pose standing on the floor (the toe End Site 0, the ankle joint its height above the
+//!   sole, about 6 cm on humanoid24), and the foot's sole height s(f) the lowest of its points':
+//!   0 when the foot stands on the floor, toe or heel down.
+//! - **Contact.** A foot is in contact in the frames where [`ground_contacts_against`] finds it
+//!   contact against the floor y = 0 and the model's rest heights: some point within
+//!   [`ContactConfig::threshold_m`] of its rest height (debounced).
+//! - **Lift.** Wherever the sole is under the floor the foot is lifted onto it: c_y(f) =
+//!   max(0, −s(f)). Nothing is pulled down: a foot that hovers stays where its segment puts it,
+//!   so no swinging foot is made to touch the floor (and skate on it).
+//! - **Lock.** A contact span whose contact point (the foot point lowest relative to its rest
+//!   height on average over the span) slides, its mean horizontal speed over the span above
+//!   [`ContactConfig::rest_speed_mps`] (the speed under which the contact analysis calls a
+//!   point at rest), is held still: c(f) = a − p(f) horizontally, a the contact point's mean
+//!   horizontal position over the span. In the free frames next to it the correction fades to
+//!   0 over [`PlantParams::blend_s`] along a cubic Hermite curve that leaves the span with the
+//!   correction's own rate, so the foot lifts off and lands without a jolt (between two spans
+//!   closer than two blends, the curve runs from the one's edge to the other's).
+//! - **Smoothing.** The corrections are smoothed over time by a Gaussian of σ =
+//!   [`PlantParams::smooth_s`] (the sole's height switches between toe and heel as the foot
+//!   rolls: a kink the knee would follow), then the lift is applied again as a floor.
+//! - **Reach.** The ankle is sent to its own position plus c(f) by the leg's IK, and the
+//!   foot's residual (the foot turns a little with the shin, since humanoid24 has no ankle DOF)
+//!   is added to the target again, [`IK_ROUNDS`] times.
+
+use glam::DVec3;
+use serde::{Deserialize, Serialize};
+
+use crate::analysis::{ContactConfig, ContactReference, foot_points, ground_contacts_against};
+use crate::humanoid::ModelClip;
+use crate::humanoid::leg_ik::{Leg, frame_globals, reach};
+use crate::skeleton::Transform;
+
+/// Most rounds of IK per frame and leg: the target corrected by the foot's residual each round
+/// (about halved each round), until it is under 0.1 mm.
+pub const IK_ROUNDS: usize = 8;
+
+/// How feet are planted.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct PlantParams {
+    /// Plant the feet at all (false: the dance as assembled, feet wherever the segments put
+    /// them).
+    pub enabled: bool,
+    /// Hold a planted foot's contact point still over its contact span (false: only heights
+    /// are corrected).
+    pub lock: bool,
+    /// Time over which a correction fades in and out around a contact span, seconds.
+    pub blend_s: f64,
+    /// σ of the Gaussian the corrections are smoothed with over time, seconds (0: none): the
+    /// sole's height switches between the toe and the heel as the foot rolls, a kink the knee
+    /// would follow.
+    pub smooth_s: f64,
+}
+
+impl Default for PlantParams {
+    /// Planted and locked, corrections fading over 0.2 s, smoothed with σ = 0.05 s.
+    fn default() -> PlantParams {
+        PlantParams {
+            enabled: true,
+            lock: true,
+            blend_s: 0.2,
+            smooth_s: 0.05,
+        }
+    }
+}
+
+/// What planting did.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Planting {
+    /// Contact spans found (both feet).
+    pub spans: usize,
+    /// Contact spans whose sliding foot was held still.
+    pub locked: usize,
+    /// Frames × legs moved.
+    pub leg_frames: usize,
+    /// Largest correction asked of a foot, metres.
+    pub max_correction_m: f64,
+    /// Largest distance left between a foot and its target (out of the leg's reach), metres.
+    pub max_residual_m: f64,
+}
+
+/// Sole height of every foot point: its height in the rest pose of `clip.model` standing on the
+/// floor, `[left, right]` in [`foot_points`] order, metres.
+pub fn rest_sole_heights(clip: &ModelClip) -> [Vec<f64>; 2] {
+    let skeleton = clip.model.skeleton();
+    let feet = foot_points(&skeleton);
+    let mut g = vec![];
+    let d = clip.dof_count();
+    frame_globals(
+        &clip.model,
+        DVec3::ZERO,
+        glam::DQuat::IDENTITY,
+        &vec![0.0; d],
+        &mut g,
+    );
+    let ys: [Vec<f64>; 2] =
+        [0, 1].map(|s| feet[s].iter().map(|&p| point(&skeleton, &g, p).y).collect());
+    let lowest = ys.iter().flatten().copied().fold(f64::INFINITY, f64::min);
+    ys.map(|v| v.into_iter().map(|y| y - lowest).collect())
+}
+
+/// The global position of a foot point (a joint, or with `true` its End Site).
+fn point(skeleton: &crate::skeleton::Skeleton, g: &[Transform], (j, end): (usize, bool)) -> DVec3 {
+    if end {
+        g[j].translation + g[j].rotation * skeleton.joints[j].end_site.unwrap_or_default()
+    } else {
+        g[j].translation
+    }
+}
+
+/// The frames `[first, end)` of every run of `on`.
+fn runs(on: &[bool]) -> Vec<(usize, usize)> {
+    let mut out = vec![];
+    let mut start = None;
+    for (f, &x) in on.iter().chain(std::iter::once(&false)).enumerate() {
+        match (x, start) {
+            (true, None) => start = Some(f),
+            (false, Some(s)) => {
+                out.push((s, f));
+                start = None;
+            }
+            _ => {}
+        }
+    }
+    out
+}
+
+/// `x` smoothed by a Gaussian of σ = `sigma` frames (truncated at 3σ), the ends continued by
+/// point reflection (x(−k) = 2x(0) − x(k)), so that a straight course is kept to the last
+/// frame; `x` itself for σ under a tenth of a frame.
+fn gaussian(x: &[DVec3], sigma: f64) -> Vec<DVec3> {
+    let n = x.len();
+    if sigma < 0.1 || n < 2 {
+        return x.to_vec();
+    }
+    let r = (3.0 * sigma).ceil() as usize;
+    let w: Vec<f64> = (0..=r)
+        .map(|k| (-0.5 * (k as f64 / sigma).powi(2)).exp())
+        .collect();
+    let total = w[0] + 2.0 * w[1..].iter().sum::<f64>();
+    let at = |i: isize| -> DVec3 {
+        let last = n as isize - 1;
+        if i < 0 {
+            x[0] * 2.0 - x[((-i).min(last)) as usize]
+        } else if i > last {
+            x[n - 1] * 2.0 - x[((2 * last - i).max(0)) as usize]
+        } else {
+            x[i as usize]
+        }
+    };
+    (0..n as isize)
+        .map(|f| {
+            let mut sum = at(f) * w[0];
+            for (k, wk) in w.iter().enumerate().skip(1) {
+                sum += (at(f - k as isize) + at(f + k as isize)) * *wk;
+            }
+            sum / total
+        })
+        .collect()
+}
+
+/// The cubic Hermite curve from `c0` (rate `v0` per frame) at frame 0 to `c1` (rate `v1`) at
+/// frame `len`, at frame `at`: position and rate continuous at both ends.
+fn hermite(c0: DVec3, v0: DVec3, c1: DVec3, v1: DVec3, len: usize, at: usize) -> DVec3 {
+    let l = len.max(1) as f64;
+    let u = (at as f64 / l).clamp(0.0, 1.0);
+    let (u2, u3) = (u * u, u * u * u);
+    c0 * (2.0 * u3 - 3.0 * u2 + 1.0)
+        + v0 * (l * (u3 - 2.0 * u2 + u))
+        + c1 * (-2.0 * u3 + 3.0 * u2)
+        + v1 * (l * (u3 - u2))
+}
+
+/// Plants the feet of `clip` (module docs); a model without two legs ([`Leg::of`]) or feet is
+/// left as it is.
+pub fn plant_feet(clip: &mut ModelClip, p: &PlantParams) -> Planting {
+    let mut report = Planting::default();
+    let n = clip.frame_count();
+    let legs = [Leg::of(&clip.model, "left"), Leg::of(&clip.model, "right")];
+    let skeleton = clip.model.skeleton();
+    let feet = foot_points(&skeleton);
+    if !p.enabled || n < 2 || feet.iter().any(Vec::is_empty) || legs.iter().any(Option::is_none) {
+        return report;
+    }
+    let rest = rest_sole_heights(clip);
+    let d = clip.dof_count();
+    // Foot points of every frame.
+    let mut g = vec![];
+    let tracks = |clip: &ModelClip, f: usize, g: &mut Vec<Transform>| -> [Vec<DVec3>; 2] {
+        frame_globals(
+            &clip.model,
+            clip.root_translation[f],
+            clip.root_rotation[f],
+            clip.frame_angles(f),
+            g,
+        );
+        [0, 1].map(|s| feet[s].iter().map(|&q| point(&skeleton, g, q)).collect())
+    };
+    let before: Vec<[Vec<DVec3>; 2]> = (0..n).map(|f| tracks(clip, f, &mut g)).collect();
+    let sole = |pts: &[DVec3], side: usize| -> f64 {
+        pts.iter()
+            .zip(&rest[side])
+            .map(|(x, r)| x.y - r)
+            .fold(f64::INFINITY, f64::min)
+    };
+    // Contact against the floor y = 0 and the rest heights.
+    let config = ContactConfig::default();
+    let reference = ContactReference {
+        floor_y_m: 0.0,
+        rest_heights_m: rest.clone().map(|v| v.into_iter().map(Some).collect()),
+    };
+    let side_track =
+        |s: usize| -> Vec<Vec<DVec3>> { before.iter().map(|b| b[s].clone()).collect() };
+    let (left, right) = (side_track(0), side_track(1));
+    let contacts =
+        ground_contacts_against(&left, &right, &[], clip.frame_time, &config, &reference);
+    let blend = (p.blend_s / clip.frame_time).round().max(1.0) as usize;
+
+    // The correction of every frame of each foot (module docs).
+    // Per frame and foot: the correction and the foot point whose place it is measured on.
+    let mut targets: [Vec<Option<(DVec3, usize)>>; 2] = [vec![None; n], vec![None; n]];
+    for (side, spans) in [&contacts.left, &contacts.right].into_iter().enumerate() {
+        let on: Vec<bool> = (0..n)
+            .map(|f| {
+                let t = f as f64 * clip.frame_time;
+                spans
+                    .iter()
+                    .any(|s| t >= s.start_s - 1e-9 && t < s.end_s - 1e-9)
+            })
+            .collect();
+        let planted = runs(&on);
+        report.spans += planted.len();
+        let mut corr: Vec<Option<DVec3>> = vec![None; n];
+        let mut key = vec![0usize; n];
+        for &(a, b) in &planted {
+            // The contact point: lowest relative to its rest height on average over the span.
+            let k = (0..feet[side].len())
+                .min_by(|&i, &j| {
+                    let mean = |i: usize| -> f64 {
+                        (a..b)
+                            .map(|f| before[f][side][i].y - rest[side][i])
+                            .sum::<f64>()
+                    };
+                    mean(i).total_cmp(&mean(j))
+                })
+                .expect("a foot has points");
+            let anchor = (a..b)
+                .map(|f| before[f][side][k] * DVec3::new(1.0, 0.0, 1.0))
+                .sum::<DVec3>()
+                / (b - a) as f64;
+            // Locked only when the contact point slides: faster on average over the span than
+            // a foot point at rest moves.
+            let path: f64 = (a + 1..b)
+                .map(|f| {
+                    let d = before[f][side][k] - before[f - 1][side][k];
+                    DVec3::new(d.x, 0.0, d.z).length()
+                })
+                .sum();
+            let slides = path / ((b - a) as f64 * clip.frame_time) > config.rest_speed_mps;
+            if slides && p.lock {
+                report.locked += 1;
+            }
+            for f in a..b {
+                key[f] = k;
+                let pt = before[f][side][k];
+                let horizontal = if p.lock && slides {
+                    DVec3::new(anchor.x - pt.x, 0.0, anchor.z - pt.z)
+                } else {
+                    DVec3::ZERO
+                };
+                corr[f] = Some(horizontal);
+            }
+        }
+        // Free frames: fades from the neighbouring spans, and no sole under the floor.
+        for f in 0..n {
+            if on[f] {
+                continue;
+            }
+            let prev = planted.iter().rev().find(|s| s.1 <= f);
+            let next = planted.iter().find(|s| s.0 > f);
+            key[f] = match (prev, next) {
+                (Some(&(_, pe)), Some(&(ns, _))) => {
+                    key[if f + 1 - pe <= ns - f { pe - 1 } else { ns }]
+                }
+                (Some(&(_, pe)), None) => key[pe - 1],
+                (None, Some(&(ns, _))) => key[ns],
+                (None, None) => 0,
+            };
+            // The correction and its rate (per frame) at the span edges next to f.
+            let edge_out = |pe: usize| -> (DVec3, DVec3) {
+                let c = corr[pe - 1].unwrap_or_default();
+                let v = if pe >= 2 && on[pe - 2] {
+                    c - corr[pe - 2].unwrap_or_default()
+                } else {
+                    DVec3::ZERO
+                };
+                (c, v)
+            };
+            let edge_in = |ns: usize| -> (DVec3, DVec3) {
+                let c = corr[ns].unwrap_or_default();
+                let v = if ns + 1 < n && on[ns + 1] {
+                    corr[ns + 1].unwrap_or_default() - c
+                } else {
+                    DVec3::ZERO
+                };
+                (c, v)
+            };
+            let c = match (prev, next) {
+                (Some(&(_, pe)), Some(&(ns, _))) if ns - pe <= 2 * blend => {
+                    // From the one span's edge to the other's, position and rate matched.
+                    let ((c0, v0), (c1, v1)) = (edge_out(pe), edge_in(ns));
+                    hermite(c0, v0, c1, v1, ns + 1 - pe, f + 1 - pe)
+                }
+                _ => {
+                    let out = prev.map_or(DVec3::ZERO, |&(_, pe)| {
+                        let (c0, v0) = edge_out(pe);
+                        if f + 1 - pe > blend {
+                            DVec3::ZERO
+                        } else {
+                            hermite(c0, v0, DVec3::ZERO, DVec3::ZERO, blend + 1, f + 1 - pe)
+                        }
+                    });
+                    let inn = next.map_or(DVec3::ZERO, |&(ns, _)| {
+                        let (c1, v1) = edge_in(ns);
+                        if ns - f > blend {
+                            DVec3::ZERO
+                        } else {
+                            hermite(
+                                DVec3::ZERO,
+                                DVec3::ZERO,
+                                c1,
+                                v1,
+                                blend + 1,
+                                blend + 1 - (ns - f),
+                            )
+                        }
+                    });
+                    out + inn
+                }
+            };
+            if c.length_squared() > 0.0 {
+                corr[f] = Some(c);
+            }
+        }
+        // The lift out of the floor, and the horizontal corrections, smoothed over time (a
+        // Gaussian of σ = smooth_s); then no sole under the floor.
+        let lift: Vec<f64> = (0..n)
+            .map(|f| (-sole(&before[f][side], side)).max(0.0))
+            .collect();
+        for f in 0..n {
+            if lift[f] > 0.0 {
+                corr[f] = Some(corr[f].unwrap_or_default() + DVec3::Y * lift[f]);
+            }
+        }
+        let raw: Vec<DVec3> = corr.iter().map(|c| c.unwrap_or_default()).collect();
+        let smooth = gaussian(&raw, p.smooth_s / clip.frame_time);
+        for f in 0..n {
+            if corr[f].is_none() && smooth[f].length_squared() < 1e-12 {
+                continue;
+            }
+            let mut c = smooth[f];
+            // No sole under the floor: the vertical correction only lifts.
+            c.y = c.y.max(lift[f]);
+            report.max_correction_m = report.max_correction_m.max(c.length());
+            targets[side][f] = Some((c, key[f]));
+        }
+    }
+
+    // The legs sent there.
+    for f in 0..n {
+        for side in 0..2 {
+            let Some((c, k)) = targets[side][f] else {
+                continue;
+            };
+            if c.length() < 1e-6 {
+                continue;
+            }
+            report.leg_frames += 1;
+            let leg = legs[side].expect("checked above");
+            // Where the foot's points should go: each moved by c.
+            let want: Vec<DVec3> = before[f][side].iter().map(|x| *x + c).collect();
+            let want_sole = sole(&want, side);
+            let mut ankle_target = g_ankle(clip, f, leg, &mut g) + c;
+            let mut residual = 0.0;
+            for _ in 0..IK_ROUNDS {
+                let (t, q) = (clip.root_translation[f], clip.root_rotation[f]);
+                let angles = &mut clip.angles[f * d..(f + 1) * d];
+                reach(&clip.model, leg, t, q, angles, ankle_target);
+                let now = tracks(clip, f, &mut g)[side].clone();
+                // The residual of the foot: its sole height, and its key point's horizontal
+                // place.
+                let dy = want_sole - sole(&now, side);
+                let dxz = (want[k] - now[k]) * DVec3::new(1.0, 0.0, 1.0);
+                let r = dxz + DVec3::Y * dy;
+                residual = r.length();
+                if residual < 1e-4 {
+                    break;
+                }
+                ankle_target += r;
+            }
+            report.max_residual_m = report.max_residual_m.max(residual);
+        }
+    }
+    report
+}
+
+/// The ankle of `leg` at frame `f` of `clip`.
+fn g_ankle(clip: &ModelClip, f: usize, leg: Leg, g: &mut Vec<Transform>) -> DVec3 {
+    frame_globals(
+        &clip.model,
+        clip.root_translation[f],
+        clip.root_rotation[f],
+        clip.frame_angles(f),
+        g,
+    );
+    g[leg.ankle].translation
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::humanoid::{humanoid24, leg_ik};
+
+    /// humanoid24 for `frames` frames at 60 fps, knees bent `knee` rad (hips flexed to keep the
+    /// shins upright), its sole `sole` m off the floor (negative: in it), the pelvis gliding
+    /// along x at `speed` m/s.
+    fn stance(knee: f64, sole: f64, speed: f64, frames: usize) -> ModelClip {
+        let model = humanoid24();
+        let d = model.dofs.len();
+        let mut pose = vec![0.0; d];
+        for side in ["left", "right"] {
+            pose[model.dof_index(&format!("{side}_knee")).unwrap()] = knee;
+            pose[model.dof_index(&format!("{side}_hip_flexion")).unwrap()] = knee;
+        }
+        let mut clip = ModelClip {
+            model,
+            frame_time: 1.0 / 60.0,
+            root_translation: vec![DVec3::ZERO; frames],
+            root_rotation: vec![glam::DQuat::IDENTITY; frames],
+            angles: pose.repeat(frames),
+        };
+        // Where the sole is with the pelvis at 0: lift the pelvis so it is at `sole`.
+        let feet = foot_points(&clip.model.skeleton());
+        let rest = rest_sole_heights(&clip);
+        let mut g = vec![];
+        leg_ik::frame_globals(
+            &clip.model,
+            DVec3::ZERO,
+            glam::DQuat::IDENTITY,
+            &pose,
+            &mut g,
+        );
+        let skeleton = clip.model.skeleton();
+        let low = feet[0]
+            .iter()
+            .zip(&rest[0])
+            .map(|(&q, r)| point(&skeleton, &g, q).y - r)
+            .fold(f64::INFINITY, f64::min);
+        for (f, t) in clip.root_translation.iter_mut().enumerate() {
+            *t = DVec3::new(speed * f as f64 / 60.0, sole - low, 0.0);
+        }
+        clip
+    }
+
+    fn foot_tracks(clip: &ModelClip) -> [Vec<Vec<DVec3>>; 2] {
+        let c = clip.to_clip();
+        let [l, r] = foot_points(&c.skeleton);
+        [
+            crate::analysis::point_tracks(&c, &l),
+            crate::analysis::point_tracks(&c, &r),
+        ]
+    }
+
+    #[test]
+    fn feet_in_the_floor_are_lifted_onto_it_and_a_standing_figure_is_left_alone() {
+        let mut on = stance(0.5, 0.0, 0.0, 120);
+        let before = on.clone();
+        let r = plant_feet(&mut on, &PlantParams::default());
+        assert!(r.max_correction_m < 1e-9, "{r:?}");
+        for (a, b) in on.angles.iter().zip(&before.angles) {
+            assert!((a - b).abs() < 1e-9);
+        }
+        let mut sunk = stance(0.5, -0.04, 0.0, 120);
+        let r = plant_feet(&mut sunk, &PlantParams::default());
+        let lowest = foot_tracks(&sunk)
+            .iter()
+            .flatten()
+            .flatten()
+            .map(|p| p.y)
+            .fold(f64::INFINITY, f64::min);
+        assert!(
+            lowest.abs() < 1e-3,
+            "lowest foot point at {lowest} m: {r:?}"
+        );
+        // The pelvis stays where it was: the legs bent to lift the feet.
+        assert_eq!(
+            sunk.root_translation,
+            stance(0.5, -0.04, 0.0, 120).root_translation
+        );
+    }
+
+    #[test]
+    fn a_sliding_planted_foot_is_held_still() {
+        // Feet on the floor while the pelvis glides 0.5 m/s for 0.6 s: the feet slide with it,
+        // faster than a foot at rest moves.
+        let mut clip = stance(1.0, 0.0, 0.5, 36);
+        let r = plant_feet(&mut clip, &PlantParams::default());
+        assert_eq!(r.locked, 2, "{r:?}");
+        let [l, _] = foot_tracks(&clip);
+        // The foot stands flat, toe and ankle on their rest heights: the ankle (the first
+        // point, as low as the toe relative to its rest height) is its contact point, and stays
+        // within a few millimetres of its anchor.
+        let ankle = l.iter().map(|p| p[0]).collect::<Vec<_>>();
+        let span = ankle
+            .iter()
+            .map(|p| (p.x - ankle[18].x).abs())
+            .fold(0.0, f64::max);
+        assert!(
+            span < 0.005,
+            "the ankle moves {span} m (it slid 0.3 m): {r:?}"
+        );
+        let unlocked = PlantParams {
+            lock: false,
+            ..PlantParams::default()
+        };
+        let mut free = stance(1.0, 0.0, 0.5, 36);
+        assert_eq!(plant_feet(&mut free, &unlocked).locked, 0);
+    }
+}
