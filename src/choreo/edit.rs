@@ -1,8 +1,14 @@
 //! The stateful edit of a dance that a server holds (the paper's editing interface, §3.3): a
 //! song's bars, the segment database, the pins (bar → segment the user set), per bar the search
-//! state of eqs. (1)–(4) ([`BarSearch`]: τ_k, S_n, L_l, the candidates shown), and undo/redo of
-//! pin changes; [`Edit::generate`] fills every unpinned bar through the pins by the
+//! state of eqs. (1)–(4) ([`BarSearch`]: the round k, S_n, L_l, the candidates shown), and
+//! undo/redo of pin changes; [`Edit::generate`] fills every unpinned bar through the pins by the
 //! minimum-cost path ([`super::fill`], Dijkstra over a transition table built once per edit).
+//!
+//! Undo and redo cover the pins only, the dance's content: a search round, a like and
+//! [`Edit::start_over`] change what the user is shown, not the dance, and are not undone (the
+//! likes survive a start over, so nothing the user chose is lost by it).
+//! [`Edit::set_search_params`] changes τ_0 and the decay for every bar's next rounds (the
+//! editor's "explore ↔ follow my likes").
 //!
 //! Everything but the database is an [`EditState`] (serde), so a server can save an edit with
 //! its scene and restore it with [`Edit::from_state`]; every method checks its bar and segment
@@ -55,7 +61,7 @@ pub enum EditError {
         /// Segments in the database.
         segments: usize,
     },
-    /// A like for a segment that was never shown for the bar.
+    /// A like for a segment that was never shown for the bar (nor liked).
     #[error("bar {bar}: segment {segment} was never shown as a candidate for this bar")]
     NotShown {
         /// The bar.
@@ -75,8 +81,12 @@ pub enum EditError {
     /// Redo with no undone change.
     #[error("nothing to redo")]
     NothingToRedo,
-    /// Every segment of the database has been shown for the bar.
-    #[error("bar {bar}: all {segments} segments have been shown; no new candidate is left")]
+    /// Every segment of the database has been shown for the bar ([`Edit::start_over`] shows
+    /// them again).
+    #[error(
+        "bar {bar}: all {segments} segments have been shown; no new candidate is left (start \
+         the bar's search over to see them again)"
+    )]
     Exhausted {
         /// The bar.
         bar: usize,
@@ -329,15 +339,37 @@ impl Edit {
         Ok(picks)
     }
 
-    /// Likes (`liked` true: into L_l) or unlikes a segment shown for `bar`.
+    /// Likes (`liked` true: into L_l) or unlikes a segment shown for `bar` (or liked before a
+    /// start over).
     pub fn like(&mut self, bar: usize, segment: usize, liked: bool) -> Result<(), EditError> {
         self.check_bar(bar)?;
         self.check_segment(segment)?;
         let s = &mut self.state.searches[bar];
-        if !s.shown.contains(&segment) {
+        if !s.shown.contains(&segment) && !s.liked.contains(&segment) {
             return Err(EditError::NotShown { bar, segment });
         }
         s.like(segment, liked);
+        Ok(())
+    }
+
+    /// Starts `bar`'s search over ([`BarSearch::start_over`]): round 0, nothing shown, the
+    /// likes kept. Not an undoable change (module docs).
+    pub fn start_over(&mut self, bar: usize) -> Result<(), EditError> {
+        self.check_bar(bar)?;
+        self.state.searches[bar].start_over();
+        Ok(())
+    }
+
+    /// The search parameters.
+    pub fn search_params(&self) -> &SearchParams {
+        &self.state.search
+    }
+
+    /// Replaces the search parameters (after checking them): every bar's next round runs with
+    /// them, at τ_k = τ_0·decay^k of its own round k.
+    pub fn set_search_params(&mut self, p: SearchParams) -> Result<(), EditError> {
+        p.check()?;
+        self.state.search = p;
         Ok(())
     }
 
@@ -464,7 +496,7 @@ mod tests {
         assert_eq!(e.bar_search(3).unwrap().liked, vec![first[1]]);
         let second = e.search(3).unwrap();
         assert!(second.iter().all(|s| !first.contains(s)));
-        assert!((e.bar_search(3).unwrap().tau - 0.95 * 0.95).abs() < 1e-15);
+        assert_eq!(e.bar_search(3).unwrap().round, 2);
         assert_eq!(e.bar_search(2).unwrap().round, 0);
 
         e.set(3, second[0]).unwrap();
@@ -489,6 +521,72 @@ mod tests {
         let mut back = Edit::from_state(e.database().clone(), state).unwrap();
         assert_eq!(back.state(), e.state());
         assert_eq!(back.search(3).unwrap(), e.search(3).unwrap());
+    }
+
+    #[test]
+    fn start_over_keeps_the_likes_reachable_and_tau0_is_set_for_the_next_rounds() {
+        let mut e = edit();
+        let first = e.search(4).unwrap();
+        e.like(4, first[0], true).unwrap();
+        e.set(4, first[1]).unwrap();
+        while e.search(4).is_ok() {}
+        assert_eq!(e.bar_search(4).unwrap().shown.len(), 40);
+        assert_eq!(
+            e.search(4),
+            Err(EditError::Exhausted {
+                bar: 4,
+                segments: 40
+            })
+        );
+        e.start_over(4).unwrap();
+        let s = e.bar_search(4).unwrap();
+        assert_eq!((s.round, s.shown.len()), (0, 0));
+        assert!(e.candidates(4).unwrap().is_empty());
+        // The like survives and the pin and its undo are untouched.
+        assert_eq!(s.liked, vec![first[0]]);
+        assert_eq!(e.pins(), &BTreeMap::from([(4, first[1])]));
+        assert_eq!(e.state().undo.len(), 1);
+        // A liked segment can be unliked though not shown since the start over; once unliked
+        // and not shown, it is not a candidate of the bar to like.
+        e.like(4, first[0], false).unwrap();
+        assert_eq!(
+            e.like(4, first[0], true),
+            Err(EditError::NotShown {
+                bar: 4,
+                segment: first[0]
+            })
+        );
+        assert!(e.bar_search(4).unwrap().liked.is_empty());
+        assert_eq!(
+            e.search(4).unwrap(),
+            first,
+            "round 0 again, as at the start"
+        );
+        assert_eq!(
+            e.start_over(8),
+            Err(EditError::NoSuchBar { bar: 8, bars: 8 })
+        );
+
+        // τ_0 for the next rounds: checked, and used at the bar's own round.
+        let bad = SearchParams {
+            tau0: 2.0,
+            ..SearchParams::default()
+        };
+        assert!(matches!(
+            e.set_search_params(bad),
+            Err(EditError::Search(SearchError::Params { .. }))
+        ));
+        assert_eq!(e.search_params().tau0, 1.0);
+        let follow = SearchParams {
+            tau0: 0.2,
+            ..SearchParams::default()
+        };
+        e.set_search_params(follow.clone()).unwrap();
+        assert_eq!(e.search_params(), &follow);
+        assert_eq!(
+            e.search_params().tau(e.bar_search(4).unwrap().round),
+            0.2 * 0.95
+        );
     }
 
     #[test]
