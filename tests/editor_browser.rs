@@ -150,12 +150,12 @@ fn the_page_searches_sets_generates_plays_saves_and_exports_in_chromium() {
     let (first, second, liked) = (ids("first"), ids("second"), ids("liked"));
     assert_eq!((first.len(), second.len()), (6, 6));
     assert!(second.iter().all(|s| !first.contains(s)));
-    // After Start over the bar is at round 1 again, the six on the page are its only shown
-    // segments, the two likes kept; the slider's τ_0 is the edit's.
+    // After Start over the bar is at round 1 again, its shown segments the two likes and the
+    // six on the page; the slider's τ_0 is the edit's.
     let c = get(addr, "/api/candidates?bar=2");
     assert_eq!(
         (c["round"].as_u64(), c["shown"].as_u64()),
-        (Some(1), Some(6))
+        (Some(1), Some(8))
     );
     let restarted = ids("after_start_over");
     let current: Vec<u64> = c["candidates"]
@@ -165,6 +165,7 @@ fn the_page_searches_sets_generates_plays_saves_and_exports_in_chromium() {
         .map(|m| m["segment"].as_u64().unwrap())
         .collect();
     assert_eq!(restarted, current);
+    assert!(restarted.iter().all(|s| !liked.contains(s)));
     assert_eq!(c["tau0"], 0.5);
     assert_eq!(c["liked"].as_array().unwrap().len(), 2);
     assert!(

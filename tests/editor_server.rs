@@ -223,18 +223,22 @@ fn liked_segments_stay_reachable_a_dry_bar_starts_over_and_tau0_is_set() {
     let (status, reason) = refused(a, "POST", "/api/search", Some(r#"{"bar": 5}"#));
     assert_eq!(status, 409);
     assert!(reason.contains("start the bar's search over"), "{reason}");
-    // Start over: round 0, nothing shown, the likes and the pin kept; Search shows six again.
+    // Start over: round 0, nothing shown but the likes, the likes and the pin kept; Search
+    // shows six again, none of them liked.
     let c = post(a, "/api/start-over", r#"{"bar": 5}"#);
     assert_eq!(
         (c["round"].as_u64(), c["shown"].as_u64()),
-        (Some(0), Some(0))
+        (Some(0), Some(2))
     );
-    assert_eq!(c["left"], n_seg);
+    assert_eq!(c["left"], n_seg - 2);
     assert!(c["candidates"].as_array().unwrap().is_empty());
     assert_eq!(c["liked"], serde_json::json!([shown[1], shown[4]]));
+    assert_eq!(c["liked_segments"].as_array().unwrap().len(), 2);
     assert_eq!(c["pin"], liked[0]);
-    assert_eq!(segments(&post(a, "/api/search", r#"{"bar": 5}"#)).len(), 6);
-    // A liked segment no longer shown can still be unliked.
+    let again = segments(&post(a, "/api/search", r#"{"bar": 5}"#));
+    assert_eq!(again.len(), 6);
+    assert!(!again.contains(&shown[1]) && !again.contains(&shown[4]));
+    // A liked card can be unliked from the Liked row.
     post(
         a,
         "/api/unlike",

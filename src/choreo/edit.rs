@@ -61,7 +61,7 @@ pub enum EditError {
         /// Segments in the database.
         segments: usize,
     },
-    /// A like for a segment that was never shown for the bar (nor liked).
+    /// A like for a segment that was never shown for the bar.
     #[error("bar {bar}: segment {segment} was never shown as a candidate for this bar")]
     NotShown {
         /// The bar.
@@ -339,21 +339,20 @@ impl Edit {
         Ok(picks)
     }
 
-    /// Likes (`liked` true: into L_l) or unlikes a segment shown for `bar` (or liked before a
-    /// start over).
+    /// Likes (`liked` true: into L_l) or unlikes a segment shown for `bar`.
     pub fn like(&mut self, bar: usize, segment: usize, liked: bool) -> Result<(), EditError> {
         self.check_bar(bar)?;
         self.check_segment(segment)?;
         let s = &mut self.state.searches[bar];
-        if !s.shown.contains(&segment) && !s.liked.contains(&segment) {
+        if !s.shown.contains(&segment) {
             return Err(EditError::NotShown { bar, segment });
         }
         s.like(segment, liked);
         Ok(())
     }
 
-    /// Starts `bar`'s search over ([`BarSearch::start_over`]): round 0, nothing shown, the
-    /// likes kept. Not an undoable change (module docs).
+    /// Starts `bar`'s search over ([`BarSearch::start_over`]): round 0, nothing shown but the
+    /// likes, which are kept. Not an undoable change (module docs).
     pub fn start_over(&mut self, bar: usize) -> Result<(), EditError> {
         self.check_bar(bar)?;
         self.state.searches[bar].start_over();
@@ -540,28 +539,21 @@ mod tests {
         );
         e.start_over(4).unwrap();
         let s = e.bar_search(4).unwrap();
-        assert_eq!((s.round, s.shown.len()), (0, 0));
+        assert_eq!((s.round, s.shown.clone()), (0, vec![first[0]]));
         assert!(e.candidates(4).unwrap().is_empty());
-        // The like survives and the pin and its undo are untouched.
+        // The like survives (it can be unliked and liked again), and the pin and its undo are
+        // untouched; the new rounds show the 39 others.
         assert_eq!(s.liked, vec![first[0]]);
         assert_eq!(e.pins(), &BTreeMap::from([(4, first[1])]));
         assert_eq!(e.state().undo.len(), 1);
-        // A liked segment can be unliked though not shown since the start over; once unliked
-        // and not shown, it is not a candidate of the bar to like.
         e.like(4, first[0], false).unwrap();
-        assert_eq!(
-            e.like(4, first[0], true),
-            Err(EditError::NotShown {
-                bar: 4,
-                segment: first[0]
-            })
-        );
-        assert!(e.bar_search(4).unwrap().liked.is_empty());
-        assert_eq!(
-            e.search(4).unwrap(),
-            first,
-            "round 0 again, as at the start"
-        );
+        e.like(4, first[0], true).unwrap();
+        let mut again = vec![];
+        while let Ok(c) = e.search(4) {
+            again.extend(c);
+        }
+        assert_eq!(again.len(), 39);
+        assert!(!again.contains(&first[0]));
         assert_eq!(
             e.start_over(8),
             Err(EditError::NoSuchBar { bar: 8, bars: 8 })
@@ -583,10 +575,9 @@ mod tests {
         };
         e.set_search_params(follow.clone()).unwrap();
         assert_eq!(e.search_params(), &follow);
-        assert_eq!(
-            e.search_params().tau(e.bar_search(4).unwrap().round),
-            0.2 * 0.95
-        );
+        let k = e.bar_search(4).unwrap().round;
+        assert_eq!(k, 7, "39 segments in rounds of six");
+        assert!((e.search_params().tau(k) - 0.2 * 0.95f64.powi(7)).abs() < 1e-15);
     }
 
     #[test]

@@ -18,8 +18,8 @@
 //! lets the likes steer from the first re-search on. τ is computed from the round, not kept,
 //! so a τ_0 changed mid-search applies to the bar's next rounds. When U \ S_n runs out, a
 //! round shows fewer candidates, and none once every segment was shown;
-//! [`BarSearch::start_over`] empties S_n (the likes stay) so that the bar can be searched
-//! again.
+//! [`BarSearch::start_over`] empties S_n of all but the likes (which stay) so that the bar can
+//! be searched again.
 //!
 //! Speed: a round over N segments is exact but does not compute N·|S_n| Eros values. The Eros
 //! axes are packed once per database ([`SearchIndex`]); per bar a cache (in [`BarSearch`], not
@@ -126,8 +126,8 @@ impl SearchParams {
 pub struct BarSearch {
     /// S_n: every segment shown for this bar, in the order shown (never shown again).
     pub shown: Vec<usize>,
-    /// L_l: the segments the user liked, in the order liked (kept by [`BarSearch::start_over`],
-    /// so a liked segment may be absent from a new S_n).
+    /// L_l: the shown segments the user liked, in the order liked (kept by
+    /// [`BarSearch::start_over`]).
     pub liked: Vec<usize>,
     /// The candidates of the last round (empty before the first).
     pub current: Vec<usize>,
@@ -179,16 +179,17 @@ impl BarSearch {
         }
     }
 
-    /// Starts the bar's search over: round 0 again (τ back to τ_0), nothing shown (S_n empty,
-    /// so every segment can come back), no current candidates. The likes L_l are kept: they are
-    /// what the user chose, the editor keeps showing them, and from the next round on (or from
-    /// round 0 when τ_0 < 1) they steer the new search; unlike them to drop them.
+    /// Starts the bar's search over: round 0 again (τ back to τ_0), no current candidates, and
+    /// S_n emptied of everything but the likes, so that every segment not liked can come back.
+    /// The likes L_l are kept: they are what the user chose, the editor keeps showing them in
+    /// their own row, and they steer the new search as before (from round 0 when τ_0 < 1).
+    /// They stay in S_n, as a liked segment always is, so the new rounds show only segments not
+    /// liked: both what is like the likes and what differs from them.
     pub fn start_over(&mut self) {
-        self.shown.clear();
+        self.shown.clone_from(&self.liked);
         self.current.clear();
         self.round = 0;
-        // The cache's min D was over the old S_n: a fresh one is taken at the next round (its
-        // max Sim over L_l stays valid, but rebuilding it is one pass).
+        // The cache's min D was over the old S_n: a fresh one is taken at the next round.
         self.cache = None;
     }
 }
@@ -740,24 +741,36 @@ pub(crate) mod tests {
         while !index.round(0.5, &mut s, &p).unwrap().is_empty() {}
         assert_eq!(s.shown.len(), 20);
         s.start_over();
-        assert_eq!((s.round, s.shown.len(), s.current.len()), (0, 0, 0));
+        // Round 0, no candidate, S_n only the likes, the likes kept.
+        assert_eq!((s.round, s.current.len()), (0, 0));
         assert_eq!(s.liked, vec![first[1]]);
-        // Round 0 again at τ_0 = 1: the same first round as a fresh bar (likes count from
-        // round 1), and every segment comes back over the rounds.
-        assert_eq!(index.round(0.5, &mut s, &p).unwrap(), first);
-        while !index.round(0.5, &mut s, &p).unwrap().is_empty() {}
-        let mut seen = s.shown.clone();
-        seen.sort();
-        assert_eq!(seen, (0..20).collect::<Vec<_>>());
-        // The next rounds after a start over are those of a fresh state with the same likes
-        // (the cache of the old S_n is not used).
+        assert_eq!(s.shown, s.liked);
+        // Every segment but the liked one comes back over the new rounds, none twice.
+        let mut again = vec![];
+        loop {
+            let c = index.round(0.5, &mut s, &p).unwrap();
+            if c.is_empty() {
+                break;
+            }
+            again.extend(c);
+        }
+        again.sort();
+        let others: Vec<usize> = (0..20).filter(|&m| m != first[1]).collect();
+        assert_eq!(again, others);
+        // The rounds after a start over are those of a fresh state holding the likes as shown
+        // (the cache of the old S_n is not used), at τ_0 < 1 too.
+        let follow = SearchParams {
+            tau0: 0.3,
+            ..SearchParams::default()
+        };
         s.start_over();
         let mut fresh = BarSearch::new();
+        fresh.shown.push(first[1]);
         fresh.like(first[1], true);
         for _ in 0..3 {
             assert_eq!(
-                index.round(0.7, &mut s, &p).unwrap(),
-                index.round(0.7, &mut fresh, &p).unwrap()
+                index.round(0.7, &mut s, &follow).unwrap(),
+                index.round(0.7, &mut fresh, &follow).unwrap()
             );
         }
     }

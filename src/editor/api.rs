@@ -9,7 +9,7 @@
 //! | `GET /api/dance` | | the whole dance of the current pins at the scene's fps (generates first) |
 //! | `GET /api/audio.wav` | | the song as 16-bit WAV |
 //! | `POST /api/search` | `{"bar": K}` | the next relevance-feedback round; as `candidates` |
-//! | `POST /api/start-over` | `{"bar": K}` | bar K's search back to round 0, nothing shown, likes kept; as `candidates` |
+//! | `POST /api/start-over` | `{"bar": K}` | bar K's search back to round 0, nothing shown but the likes (kept); as `candidates` |
 //! | `POST /api/search-params` | `{"tau0": x, "tau_decay": y}` (either) | τ_0 and decay for every bar's next rounds; the search parameters |
 //! | `POST /api/like` | `{"bar": K, "segment": S}` | S into bar K's liked set L_l |
 //! | `POST /api/unlike` | `{"bar": K, "segment": S}` | S out of L_l |

@@ -94,13 +94,14 @@ try {
   const pinned = second[1].segment;
   await (await page.$$('#candidates .cand button.set'))[1].click();
   await page.waitForSelector('#candidates .cand.pinned');
-  // Start over: round 0 again, six fresh candidates, the liked row still there.
+  // Start over: round 0 again, six candidates none of them liked, the liked row still there.
   await page.click('#start-over');
   await page.waitForFunction(() => document.getElementById('status').textContent.includes('started over'), null, { timeout: 10000 });
   const restarted = await page.textContent('#bar-info');
-  if (!restarted.startsWith('round 1 ·') || !restarted.includes(' 6 shown')) fail(`after Start over: ${restarted}`);
+  if (!restarted.startsWith('round 1 ·') || !restarted.includes(' 8 shown')) fail(`after Start over: ${restarted}`);
   const third = await cards();
   if (third.length !== 6) fail(`${third.length} candidates after Start over`);
+  if (third.some((c) => liked.includes(c.segment))) fail(`a liked segment among the new candidates: ${third.map((c) => c.segment)}`);
   if ((await page.$$('#liked .cand')).length !== 2) fail('the liked row is gone after Start over');
   await page.screenshot({ path: join(shots, 'editor_start_over.png'), fullPage: true });
 

@@ -127,7 +127,7 @@ function showCandidates(c) {
   $('start-over').disabled = c.shown === 0;
   $('start-over').classList.toggle('offer', dry);
   $('dry').hidden = !dry;
-  $('dry').textContent = dry ? `All ${c.shown} segments have been shown for this bar. Start over to see them again — your likes stay.` : '';
+  $('dry').textContent = dry ? `All ${c.shown} segments have been shown for this bar. Start over to see them again — your likes stay in their row.` : '';
   $('unpin').disabled = pin === null || pin === undefined;
   views = [
     ...fillCards($('candidates'), c, c.candidates, pin),
