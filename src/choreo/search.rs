@@ -728,6 +728,16 @@ pub(crate) mod tests {
         let old: SearchParams =
             serde_json::from_str(r#"{"rho": 0.5, "candidates": 6, "tau_decay": 0.9}"#).unwrap();
         assert_eq!((old.tau0, old.tau_decay), (1.0, 0.9));
+        // And as a scene writes them (RON): the old field set, or only the new field.
+        let old: SearchParams =
+            ron::from_str("(rho: 0.5, candidates: 6, tau_decay: 0.95)").unwrap();
+        assert_eq!(old, SearchParams::default());
+        let new: SearchParams = ron::from_str("(tau0: 0.5)").unwrap();
+        assert_eq!((new.tau0, new.tau_decay, new.candidates), (0.5, 0.95, 6));
+        assert!(
+            ron::from_str::<SearchParams>("(tau_0: 0.5)").is_err(),
+            "a misspelt field"
+        );
     }
 
     #[test]
