@@ -1,7 +1,9 @@
 //! The dance editor end to end in a real browser: `marionette edit` on (a copy of) the
 //! project's own dance scene, `scenes/dance.ron`, and `tests/browser/editor.mjs` driving
 //! headless Chromium through playwright-core — click a bar, six animated candidates drawn,
-//! like two, Search gives six new ones, Set, Generate, play, next bar by key, save, export —
+//! like two, Search gives six new ones and a "Liked" row of the two, the explore ↔ follow
+//! slider sets τ_0, Set, Start over (six candidates again, the likes kept), Generate, play,
+//! next bar by key, save, export —
 //! then the server's state, the saved scene and the exported BVH checked here, and `marionette
 //! run` of the saved scene shown to write that same BVH. Then the latency the page sees on a
 //! 2,000-segment database (`tests/browser/latency.mjs`; printed and written to
@@ -148,8 +150,23 @@ fn the_page_searches_sets_generates_plays_saves_and_exports_in_chromium() {
     let (first, second, liked) = (ids("first"), ids("second"), ids("liked"));
     assert_eq!((first.len(), second.len()), (6, 6));
     assert!(second.iter().all(|s| !first.contains(s)));
+    // After Start over the bar is at round 1 again, its shown segments the two likes and the
+    // six on the page; the slider's τ_0 is the edit's.
     let c = get(addr, "/api/candidates?bar=2");
-    assert_eq!(c["round"], 2);
+    assert_eq!(
+        (c["round"].as_u64(), c["shown"].as_u64()),
+        (Some(1), Some(8))
+    );
+    let restarted = ids("after_start_over");
+    let current: Vec<u64> = c["candidates"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|m| m["segment"].as_u64().unwrap())
+        .collect();
+    assert_eq!(restarted, current);
+    assert!(restarted.iter().all(|s| !liked.contains(s)));
+    assert_eq!(c["tau0"], 0.5);
     assert_eq!(c["liked"].as_array().unwrap().len(), 2);
     assert!(
         liked

@@ -165,6 +165,96 @@ fn the_api_flow_search_like_search_set_generate_save_export() {
     ed.stop();
 }
 
+#[test]
+fn liked_segments_stay_reachable_a_dry_bar_starts_over_and_tau0_is_set() {
+    let (ed, _) = start("likes");
+    let a = ed.addr();
+    let n_seg = get(a, "/api/state")["segments"].as_u64().unwrap();
+    assert_eq!(get(a, "/api/state")["search"]["tau0"], 1.0);
+
+    // Like two of round 0; after Search they are gone from the candidates but in the liked
+    // row, with their frames.
+    let first = post(a, "/api/search", r#"{"bar": 5}"#);
+    let shown = segments(&first);
+    assert_eq!(first["left"], n_seg - 6);
+    for s in [shown[1], shown[4]] {
+        post(a, "/api/like", &format!(r#"{{"bar": 5, "segment": {s}}}"#));
+    }
+    let second = post(a, "/api/search", r#"{"bar": 5}"#);
+    assert!(segments(&second).iter().all(|s| !shown.contains(s)));
+    let liked: Vec<u64> = second["liked_segments"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c["segment"].as_u64().unwrap())
+        .collect();
+    assert_eq!(liked, vec![shown[1], shown[4]]);
+    let row = &second["liked_segments"][0];
+    assert_eq!(row["liked"], true);
+    assert_eq!(row["frames"].as_array().unwrap().len(), 32);
+    // A liked card can be Set.
+    let s = post(
+        a,
+        "/api/set",
+        &format!(r#"{{"bar": 5, "segment": {}}}"#, liked[0]),
+    );
+    assert_eq!(s["pins"]["5"], liked[0]);
+
+    // The slider: τ_0 for the next rounds (checked), τ = τ_0·0.95^k of the bar's round k.
+    let p = post(a, "/api/search-params", r#"{"tau0": 0.3}"#);
+    assert_eq!(
+        (p["tau0"].as_f64(), p["tau_decay"].as_f64()),
+        (Some(0.3), Some(0.95))
+    );
+    let c = get(a, "/api/candidates?bar=5");
+    assert_eq!(c["round"], 2);
+    assert!((c["tau"].as_f64().unwrap() - 0.3 * 0.95 * 0.95).abs() < 1e-12);
+    let (status, reason) = refused(a, "POST", "/api/search-params", Some(r#"{"tau0": 1.5}"#));
+    assert_eq!(status, 400);
+    assert!(reason.contains("tau0 must lie in [0, 1]"), "{reason}");
+    assert_eq!(get(a, "/api/state")["search"]["tau0"], 0.3);
+
+    // Search until the bar runs dry: `left` says so before the refusal.
+    let mut c = c;
+    while c["left"] != 0 {
+        c = post(a, "/api/search", r#"{"bar": 5}"#);
+    }
+    assert_eq!(c["shown"], n_seg);
+    let (status, reason) = refused(a, "POST", "/api/search", Some(r#"{"bar": 5}"#));
+    assert_eq!(status, 409);
+    assert!(reason.contains("start the bar's search over"), "{reason}");
+    // Start over: round 0, nothing shown but the likes, the likes and the pin kept; Search
+    // shows six again, none of them liked.
+    let c = post(a, "/api/start-over", r#"{"bar": 5}"#);
+    assert_eq!(
+        (c["round"].as_u64(), c["shown"].as_u64()),
+        (Some(0), Some(2))
+    );
+    assert_eq!(c["left"], n_seg - 2);
+    assert!(c["candidates"].as_array().unwrap().is_empty());
+    assert_eq!(c["liked"], serde_json::json!([shown[1], shown[4]]));
+    assert_eq!(c["liked_segments"].as_array().unwrap().len(), 2);
+    assert_eq!(c["pin"], liked[0]);
+    let again = segments(&post(a, "/api/search", r#"{"bar": 5}"#));
+    assert_eq!(again.len(), 6);
+    assert!(!again.contains(&shown[1]) && !again.contains(&shown[4]));
+    // A liked card can be unliked from the Liked row.
+    post(
+        a,
+        "/api/unlike",
+        &format!(r#"{{"bar": 5, "segment": {}}}"#, shown[4]),
+    );
+    assert_eq!(
+        get(a, "/api/candidates?bar=5")["liked"],
+        serde_json::json!([shown[1]])
+    );
+    assert_eq!(
+        refused(a, "POST", "/api/start-over", Some(r#"{"bar": 99}"#)).0,
+        400
+    );
+    ed.stop();
+}
+
 /// The status and the one-line reason of a request.
 fn refused(a: SocketAddr, method: &str, path: &str, body: Option<&str>) -> (u16, String) {
     let r = request(a, method, path, body);

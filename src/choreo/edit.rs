@@ -1,8 +1,14 @@
 //! The stateful edit of a dance that a server holds (the paper's editing interface, §3.3): a
 //! song's bars, the segment database, the pins (bar → segment the user set), per bar the search
-//! state of eqs. (1)–(4) ([`BarSearch`]: τ_k, S_n, L_l, the candidates shown), and undo/redo of
-//! pin changes; [`Edit::generate`] fills every unpinned bar through the pins by the
+//! state of eqs. (1)–(4) ([`BarSearch`]: the round k, S_n, L_l, the candidates shown), and
+//! undo/redo of pin changes; [`Edit::generate`] fills every unpinned bar through the pins by the
 //! minimum-cost path ([`super::fill`], Dijkstra over a transition table built once per edit).
+//!
+//! Undo and redo cover the pins only, the dance's content: a search round, a like and
+//! [`Edit::start_over`] change what the user is shown, not the dance, and are not undone (the
+//! likes survive a start over, so nothing the user chose is lost by it).
+//! [`Edit::set_search_params`] changes τ_0 and the decay for every bar's next rounds (the
+//! editor's "explore ↔ follow my likes").
 //!
 //! Everything but the database is an [`EditState`] (serde), so a server can save an edit with
 //! its scene and restore it with [`Edit::from_state`]; every method checks its bar and segment
@@ -75,8 +81,12 @@ pub enum EditError {
     /// Redo with no undone change.
     #[error("nothing to redo")]
     NothingToRedo,
-    /// Every segment of the database has been shown for the bar.
-    #[error("bar {bar}: all {segments} segments have been shown; no new candidate is left")]
+    /// Every segment of the database has been shown for the bar ([`Edit::start_over`] shows
+    /// them again).
+    #[error(
+        "bar {bar}: all {segments} segments have been shown; no new candidate is left (start \
+         the bar's search over to see them again)"
+    )]
     Exhausted {
         /// The bar.
         bar: usize,
@@ -341,6 +351,27 @@ impl Edit {
         Ok(())
     }
 
+    /// Starts `bar`'s search over ([`BarSearch::start_over`]): round 0, nothing shown but the
+    /// likes, which are kept. Not an undoable change (module docs).
+    pub fn start_over(&mut self, bar: usize) -> Result<(), EditError> {
+        self.check_bar(bar)?;
+        self.state.searches[bar].start_over();
+        Ok(())
+    }
+
+    /// The search parameters.
+    pub fn search_params(&self) -> &SearchParams {
+        &self.state.search
+    }
+
+    /// Replaces the search parameters (after checking them): every bar's next round runs with
+    /// them, at τ_k = τ_0·decay^k of its own round k.
+    pub fn set_search_params(&mut self, p: SearchParams) -> Result<(), EditError> {
+        p.check()?;
+        self.state.search = p;
+        Ok(())
+    }
+
     /// Records and applies a pin change (none when it changes nothing).
     fn change(&mut self, bar: usize, after: Option<usize>) {
         let before = self.state.pins.get(&bar).copied();
@@ -464,7 +495,7 @@ mod tests {
         assert_eq!(e.bar_search(3).unwrap().liked, vec![first[1]]);
         let second = e.search(3).unwrap();
         assert!(second.iter().all(|s| !first.contains(s)));
-        assert!((e.bar_search(3).unwrap().tau - 0.95 * 0.95).abs() < 1e-15);
+        assert_eq!(e.bar_search(3).unwrap().round, 2);
         assert_eq!(e.bar_search(2).unwrap().round, 0);
 
         e.set(3, second[0]).unwrap();
@@ -489,6 +520,64 @@ mod tests {
         let mut back = Edit::from_state(e.database().clone(), state).unwrap();
         assert_eq!(back.state(), e.state());
         assert_eq!(back.search(3).unwrap(), e.search(3).unwrap());
+    }
+
+    #[test]
+    fn start_over_keeps_the_likes_reachable_and_tau0_is_set_for_the_next_rounds() {
+        let mut e = edit();
+        let first = e.search(4).unwrap();
+        e.like(4, first[0], true).unwrap();
+        e.set(4, first[1]).unwrap();
+        while e.search(4).is_ok() {}
+        assert_eq!(e.bar_search(4).unwrap().shown.len(), 40);
+        assert_eq!(
+            e.search(4),
+            Err(EditError::Exhausted {
+                bar: 4,
+                segments: 40
+            })
+        );
+        e.start_over(4).unwrap();
+        let s = e.bar_search(4).unwrap();
+        assert_eq!((s.round, s.shown.clone()), (0, vec![first[0]]));
+        assert!(e.candidates(4).unwrap().is_empty());
+        // The like survives (it can be unliked and liked again), and the pin and its undo are
+        // untouched; the new rounds show the 39 others.
+        assert_eq!(s.liked, vec![first[0]]);
+        assert_eq!(e.pins(), &BTreeMap::from([(4, first[1])]));
+        assert_eq!(e.state().undo.len(), 1);
+        e.like(4, first[0], false).unwrap();
+        e.like(4, first[0], true).unwrap();
+        let mut again = vec![];
+        while let Ok(c) = e.search(4) {
+            again.extend(c);
+        }
+        assert_eq!(again.len(), 39);
+        assert!(!again.contains(&first[0]));
+        assert_eq!(
+            e.start_over(8),
+            Err(EditError::NoSuchBar { bar: 8, bars: 8 })
+        );
+
+        // τ_0 for the next rounds: checked, and used at the bar's own round.
+        let bad = SearchParams {
+            tau0: 2.0,
+            ..SearchParams::default()
+        };
+        assert!(matches!(
+            e.set_search_params(bad),
+            Err(EditError::Search(SearchError::Params { .. }))
+        ));
+        assert_eq!(e.search_params().tau0, 1.0);
+        let follow = SearchParams {
+            tau0: 0.2,
+            ..SearchParams::default()
+        };
+        e.set_search_params(follow.clone()).unwrap();
+        assert_eq!(e.search_params(), &follow);
+        let k = e.bar_search(4).unwrap().round;
+        assert_eq!(k, 7, "39 segments in rounds of six");
+        assert!((e.search_params().tau(k) - 0.2 * 0.95f64.powi(7)).abs() < 1e-15);
     }
 
     #[test]

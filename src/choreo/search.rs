@@ -11,9 +11,15 @@
 //! new one is far from all shown before it, in earlier rounds and in this one. The paper leaves
 //! the min over an empty S_n (the very first pick) and the max over an empty L_l undefined;
 //! here both terms are 0 then, so the first candidate of a bar is the best match of intensity
-//! alone (argmax rel) and the next five spread out from it. τ_k = 0.95·τ_{k−1}, τ_0 = 1 (eq. 4),
-//! k the round: round 0 is pure diversity, later rounds lean more and more on the likes. When
-//! U \ S_n runs out, a round shows fewer candidates, and none once every segment was shown.
+//! alone (argmax rel) and the next five spread out from it. τ_k = decay·τ_{k−1} (eq. 4), so
+//! τ_k = τ_0·decay^k with k the bar's round ([`SearchParams::tau`]); the paper's τ_0 = 1 and
+//! decay = 0.95 are the defaults: round 0 is pure diversity and the likes weigh only 1 − 0.95
+//! = 5 % of Φ in the first re-search. A smaller τ_0 (the editor's "explore ↔ follow my likes")
+//! lets the likes steer from the first re-search on. τ is computed from the round, not kept,
+//! so a τ_0 changed mid-search applies to the bar's next rounds. When U \ S_n runs out, a
+//! round shows fewer candidates, and none once every segment was shown;
+//! [`BarSearch::start_over`] empties S_n of all but the likes (which stay) so that the bar can
+//! be searched again.
 //!
 //! Speed: a round over N segments is exact but does not compute N·|S_n| Eros values. The Eros
 //! axes are packed once per database ([`SearchIndex`]); per bar a cache (in [`BarSearch`], not
@@ -58,37 +64,47 @@ pub enum SearchError {
     },
 }
 
-/// The parameters of eq. (1) and (4).
+/// The parameters of eq. (1) and (4). Every field has a default (serde), so a scene gives only
+/// the ones it changes: `search: (tau0: 0.5)`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, default)]
 pub struct SearchParams {
     /// ρ ∈ [0, 1]: the weight of rel against Φ in eq. (1).
     pub rho: f64,
     /// Candidates shown per round (the paper's six), ≥ 1.
     pub candidates: usize,
+    /// τ_0 ∈ [0, 1] of eq. (4): the weight of diversity against the likes in a bar's first
+    /// round (the paper's 1; 0 follows the likes alone).
+    pub tau0: f64,
     /// τ_k / τ_{k−1} of eq. (4) ∈ (0, 1] (the paper's 19/20).
     pub tau_decay: f64,
 }
 
 impl Default for SearchParams {
     /// ρ = 0.5 (the paper gives no value; intensity match and Φ weigh the same), six candidates,
-    /// τ decay 0.95.
+    /// the paper's τ_0 = 1 and decay 0.95.
     fn default() -> SearchParams {
         SearchParams {
             rho: 0.5,
             candidates: 6,
+            tau0: 1.0,
             tau_decay: 0.95,
         }
     }
 }
 
 impl SearchParams {
-    /// Checks the ranges (ρ ∈ [0, 1], candidates ≥ 1, decay ∈ (0, 1]).
+    /// Checks the ranges (ρ ∈ [0, 1], candidates ≥ 1, τ_0 ∈ [0, 1], decay ∈ (0, 1]).
     pub fn check(&self) -> Result<(), SearchError> {
         let message = if !(0.0..=1.0).contains(&self.rho) {
             format!("rho must lie in [0, 1], found {}", self.rho)
         } else if self.candidates == 0 {
             "candidates must be at least 1, found 0".to_string()
+        } else if !(0.0..=1.0).contains(&self.tau0) {
+            format!(
+                "tau0 must lie in [0, 1] (1: diversity only, 0: likes only), found {}",
+                self.tau0
+            )
         } else if !(self.tau_decay > 0.0 && self.tau_decay <= 1.0) {
             format!("tau_decay must lie in (0, 1], found {}", self.tau_decay)
         } else {
@@ -96,17 +112,22 @@ impl SearchParams {
         };
         Err(SearchError::Params { message })
     }
+
+    /// τ_k = τ_0·decay^k of eq. (4): τ of a bar's round `k` (0 its first).
+    pub fn tau(&self, k: usize) -> f64 {
+        self.tau0 * self.tau_decay.powi(k.min(i32::MAX as usize) as i32)
+    }
 }
 
-/// The search state of one bar: τ_k, S_n, L_l and the candidates of the last round.
+/// The search state of one bar: the round k (τ_k = [`SearchParams::tau`]`(k)`), S_n, L_l and
+/// the candidates of the last round.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BarSearch {
-    /// τ of the next round (eq. 4; 1 before the first).
-    pub tau: f64,
     /// S_n: every segment shown for this bar, in the order shown (never shown again).
     pub shown: Vec<usize>,
-    /// L_l: the shown segments the user liked, in the order liked.
+    /// L_l: the shown segments the user liked, in the order liked (kept by
+    /// [`BarSearch::start_over`]).
     pub liked: Vec<usize>,
     /// The candidates of the last round (empty before the first).
     pub current: Vec<usize>,
@@ -120,8 +141,7 @@ pub struct BarSearch {
 impl PartialEq for BarSearch {
     /// The same state (the cache, which only saves time, is ignored).
     fn eq(&self, o: &BarSearch) -> bool {
-        self.tau == o.tau
-            && self.shown == o.shown
+        self.shown == o.shown
             && self.liked == o.liked
             && self.current == o.current
             && self.round == o.round
@@ -129,10 +149,9 @@ impl PartialEq for BarSearch {
 }
 
 impl Default for BarSearch {
-    /// Before the first round: τ = 1, nothing shown or liked.
+    /// Before the first round: nothing shown or liked.
     fn default() -> BarSearch {
         BarSearch {
-            tau: 1.0,
             shown: vec![],
             liked: vec![],
             current: vec![],
@@ -158,6 +177,20 @@ impl BarSearch {
             }
             _ => {}
         }
+    }
+
+    /// Starts the bar's search over: round 0 again (τ back to τ_0), no current candidates, and
+    /// S_n emptied of everything but the likes, so that every segment not liked can come back.
+    /// The likes L_l are kept: they are what the user chose, the editor keeps showing them in
+    /// their own row, and they steer the new search as before (from round 0 when τ_0 < 1).
+    /// They stay in S_n, as a liked segment always is, so the new rounds show only segments not
+    /// liked: both what is like the likes and what differs from them.
+    pub fn start_over(&mut self) {
+        self.shown.clone_from(&self.liked);
+        self.current.clear();
+        self.round = 0;
+        // The cache's min D was over the old S_n: a fresh one is taken at the next round.
+        self.cache = None;
     }
 }
 
@@ -334,8 +367,9 @@ impl SearchIndex {
 
     /// One round of eq. (1) for a bar of normalised music intensity `bar_intensity` (its
     /// percentile rank among the song's bars, [`super::relevance::music_intensity`]): up to
-    /// `p.candidates` segments, each added to `state.shown` as chosen; then `state.current` is
-    /// the round's candidates, τ decays and the round count grows. With nothing left to show it
+    /// `p.candidates` segments, each added to `state.shown` as chosen, at τ = `p.tau(k)` for
+    /// the state's round k; then `state.current` is the round's candidates and the round count
+    /// grows (so τ decays). With nothing left to show it
     /// returns no candidate and leaves the state as it was.
     pub fn round(
         &self,
@@ -369,7 +403,7 @@ impl SearchIndex {
             }
             cache.liked.extend_from_slice(new_likes);
         }
-        let (tau, rho) = (state.tau, p.rho);
+        let (tau, rho) = (p.tau(state.round), p.rho);
         let mut is_shown = vec![false; n];
         for &s in &state.shown {
             is_shown[s] = true;
@@ -417,7 +451,6 @@ impl SearchIndex {
         if !picks.is_empty() {
             state.current = picks.clone();
             state.round += 1;
-            state.tau *= p.tau_decay;
         }
         Ok(picks)
     }
@@ -554,7 +587,8 @@ pub(crate) mod tests {
                         .iter()
                         .map(|&l| index.sim(m, l))
                         .fold(0.0, f64::max);
-                    let s = SearchIndex::objective(q, index.motion[m], md, ms, state.tau, p.rho);
+                    let tau = p.tau(state.round);
+                    let s = SearchIndex::objective(q, index.motion[m], md, ms, tau, p.rho);
                     (m, s)
                 })
                 .fold(None, |b: Option<(usize, f64)>, (m, s)| match b {
@@ -568,7 +602,6 @@ pub(crate) mod tests {
         if !picks.is_empty() {
             state.current = picks.clone();
             state.round += 1;
-            state.tau *= p.tau_decay;
         }
         picks
     }
@@ -593,9 +626,15 @@ pub(crate) mod tests {
     fn lazy_rounds_are_the_full_scan_and_never_repeat() {
         let db = random_db(300, 2);
         let index = SearchIndex::new(&db);
-        for (rho, q) in [(0.5, 0.8), (0.0, 0.1), (1.0, 0.5), (0.2, 0.33)] {
+        for (rho, q, tau0) in [
+            (0.5, 0.8, 1.0),
+            (0.0, 0.1, 1.0),
+            (1.0, 0.5, 0.3),
+            (0.2, 0.33, 0.5),
+        ] {
             let p = SearchParams {
                 rho,
+                tau0,
                 ..SearchParams::default()
             };
             let (mut fast, mut slow) = (BarSearch::new(), BarSearch::new());
@@ -619,13 +658,130 @@ pub(crate) mod tests {
             seen.sort();
             seen.dedup();
             assert_eq!(seen.len(), 48, "a shown segment came back");
-            assert!((fast.tau - 0.95f64.powi(8)).abs() < 1e-15);
+            assert_eq!(fast.round, 8);
             // A state restored without its cache gives the same next round.
             let mut restored: BarSearch =
                 serde_json::from_str(&serde_json::to_string(&fast).unwrap()).unwrap();
             assert_eq!(restored, fast);
             let a = index.round(q, &mut fast, &p).unwrap();
             assert_eq!(index.round(q, &mut restored, &p).unwrap(), a);
+        }
+    }
+
+    #[test]
+    fn tau_k_is_tau0_times_decay_to_the_k_and_out_of_range_is_refused() {
+        let p = SearchParams {
+            tau0: 0.4,
+            tau_decay: 0.8,
+            ..SearchParams::default()
+        };
+        let mut t = 0.4;
+        for k in 0..12 {
+            assert!(
+                (p.tau(k) - t).abs() < 1e-15,
+                "round {k}: {} vs {t}",
+                p.tau(k)
+            );
+            t *= 0.8;
+        }
+        assert_eq!(SearchParams::default().tau(0), 1.0);
+        assert_eq!(SearchParams::default().tau(1), 0.95);
+        // The round runs at τ_k of the state's round: with τ_0 = 0 and ρ = 0 the first pick
+        // after a like is the most similar to it (the liked one itself is already shown).
+        let db = random_db(80, 6);
+        let index = SearchIndex::new(&db);
+        let follow = SearchParams {
+            rho: 0.0,
+            tau0: 0.0,
+            ..SearchParams::default()
+        };
+        let mut s = BarSearch::new();
+        let first = index.round(0.5, &mut s, &follow).unwrap();
+        s.like(first[2], true);
+        let next = index.round(0.5, &mut s, &follow).unwrap();
+        let nearest = (0..80)
+            .filter(|m| !first.contains(m))
+            .max_by(|&a, &b| {
+                index
+                    .sim(a, first[2])
+                    .total_cmp(&index.sim(b, first[2]))
+                    .then(b.cmp(&a))
+            })
+            .unwrap();
+        assert_eq!(next[0], nearest);
+        // Out of range: a clear error naming the field.
+        for (tau0, tau_decay) in [(1.5, 0.95), (-0.1, 0.95), (f64::NAN, 0.95), (0.5, 0.0)] {
+            let bad = SearchParams {
+                tau0,
+                tau_decay,
+                ..SearchParams::default()
+            };
+            let e = bad.check().unwrap_err().to_string();
+            let field = if tau_decay == 0.0 {
+                "tau_decay"
+            } else {
+                "tau0"
+            };
+            assert!(e.contains(field), "{e}");
+        }
+        // Old scenes without tau0 still read, with the paper's τ_0 = 1.
+        let old: SearchParams =
+            serde_json::from_str(r#"{"rho": 0.5, "candidates": 6, "tau_decay": 0.9}"#).unwrap();
+        assert_eq!((old.tau0, old.tau_decay), (1.0, 0.9));
+        // And as a scene writes them (RON): the old field set, or only the new field.
+        let old: SearchParams =
+            ron::from_str("(rho: 0.5, candidates: 6, tau_decay: 0.95)").unwrap();
+        assert_eq!(old, SearchParams::default());
+        let new: SearchParams = ron::from_str("(tau0: 0.5)").unwrap();
+        assert_eq!((new.tau0, new.tau_decay, new.candidates), (0.5, 0.95, 6));
+        assert!(
+            ron::from_str::<SearchParams>("(tau_0: 0.5)").is_err(),
+            "a misspelt field"
+        );
+    }
+
+    #[test]
+    fn start_over_shows_every_segment_again_and_keeps_the_likes() {
+        let db = random_db(20, 8);
+        let index = SearchIndex::new(&db);
+        let p = SearchParams::default();
+        let mut s = BarSearch::new();
+        let first = index.round(0.5, &mut s, &p).unwrap();
+        s.like(first[1], true);
+        while !index.round(0.5, &mut s, &p).unwrap().is_empty() {}
+        assert_eq!(s.shown.len(), 20);
+        s.start_over();
+        // Round 0, no candidate, S_n only the likes, the likes kept.
+        assert_eq!((s.round, s.current.len()), (0, 0));
+        assert_eq!(s.liked, vec![first[1]]);
+        assert_eq!(s.shown, s.liked);
+        // Every segment but the liked one comes back over the new rounds, none twice.
+        let mut again = vec![];
+        loop {
+            let c = index.round(0.5, &mut s, &p).unwrap();
+            if c.is_empty() {
+                break;
+            }
+            again.extend(c);
+        }
+        again.sort();
+        let others: Vec<usize> = (0..20).filter(|&m| m != first[1]).collect();
+        assert_eq!(again, others);
+        // The rounds after a start over are those of a fresh state holding the likes as shown
+        // (the cache of the old S_n is not used), at τ_0 < 1 too.
+        let follow = SearchParams {
+            tau0: 0.3,
+            ..SearchParams::default()
+        };
+        s.start_over();
+        let mut fresh = BarSearch::new();
+        fresh.shown.push(first[1]);
+        fresh.like(first[1], true);
+        for _ in 0..3 {
+            assert_eq!(
+                index.round(0.7, &mut s, &follow).unwrap(),
+                index.round(0.7, &mut fresh, &follow).unwrap()
+            );
         }
     }
 

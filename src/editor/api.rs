@@ -5,10 +5,12 @@
 //! |---|---|---|
 //! | `GET /api/state` | | pins, undo/redo depth, last fill, tempo, song length, figure links |
 //! | `GET /api/bars` | | every bar (span, dB, normalised intensity, pin, filled segment), beats |
-//! | `GET /api/candidates` | `?bar=K` | bar K's round, τ, liked, and its six candidates' frames |
+//! | `GET /api/candidates` | `?bar=K` | bar K's round, τ, segments left, its six candidates' frames and its liked segments' frames |
 //! | `GET /api/dance` | | the whole dance of the current pins at the scene's fps (generates first) |
 //! | `GET /api/audio.wav` | | the song as 16-bit WAV |
 //! | `POST /api/search` | `{"bar": K}` | the next relevance-feedback round; as `candidates` |
+//! | `POST /api/start-over` | `{"bar": K}` | bar K's search back to round 0, nothing shown but the likes (kept); as `candidates` |
+//! | `POST /api/search-params` | `{"tau0": x, "tau_decay": y}` (either) | τ_0 and decay for every bar's next rounds; the search parameters |
 //! | `POST /api/like` | `{"bar": K, "segment": S}` | S into bar K's liked set L_l |
 //! | `POST /api/unlike` | `{"bar": K, "segment": S}` | S out of L_l |
 //! | `POST /api/set` | `{"bar": K, "segment": S}` | pins S to bar K |
@@ -21,7 +23,8 @@
 //! Errors are `{"error": "one line"}`: 400 for a malformed request (bad JSON, unknown field,
 //! index out of range), 404 for an unknown route, 405 for a wrong method, 409 for an action the
 //! edit's state refuses (nothing to undo, not shown, no candidate left), 500 for a failure to
-//! write the scene.
+//! write the scene. A parameter out of range (τ_0 outside [0, 1]) is a 400. τ_0 set through
+//! the API is the session's: Save writes the pins, not the search parameters.
 
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
@@ -85,6 +88,13 @@ struct BarSegmentBody {
 #[serde(deny_unknown_fields)]
 struct Empty {}
 
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct TauBody {
+    tau0: Option<f64>,
+    tau_decay: Option<f64>,
+}
+
 /// Parses a JSON body into `T` or answers 400 with serde's one-line reason.
 fn body<T: DeserializeOwned>(b: &[u8]) -> Result<T, Reply> {
     let b = if b.iter().all(u8::is_ascii_whitespace) {
@@ -134,8 +144,10 @@ const GETS: [&str; 5] = [
     "/api/dance",
     "/api/audio.wav",
 ];
-const POSTS: [&str; 10] = [
+const POSTS: [&str; 12] = [
     "/api/search",
+    "/api/start-over",
+    "/api/search-params",
     "/api/like",
     "/api/unlike",
     "/api/set",
@@ -197,6 +209,21 @@ fn route(s: &mut Session, method: &str, path: &str, query: &str, b: &[u8]) -> Re
             let BarBody { bar } = body(b)?;
             s.edit_mut().search(bar).map_err(|e| fail(e.into()))?;
             candidates(s, bar)
+        }
+        "/api/start-over" => {
+            let BarBody { bar } = body(b)?;
+            s.edit_mut().start_over(bar).map_err(|e| fail(e.into()))?;
+            candidates(s, bar)
+        }
+        "/api/search-params" => {
+            let TauBody { tau0, tau_decay } = body(b)?;
+            let mut p = s.edit().search_params().clone();
+            p.tau0 = tau0.unwrap_or(p.tau0);
+            p.tau_decay = tau_decay.unwrap_or(p.tau_decay);
+            s.edit_mut()
+                .set_search_params(p)
+                .map_err(|e| fail(e.into()))?;
+            ok(json!(s.edit().search_params()))
         }
         "/api/like" | "/api/unlike" => {
             let BarSegmentBody { bar, segment } = body(b)?;
@@ -268,6 +295,7 @@ fn state(s: &Session) -> Value {
         "undo": st.undo.len(),
         "redo": st.redo.len(),
         "fill": s.fill().map(|f| json!({ "segments": f.segments, "total_cost": f.total_cost })),
+        "search": e.search_params(),
         "tempo_bpm": s.song().tempo_bpm,
         "song_s": s.song().samples.len() as f64 / s.song().sample_rate as f64,
         "parents": s.point_parents(),
@@ -307,7 +335,7 @@ struct DanceAnswer<'a> {
     frames: &'a Frames,
 }
 
-/// One candidate of `GET /api/candidates` and `POST /api/search`.
+/// One candidate (or liked segment) of `GET /api/candidates` and `POST /api/search`.
 #[derive(Serialize)]
 struct Candidate<'a> {
     segment: usize,
@@ -324,12 +352,21 @@ struct Candidates<'a> {
     bar: usize,
     start_s: f64,
     end_s: f64,
+    /// Rounds run (the k of the next round).
     round: usize,
+    /// τ of the next round, τ_0·decay^k.
     tau: f64,
+    tau0: f64,
+    tau_decay: f64,
+    /// Segments shown for the bar since its search (re)started.
     shown: usize,
+    /// Segments never shown yet: 0 when the bar has run dry (then only a start over helps).
+    left: usize,
     liked: &'a [usize],
     pin: Option<&'a usize>,
     candidates: Vec<Candidate<'a>>,
+    /// The liked segments, in the order liked, with their frames (reachable after any round).
+    liked_segments: Vec<Candidate<'a>>,
 }
 
 fn candidates(s: &Session, bar: usize) -> Result<Reply, Reply> {
@@ -337,18 +374,18 @@ fn candidates(s: &Session, bar: usize) -> Result<Reply, Reply> {
     let search = e.bar_search(bar).map_err(|e| fail(e.into()))?;
     let b = e.bars()[bar];
     let db = e.database();
-    let mut list = vec![];
-    for &seg in &search.current {
+    let card = |seg: usize| -> Result<Candidate, Reply> {
         let m = &db.segments[seg];
-        list.push(Candidate {
+        Ok(Candidate {
             segment: seg,
             liked: search.liked.contains(&seg),
             intensity: m.intensity,
             source: db.sources.get(m.clip).map(|c| c.file.as_str()),
             source_bar: m.bar,
             frames: s.segment_frames(seg).map_err(fail)?,
-        });
-    }
+        })
+    };
+    let p = e.search_params();
     Ok(Reply::json(
         200,
         &Candidates {
@@ -356,11 +393,23 @@ fn candidates(s: &Session, bar: usize) -> Result<Reply, Reply> {
             start_s: b.start_s,
             end_s: b.end_s,
             round: search.round,
-            tau: search.tau,
+            tau: p.tau(search.round),
+            tau0: p.tau0,
+            tau_decay: p.tau_decay,
             shown: search.shown.len(),
+            left: db.segments.len().saturating_sub(search.shown.len()),
             liked: &search.liked,
             pin: e.pins().get(&bar),
-            candidates: list,
+            candidates: search
+                .current
+                .iter()
+                .map(|&m| card(m))
+                .collect::<Result<_, _>>()?,
+            liked_segments: search
+                .liked
+                .iter()
+                .map(|&m| card(m))
+                .collect::<Result<_, _>>()?,
         },
     ))
 }

@@ -73,10 +73,38 @@ try {
   const second = await cards();
   for (const c of second) if (c.lit < c.pixels * 0.002) fail(`new candidate #${c.segment} is blank`);
 
+  // The two liked stay reachable: a "Liked" row of two live cards, each with Set.
+  const likedRow = await page.$$eval('#liked .cand', (cs) => cs.map((c) => ({
+    segment: Number(c.dataset.segment), set: !!c.querySelector('button.set'), on: !!c.querySelector('button.like.on'),
+  })));
+  if (likedRow.map((c) => c.segment).join() !== liked.join()) fail(`liked row ${JSON.stringify(likedRow)}, liked ${liked}`);
+  if (!likedRow.every((c) => c.set && c.on)) fail(`liked cards without Set or ♥: ${JSON.stringify(likedRow)}`);
+  if (await page.isHidden('#liked-head')) fail('the Liked heading is hidden');
+
+  // The explore ↔ follow slider: halfway sets τ₀ = 0.5 for the next rounds.
+  await page.$eval('#tau0', (r) => { r.value = '0.5'; r.dispatchEvent(new Event('input')); r.dispatchEvent(new Event('change')); });
+  await page.waitForFunction(() => document.getElementById('status').textContent.startsWith('τ₀ 0.50'), null, { timeout: 10000 });
+  const tauShown = await page.textContent('#tau0-value');
+  if (tauShown !== 'τ₀ 0.50') fail(`slider label ${tauShown}`);
+  const barInfo = await page.textContent('#bar-info');
+  if (!barInfo.includes('τ 0.451')) fail(`τ of round 2 at τ₀ 0.5 not shown: ${barInfo}`);
+  await page.screenshot({ path: join(shots, 'editor_liked.png'), fullPage: true });
+
   // Set the second new candidate, then Generate.
   const pinned = second[1].segment;
   await (await page.$$('#candidates .cand button.set'))[1].click();
   await page.waitForSelector('#candidates .cand.pinned');
+  // Start over: round 0 again, six candidates none of them liked, the liked row still there.
+  await page.click('#start-over');
+  await page.waitForFunction(() => document.getElementById('status').textContent.includes('started over'), null, { timeout: 10000 });
+  const restarted = await page.textContent('#bar-info');
+  if (!restarted.startsWith('round 1 ·') || !restarted.includes(' 8 shown')) fail(`after Start over: ${restarted}`);
+  const third = await cards();
+  if (third.length !== 6) fail(`${third.length} candidates after Start over`);
+  if (third.some((c) => liked.includes(c.segment))) fail(`a liked segment among the new candidates: ${third.map((c) => c.segment)}`);
+  if ((await page.$$('#liked .cand')).length !== 2) fail('the liked row is gone after Start over');
+  await page.screenshot({ path: join(shots, 'editor_start_over.png'), fullPage: true });
+
   await page.click('#generate');
   await page.waitForFunction(() => document.getElementById('status').textContent.startsWith('generated'), null, { timeout: 10000 });
 
@@ -109,6 +137,7 @@ try {
   if (errors.length) fail('page errors: ' + errors.join(' | '));
   console.log(JSON.stringify({
     load_ms: loadMs, first: first.map((c) => c.segment), liked, second: second.map((c) => c.segment),
+    after_start_over: third.map((c) => c.segment),
     pinned_bar: 2, pinned, lit: first.map((c) => c.lit), dance_lit: danceLit, bvh: bvhPath,
   }));
 } finally {

@@ -119,13 +119,28 @@ function showCandidates(c) {
   cands = c;
   const pin = bars[c.bar] ? bars[c.bar].pin : c.pin;
   $('bar-title').textContent = `Bar ${c.bar + 1}`;
-  $('bar-info').textContent = `round ${c.round} · τ ${c.tau.toFixed(3)} · ${c.shown} shown · ${c.liked.length} liked` +
+  $('bar-info').textContent = `round ${c.round} · τ ${c.tau.toFixed(3)} · ${c.shown} shown · ${c.left} left · ${c.liked.length} liked` +
     (pin !== null && pin !== undefined ? ` · pinned #${pin}` : '');
-  $('search').disabled = false;
+  // A bar that ran dry: say so, and offer Start over instead of a Search that cannot answer.
+  const dry = c.left === 0;
+  $('search').disabled = dry;
+  $('start-over').disabled = c.shown === 0;
+  $('start-over').classList.toggle('offer', dry);
+  $('dry').hidden = !dry;
+  $('dry').textContent = dry ? `All ${c.shown} segments have been shown for this bar. Start over to see them again — your likes stay in their row.` : '';
   $('unpin').disabled = pin === null || pin === undefined;
-  const box = $('candidates');
+  views = [
+    ...fillCards($('candidates'), c, c.candidates, pin),
+    ...fillCards($('liked'), c, c.liked_segments, pin),
+  ];
+  $('liked-head').hidden = c.liked_segments.length === 0;
+  $('liked-head').textContent = `Liked (${c.liked_segments.length}) — kept across rounds and Start over`;
+}
+
+// One card per segment of `list` into `box` (a live stick figure, Like/Unlike, Set); their views.
+function fillCards(box, c, list, pin) {
   box.replaceChildren();
-  views = c.candidates.map((m) => {
+  return list.map((m) => {
     const card = document.createElement('div');
     card.className = 'cand' + (pin === m.segment ? ' pinned' : '');
     card.dataset.segment = m.segment;
@@ -139,11 +154,10 @@ function showCandidates(c) {
     const like = document.createElement('button');
     like.className = 'like' + (m.liked ? ' on' : '');
     like.textContent = m.liked ? '♥ Liked' : '♡ Like';
+    like.title = m.liked ? 'Take this segment out of your likes' : 'Like: the next Search leans toward segments like this one';
     like.onclick = () => act(async () => {
       await api('POST', m.liked ? '/api/unlike' : '/api/like', { bar: c.bar, segment: m.segment });
-      m.liked = !m.liked;
-      c.liked = m.liked ? [...c.liked, m.segment] : c.liked.filter((s) => s !== m.segment);
-      showCandidates(c);
+      showCandidates(await api('GET', `/api/candidates?bar=${c.bar}`));
     });
     const set = document.createElement('button');
     set.className = 'set';
@@ -162,6 +176,13 @@ function showCandidates(c) {
     v.frames = m.frames;
     return v;
   });
+}
+
+// The "explore ↔ follow my likes" slider: its position is 1 − τ_0.
+function showTau(p) {
+  $('tau0').value = (1 - p.tau0).toFixed(2);
+  $('tau0-value').textContent = `τ₀ ${p.tau0.toFixed(2)}`;
+  $('tau-decay').textContent = String(p.tau_decay);
 }
 
 async function act(f) {
@@ -222,6 +243,20 @@ $('search').onclick = () => act(async () => {
   await refreshBars();
   status(`bar ${selected + 1}: round ${c.round}`);
 });
+$('start-over').onclick = () => act(async () => {
+  await api('POST', '/api/start-over', { bar: selected });
+  const c = await api('POST', '/api/search', { bar: selected });
+  showCandidates(c);
+  await refreshBars();
+  status(`bar ${selected + 1}: started over (${c.liked.length} liked kept)`);
+});
+$('tau0').oninput = () => { $('tau0-value').textContent = `τ₀ ${(1 - Number($('tau0').value)).toFixed(2)}`; };
+$('tau0').onchange = () => act(async () => {
+  const p = await api('POST', '/api/search-params', { tau0: Number((1 - Number($('tau0').value)).toFixed(2)) });
+  showTau(p);
+  if (selected !== null) showCandidates(await api('GET', `/api/candidates?bar=${selected}`));
+  status(`τ₀ ${p.tau0.toFixed(2)} for the next rounds of every bar`);
+});
 $('unpin').onclick = () => act(async () => {
   await api('POST', '/api/unpin', { bar: selected });
   dance = null;
@@ -264,6 +299,7 @@ window.addEventListener('resize', () => timeline.draw());
   figure = { parents: s.parents, sides: s.sides, head: s.head };
   danceView = new StickView($('dance'), figure);
   danceView.dist = 4.6;
+  showTau(s.search);
   await refreshBars();
   status(`${s.bars} bars · ${s.segments} segments · ${s.tempo_bpm.toFixed(1)} BPM`);
   // The first load (navigation start to a usable page), for tests/browser/latency.mjs.
