@@ -239,6 +239,26 @@ pub fn dance_metrics(dance: &Dance, beats_s: &[f64], fill: &Fill) -> DanceMetric
     }
 }
 
+/// The beat alignment score of a source clip on its own beat: [`beat_alignment_score`] of its
+/// [`motion_beats`] against its kinematic beat grid t_k = first_beat_s + k · 60 / tempo_bpm (every
+/// k with t_k within the clip, k < 0 included), σ = [`BAS_SIGMA_S`]; what the dance's own score is
+/// measured against. 0 for a tempo that is not a positive number of BPM, a beat shorter than a
+/// frame, or a clip without motion beats.
+pub fn source_beat_alignment(clip: &ModelClip, beat: &super::segments::Beat) -> f64 {
+    let period = 60.0 / beat.tempo_bpm;
+    if !(period.is_finite() && period >= clip.frame_time && beat.first_beat_s.is_finite()) {
+        return 0.0;
+    }
+    let duration = clip.frame_count() as f64 * clip.frame_time;
+    let k0 = -(beat.first_beat_s / period).floor();
+    let grid: Vec<f64> = (0..=clip.frame_count())
+        .map(|k| beat.first_beat_s + (k0 + k as f64) * period)
+        .take_while(|&t| t <= duration)
+        .filter(|&t| t >= 0.0)
+        .collect();
+    beat_alignment_score(&motion_beats(clip), &grid, BAS_SIGMA_S)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

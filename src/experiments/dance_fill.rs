@@ -318,7 +318,12 @@ fn trial(
     bars: &[Bar],
     cfg: &DanceFillConfig,
 ) -> Result<Trial, DanceFillError> {
-    let dance = assemble(db, segments, bars, &cfg.dance)?;
+    // The bars have no song: their beats are the quarters of each bar.
+    let beats: Vec<f64> = bars
+        .iter()
+        .flat_map(|b| (0..4).map(move |c| b.start_s + 0.25 * c as f64 * (b.end_s - b.start_s)))
+        .collect();
+    let dance = assemble(db, segments, bars, &beats, &cfg.dance)?;
     let (seam, inside) = seam_jerk(&dance);
     let connections: Vec<_> = segments
         .windows(2)

@@ -412,7 +412,7 @@ pub fn run_dance(
     let bars = &bars[..];
     let bars_n = bars.len();
     let filled = fill::fill(&db, bars_n, &pins, &scene.fill)?;
-    let d = dance::assemble(&db, &filled.segments, bars, &scene.dance)?;
+    let d = dance::assemble(&db, &filled.segments, bars, &analysis.beats_s, &scene.dance)?;
     let m = metrics::dance_metrics(&d, &analysis.beats_s, &filled);
 
     // motion.bvh at the song's timing: the first frame held from t = 0 to the first bar.
