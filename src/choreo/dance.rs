@@ -400,11 +400,21 @@ pub fn assemble(
     })
 }
 
+/// Speed-curve samples per segment frame that [`segment_beats`] looks for minima in.
+pub const BEAT_SUBSAMPLES: usize = 4;
+
 /// A segment's own beats: the phases of the speed minima near its counts 2 … [`BEATS_PER_BAR`]
-/// ([`count_minima`] of the speed curve of its frames at its real timing, by forward kinematics).
+/// ([`count_minima`] of the speed curve, by forward kinematics, of the motion the dance plays:
+/// the segment on the spline [`assemble`] samples it by, [`BEAT_SUBSAMPLES`] samples a frame: a
+/// bar of 32 frames at 85 BPM has a frame every 88 ms, too coarse for beats judged within
+/// σ = 50 ms). The speed is taken at one frame per unit time: a bar's length scales the curve,
+/// not where its minima are.
 pub fn segment_beats(seg: &Segment, model: &crate::humanoid::Model) -> Vec<Option<f64>> {
-    let clip = seg.clip(model);
-    let speed = speed_curve(&clip.to_clip().point_frames(), 1.0 / clip.frame_time);
+    let n = seg.frame_count() * BEAT_SUBSAMPLES;
+    let step = 1.0 / BEAT_SUBSAMPLES as f64;
+    let mut clip = sample(seg, model.dofs.len(), (0..n).map(|i| i as f64 * step));
+    clip.frame_time = step;
+    let speed = speed_curve(&clip.to_clip().point_frames(), 1.0 / step);
     count_minima(&speed, BEATS_PER_BAR)
 }
 

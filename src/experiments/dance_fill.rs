@@ -68,7 +68,8 @@ pub struct DanceFillConfig {
 }
 
 impl Default for DanceFillConfig {
-    /// 16 bars of 2 s, 40 pin sets of 3 pins, 30 fps, 5 seam frames, seed 1.
+    /// 16 bars of 2 s, 40 pin sets of 3 pins, 30 fps, 5 seam frames, the paper's uniform
+    /// resize (no beat warp: Fig. 5 measures the paper's assembly), seed 1.
     fn default() -> DanceFillConfig {
         DanceFillConfig {
             bars: 16,
@@ -76,7 +77,10 @@ impl Default for DanceFillConfig {
             pins_per_set: 3,
             bar_s: 2.0,
             fill: FillParams::default(),
-            dance: DanceParams::default(),
+            dance: DanceParams {
+                beat_warp: false,
+                ..DanceParams::default()
+            },
             seed: 1,
         }
     }
