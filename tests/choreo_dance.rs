@@ -286,3 +286,141 @@ fn the_salsa_scene_runs_on_the_shared_data() {
     check_report(&r, &out, &[(0, seg(0)), (8, seg(8))]);
     std::fs::remove_dir_all(&d).unwrap();
 }
+
+/// humanoid24 at 60 fps dancing `bars` bars at 120 BPM (beats of 0.5 s from t = 0), its arms,
+/// legs and waist swinging one way per beat, θ = A (1 − cos πτ) / 2, so that every point stops
+/// once per beat, where τ is a whole number: at the times t_j = (j + off[j mod 4]) × 0.5 s.
+/// With `off` = 0 the speed minima sit on the counts; else count j mod 4 is late or early.
+fn swinging(bars: usize, off: [f64; 4]) -> marionette::humanoid::ModelClip {
+    let model = marionette::humanoid::humanoid24();
+    let d = model.dofs.len();
+    let beat = 0.5;
+    let fps = 60.0;
+    let frames = (bars as f64 * 4.0 * beat * fps) as usize + 30;
+    let knots: Vec<f64> = (0..=bars * 4 + 2)
+        .map(|j| (j as f64 + off[j % 4]) * beat)
+        .collect();
+    // τ(t): piecewise linear through (t_j, j).
+    let tau = |t: f64| -> f64 {
+        let j = knots.partition_point(|&k| k <= t).clamp(1, knots.len() - 1) - 1;
+        j as f64 + (t - knots[j]) / (knots[j + 1] - knots[j])
+    };
+    let swings: Vec<(usize, f64)> = [
+        ("left_shoulder_flexion", 0.9),
+        ("right_shoulder_flexion", -0.7),
+        ("left_elbow_flexion", 0.8),
+        ("right_elbow_flexion", 0.6),
+        ("left_knee", 0.5),
+        ("right_knee", 0.4),
+        ("waist_flexion", 0.2),
+    ]
+    .iter()
+    .map(|&(n, a)| (model.dof_index(n).unwrap(), a))
+    .collect();
+    let mut angles = vec![0.0; frames * d];
+    for f in 0..frames {
+        let s = 0.5 * (1.0 - (std::f64::consts::PI * tau(f as f64 / fps)).cos());
+        for &(j, a) in &swings {
+            angles[f * d + j] = a * s;
+        }
+    }
+    marionette::humanoid::ModelClip {
+        model,
+        frame_time: 1.0 / fps,
+        root_translation: vec![glam::DVec3::new(0.0, 0.93, 0.0); frames],
+        root_rotation: vec![glam::DQuat::IDENTITY; frames],
+        angles,
+    }
+}
+
+#[test]
+fn beats_off_the_counts_are_warped_onto_the_music_and_the_seams_stay_smooth() {
+    use marionette::choreo::dance::{DanceParams, assemble};
+    use marionette::choreo::database::Database;
+    use marionette::choreo::metrics::{
+        BAS_SIGMA_S, beat_alignment_score, motion_beats, seam_jerk, source_beat_alignment,
+    };
+    use marionette::choreo::music::Bar;
+    use marionette::choreo::segments::{Beat, BuildParams, TempoSource};
+
+    // Counts 2, 3, 4 of every bar 0.07 s late, 0.06 s early, 0.06 s late.
+    let off = [0.0, 0.14, -0.12, 0.12];
+    let clip = swinging(4, off);
+    let beat = Beat {
+        tempo_bpm: 120.0,
+        first_beat_s: 0.0,
+        source: TempoSource::Manifest,
+    };
+    // The source on its own beat grid: lower than a clip whose minima sit on the counts.
+    let own = source_beat_alignment(&clip, &beat);
+    let on_counts = source_beat_alignment(&swinging(4, [0.0; 4]), &beat);
+    eprintln!("source BAS: off the counts {own:.3}, on the counts {on_counts:.3}");
+    assert!(on_counts > 0.95 && own < 0.75, "{on_counts} {own}");
+    // A grid a quarter beat late misses every beat.
+    let late = Beat {
+        first_beat_s: 0.125,
+        ..beat
+    };
+    assert!(source_beat_alignment(&swinging(4, [0.0; 4]), &late) < 0.1);
+
+    let db = Database::from_clips(
+        &[("off_counts".to_string(), clip, Some(beat))],
+        &BuildParams::default(),
+    )
+    .unwrap();
+    assert_eq!(db.segments.len(), 4);
+    // A song of 6 bars of 2.1 s from 0.4 s, its beats not quite even (as tracked beats are).
+    let bar_s = 2.1;
+    let bars: Vec<Bar> = (0..6)
+        .map(|k| Bar {
+            start_s: 0.4 + k as f64 * bar_s,
+            end_s: 0.4 + (k + 1) as f64 * bar_s,
+            rms: 0.1,
+            rms_db: -20.0,
+        })
+        .collect();
+    let jitter = [0.0, 0.02, -0.015, 0.01];
+    let beats: Vec<f64> = (0..24)
+        .map(|j| 0.4 + (j as f64 * 0.25 + jitter[j % 4] / bar_s) * bar_s)
+        .collect();
+    let segs = [0, 1, 2, 3, 1, 2];
+    let dance = |beat_warp: bool| {
+        let p = DanceParams {
+            beat_warp,
+            ..DanceParams::default()
+        };
+        assemble(&db, &segs, &bars, &beats, &p).unwrap()
+    };
+    let (warped, uniform) = (dance(true), dance(false));
+    assert_eq!(warped.warped_beats, vec![3; 6]);
+    assert_eq!(uniform.warped_beats, vec![0; 6]);
+    assert_eq!(warped.clip.frame_count(), uniform.clip.frame_count());
+    let music: Vec<f64> = beats.iter().map(|t| t - 0.4).collect();
+    let bas = |d: &marionette::choreo::dance::Dance| {
+        let m = motion_beats(&d.clip);
+        (beat_alignment_score(&m, &music, BAS_SIGMA_S), m.len())
+    };
+    let ((w, wn), (u, un)) = (bas(&warped), bas(&uniform));
+    let (sw, su) = (seam_jerk(&warped).0, seam_jerk(&uniform).0);
+    let (iw, iu) = (seam_jerk(&warped).1, seam_jerk(&uniform).1);
+    eprintln!(
+        "BAS warped {w:.3} ({wn} motion beats), uniform {u:.3} ({un}); seam jerk peak / mean \
+         warped {:.0} / {:.0}, uniform {:.0} / {:.0} rad/s³; inside {:.0} / {:.0} against {:.0} \
+         / {:.0}",
+        sw.peak_rad_s3,
+        sw.mean_rad_s3,
+        su.peak_rad_s3,
+        su.mean_rad_s3,
+        iw.peak_rad_s3,
+        iw.mean_rad_s3,
+        iu.peak_rad_s3,
+        iu.mean_rad_s3
+    );
+    // The dance's beats land on the music only with the warp.
+    assert!(w > 0.9, "warped BAS {w}");
+    assert!(u < 0.75, "uniform BAS {u}");
+    assert_eq!(wn, un, "the same motion beats, moved");
+    // The seams no rougher than without the warp (within 1.25×).
+    assert!(sw.peak_rad_s3 <= 1.25 * su.peak_rad_s3);
+    assert!(sw.mean_rad_s3 <= 1.25 * su.mean_rad_s3);
+}

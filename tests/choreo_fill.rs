@@ -84,12 +84,12 @@ fn a_fill_keeps_its_pins_and_assembles_into_a_dance_as_long_as_its_bars() {
     }
     // A song's bars of 1.93 s from 0.71 s, 30 fps: 16 bars last 30.88 s, 926 frames.
     let b = bars(16, 1.93, 0.71);
-    let d = assemble(&db, &f.segments, &b, &DanceParams::default()).unwrap();
+    let beats: Vec<f64> = (0..64).map(|k| 0.71 + k as f64 * 1.93 / 4.0).collect();
+    let d = assemble(&db, &f.segments, &b, &beats, &DanceParams::default()).unwrap();
     let duration = d.clip.frame_count() as f64 * d.clip.frame_time;
     assert!((duration - 16.0 * 1.93).abs() < 1e-9, "{duration}");
     assert_eq!(d.clip.frame_count(), 926);
     assert_eq!(d.bar_frames.last().unwrap().1, 926);
-    let beats: Vec<f64> = (0..64).map(|k| 0.71 + k as f64 * 1.93 / 4.0).collect();
     let m = dance_metrics(&d, &beats, &f);
     eprintln!("generated dance metrics: {m:?}");
     assert!((m.transition_cost - f.total_cost).abs() < 1e-12);

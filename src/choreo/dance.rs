@@ -10,6 +10,16 @@
 //!   frames) (the segment's frames lie at phases i / frames): angles and root position on the
 //!   natural cubic spline through the segment's frames (linear interpolation would put a kink,
 //!   a spike of jerk, at every segment frame), root orientation by slerp; a whole frame exactly.
+//! - **Beats on the music** ([`DanceParams::beat_warp`], [`super::warp`]). With the warp on, the
+//!   phase u is first mapped to the segment phase w(u) of the bar's warp, a monotone cubic
+//!   through (0, 0), (song beat phase, segment beat phase) …, (1, 1) with slope 1 at both ends:
+//!   the segment's own beats (its speed minima near counts 2, 3 and 4, found from its frames by
+//!   forward kinematics, [`super::warp::count_minima`]) fall on the song's beats inside the bar
+//!   (the beats of `beats_s` strictly between its start and end, as phases), and the bar lines
+//!   keep the uniform resize's rate, so the seams stay C¹. A bar whose song beats inside are not
+//!   [`BEATS_PER_BAR`] − 1 (a song in another metre, beats not tracked) is resized uniformly,
+//!   and so is a count whose minimum is not clear or whose knot would break the warp's rate
+//!   bound. With the warp off, every bar is the paper's uniform resize, w(u) = u.
 //! - **Root carried on.** The first segment keeps its root. Every later segment is turned about
 //!   the vertical (Y) axis and shifted horizontally so that its first frame's pelvis stands where
 //!   the previous segment, extrapolated by one of its frames to phase 1, ends, with that heading
@@ -33,7 +43,8 @@ use serde::{Deserialize, Serialize};
 
 use super::database::Database;
 use super::music::Bar;
-use super::segments::Segment;
+use super::segments::{BEATS_PER_BAR, Segment, speed_curve};
+use super::warp::{Warp, count_minima};
 use crate::humanoid::{ModelClip, humanoid24};
 
 /// Slowest frame rate of a dance, frames per second.
@@ -52,14 +63,25 @@ pub struct DanceParams {
     pub fps: f64,
     /// Frames rewritten on each side of a seam (the paper's 5).
     pub seam_frames: usize,
+    /// Whether each bar's time is warped so that the segment's own beats (its speed minima near
+    /// the counts) fall on the song's beats (module docs; true when a scene does not say);
+    /// false: the paper's uniform resize of every segment to its bar.
+    #[serde(default = "beat_warp_default")]
+    pub beat_warp: bool,
+}
+
+/// A scene that does not say warps its bars' beats onto the music.
+fn beat_warp_default() -> bool {
+    true
 }
 
 impl Default for DanceParams {
-    /// 30 fps, 5 frames on each side of a seam.
+    /// 30 fps, 5 frames on each side of a seam, beats warped onto the music.
     fn default() -> DanceParams {
         DanceParams {
             fps: 30.0,
             seam_frames: 5,
+            beat_warp: true,
         }
     }
 }
@@ -79,6 +101,9 @@ pub struct Dance {
     pub segments: Vec<usize>,
     /// Frames rewritten on each side of a seam.
     pub seam_frames: usize,
+    /// Per bar, how many of the segment's beats the warp moved onto the song's (0 for a bar
+    /// resized uniformly; at most [`BEATS_PER_BAR`] − 1).
+    pub warped_beats: Vec<usize>,
 }
 
 impl Dance {
@@ -185,11 +210,14 @@ pub fn heading(q: DQuat) -> f64 {
     f.x.atan2(f.z)
 }
 
-/// Assembles `segments` (one per bar, database indices) at the timing of `bars` (module docs).
+/// Assembles `segments` (one per bar, database indices) at the timing of `bars`, each
+/// segment's beats warped onto the song's beats `beats_s` (song time, seconds, increasing) when
+/// `p.beat_warp` (module docs).
 pub fn assemble(
     db: &Database,
     segments: &[usize],
     bars: &[Bar],
+    beats_s: &[f64],
     p: &DanceParams,
 ) -> Result<Dance, DanceError> {
     let model = humanoid24();
@@ -295,15 +323,28 @@ pub fn assemble(
     // The carry-on of the previous bar: its rotation about Y and horizontal offset, and where
     // its segment ends (extrapolated to phase 1) in the dance.
     let mut end: Option<(DVec3, f64)> = None;
+    // Each segment's beats (phases of counts 2, 3, 4), found once per segment.
+    let mut beats_of: std::collections::BTreeMap<usize, Vec<Option<f64>>> = Default::default();
+    let mut warped_beats = Vec::with_capacity(bars.len());
     for (k, (&s, bar)) in segments.iter().zip(bars).enumerate() {
         let seg = &db.segments[s];
         let m = seg.frame_count();
         let (first, stop) = bar_frames[k];
         let length = bar.end_s - bar.start_s;
+        let warp = if p.beat_warp {
+            let own = beats_of
+                .entry(s)
+                .or_insert_with(|| segment_beats(seg, &model));
+            bar_warp(bar, beats_s, own)
+        } else {
+            Warp::identity()
+        };
+        warped_beats.push(warp.knots().len() - 2);
         let part = sample(
             seg,
             dofs,
-            (first..stop).map(|f| (f as f64 * dt - (bar.start_s - start_s)) / length * m as f64),
+            (first..stop)
+                .map(|f| warp.at((f as f64 * dt - (bar.start_s - start_s)) / length) * m as f64),
         );
         // The rigid carry-on: yaw ψ and horizontal offset o, world = R_ψ p + o.
         let (turn, offset) = match end {
@@ -355,7 +396,48 @@ pub fn assemble(
         bar_frames,
         segments: segments.to_vec(),
         seam_frames: w,
+        warped_beats,
     })
+}
+
+/// Speed-curve samples per segment frame that [`segment_beats`] looks for minima in.
+pub const BEAT_SUBSAMPLES: usize = 4;
+
+/// A segment's own beats: the phases of the speed minima near its counts 2 … [`BEATS_PER_BAR`]
+/// ([`count_minima`] of the speed curve, by forward kinematics, of the motion the dance plays:
+/// the segment on the spline [`assemble`] samples it by, [`BEAT_SUBSAMPLES`] samples a frame: a
+/// bar of 32 frames at 85 BPM has a frame every 88 ms, too coarse for beats judged within
+/// σ = 50 ms). The speed is taken at one frame per unit time: a bar's length scales the curve,
+/// not where its minima are.
+pub fn segment_beats(seg: &Segment, model: &crate::humanoid::Model) -> Vec<Option<f64>> {
+    let n = seg.frame_count() * BEAT_SUBSAMPLES;
+    let step = 1.0 / BEAT_SUBSAMPLES as f64;
+    let mut clip = sample(seg, model.dofs.len(), (0..n).map(|i| i as f64 * step));
+    clip.frame_time = step;
+    let speed = speed_curve(&clip.to_clip().point_frames(), 1.0 / step);
+    count_minima(&speed, BEATS_PER_BAR)
+}
+
+/// The warp of `bar` that moves the segment's beats `own` (phases of counts 2, 3, …) onto the
+/// song's beats inside the bar; the identity unless the song has exactly `own.len()` beats
+/// strictly inside it (module docs).
+fn bar_warp(bar: &Bar, beats_s: &[f64], own: &[Option<f64>]) -> Warp {
+    let length = bar.end_s - bar.start_s;
+    let tol = 1e-6 * length;
+    let song: Vec<f64> = beats_s
+        .iter()
+        .filter(|&&t| t > bar.start_s + tol && t < bar.end_s - tol)
+        .map(|&t| (t - bar.start_s) / length)
+        .collect();
+    if song.len() != own.len() {
+        return Warp::identity();
+    }
+    let pairs: Vec<(f64, f64)> = song
+        .iter()
+        .zip(own)
+        .filter_map(|(&u, w)| w.map(|w| (u, w)))
+        .collect();
+    Warp::through(&pairs)
 }
 
 /// A segment's root positions, orientations and angles at frame positions `xs` (fractional
@@ -542,6 +624,13 @@ mod tests {
             .collect()
     }
 
+    /// Beats at the quarters of every bar.
+    fn quarters(bars: &[Bar]) -> Vec<f64> {
+        bars.iter()
+            .flat_map(|b| (0..4).map(move |c| b.start_s + 0.25 * c as f64 * (b.end_s - b.start_s)))
+            .collect()
+    }
+
     #[test]
     fn frames_outside_the_seams_are_the_segments_and_the_dance_lasts_its_bars() {
         let db = generated_database(3, 3, 4).unwrap();
@@ -551,8 +640,9 @@ mod tests {
         let p = DanceParams {
             fps: 16.0,
             seam_frames: 5,
+            beat_warp: false,
         };
-        let d = assemble(&db, &segs, &b, &p).unwrap();
+        let d = assemble(&db, &segs, &b, &[], &p).unwrap();
         let dofs = d.clip.dof_count();
         assert_eq!(d.clip.frame_count(), 128);
         assert_eq!(d.clip.frame_count() as f64 * d.clip.frame_time, 8.0);
@@ -596,7 +686,13 @@ mod tests {
     fn the_root_carries_on_across_seams() {
         let db = generated_database(5, 4, 4).unwrap();
         let segs = [1, 7, 3, 12, 0, 9];
-        let d = assemble(&db, &segs, &bars(6, 1.9, 0.0), &DanceParams::default()).unwrap();
+        let b = bars(6, 1.9, 0.0);
+        let d = assemble(&db, &segs, &b, &quarters(&b), &DanceParams::default()).unwrap();
+        assert!(
+            d.warped_beats.iter().sum::<usize>() > 0,
+            "{:?}",
+            d.warped_beats
+        );
         let t = &d.clip.root_translation;
         let step = |f: usize| {
             let v = t[f + 1] - t[f];
@@ -629,16 +725,16 @@ mod tests {
             ..db.clone()
         };
         assert_eq!(
-            assemble(&empty, &[0, 0], &b, &p),
+            assemble(&empty, &[0, 0], &b, &[], &p),
             Err(DanceError::EmptyDatabase)
         );
-        assert_eq!(assemble(&db, &[], &[], &p), Err(DanceError::NoBars));
+        assert_eq!(assemble(&db, &[], &[], &[], &p), Err(DanceError::NoBars));
         assert!(matches!(
-            assemble(&db, &[0], &b, &p),
+            assemble(&db, &[0], &b, &[], &p),
             Err(DanceError::Count { .. })
         ));
         assert!(matches!(
-            assemble(&db, &[0, 99], &b, &p),
+            assemble(&db, &[0, 99], &b, &[], &p),
             Err(DanceError::NoSuchSegment {
                 bar: 1,
                 segment: 99,
@@ -648,30 +744,30 @@ mod tests {
         let mut z = b.clone();
         z[1].end_s = z[1].start_s;
         assert!(matches!(
-            assemble(&db, &[0, 1], &z, &p),
+            assemble(&db, &[0, 1], &z, &[], &p),
             Err(DanceError::BadBar { bar: 1, .. })
         ));
         let mut g = b.clone();
         g[1].start_s += 0.5;
         assert!(matches!(
-            assemble(&db, &[0, 1], &g, &p),
+            assemble(&db, &[0, 1], &g, &[], &p),
             Err(DanceError::Gap { bar: 1, .. })
         ));
         for fps in [0.0, -3.0, f64::NAN, 5000.0] {
             let q = DanceParams {
                 fps,
-                seam_frames: 5,
+                ..DanceParams::default()
             };
             assert!(matches!(
-                assemble(&db, &[0, 1], &b, &q),
+                assemble(&db, &[0, 1], &b, &[], &q),
                 Err(DanceError::Fps { .. })
             ));
         }
         let q = DanceParams {
             fps: 5.0,
-            seam_frames: 5,
+            ..DanceParams::default()
         };
-        let e = assemble(&db, &[0, 1], &b, &q).unwrap_err();
+        let e = assemble(&db, &[0, 1], &b, &[], &q).unwrap_err();
         assert!(
             matches!(
                 e,

@@ -217,6 +217,7 @@ pub fn source_metrics(db: &Database, segments: &[usize], fps: f64) -> SourceMetr
     let params = DanceParams {
         fps,
         seam_frames: 0,
+        beat_warp: false,
     };
     let (mut skate_sum, mut skate_n, mut bas_sum, mut count) = (0.0, 0.0, 0.0, 0usize);
     for &s in segments {
@@ -230,17 +231,20 @@ pub fn source_metrics(db: &Database, segments: &[usize], fps: f64) -> SourceMetr
             rms: 0.0,
             rms_db: f64::NEG_INFINITY,
         };
-        let Ok(alone) = assemble(db, &[s], std::slice::from_ref(&bar), &params) else {
+        let Ok(alone) = assemble(db, &[s], std::slice::from_ref(&bar), &[], &params) else {
             continue;
         };
         let (skating, contact) = foot_skating_on_floor(&alone.clip);
         let samples = contact * alone.clip.frame_count() as f64;
         skate_sum += skating * samples;
         skate_n += samples;
-        let counts: Vec<f64> = (0..=BEATS_PER_BAR)
-            .map(|k| k as f64 * len / BEATS_PER_BAR as f64)
-            .collect();
-        bas_sum += beat_alignment_score(&motion_beats(&alone.clip), &counts, BAS_SIGMA_S);
+        // Its own counts: four to the bar, the first at its start.
+        let counts = super::segments::Beat {
+            tempo_bpm: 60.0 * BEATS_PER_BAR as f64 / len,
+            first_beat_s: 0.0,
+            source: super::segments::TempoSource::Manifest,
+        };
+        bas_sum += source_beat_alignment(&alone.clip, &counts);
         count += 1;
     }
     SourceMetrics {
@@ -446,6 +450,26 @@ pub fn dance_metrics(dance: &Dance, beats_s: &[f64], fill: &Fill) -> DanceMetric
             0.0
         },
     }
+}
+
+/// The beat alignment score of a source clip on its own beat: [`beat_alignment_score`] of its
+/// [`motion_beats`] against its kinematic beat grid t_k = first_beat_s + k · 60 / tempo_bpm (every
+/// k with t_k within the clip, k < 0 included), σ = [`BAS_SIGMA_S`]; what the dance's own score is
+/// measured against. 0 for a tempo that is not a positive number of BPM, a beat shorter than a
+/// frame, or a clip without motion beats.
+pub fn source_beat_alignment(clip: &ModelClip, beat: &super::segments::Beat) -> f64 {
+    let period = 60.0 / beat.tempo_bpm;
+    if !(period.is_finite() && period >= clip.frame_time && beat.first_beat_s.is_finite()) {
+        return 0.0;
+    }
+    let duration = clip.frame_count() as f64 * clip.frame_time;
+    let k0 = -(beat.first_beat_s / period).floor();
+    let grid: Vec<f64> = (0..=clip.frame_count())
+        .map(|k| beat.first_beat_s + (k0 + k as f64) * period)
+        .take_while(|&t| t <= duration)
+        .filter(|&t| t >= 0.0)
+        .collect();
+    beat_alignment_score(&motion_beats(clip), &grid, BAS_SIGMA_S)
 }
 
 #[cfg(test)]

@@ -16,6 +16,8 @@
 //! - [`dance`]: the chosen segments assembled at the song's bar timing, root carried on, seams
 //!   rewritten by cubic interpolation;
 //! - [`feet`]: the dance's planted feet put on the floor and held still by leg IK;
+//! - [`warp`]: the beat warp of a bar, a monotone cubic time map that puts a segment's own
+//!   beats (speed minima) on the song's beats, C¹ at the bar lines;
 //! - [`metrics`]: beat alignment score, seam jerk, foot skating, transition cost of a dance;
 //! - [`augment`]: a larger database from a real one by mirror images and time offsets;
 //! - [`relevance`]: rel(q, m), music intensity against motion intensity, both as percentile ranks;
@@ -38,3 +40,4 @@ pub mod relevance;
 pub mod search;
 pub mod segments;
 pub mod transition;
+pub mod warp;

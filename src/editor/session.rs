@@ -197,6 +197,7 @@ impl Session {
             self.edit.database(),
             &segments,
             self.edit.bars(),
+            &self.song.beats_s,
         )?;
         Ok(d)
     }

@@ -68,7 +68,8 @@ pub struct DanceFillConfig {
 }
 
 impl Default for DanceFillConfig {
-    /// 16 bars of 2 s, 40 pin sets of 3 pins, 30 fps, 5 seam frames, seed 1.
+    /// 16 bars of 2 s, 40 pin sets of 3 pins, 30 fps, 5 seam frames, the paper's uniform
+    /// resize (no beat warp: Fig. 5 measures the paper's assembly), seed 1.
     fn default() -> DanceFillConfig {
         DanceFillConfig {
             bars: 16,
@@ -76,7 +77,10 @@ impl Default for DanceFillConfig {
             pins_per_set: 3,
             bar_s: 2.0,
             fill: FillParams::paper(),
-            dance: DanceParams::default(),
+            dance: DanceParams {
+                beat_warp: false,
+                ..DanceParams::default()
+            },
             seed: 1,
         }
     }
@@ -318,7 +322,12 @@ fn trial(
     bars: &[Bar],
     cfg: &DanceFillConfig,
 ) -> Result<Trial, DanceFillError> {
-    let dance = assemble(db, segments, bars, &cfg.dance)?;
+    // The bars have no song: their beats are the quarters of each bar.
+    let beats: Vec<f64> = bars
+        .iter()
+        .flat_map(|b| (0..4).map(move |c| b.start_s + 0.25 * c as f64 * (b.end_s - b.start_s)))
+        .collect();
+    let dance = assemble(db, segments, bars, &beats, &cfg.dance)?;
     let (seam, inside) = seam_jerk(&dance);
     let connections: Vec<_> = segments
         .windows(2)

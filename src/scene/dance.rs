@@ -395,16 +395,18 @@ fn resolve_pins(pins: &[Pin], db: &Database) -> Result<Pins, SceneError> {
     Ok(out)
 }
 
-/// The dance of `segments` (one per bar of `bars`) as `scene` makes it, for `marionette run`
-/// and the editor alike: assembled at the bars' timing ([`dance::assemble`]), then its feet put
-/// on the floor ([`plant_feet`]).
+/// The dance of `segments` (one per bar of `bars`, the song's beats at `beats_s`) as `scene`
+/// makes it, for `marionette run` and the editor alike: assembled at the bars' timing, each
+/// bar's beats warped onto the song's ([`dance::assemble`]), then its feet put on the floor
+/// ([`plant_feet`]).
 pub fn perform(
     scene: &DanceScene,
     db: &Database,
     segments: &[usize],
     bars: &[Bar],
+    beats_s: &[f64],
 ) -> Result<(dance::Dance, Planting), SceneError> {
-    let mut d = dance::assemble(db, segments, bars, &scene.dance)?;
+    let mut d = dance::assemble(db, segments, bars, beats_s, &scene.dance)?;
     let planting = plant_feet(&mut d.clip, &scene.feet);
     Ok((d, planting))
 }
@@ -431,7 +433,7 @@ pub fn run_dance(
     let bars_n = bars.len();
     let music_rank = relevance::music_intensity(bars);
     let filled = fill::fill(&db, &music_rank, &pins, &scene.fill)?;
-    let (d, planting) = perform(scene, &db, &filled.segments, bars)?;
+    let (d, planting) = perform(scene, &db, &filled.segments, bars, &analysis.beats_s)?;
     let m = metrics::dance_metrics(&d, &analysis.beats_s, &filled);
     let sources = metrics::source_metrics(&db, &filled.segments, 1.0 / d.clip.frame_time);
     let motion_rank_db = relevance::motion_intensity(&db);
