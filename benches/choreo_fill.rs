@@ -12,7 +12,7 @@ use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use marionette::choreo::augment::augment;
-use marionette::choreo::database::{BuildParams, Database, Manifest};
+use marionette::choreo::database::{BuildParams, Database, Manifest, OnRefusal};
 use marionette::choreo::fill::{FillParams, Pins, fill, fill_dijkstra_with_table, fill_with_table};
 use marionette::choreo::transition::TransitionTable;
 use marionette::experiments::dance_fill::generated_database;
@@ -21,7 +21,7 @@ use marionette::experiments::dance_fill::generated_database;
 fn database() -> Database {
     let dir = marionette::io::data_dir().join("dance");
     let base = Manifest::from_folder(&dir)
-        .and_then(|m| Database::build(&m, &BuildParams::default(), |_, _| {}));
+        .and_then(|m| Database::build(&m, &BuildParams::default(), OnRefusal::Fail, |_, _| {}));
     let base = match base {
         Ok(db) => {
             eprintln!("shared dance clips: {} segments", db.segments.len());

@@ -12,14 +12,14 @@ use std::hint::black_box;
 
 use criterion::{BatchSize, Criterion, Throughput, criterion_group, criterion_main};
 use marionette::choreo::augment::augment;
-use marionette::choreo::database::{BuildParams, Database, Manifest};
+use marionette::choreo::database::{BuildParams, Database, Manifest, OnRefusal};
 use marionette::choreo::search::{BarSearch, SearchIndex, SearchParams};
 
 fn bench(c: &mut Criterion) {
     let dir = marionette::io::data_dir().join("dance");
     let (real, source) = match Manifest::from_folder(&dir) {
         Ok(m) => (
-            Database::build(&m, &BuildParams::default(), |_, _| {}).unwrap(),
+            Database::build(&m, &BuildParams::default(), OnRefusal::Fail, |_, _| {}).unwrap(),
             "shared dance clips",
         ),
         Err(e) => {
@@ -69,17 +69,36 @@ fn bench(c: &mut Criterion) {
     let (gen_db, gen_dir) = dance_clips::generated_database("bench-build", 6);
     let manifest = Manifest::from_folder(&gen_dir).unwrap();
     // The folder holds the six BVH clips only; their tempo comes from the kinematic beat here.
-    let built = Database::build(&manifest, &BuildParams::default(), |_, _| {}).unwrap();
+    let built = Database::build(
+        &manifest,
+        &BuildParams::default(),
+        OnRefusal::Fail,
+        |_, _| {},
+    )
+    .unwrap();
     g.throughput(Throughput::Elements(built.segments.len() as u64));
     g.bench_function("build_6_generated_clips_kinematic_beat", |b| {
         b.iter(|| {
-            black_box(Database::build(&manifest, &BuildParams::default(), |_, _| {}).unwrap())
+            black_box(
+                Database::build(
+                    &manifest,
+                    &BuildParams::default(),
+                    OnRefusal::Fail,
+                    |_, _| {},
+                )
+                .unwrap(),
+            )
         })
     });
     if let Ok(m) = Manifest::from_folder(&dir) {
         g.throughput(Throughput::Elements(real.segments.len() as u64));
         g.bench_function("build_shared_dance_clips", |b| {
-            b.iter(|| black_box(Database::build(&m, &BuildParams::default(), |_, _| {}).unwrap()))
+            b.iter(|| {
+                black_box(
+                    Database::build(&m, &BuildParams::default(), OnRefusal::Fail, |_, _| {})
+                        .unwrap(),
+                )
+            })
         });
     }
     g.throughput(Throughput::Elements(200));

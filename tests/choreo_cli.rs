@@ -138,3 +138,156 @@ fn dance_db_builds_from_a_manifest_and_refuses_an_empty_folder() {
     assert!(err.contains("no dance clip in the folder"), "{err}");
     assert!(!none.exists());
 }
+
+/// `marionette dance db` on a folder with a file that is not BVH and a still clip beside two good
+/// ones: one line each for the bad ones naming them and why, a database from the good ones,
+/// exit 0, and `dance info` lists what was skipped; `--strict` fails on the first refusal; a
+/// folder with nothing usable fails naming each clip; `--music-bpm` takes the tempo to the
+/// song's octave level and says so.
+#[test]
+fn dance_db_skips_what_it_cannot_use_and_says_why() {
+    use marionette::choreo::authored::{AuthoredDance, generate, write_bvh_folder};
+    use marionette::humanoid::ModelClip;
+
+    let dir = std::env::temp_dir().join(format!("marionette-dance-skip-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let (mixed, bad) = (dir.join("mixed"), dir.join("bad"));
+    let clips = generate(&AuthoredDance {
+        bpm: 112.0,
+        clips: 2,
+        bars_per_clip: 4,
+        ..AuthoredDance::default()
+    })
+    .unwrap();
+    write_bvh_folder(&clips, &mixed).unwrap();
+    for d in [&mixed, &bad] {
+        std::fs::create_dir_all(d).unwrap();
+        let like = &clips[0].motion;
+        let n = (12.0 / like.frame_time) as usize;
+        let still = ModelClip {
+            model: like.model.clone(),
+            frame_time: like.frame_time,
+            root_translation: vec![like.root_translation[0]; n],
+            root_rotation: vec![like.root_rotation[0]; n],
+            angles: like.angles[..like.dof_count()].repeat(n),
+        };
+        marionette::bvh::write_file(&still.to_clip().to_bvh(), &d.join("still.bvh")).unwrap();
+        std::fs::write(
+            d.join("a_broken.bvh"),
+            "HIERARCHY\nROOT hips\n{ OFFSET 0 0\n",
+        )
+        .unwrap();
+    }
+    let run = |args: &[&std::ffi::OsStr]| {
+        Command::new(env!("CARGO_BIN_EXE_marionette"))
+            .args(args)
+            .output()
+            .unwrap()
+    };
+    let db = dir.join("db.json");
+    let out = run(&[
+        "dance".as_ref(),
+        "db".as_ref(),
+        mixed.as_ref(),
+        "--out".as_ref(),
+        db.as_ref(),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    eprintln!("{err}");
+    assert!(out.status.success(), "{err}");
+    let skipped: Vec<&str> = err.lines().filter(|l| l.contains("skipped")).collect();
+    assert!(
+        skipped
+            .iter()
+            .any(|l| l.contains("a_broken.bvh") && l.contains("line 4")),
+        "{err}"
+    );
+    assert!(
+        skipped
+            .iter()
+            .any(|l| l.contains("still.bvh") && l.contains("no kinematic tempo")),
+        "{err}"
+    );
+    assert_eq!(err.matches("(kinematic)").count(), 2, "{err}");
+    assert!(err.contains("from 2 clips (2 skipped)"), "{err}");
+    let info = run(&["dance".as_ref(), "info".as_ref(), db.as_ref()]);
+    let text = String::from_utf8_lossy(&info.stdout);
+    assert!(
+        info.status.success(),
+        "{}",
+        String::from_utf8_lossy(&info.stderr)
+    );
+    assert!(text.contains("from 2 clips (2 skipped)"), "{text}");
+    assert!(
+        text.lines().any(|l| l.contains("skipped")
+            && l.contains("still.bvh")
+            && l.contains("no kinematic tempo")),
+        "{text}"
+    );
+    assert!(
+        text.lines()
+            .any(|l| l.contains("skipped") && l.contains("a_broken.bvh")),
+        "{text}"
+    );
+
+    // --strict: the first refusal (the broken file, first by name) fails, nothing written.
+    let strict = dir.join("strict.json");
+    let out = run(&[
+        "dance".as_ref(),
+        "db".as_ref(),
+        mixed.as_ref(),
+        "--out".as_ref(),
+        strict.as_ref(),
+        "--strict".as_ref(),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{err}");
+    assert!(
+        err.contains("a_broken.bvh") && err.contains("line 4"),
+        "{err}"
+    );
+    assert!(!strict.exists());
+
+    // Nothing usable: an error naming each clip and why, nothing written.
+    let none = dir.join("none.json");
+    let out = run(&[
+        "dance".as_ref(),
+        "db".as_ref(),
+        bad.as_ref(),
+        "--out".as_ref(),
+        none.as_ref(),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{err}");
+    assert!(err.contains("no clip could be used"), "{err}");
+    let last = err.rsplit("no clip could be used").next().unwrap();
+    assert!(
+        last.contains("a_broken.bvh") && last.contains("still.bvh"),
+        "{err}"
+    );
+    assert!(!none.exists());
+
+    // For a song at 58 BPM the 112 BPM clips take two of their beats per song beat.
+    let slow = dir.join("slow.json");
+    let out = run(&[
+        "dance".as_ref(),
+        "db".as_ref(),
+        mixed.as_ref(),
+        "--out".as_ref(),
+        slow.as_ref(),
+        "--music-bpm".as_ref(),
+        "58".as_ref(),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    let d = marionette::choreo::database::Database::load(&slow).unwrap();
+    assert_eq!(d.params.music_bpm, Some(58.0));
+    for s in &d.sources {
+        assert!((s.beat.tempo_bpm / 56.0 - 1.0).abs() < 0.02, "{:?}", s.beat);
+    }
+    assert_eq!(err.matches("octave nearest the song").count(), 2, "{err}");
+    let info = run(&["dance".as_ref(), "info".as_ref(), slow.as_ref()]);
+    let text = String::from_utf8_lossy(&info.stdout);
+    assert!(text.contains("for a song at 58.00 BPM"), "{text}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

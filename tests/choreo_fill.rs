@@ -7,7 +7,7 @@
 mod common;
 
 use marionette::choreo::dance::{DanceParams, assemble};
-use marionette::choreo::database::{BuildParams, Database, Manifest};
+use marionette::choreo::database::{BuildParams, Database, Manifest, OnRefusal};
 use marionette::choreo::fill::{FillParams, Pins, fill, fill_dijkstra};
 use marionette::choreo::metrics::dance_metrics;
 use marionette::choreo::music::Bar;
@@ -130,7 +130,7 @@ fn pins_past_the_end_or_to_missing_segments_are_refused() {
 fn shared_database() -> Option<Database> {
     let dir = common::data_path("dance")?;
     let m = Manifest::from_folder(&dir).unwrap();
-    Some(Database::build(&m, &BuildParams::default(), |_, _| {}).unwrap())
+    Some(Database::build(&m, &BuildParams::default(), OnRefusal::Fail, |_, _| {}).unwrap())
 }
 
 #[test]

@@ -16,7 +16,7 @@ use std::sync::Arc;
 
 use dance_clips::{generated_database, scratch, tempo};
 use marionette::choreo::augment::{augment, augment_with_variants};
-use marionette::choreo::database::{BuildParams, Database, Manifest, load_model_clip};
+use marionette::choreo::database::{BuildParams, Database, Manifest, OnRefusal, load_model_clip};
 use marionette::choreo::edit::Edit;
 use marionette::choreo::eros::eros;
 use marionette::choreo::fill::FillParams;
@@ -207,6 +207,7 @@ fn fig4_on_the_shared_dance_clips() {
     let db = Database::build(
         &Manifest::from_folder(&dir).unwrap(),
         &BuildParams::default(),
+        OnRefusal::Fail,
         |_, _| {},
     )
     .unwrap();

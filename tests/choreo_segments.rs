@@ -7,8 +7,12 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
-use marionette::choreo::database::{BuildParams, Database, Manifest, ManifestClip};
-use marionette::choreo::segments::{Beat, SegmentError, TempoSource, cut_segments, kinematic_beat};
+use marionette::choreo::database::{
+    BuildParams, ClipOutcome, Database, Manifest, ManifestClip, OnRefusal,
+};
+use marionette::choreo::segments::{
+    Beat, MAX_BPM, MIN_BPM, SegmentError, TempoSource, cut_segments, kinematic_beat,
+};
 use marionette::humanoid::{ModelClip, humanoid24};
 
 use glam::{DQuat, DVec3};
@@ -50,7 +54,7 @@ fn dance_bars_at_120_bpm_give_its_four_bars() {
     )
     .unwrap();
     let m = Manifest::load(&manifest).unwrap();
-    let db = Database::build(&m, &BuildParams::default(), |_, _| {}).unwrap();
+    let db = Database::build(&m, &BuildParams::default(), OnRefusal::Fail, |_, _| {}).unwrap();
     assert_eq!(db.segments.len(), 4);
     assert_eq!(db.sources[0].segments, 4);
     assert_eq!(db.sources[0].beat.source, TempoSource::Manifest);
@@ -103,6 +107,7 @@ fn dance_bars_at_120_bpm_give_its_four_bars() {
     let k = Database::build(
         &Manifest::from_folder(&folder).unwrap(),
         &BuildParams::default(),
+        OnRefusal::Fail,
         |_, _| {},
     )
     .unwrap();
@@ -161,6 +166,7 @@ fn kinematic_tempo_of_a_generated_clip_is_within_2_percent() {
         let db = Database::build(
             &one_clip(file, None, None),
             &BuildParams::default(),
+            OnRefusal::Fail,
             |_, _| {},
         )
         .unwrap();
@@ -189,7 +195,8 @@ fn shared_dance_clips_segments_and_tempo() {
         return;
     };
     let m = Manifest::from_folder(&dir).unwrap();
-    let db = Database::build(&m, &BuildParams::default(), |_, s| {
+    let db = Database::build(&m, &BuildParams::default(), OnRefusal::Fail, |_, s| {
+        let ClipOutcome::Used(s) = s else { return };
         eprintln!(
             "{}: {} frames at {:.0} fps, {:.2} BPM ({:?}), first beat {:.3} s, {} segments",
             Path::new(&s.file).file_name().unwrap().to_string_lossy(),
@@ -211,7 +218,7 @@ fn shared_dance_clips_segments_and_tempo() {
     assert_eq!(db.sources.len(), m.clips.len());
     for s in &db.sources {
         assert!(s.segments >= 1);
-        assert!((60.0..=180.0).contains(&s.beat.tempo_bpm));
+        assert!((MIN_BPM..=MAX_BPM).contains(&s.beat.tempo_bpm));
         let dur = s.frames as f64 / s.fps;
         assert_eq!(
             s.segments,
@@ -227,7 +234,7 @@ fn shared_dance_clips_segments_and_tempo() {
             .iter()
             .map(|&(a, b)| {
                 let w = clip.window(a, b).unwrap();
-                kinematic_beat(&w, &name)
+                kinematic_beat(&w, &name, None)
                     .map(|b| format!("{:.2}", b.tempo_bpm))
                     .unwrap_or_else(|e| e.to_string())
             })
@@ -282,6 +289,7 @@ fn bad_input_gives_one_clear_error_each() {
     let e = Database::build(
         &one_clip(dance_bars(), Some(120.0), Some((0.0, 1.0))),
         &BuildParams::default(),
+        OnRefusal::Fail,
         |_, _| {},
     )
     .unwrap_err();
@@ -308,6 +316,7 @@ fn bad_input_gives_one_clear_error_each() {
     let e = Database::build(
         &Manifest::from_folder(&bad).unwrap(),
         &BuildParams::default(),
+        OnRefusal::Fail,
         |_, _| {},
     )
     .unwrap_err();
@@ -327,8 +336,216 @@ fn bad_input_gives_one_clear_error_each() {
     let e = Database::build(
         &one_clip(dance_bars(), Some(0.0), None),
         &BuildParams::default(),
+        OnRefusal::Fail,
         |_, _| {},
     )
     .unwrap_err();
     assert!(matches!(e, SegmentError::Tempo { .. }), "{e}");
+}
+
+/// A folder of two good clips (the project's own dance at 112 BPM, written as BVH), a still
+/// clip (the first pose held for 12 s: no tempo) and a file that is not BVH, named so that
+/// the broken one comes first.
+fn folder_with_bad_clips(name: &str) -> PathBuf {
+    let dir = scratch(name);
+    let p = marionette::choreo::authored::AuthoredDance {
+        bpm: 112.0,
+        clips: 2,
+        bars_per_clip: 4,
+        ..Default::default()
+    };
+    let clips = marionette::choreo::authored::generate(&p).unwrap();
+    marionette::choreo::authored::write_bvh_folder(&clips, &dir).unwrap();
+    write_still_and_broken(&dir, &clips[0].motion);
+    dir
+}
+
+/// `still.bvh` (the first pose of `like` held for 12 s) and `a_broken.bvh` (not BVH) in `dir`.
+fn write_still_and_broken(dir: &Path, like: &ModelClip) {
+    let n = (12.0 / like.frame_time) as usize;
+    let d = like.dof_count();
+    let still = ModelClip {
+        model: like.model.clone(),
+        frame_time: like.frame_time,
+        root_translation: vec![like.root_translation[0]; n],
+        root_rotation: vec![like.root_rotation[0]; n],
+        angles: like.angles[..d].repeat(n),
+    };
+    marionette::bvh::write_file(&still.to_clip().to_bvh(), &dir.join("still.bvh")).unwrap();
+    std::fs::write(
+        dir.join("a_broken.bvh"),
+        "HIERARCHY\nROOT hips\n{ OFFSET 0 0\n",
+    )
+    .unwrap();
+}
+
+#[test]
+fn a_clip_that_cannot_be_used_is_skipped_named_and_recorded() {
+    let dir = folder_with_bad_clips("skip");
+    let m = Manifest::from_folder(&dir).unwrap();
+    assert_eq!(m.clips.len(), 4);
+    let mut lines = vec![];
+    let db = Database::build(&m, &BuildParams::default(), OnRefusal::Skip, |i, o| {
+        lines.push(match o {
+            ClipOutcome::Used(s) => format!("{i} used {}", s.file),
+            ClipOutcome::Skipped(s) => format!("{i} skipped {}", s.reason),
+        })
+    })
+    .unwrap();
+    eprintln!("{lines:#?}");
+    assert_eq!(lines.len(), 4, "one line per clip: {lines:?}");
+    // The two good clips give their bars, indexed 0 and 1 in the database.
+    assert_eq!(db.sources.len(), 2);
+    for (k, s) in db.sources.iter().enumerate() {
+        assert!(s.file.contains("authored_"), "{}", s.file);
+        assert!(
+            (s.beat.tempo_bpm / 112.0 - 1.0).abs() < 0.02,
+            "{:?}",
+            s.beat
+        );
+        assert_eq!(db.segments_of(k).count(), s.segments);
+        assert!(s.segments >= 3);
+    }
+    assert_eq!(
+        db.segments.len(),
+        db.sources.iter().map(|s| s.segments).sum::<usize>()
+    );
+    // The broken file and the still clip are named, each with why.
+    assert_eq!(db.skipped.len(), 2, "{:?}", db.skipped);
+    let broken = &db.skipped[0];
+    assert!(broken.file.ends_with("a_broken.bvh"), "{broken:?}");
+    assert!(
+        broken.reason.contains("a_broken.bvh") && broken.reason.contains("line 4"),
+        "{broken:?}"
+    );
+    let still = &db.skipped[1];
+    assert!(still.file.ends_with("still.bvh"), "{still:?}");
+    assert!(
+        still.reason.contains("still.bvh") && still.reason.contains("no kinematic tempo"),
+        "{still:?}"
+    );
+    // Saved and loaded, the skipped clips are still there; a database written before they
+    // were recorded (no `skipped` field) still loads, with none.
+    let out = dir.join("db.json");
+    db.save(&out).unwrap();
+    assert_eq!(Database::load(&out).unwrap().skipped, db.skipped);
+    let mut old: serde_json::Value = serde_json::from_slice(&db.to_json()).unwrap();
+    old.as_object_mut().unwrap().remove("skipped");
+    std::fs::write(&out, serde_json::to_vec(&old).unwrap()).unwrap();
+    let back = Database::load(&out).unwrap();
+    assert!(back.skipped.is_empty());
+    assert_eq!(back.segments.len(), db.segments.len());
+
+    // Strict: the first refusal fails the build, with that clip's own error.
+    let e = Database::build(&m, &BuildParams::default(), OnRefusal::Fail, |_, _| {}).unwrap_err();
+    assert!(matches!(e, SegmentError::Load { .. }), "{e}");
+    assert!(e.to_string().contains("a_broken.bvh"), "{e}");
+
+    // Nothing usable: one error that names every clip and says why.
+    let bad = scratch("skip-all-bad");
+    let one = marionette::choreo::authored::generate(&Default::default()).unwrap();
+    write_still_and_broken(&bad, &one[0].motion);
+    let e = Database::build(
+        &Manifest::from_folder(&bad).unwrap(),
+        &BuildParams::default(),
+        OnRefusal::Skip,
+        |_, _| {},
+    )
+    .unwrap_err();
+    let msg = e.to_string();
+    assert!(matches!(e, SegmentError::NoUsableClip { .. }), "{msg}");
+    assert!(
+        msg.contains("a_broken.bvh") && msg.contains("line 4"),
+        "{msg}"
+    );
+    assert!(
+        msg.contains("still.bvh") && msg.contains("no kinematic tempo"),
+        "{msg}"
+    );
+}
+
+#[test]
+fn the_song_tempo_takes_a_generated_clip_to_its_octave_level() {
+    // A clip that swings on every beat at 113.7 BPM (it repeats every two beats too): for a
+    // song at 60 BPM its bars are two of its beats long, for a song at 110 its own beat.
+    let dir = scratch("octave");
+    let file = dir.join("gen.bvh");
+    let clip = generated(113.7, 0.31, 120.0, 24.0);
+    marionette::bvh::write_file(&clip.to_clip().to_bvh(), &file).unwrap();
+    for (music, want) in [(None, 113.7), (Some(110.0), 113.7), (Some(60.0), 56.85)] {
+        let params = BuildParams {
+            music_bpm: music,
+            ..BuildParams::default()
+        };
+        let db = Database::build(
+            &one_clip(file.clone(), None, None),
+            &params,
+            OnRefusal::Fail,
+            |_, _| {},
+        )
+        .unwrap();
+        let beat = db.sources[0].beat;
+        eprintln!(
+            "song {music:?}: {:.3} BPM ({:?})",
+            beat.tempo_bpm, beat.source
+        );
+        assert!(
+            (beat.tempo_bpm / want - 1.0).abs() < 0.02,
+            "{music:?}: {beat:?}"
+        );
+        let how = match music {
+            None => TempoSource::Kinematic,
+            Some(_) => TempoSource::KinematicMatched,
+        };
+        assert_eq!(beat.source, how);
+    }
+}
+
+/// The kinematic tempo of every shared clip: `dance` (the scenes') and `dance_more` (held out of
+/// tuning), alone and for the shared song of `scenes/dance_salsa.ron` (its tempo measured here).
+#[test]
+#[cfg_attr(
+    not(shared_data),
+    ignore = "needs the shared data: set MARIONETTE_DATA (default ../shared/data)"
+)]
+fn every_shared_clip_gets_a_tempo_in_range_alone_and_for_the_song() {
+    let (Some(dance), Some(more), Some(song)) = (
+        common::data_path("dance"),
+        common::data_path("dance_more"),
+        common::data_path("audio/supertux_chipdisko.ogg"),
+    ) else {
+        return;
+    };
+    let audio = marionette::choreo::music::decode::decode_file(&song).unwrap();
+    let music =
+        marionette::choreo::music::analyze(&audio.samples, audio.sample_rate, &Default::default())
+            .unwrap()
+            .tempo_bpm;
+    eprintln!("supertux_chipdisko.ogg: {music:.2} BPM");
+    for dir in [dance, more] {
+        let m = Manifest::from_folder(&dir).unwrap();
+        for c in &m.clips {
+            let clip = marionette::choreo::database::load_model_clip(&c.file).unwrap();
+            let name = c.file.file_name().unwrap().to_string_lossy().to_string();
+            let alone = kinematic_beat(&clip, &name, None).unwrap();
+            let matched = kinematic_beat(&clip, &name, Some(music)).unwrap();
+            eprintln!(
+                "{}/{name}: {:.2} BPM alone, {:.2} BPM for the song at {music:.2}",
+                dir.file_name().unwrap().to_string_lossy(),
+                alone.tempo_bpm,
+                matched.tempo_bpm
+            );
+            for b in [alone, matched] {
+                assert!((MIN_BPM..=MAX_BPM).contains(&b.tempo_bpm), "{name}: {b:?}");
+            }
+            // The song can only move the tempo by whole octaves.
+            let octaves = (matched.tempo_bpm / alone.tempo_bpm).log2();
+            assert!(
+                (octaves - octaves.round()).abs() < 0.05,
+                "{name}: {} against {}",
+                matched.tempo_bpm,
+                alone.tempo_bpm
+            );
+        }
+    }
 }

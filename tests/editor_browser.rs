@@ -22,7 +22,7 @@ use std::time::Instant;
 
 use editor_fixture::{assert_bvh_lasts_the_bars, get, scene_on};
 use marionette::choreo::augment::augment;
-use marionette::choreo::database::{BuildParams, Database, Manifest};
+use marionette::choreo::database::{BuildParams, Database, Manifest, OnRefusal};
 use marionette::editor::session::Session;
 use marionette::experiments::dance_fill::generated_database;
 
@@ -224,7 +224,7 @@ fn latency_of_search_generate_and_first_load_on_2000_segments() {
     // them, the project's generated clips) grown by mirror images and time offsets.
     let dir = marionette::io::data_dir().join("dance");
     let base = Manifest::from_folder(&dir)
-        .and_then(|m| Database::build(&m, &BuildParams::default(), |_, _| {}));
+        .and_then(|m| Database::build(&m, &BuildParams::default(), OnRefusal::Fail, |_, _| {}));
     let (base, source) = match base {
         Ok(db) => (db, format!("the shared dance clips of {}", dir.display())),
         Err(_) => (

@@ -289,6 +289,7 @@ pub fn augment_with_variants(db: &Database, target_segments: usize, seed: u64) -
             model: db.model.clone(),
             params: db.params.clone(),
             sources,
+            skipped: db.skipped.clone(),
             segments,
             eros_weights: weights,
         },

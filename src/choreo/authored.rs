@@ -912,7 +912,8 @@ mod tests {
                 ..AuthoredDance::default()
             };
             for clip in generate(&p).unwrap() {
-                let b = crate::choreo::segments::kinematic_beat(&clip.motion, &clip.name).unwrap();
+                let b = crate::choreo::segments::kinematic_beat(&clip.motion, &clip.name, None)
+                    .unwrap();
                 eprintln!(
                     "{bpm} {}: {:.2} BPM, first beat {:.3} s",
                     clip.name, b.tempo_bpm, b.first_beat_s
@@ -968,6 +969,7 @@ mod tests {
         let db = crate::choreo::database::Database::build(
             &manifest,
             &crate::choreo::database::BuildParams::default(),
+            crate::choreo::database::OnRefusal::Fail,
             |_, _| {},
         )
         .unwrap();

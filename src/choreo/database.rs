@@ -138,6 +138,50 @@ fn is_manifest(p: &Path) -> bool {
         .is_some_and(|t| crate::io::parse_ron::<Manifest>(&t, "").is_ok())
 }
 
+/// One manifest clip loaded, windowed, given its beat and cut into bars as the database's
+/// clip `index`.
+fn clip_segments(
+    c: &ManifestClip,
+    name: &str,
+    index: usize,
+    params: &BuildParams,
+) -> Result<(Source, Vec<Segment>), SegmentError> {
+    let mut clip = load_model_clip(&c.file)?;
+    if let Some((a, b)) = c.window {
+        clip = clip.window(a, b).ok_or_else(|| SegmentError::Manifest {
+            path: name.to_string(),
+            message: format!(
+                "window {a:.3}..{b:.3} s holds no frame of the clip ({:.3} s)",
+                clip.frame_count() as f64 * clip.frame_time
+            ),
+        })?;
+    }
+    let beat = match c.tempo_bpm {
+        Some(tempo_bpm) => Beat {
+            tempo_bpm,
+            first_beat_s: c.first_beat_s.unwrap_or(0.0),
+            source: TempoSource::Manifest,
+        },
+        None => {
+            let mut b = kinematic_beat(&clip, name, params.music_bpm)?;
+            if let Some(f) = c.first_beat_s {
+                b.first_beat_s = f;
+            }
+            b
+        }
+    };
+    let cut = cut_segments(&clip, name, index, &beat, params)?;
+    let source = Source {
+        file: name.to_string(),
+        frames: clip.frame_count(),
+        fps: 1.0 / clip.frame_time,
+        window: c.window,
+        beat,
+        segments: cut.len(),
+    };
+    Ok((source, cut))
+}
+
 /// A clip on humanoid24: a BVH mapped with the detected mapping, retargeted and played on
 /// humanoid24's own proportions with its root path scaled by the ratio of the leg lengths
 /// ([`crate::mapping::onto_model`]), or a keyframed .ron clip; set on its floor ([`grounded`]).
@@ -203,6 +247,36 @@ pub struct Source {
     pub segments: usize,
 }
 
+/// A clip the database was not built from, and why.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Skipped {
+    /// The clip file as given.
+    pub file: String,
+    /// Why it was refused (the error, naming the file).
+    pub reason: String,
+}
+
+/// What [`Database::build`] does with a clip it cannot use (unreadable, not mappable onto
+/// humanoid24, no tempo found, shorter than a bar, a window outside it).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum OnRefusal {
+    /// Skip it, record it in [`Database::skipped`] and go on; an error only when no clip is
+    /// left.
+    #[default]
+    Skip,
+    /// Fail with its error.
+    Fail,
+}
+
+/// What happened to one clip of a build, for progress reports.
+#[derive(Debug, Clone, Copy)]
+pub enum ClipOutcome<'a> {
+    /// The clip gave segments.
+    Used(&'a Source),
+    /// The clip was skipped ([`OnRefusal::Skip`]).
+    Skipped(&'a Skipped),
+}
+
 /// The dance-segment database.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Database {
@@ -214,6 +288,9 @@ pub struct Database {
     pub params: BuildParams,
     /// The clips it was built from.
     pub sources: Vec<Source>,
+    /// The clips of the manifest or folder it was not built from, and why (in their order).
+    #[serde(default)]
+    pub skipped: Vec<Skipped>,
     /// Every segment, clip by clip, bar by bar.
     pub segments: Vec<Segment>,
     /// Eros weights over all segments ([`eros_weights`]).
@@ -221,12 +298,15 @@ pub struct Database {
 }
 
 impl Database {
-    /// Builds a database from a manifest's clips; `progress` is called after each clip with its
-    /// index and what it gave.
+    /// Builds a database from a manifest's clips; a clip it cannot use is skipped or fails the
+    /// build as `on_refusal` says, and with every clip skipped the build fails naming each and
+    /// why ([`SegmentError::NoUsableClip`]). `progress` is called after each clip with its
+    /// index in the manifest and what it gave.
     pub fn build(
         manifest: &Manifest,
         params: &BuildParams,
-        mut progress: impl FnMut(usize, &Source),
+        on_refusal: OnRefusal,
+        mut progress: impl FnMut(usize, ClipOutcome<'_>),
     ) -> Result<Database, SegmentError> {
         if params.bar_frames < 2 {
             return Err(SegmentError::Manifest {
@@ -235,47 +315,33 @@ impl Database {
             });
         }
         let mut sources = vec![];
+        let mut skipped = vec![];
         let mut segments = vec![];
         for (i, c) in manifest.clips.iter().enumerate() {
             let name = c.file.display().to_string();
-            let mut clip = load_model_clip(&c.file)?;
-            if let Some((a, b)) = c.window {
-                clip = clip.window(a, b).ok_or_else(|| SegmentError::Manifest {
-                    path: name.clone(),
-                    message: format!(
-                        "window {a:.3}..{b:.3} s holds no frame of the clip ({:.3} s)",
-                        clip.frame_count() as f64 * clip.frame_time
-                    ),
-                })?;
-            }
-            let beat = match c.tempo_bpm {
-                Some(tempo_bpm) => Beat {
-                    tempo_bpm,
-                    first_beat_s: c.first_beat_s.unwrap_or(0.0),
-                    source: TempoSource::Manifest,
-                },
-                None => {
-                    let mut b = kinematic_beat(&clip, &name)?;
-                    if let Some(f) = c.first_beat_s {
-                        b.first_beat_s = f;
-                    }
-                    b
+            match clip_segments(c, &name, sources.len(), params) {
+                Ok((source, cut)) => {
+                    progress(i, ClipOutcome::Used(&source));
+                    sources.push(source);
+                    segments.extend(cut);
                 }
-            };
-            let cut = cut_segments(&clip, &name, i, &beat, params)?;
-            let source = Source {
-                file: name,
-                frames: clip.frame_count(),
-                fps: 1.0 / clip.frame_time,
-                window: c.window,
-                beat,
-                segments: cut.len(),
-            };
-            progress(i, &source);
-            sources.push(source);
-            segments.extend(cut);
+                Err(e) if on_refusal == OnRefusal::Skip => {
+                    let s = Skipped {
+                        file: name,
+                        reason: e.to_string(),
+                    };
+                    progress(i, ClipOutcome::Skipped(&s));
+                    skipped.push(s);
+                }
+                Err(e) => return Err(e),
+            }
         }
-        Ok(Database::of_segments(params, sources, segments))
+        if sources.is_empty() {
+            return Err(SegmentError::NoUsableClip { skipped });
+        }
+        let mut db = Database::of_segments(params, sources, segments);
+        db.skipped = skipped;
+        Ok(db)
     }
 
     /// A database from clips already on humanoid24 (e.g. the project's own dance, built in
@@ -295,7 +361,7 @@ impl Database {
         for (i, (name, clip, beat)) in clips.iter().enumerate() {
             let beat = match beat {
                 Some(b) => *b,
-                None => kinematic_beat(clip, name)?,
+                None => kinematic_beat(clip, name, params.music_bpm)?,
             };
             let cut = cut_segments(clip, name, i, &beat, params)?;
             sources.push(Source {
@@ -320,6 +386,7 @@ impl Database {
             model: "humanoid24".into(),
             params: params.clone(),
             sources,
+            skipped: vec![],
             segments,
             eros_weights,
         }

@@ -558,6 +558,7 @@ pub(crate) mod tests {
             model: "humanoid24".into(),
             params: Default::default(),
             sources: vec![],
+            skipped: vec![],
             eros_weights: crate::choreo::eros::eros_weights(&pcas),
             segments,
         }

@@ -588,6 +588,7 @@ pub fn generated_database(
         model: "humanoid24".into(),
         params,
         sources,
+        skipped: vec![],
         segments,
         eros_weights,
     })

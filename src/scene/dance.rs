@@ -19,7 +19,7 @@ use super::source::resolve_path;
 use super::{SceneError, write_output};
 use crate::choreo::authored::{AuthoredDance, generate};
 use crate::choreo::dance::{self, DanceParams};
-use crate::choreo::database::{BuildParams, Database, Manifest};
+use crate::choreo::database::{BuildParams, ClipOutcome, Database, Manifest, OnRefusal};
 use crate::choreo::feet::{PlantParams, Planting, plant_feet};
 use crate::choreo::fill::{self, FillParams, Pins};
 use crate::choreo::metrics;
@@ -215,7 +215,7 @@ pub fn load_dance(scene: &DanceScene, base: &Path) -> Result<DanceInputs, SceneE
         None => analysis.bars.len(),
     };
     let bars = analysis.bars[..bars_n].to_vec();
-    let (db, moves, db_origin) = load_database(scene, base)?;
+    let (db, moves, db_origin) = load_database(scene, base, analysis.tempo_bpm)?;
     let pins = resolve_pins(&scene.pins, &db)?;
     Ok(DanceInputs {
         samples: song.samples,
@@ -263,10 +263,13 @@ fn load_song(src: &SongSource, base: &Path) -> Result<Song, SceneError> {
     }
 }
 
-/// The database and, for the project's own dance, each clip's moves.
+/// The database and, for the project's own dance, each clip's moves; clips are built for the
+/// song's tempo `music_bpm` (their kinematic tempo takes the octave level nearest it) unless
+/// the scene's build parameters give one.
 fn load_database(
     s: &DanceScene,
     base: &Path,
+    music_bpm: f64,
 ) -> Result<(Database, Vec<Vec<String>>, String), SceneError> {
     match &s.database {
         DatabaseSource::Authored(a) => {
@@ -294,7 +297,15 @@ fn load_database(
         DatabaseSource::Clips(p) => {
             let path = resolve_path(p, base);
             let manifest = Manifest::from_path(&path)?;
-            let db = Database::build(&manifest, &s.build, |_, _| {})?;
+            let params = BuildParams {
+                music_bpm: s.build.music_bpm.or(Some(music_bpm)),
+                ..s.build.clone()
+            };
+            let db = Database::build(&manifest, &params, OnRefusal::Skip, |_, outcome| {
+                if let ClipOutcome::Skipped(k) = outcome {
+                    eprintln!("warning: skipped {}", k.reason);
+                }
+            })?;
             Ok((db, vec![], path.display().to_string()))
         }
         DatabaseSource::File(p) => {
@@ -567,6 +578,9 @@ pub fn run_dance(
             "clip": clip_name(&s.file), "segments": s.segments,
             "tempo_bpm": s.beat.tempo_bpm, "first_beat_s": s.beat.first_beat_s,
             "tempo_from": format!("{:?}", s.beat.source),
+        })).collect::<Vec<_>>(),
+        "database_skipped": db.skipped.iter().map(|s| json!({
+            "clip": clip_name(&s.file), "reason": s.reason,
         })).collect::<Vec<_>>(),
         "pins": pins.iter().map(|(b, s)| json!({"bar": b, "segment": s})).collect::<Vec<_>>(),
         "no_adjacent_repeat": scene.fill.no_adjacent_repeat,

@@ -10,7 +10,7 @@
 use std::path::PathBuf;
 
 use glam::{DQuat, DVec3};
-use marionette::choreo::database::{BuildParams, Database, Manifest, ManifestClip};
+use marionette::choreo::database::{BuildParams, Database, Manifest, ManifestClip, OnRefusal};
 use marionette::humanoid::{ModelClip, humanoid24};
 
 /// A fresh scratch folder.
@@ -138,7 +138,7 @@ pub fn generated_database(name: &str, clips: usize) -> (Database, PathBuf) {
         clips: list,
     };
     (
-        Database::build(&m, &BuildParams::default(), |_, _| {}).unwrap(),
+        Database::build(&m, &BuildParams::default(), OnRefusal::Fail, |_, _| {}).unwrap(),
         dir,
     )
 }

@@ -1,13 +1,14 @@
-//! `marionette dance db FOLDER|MANIFEST --out DB`: builds the dance-segment database (a line
-//! per clip on stderr as it goes); `marionette dance info DB`: what a database was built from
-//! and how long it took to load.
+//! `marionette dance db FOLDER|MANIFEST --out DB [--music-bpm BPM] [--strict]`: builds the
+//! dance-segment database (a line per clip on stderr as it goes: what it gave, or why it was
+//! skipped); `marionette dance info DB`: what a database was built from, what it skipped, and
+//! how long it took to load.
 
 use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::Result;
 
-use marionette::choreo::database::{BuildParams, Database, Manifest};
+use marionette::choreo::database::{BuildParams, ClipOutcome, Database, Manifest, OnRefusal};
 use marionette::choreo::segments::TempoSource;
 
 // The command's arguments (its help text is on `Command::Dance`).
@@ -29,6 +30,14 @@ enum DanceCommand {
         /// Frames every bar is resampled to.
         #[arg(long, default_value_t = 32)]
         bar_frames: usize,
+        /// The tempo of the song the database is for (BPM): each kinematic tempo takes the
+        /// octave level nearest it that the motion supports.
+        #[arg(long)]
+        music_bpm: Option<f64>,
+        /// Fail on the first clip that cannot be used, instead of skipping it with a line
+        /// that says why.
+        #[arg(long)]
+        strict: bool,
     },
     /// Print what a database was built from (sources, tempo per clip and how it was found,
     /// segments per clip) and the time it took to load.
@@ -43,6 +52,7 @@ fn how(source: TempoSource) -> &'static str {
     match source {
         TempoSource::Manifest => "manifest",
         TempoSource::Kinematic => "kinematic",
+        TempoSource::KinematicMatched => "kinematic, octave nearest the song",
     }
 }
 
@@ -53,34 +63,49 @@ pub fn dance(a: Args) -> Result<()> {
             input,
             out,
             bar_frames,
+            music_bpm,
+            strict,
         } => {
+            if let Some(m) = music_bpm.filter(|m| !(m.is_finite() && *m > 0.0)) {
+                anyhow::bail!("--music-bpm must be a positive number of BPM, found {m}");
+            }
             let manifest = Manifest::from_path(&input)?;
             let n = manifest.clips.len();
             let start = Instant::now();
             let params = BuildParams {
                 bar_frames,
+                music_bpm,
                 ..BuildParams::default()
             };
-            let db = Database::build(&manifest, &params, |i, s| {
-                let how = how(s.beat.source);
-                eprintln!(
-                    "[{}/{n}] {}: {} frames at {:.1} fps, {:.2} BPM ({how}), first beat {:.3} s, \
+            let policy = if strict {
+                OnRefusal::Fail
+            } else {
+                OnRefusal::Skip
+            };
+            let db = Database::build(&manifest, &params, policy, |i, outcome| match outcome {
+                ClipOutcome::Used(s) => eprintln!(
+                    "[{}/{n}] {}: {} frames at {:.1} fps, {:.2} BPM ({}), first beat {:.3} s, \
                      {} segments",
                     i + 1,
                     s.file,
                     s.frames,
                     s.fps,
                     s.beat.tempo_bpm,
+                    how(s.beat.source),
                     s.beat.first_beat_s,
                     s.segments
-                );
+                ),
+                ClipOutcome::Skipped(s) => {
+                    eprintln!("[{}/{n}] skipped {}", i + 1, s.reason)
+                }
             })?;
             db.save(&out)?;
             eprintln!(
-                "wrote {}: {} segments from {} clips in {:.2} s",
+                "wrote {}: {} segments from {} clips ({} skipped) in {:.2} s",
                 out.display(),
                 db.segments.len(),
                 db.sources.len(),
+                db.skipped.len(),
                 start.elapsed().as_secs_f64()
             );
             Ok(())
@@ -90,12 +115,13 @@ pub fn dance(a: Args) -> Result<()> {
             let d = Database::load(&db)?;
             let secs = start.elapsed().as_secs_f64();
             println!(
-                "{}: {} segments of {} frames on {} from {} clips, loaded in {:.3} s",
+                "{}: {} segments of {} frames on {} from {} clips ({} skipped), loaded in {:.3} s",
                 db.display(),
                 d.segments.len(),
                 d.params.bar_frames,
                 d.model,
                 d.sources.len(),
+                d.skipped.len(),
                 secs
             );
             for s in &d.sources {
@@ -109,6 +135,12 @@ pub fn dance(a: Args) -> Result<()> {
                     s.beat.first_beat_s,
                     s.segments
                 );
+            }
+            if let Some(m) = d.params.music_bpm {
+                println!("  octave levels chosen for a song at {m:.2} BPM");
+            }
+            for s in &d.skipped {
+                println!("  skipped {}", s.reason);
             }
             Ok(())
         }
