@@ -123,7 +123,7 @@ pub enum TempoSource {
     /// the tempo prior.
     Kinematic,
     /// Estimated from the motion, its octave level the one nearest the song's tempo
-    /// ([`BuildParams::music_bpm`]) among those the motion's autocorrelation supports.
+    /// ([`BuildParams::music_bpm`]) ([`kinematic_tempo`]).
     KinematicMatched,
 }
 
@@ -349,8 +349,11 @@ fn farthest_period(acf: &Autocorrelation, p: Peak) -> f64 {
 ///    as well twice as often and the tempo doubles (a motion that repeats every beat also
 ///    repeats every two beats: the prior alone would halve a fast tempo);
 /// 3. with the song's tempo `music_bpm`, the octave level (the tempo × 2^k, k = −2..2, in
-///    range) that the motion supports and that lies nearest the song's tempo in log scale
-///    (|log2(tempo / music_bpm)| least). A level of ℓ frames, for a beat of L, is supported
+///    range) nearest the song's tempo in log scale (|log2(tempo / music_bpm)| least), a finer
+///    level (k > 0) always (it divides the motion's beat evenly, so the motion's beats stay on
+///    its counts and its bars take the song's length: a 41 BPM salsa bar of 5.9 s would be
+///    danced three times as fast in a 2 s bar of a 120 BPM song), a coarser one (k < 0) when
+///    the motion supports it. A level of ℓ frames, for a beat of L, is supported
 ///    when r(ℓ) is above r(ℓ ± w), w = min(ℓ, L)/4 (half-way to the troughs of the shorter
 ///    period): r peaks within about w/2 of ℓ. r need not be positive there: for
 ///    v(t) = cos ωt + a cos 2ωt, r ∝ cos ωℓ + a² cos 2ωℓ supports the half period as soon as
@@ -400,7 +403,12 @@ pub fn kinematic_tempo(speed: &[f64], fps: f64, music_bpm: Option<f64>) -> Optio
         for k in [-2, -1, 1, 2] {
             let m = 2f64.powi(k);
             let lag = beat.lag / m;
-            let level = (MIN_BPM..=MAX_BPM).contains(&bpm(lag)) && acf.supports(lag, beat.lag);
+            // A finer level (k > 0) divides the beat evenly: the motion's own beats fall on
+            // every 2^k-th count of it, whether or not it moves at the finer period too, and
+            // its bars are as many beats of the song's length. A coarser level needs the
+            // motion to come back there.
+            let level =
+                (MIN_BPM..=MAX_BPM).contains(&bpm(lag)) && (k > 0 || acf.supports(lag, beat.lag));
             if level && distance(lag) < distance(beat.lag / octave) {
                 octave = m;
             }
@@ -806,7 +814,7 @@ mod tests {
     }
 
     #[test]
-    fn the_octave_level_nearest_the_song_is_chosen_when_the_motion_supports_it() {
+    fn the_octave_level_nearest_the_song_is_chosen() {
         let fps = 100.0;
         let near = |t: Option<f64>, bpm: f64| t.is_some_and(|t| (t / bpm - 1.0).abs() < 0.01);
         // 75 BPM with stronger half beats: alone, 75 (the prior and the full period); for a
@@ -820,17 +828,18 @@ mod tests {
         }
         let t = kinematic_tempo(&s, fps, Some(70.0));
         assert!(near(t, 75.0), "{t:?}");
-        // Half beats 0.75 times as strong as the beats: r is negative at the half beat but
-        // peaks there (a > ½), and the song at 150 takes it; 0.4 times (a < ½), no peak.
-        let s = with_half_beats(75.0, 0.45, fps, 30.0);
-        let t = kinematic_tempo(&s, fps, Some(150.0));
-        assert!(near(t, 150.0), "{t:?}");
-        let s = with_half_beats(75.0, 0.24, fps, 30.0);
-        let t = kinematic_tempo(&s, fps, Some(150.0));
-        assert!(near(t, 75.0), "{t:?}");
-        // Without half beats the motion does not support 150: a song at 150 leaves it at 75.
-        let s = with_half_beats(75.0, 0.0, fps, 30.0);
-        let t = kinematic_tempo(&s, fps, Some(150.0));
+        // Half beats weak or absent: the finer level divides the beat evenly all the same, and
+        // a song at 150 takes it.
+        for half in [0.45, 0.24, 0.0] {
+            let s = with_half_beats(75.0, half, fps, 30.0);
+            let t = kinematic_tempo(&s, fps, Some(150.0));
+            assert!(near(t, 150.0), "half beats {half}: {t:?}");
+        }
+        // A coarser level needs the motion to come back there: 75 BPM with strong half beats
+        // repeats every 75 BPM beat, and a song at 37.5 BPM (out of range) leaves it at 75;
+        // a song at 40 takes 37.5 only in range, so the nearest level in range, 75, stays.
+        let s = with_half_beats(75.0, 1.0, fps, 30.0);
+        let t = kinematic_tempo(&s, fps, Some(40.0));
         assert!(near(t, 75.0), "{t:?}");
         // A motion at 160 BPM repeats every two beats too: for a song at 80, 80; alone, 160
         // (its fundamental, though the prior weighs 80 more).
