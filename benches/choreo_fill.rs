@@ -6,14 +6,24 @@
 //! - `transition_table_2000`: every connection C(a → b) of the 2,000 × 2,000 pairs (rayon);
 //! - `fill_64x2000`: [`fill`] as the API gives it, the table built inside, then the exact DP;
 //! - `fill_with_table_64x2000` / `fill_dijkstra_with_table_64x2000`: the exact DP / Dijkstra on
-//!   a prepared table (an editor builds the table once per database).
+//!   a prepared table (an editor builds the table once per database);
+//! - `fill_assemble_64x2000` (issue 34: under 50 ms): what Generate does once the table is
+//!   built: the fill with the music term, then the dance assembled at 30 fps with every bar's
+//!   beats warped onto the song's and its feet put on the floor ([`plant_feet`]), 64 bars of
+//!   1.76 s (136 BPM).
+//!
+//! The music: 64 bars whose loudness rises and falls, as percentile ranks.
 
 use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use marionette::choreo::augment::augment;
+use marionette::choreo::dance::{DanceParams, assemble};
 use marionette::choreo::database::{BuildParams, Database, Manifest, OnRefusal};
+use marionette::choreo::feet::{PlantParams, plant_feet};
 use marionette::choreo::fill::{FillParams, Pins, fill, fill_dijkstra_with_table, fill_with_table};
+use marionette::choreo::music::Bar;
+use marionette::choreo::relevance::percentile_ranks;
 use marionette::choreo::transition::TransitionTable;
 use marionette::experiments::dance_fill::generated_database;
 
@@ -43,8 +53,22 @@ fn bench(c: &mut Criterion) {
     let n = db.segments.len();
     let pins = Pins::from([(5, 17 % n), (21, 901 % n), (40, 1402 % n), (58, 3 % n)]);
     let table = TransitionTable::new(&db, &p.transition).unwrap();
-    let a = fill_dijkstra_with_table(&db, &table, 64, &pins, &p).unwrap();
-    let b = fill_with_table(&db, &table, 64, &pins, &p).unwrap();
+    let loudness: Vec<f64> = (0..64)
+        .map(|k| (k as f64 * 0.37).sin() + 1e-3 * k as f64)
+        .collect();
+    let music = percentile_ranks(&loudness);
+    let bar_s = 4.0 * 60.0 / 136.0;
+    let bars: Vec<Bar> = (0..64)
+        .map(|k| Bar {
+            start_s: k as f64 * bar_s,
+            end_s: (k + 1) as f64 * bar_s,
+            rms: 0.1,
+            rms_db: -20.0,
+        })
+        .collect();
+    let beats: Vec<f64> = (0..=256).map(|k| k as f64 * bar_s / 4.0).collect();
+    let a = fill_dijkstra_with_table(&db, &table, &music, &pins, &p).unwrap();
+    let b = fill_with_table(&db, &table, &music, &pins, &p).unwrap();
     assert_eq!(a, b, "Dijkstra and the DP agree");
     eprintln!("64 bars: total cost {:.4}", a.total_cost);
     let mut g = c.benchmark_group("choreo_fill");
@@ -53,13 +77,21 @@ fn bench(c: &mut Criterion) {
         bch.iter(|| black_box(TransitionTable::new(&db, &p.transition).unwrap()))
     });
     g.bench_function("fill_64x2000", |bch| {
-        bch.iter(|| black_box(fill(&db, 64, &pins, &p).unwrap()))
+        bch.iter(|| black_box(fill(&db, &music, &pins, &p).unwrap()))
     });
     g.bench_function("fill_with_table_64x2000", |bch| {
-        bch.iter(|| black_box(fill_with_table(&db, &table, 64, &pins, &p).unwrap()))
+        bch.iter(|| black_box(fill_with_table(&db, &table, &music, &pins, &p).unwrap()))
     });
     g.bench_function("fill_dijkstra_with_table_64x2000", |bch| {
-        bch.iter(|| black_box(fill_dijkstra_with_table(&db, &table, 64, &pins, &p).unwrap()))
+        bch.iter(|| black_box(fill_dijkstra_with_table(&db, &table, &music, &pins, &p).unwrap()))
+    });
+    g.bench_function("fill_assemble_64x2000", |bch| {
+        bch.iter(|| {
+            let f = fill_with_table(&db, &table, &music, &pins, &p).unwrap();
+            let mut d = assemble(&db, &f.segments, &bars, &beats, &DanceParams::default()).unwrap();
+            let planted = plant_feet(&mut d.clip, &PlantParams::default());
+            black_box((d, planted))
+        })
     });
     g.finish();
 }

@@ -351,6 +351,7 @@ fn likes_pull_the_second_re_search_toward_them_on_the_shared_clips() {
     let db = Database::build(
         &Manifest::from_folder(&dir).unwrap(),
         &BuildParams::default(),
+        OnRefusal::Fail,
         |_, _| {},
     )
     .unwrap();

@@ -155,6 +155,34 @@ fn the_api_flow_search_like_search_set_generate_save_export() {
     let dance = get(a, "/api/dance");
     let lead = (dance["start_s"].as_f64().unwrap() * 30.0).round() as usize;
     assert_eq!(dance["frames"].as_array().unwrap().len() + lead, frames);
+    // The figures the page's status gives are the report's for the same dance.
+    let (fig, m) = (&dance["figures"], &report["metrics"]);
+    for (shown, reported) in [
+        (
+            &fig["metrics"]["beat_alignment_score"],
+            &m["beat_alignment_score"],
+        ),
+        (&fig["metrics"]["foot_skating_m_s"], &m["foot_skating_m_s"]),
+        (
+            &fig["metrics"]["foot_penetration"]["deepest_m"],
+            &m["foot_penetration"]["deepest_m"],
+        ),
+        (
+            &fig["metrics"]["seam_jerk"]["mean_rad_s3"],
+            &m["seam_jerk_mean_rad_s3"],
+        ),
+        (
+            &fig["sources"]["foot_skating_m_s"],
+            &m["sources"]["foot_skating_m_s"],
+        ),
+        (
+            &fig["sources"]["beat_alignment_score"],
+            &m["sources"]["beat_alignment_score"],
+        ),
+        (&fig["intensity_spearman"], &m["intensity_spearman"]),
+    ] {
+        assert_eq!(shown, reported);
+    }
 
     let wav = request(a, "GET", "/api/audio.wav", None);
     assert_eq!(wav.status, 200);

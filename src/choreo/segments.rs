@@ -4,13 +4,13 @@
 //!
 //! Dance capture has no music, so when no manifest gives a clip's tempo and first beat they are
 //! found from the motion itself (the kinematic beat): the speed curve v(f) = Σ_i |ẋ_i(f)| over
-//! every joint, less its slow trend ([`detrend`]: a dancer travelling or slowing down), its
-//! autocorrelation r(ℓ) = Σ_f (v(f) − v̄)(v(f+ℓ) − v̄) / ((n − ℓ) σ²) searched for the beat
-//! period between [`MIN_BPM`] and [`MAX_BPM`] ([`kinematic_tempo`]: the highest local peak of
-//! r(ℓ) weighted by a log-normal tempo prior, centre [`PRIOR_BPM`], σ one octave, then its
-//! fundamental, and, when the database is built for a song, the octave level the motion
-//! supports nearest the song's tempo; refined by a parabola through its neighbours), and the
-//! first beat the phase φ ∈ [0, T) whose beats φ + kT fall on the lowest mean speed (dancers
+//! every joint, its autocorrelation r(ℓ) = Σ_f (v(f) − v̄)(v(f+ℓ) − v̄) / ((n − ℓ) σ²) searched
+//! for the beat period between [`MIN_BPM`] and [`MAX_BPM`] (the highest local peak of r(ℓ)
+//! weighted by the music kernel's log-normal tempo prior, centre [`PRIOR_BPM`], σ one octave, so
+//! that the beat wins over the two-beat period whose r is as high; refined by a parabola through
+//! its neighbours); when the database is built for a song, the octave level of that beat
+//! nearest the song's tempo ([`kinematic_tempo`]); and the first beat the phase φ ∈ [0, T) whose
+//! beats φ + kT fall on the lowest mean speed (dancers
 //! mark the count with the minima of their speed).
 
 use glam::{DQuat, DVec3};
@@ -24,10 +24,13 @@ use crate::humanoid::ModelClip;
 pub const BEATS_PER_BAR: usize = 4;
 
 /// Slowest tempo the kinematic beat looks for, beats per minute.
-pub const MIN_BPM: f64 = 40.0;
+pub const MIN_BPM: f64 = 60.0;
 
 /// Fastest tempo the kinematic beat looks for, beats per minute.
-pub const MAX_BPM: f64 = 200.0;
+pub const MAX_BPM: f64 = 180.0;
+
+/// The tempi between which a song may take the octave level of a clip's beat, BPM.
+pub const LEVEL_BPM: (f64, f64) = (40.0, 200.0);
 
 /// Centre of the log-normal tempo prior of the kinematic beat, BPM (σ one octave).
 pub const PRIOR_BPM: f64 = 120.0;
@@ -153,268 +156,76 @@ pub fn speed_curve(positions: &[Vec<DVec3>], fps: f64) -> Vec<f64> {
         .collect()
 }
 
-/// The speed curve less its slow trend: v(f) − v̄_W(f), v̄_W the centred moving average over
-/// W = 60 / [`MIN_BPM`] s (one period of the slowest beat, so that a box of that width has its
-/// zeros on every multiple of [`MIN_BPM`] and passes every beat in range with a gain between
-/// 0.78 and 1.22, while a trend slower than one cycle in 10 s keeps less than 4 % of itself:
-/// a dancer travelling, slowing down or speeding up does not swamp the beat). Only the frames
-/// whose whole window lies inside the curve are kept (the first and last W/2 are dropped).
-pub fn detrend(speed: &[f64], fps: f64) -> Vec<f64> {
-    let h = (0.5 * fps * 60.0 / MIN_BPM).round().max(1.0) as usize;
+/// The beat of a speed curve sampled at `fps`: the beat period with the highest normalised
+/// autocorrelation between [`MIN_BPM`] and [`MAX_BPM`] (module docs), in BPM; `None` when the
+/// curve is too short for two periods of the slowest tempo or is constant.
+fn beat_tempo(speed: &[f64], fps: f64) -> Option<f64> {
     let n = speed.len();
-    if n < 2 * h + 1 {
-        return vec![];
-    }
-    let mut prefix = Vec::with_capacity(n + 1);
-    prefix.push(0.0);
-    for v in speed {
-        prefix.push(prefix[prefix.len() - 1] + v);
-    }
-    let w = (2 * h + 1) as f64;
-    (h..n - h)
-        .map(|f| speed[f] - (prefix[f + h + 1] - prefix[f - h]) / w)
-        .collect()
-}
-
-/// The normalised autocorrelation r(ℓ) of a detrended curve: tabulated over the lags of the
-/// tempo range, computed where asked beyond it.
-struct Autocorrelation {
-    /// The curve less its mean.
-    c: Vec<f64>,
-    /// Its variance σ².
-    var: f64,
-    /// The first tabulated lag, frames.
-    lag0: usize,
-    /// r(lag0 + k).
-    table: Vec<f64>,
-}
-
-impl Autocorrelation {
-    /// r(ℓ) = Σ_f c(f) c(f+ℓ) / ((n − ℓ) σ²) of `c` (mean removed here), tabulated for ℓ in
-    /// `lags`; `None` when `c` is constant or shorter than the last lag.
-    fn of(c: &[f64], lags: std::ops::RangeInclusive<usize>) -> Option<Autocorrelation> {
-        let n = c.len();
-        if n <= *lags.end() {
-            return None;
-        }
-        let mean = c.iter().sum::<f64>() / n as f64;
-        let c: Vec<f64> = c.iter().map(|v| v - mean).collect();
-        let var = c.iter().map(|x| x * x).sum::<f64>() / n as f64;
-        if var <= 1e-12 {
-            return None;
-        }
-        let mut acf = Autocorrelation {
-            c,
-            var,
-            lag0: *lags.start(),
-            table: vec![],
-        };
-        acf.table = lags.map(|lag| acf.at(lag)).collect();
-        Some(acf)
-    }
-
-    /// r(`lag`), from the table when it holds it (`lag` < n).
-    fn at(&self, lag: usize) -> f64 {
-        if let Some(r) = lag.checked_sub(self.lag0).and_then(|k| self.table.get(k)) {
-            return *r;
-        }
-        let n = self.c.len();
-        let s: f64 = (0..n - lag).map(|f| self.c[f] * self.c[f + lag]).sum();
-        s / ((n - lag) as f64 * self.var)
-    }
-
-    /// r at a fractional lag, linear between the integer lags around it.
-    fn interpolated(&self, lag: f64) -> f64 {
-        let i = lag.floor() as usize;
-        let t = lag - i as f64;
-        self.at(i) * (1.0 - t) + self.at(i + 1) * t
-    }
-
-    /// Whether the motion comes back after `lag` frames as a level of a beat of `beat_lag`
-    /// frames: r at `lag` above r at lag ± w, w = min(lag, beat_lag)/4, half-way to the
-    /// troughs of the shorter period (so r peaks within about w/2 of `lag`).
-    fn supports(&self, lag: f64, beat_lag: f64) -> bool {
-        let w = 0.25 * lag.min(beat_lag);
-        if lag - w < 1.0 || lag + w + 1.0 > self.max_lag() as f64 {
-            return false;
-        }
-        let r = self.interpolated(lag);
-        r > self.interpolated(lag - w) && r > self.interpolated(lag + w)
-    }
-
-    /// The longest lag r is looked at: half the curve, so that at least half of its frames
-    /// enter every r(ℓ).
-    fn max_lag(&self) -> usize {
-        self.c.len() / 2
-    }
-
-    /// The highest point of r over the integer lags of [lo, hi] (within 1 ..= [`Self::max_lag`])
-    /// when it lies strictly inside that window (higher than r at both ends): its lag refined by
-    /// a parabola through its neighbours, and its height. `None` when r rises to an end of the
-    /// window.
-    fn peak_in(&self, lo: f64, hi: f64) -> Option<Peak> {
-        let a = lo.ceil().max(1.0) as usize;
-        let b = hi.floor().min(self.max_lag() as f64).max(0.0) as usize;
-        if b < a + 2 {
-            return None;
-        }
-        let (k, _) = (a..=b)
-            .map(|l| (l, self.at(l)))
-            .fold((a, f64::NEG_INFINITY), |m, x| if x.1 > m.1 { x } else { m });
-        if k == a || k == b {
-            return None;
-        }
-        Some(self.refined(k))
-    }
-
-    /// The peak at lag `k` (a local maximum) refined by a parabola through its neighbours.
-    fn refined(&self, k: usize) -> Peak {
-        let (a, b, c) = (self.at(k - 1), self.at(k), self.at(k + 1));
-        let denom = a - 2.0 * b + c;
-        let offset = if denom.abs() > 1e-15 {
-            (0.5 * (a - c) / denom).clamp(-0.5, 0.5)
-        } else {
-            0.0
-        };
-        let correction = -0.25 * (a - c) * offset;
-        Peak {
-            lag: k as f64 + offset,
-            r: b + correction,
-            correction: correction.abs(),
-        }
-    }
-
-    /// Every positive local maximum of r inside the table.
-    fn peaks(&self) -> impl Iterator<Item = Peak> + '_ {
-        let r = &self.table;
-        (1..r.len() - 1)
-            .filter(|&k| r[k] > 0.0 && r[k] >= r[k - 1] && r[k] >= r[k + 1])
-            .map(|k| self.refined(self.lag0 + k))
-    }
-}
-
-/// A peak of the autocorrelation: its lag (frames, refined) and height, and how much the
-/// parabola moved the height from the highest sampled lag (the resolution of the height).
-#[derive(Debug, Clone, Copy)]
-struct Peak {
-    lag: f64,
-    r: f64,
-    correction: f64,
-}
-
-/// The log-normal tempo prior of the kinematic beat at `bpm`: exp(−½ log2(bpm / 120)²).
-fn tempo_prior(bpm: f64) -> f64 {
-    (-0.5 * (bpm / PRIOR_BPM).log2().powi(2)).exp()
-}
-
-/// The peak of the octave level `lag` (frames) of a beat of `beat_lag` frames: the highest
-/// point of r strictly inside lag ± p/4, p the shorter of the two periods (a motion that
-/// repeats every p frames has its troughs of r at lag ± p/2: the window reaches half-way to
-/// them). `None` when r has no peak there: nothing in the motion comes back after `lag`
-/// more than around it. (r need not be positive at the peak: for a speed curve
-/// v(t) = cos ωt + a cos 2ωt, r ∝ cos ωℓ + a² cos 2ωℓ has a peak at ℓ = π/ω, the half
-/// period, as soon as a > ½, while r(π/ω) > 0 only for a > 1.)
-fn level_peak(acf: &Autocorrelation, lag: f64, beat_lag: f64) -> Option<Peak> {
-    let half = 0.25 * lag.min(beat_lag);
-    acf.peak_in(lag - half, lag + half)
-}
-
-/// The period (frames) of the level whose peak is `p`, measured on its farthest repetition:
-/// a peak's refined lag is within half a frame of the true one, so the period measured on the
-/// k-th repetition is within 1/(2k) frame, and r's peak at the 2k-th repetition is predicted
-/// within a frame, plus half a frame of its own. While r has a peak ([`level_peak`]) there,
-/// that close, the period becomes its lag over 2k (each doubling halves the error); up to
-/// [`Autocorrelation::max_lag`]. A motion whose tempo drifts stops early, on its own peak.
-fn farthest_period(acf: &Autocorrelation, p: Peak) -> f64 {
-    let (mut period, mut k) = (p.lag, 1.0);
-    while let Some(q) = level_peak(acf, 2.0 * k * period, period) {
-        if (q.lag - 2.0 * k * period).abs() > 1.5 {
-            break;
-        }
-        k *= 2.0;
-        period = q.lag / k;
-    }
-    period
-}
-
-/// The kinematic tempo of a speed curve sampled at `fps`, in BPM, between [`MIN_BPM`] and
-/// [`MAX_BPM`], from the autocorrelation r(ℓ) of the detrended curve ([`detrend`]):
-///
-/// 1. the beat is the positive local maximum of r with the highest r(ℓ) · prior(ℓ), the
-///    log-normal tempo prior (centre [`PRIOR_BPM`], σ one octave) that makes the beat win over
-///    the two-beat period whose r is as high;
-/// 2. its fundamental: while r has a peak at half the lag (a supported level, below) at least
-///    as high (within the two heights' resolution: what the parabola added to each sampled
-///    peak), the motion repeats
-///    as well twice as often and the tempo doubles (a motion that repeats every beat also
-///    repeats every two beats: the prior alone would halve a fast tempo);
-/// 3. with the song's tempo `music_bpm`, the octave level (the tempo × 2^k, k = −2..2, in
-///    range) nearest the song's tempo in log scale (|log2(tempo / music_bpm)| least), a finer
-///    level (k > 0) always (it divides the motion's beat evenly, so the motion's beats stay on
-///    its counts and its bars take the song's length: a 41 BPM salsa bar of 5.9 s would be
-///    danced three times as fast in a 2 s bar of a 120 BPM song), a coarser one (k < 0) when
-///    the motion supports it. A level of ℓ frames, for a beat of L, is supported
-///    when r(ℓ) is above r(ℓ ± w), w = min(ℓ, L)/4 (half-way to the troughs of the shorter
-///    period): r peaks within about w/2 of ℓ. r need not be positive there: for
-///    v(t) = cos ωt + a cos 2ωt, r ∝ cos ωℓ + a² cos 2ωℓ supports the half period as soon as
-///    a > 0.54, though r(π/ω) > 0 only for a > 1. Only octaves: a bar is four beats of 4/4,
-///    and a 3:2 level would cut bars across the dance's own beats.
-///
-/// The tempo is the beat's period measured on its farthest repetition (while r peaks
-/// within 1.5 frames of twice the last multiple found, the period is that peak's lag over its
-/// multiple: half a frame of error on the first peak predicts the next within a frame, plus
-/// half a frame of its own; up to half the curve's length), each peak's lag refined by a
-/// parabola through its neighbours, times the octave the song chose, kept in range (the
-/// refinement moves it by less than half a frame of lag). `None` when the curve is too short
-/// for two periods of the slowest tempo (plus the detrending window), is constant after
-/// detrending, or r has no positive peak in range.
-pub fn kinematic_tempo(speed: &[f64], fps: f64, music_bpm: Option<f64>) -> Option<f64> {
-    let min_lag = (fps * 60.0 / MAX_BPM).floor().max(2.0) as usize;
+    let min_lag = (fps * 60.0 / MAX_BPM).floor().max(1.0) as usize;
     let max_lag = (fps * 60.0 / MIN_BPM).ceil() as usize;
-    let c = detrend(speed, fps);
-    if c.len() < 2 * max_lag + 2 {
+    if n < 2 * max_lag + 2 {
         return None;
     }
-    let acf = Autocorrelation::of(&c, min_lag - 1..=max_lag + 1)?;
-    let bpm = |lag: f64| 60.0 * fps / lag;
-    let in_range = |p: &Peak| (MIN_BPM..=MAX_BPM).contains(&bpm(p.lag));
-    let mut beat = acf
-        .peaks()
-        .filter(in_range)
-        .map(|p| (p, p.r * tempo_prior(bpm(p.lag))))
-        .fold(None::<(Peak, f64)>, |best, (p, s)| match best {
-            Some((_, b)) if b >= s => best,
-            _ => Some((p, s)),
-        })?
-        .0;
-    loop {
-        let half = 0.5 * beat.lag;
-        let Some(h) = level_peak(&acf, half, beat.lag).filter(in_range) else {
-            break;
-        };
-        if !acf.supports(half, beat.lag) || h.r + h.correction + beat.correction < beat.r {
-            break;
-        }
-        beat = h;
+    let mean = speed.iter().sum::<f64>() / n as f64;
+    let c: Vec<f64> = speed.iter().map(|v| v - mean).collect();
+    let var = c.iter().map(|x| x * x).sum::<f64>() / n as f64;
+    if var <= 1e-12 {
+        return None;
     }
-    let mut octave = 1.0;
-    if let Some(music) = music_bpm.filter(|m| m.is_finite() && *m > 0.0) {
-        let distance = |lag: f64| (bpm(lag) / music).log2().abs();
-        for k in [-2, -1, 1, 2] {
-            let m = 2f64.powi(k);
-            let lag = beat.lag / m;
-            // A finer level (k > 0) divides the beat evenly: the motion's own beats fall on
-            // every 2^k-th count of it, whether or not it moves at the finer period too, and
-            // its bars are as many beats of the song's length. A coarser level needs the
-            // motion to come back there.
-            let level =
-                (MIN_BPM..=MAX_BPM).contains(&bpm(lag)) && (k > 0 || acf.supports(lag, beat.lag));
-            if level && distance(lag) < distance(beat.lag / octave) {
-                octave = m;
-            }
+    let r = |lag: usize| -> f64 {
+        let s: f64 = (0..n - lag).map(|f| c[f] * c[f + lag]).sum();
+        s / ((n - lag) as f64 * var)
+    };
+    let rs: Vec<f64> = (min_lag - 1..=max_lag + 1).map(r).collect();
+    // The highest local maximum inside the range, weighted by the tempo prior.
+    let prior = |k: usize| -> f64 {
+        let bpm = 60.0 * fps / (min_lag - 1 + k) as f64;
+        (-0.5 * (bpm / PRIOR_BPM).log2().powi(2)).exp()
+    };
+    let mut best: Option<(usize, f64)> = None;
+    for k in 1..rs.len() - 1 {
+        let score = rs[k] * prior(k);
+        if rs[k] > 0.0
+            && rs[k] >= rs[k - 1]
+            && rs[k] >= rs[k + 1]
+            && best.is_none_or(|(_, b)| score > b)
+        {
+            best = Some((k, score));
         }
     }
-    Some((octave * bpm(farthest_period(&acf, beat))).clamp(MIN_BPM, MAX_BPM))
+    let (k, _) = best?;
+    let (a, b, cc) = (rs[k - 1], rs[k], rs[k + 1]);
+    let denom = a - 2.0 * b + cc;
+    let offset = if denom.abs() > 1e-15 {
+        (0.5 * (a - cc) / denom).clamp(-0.5, 0.5)
+    } else {
+        0.0
+    };
+    let lag = (min_lag - 1 + k) as f64 + offset;
+    Some(60.0 * fps / lag)
+}
+
+/// The kinematic tempo of a speed curve sampled at `fps`, in BPM: its beat ([`beat_tempo`],
+/// between [`MIN_BPM`] and [`MAX_BPM`]); with the song's tempo `music_bpm`, the octave level
+/// of it (the beat × 2^k) nearest the song's tempo in log scale (|log2(tempo / music_bpm)|
+/// least) between [`LEVEL_BPM`]. A motion that repeats every beat repeats every two beats,
+/// and a beat halved still has the motion's own beats on every other count, so every level is
+/// a metrical level of the motion; the one nearest the song's makes its bars as long as the
+/// song's, so it is danced at its own speed (a bar of 5.9 s danced in 2 s would be three
+/// times as fast). `None` as [`beat_tempo`].
+pub fn kinematic_tempo(speed: &[f64], fps: f64, music_bpm: Option<f64>) -> Option<f64> {
+    let beat = beat_tempo(speed, fps)?;
+    let Some(music) = music_bpm.filter(|m| m.is_finite() && *m > 0.0) else {
+        return Some(beat);
+    };
+    let level = (-3..=3)
+        .map(|k| beat * 2f64.powi(k))
+        .filter(|t| (LEVEL_BPM.0..=LEVEL_BPM.1).contains(t))
+        .min_by(|a, b| {
+            let d = |t: f64| (t / music).log2().abs();
+            d(*a).total_cmp(&d(*b))
+        });
+    Some(level.unwrap_or(beat))
 }
 
 /// The first beat of a speed curve at a known tempo: the phase φ ∈ [0, T) (T = 60/tempo s)
@@ -461,10 +272,10 @@ pub fn kinematic_beat(
         clip: name.to_string(),
         message: format!(
             "no kinematic tempo between {MIN_BPM} and {MAX_BPM} BPM: the autocorrelation of the \
-             detrended speed curve has no positive peak there (no regular speed minima), or the \
-             motion is still or shorter than {:.1} s ({} frames at {:.1} fps); give tempo_bpm \
-             and first_beat_s in a manifest",
-            3.0 * 60.0 / MIN_BPM,
+             speed curve has no positive peak there (no regular speed minima), or the motion is \
+             still or shorter than {:.1} s ({} frames at {:.1} fps); give tempo_bpm and \
+             first_beat_s in a manifest",
+            2.0 * 60.0 / MIN_BPM,
             speed.len(),
             fps
         ),
@@ -753,105 +564,25 @@ mod tests {
         }
     }
 
-    /// `curve` with a slow trend added: a ramp of `ramp` m/s over the curve and a sinusoid of
-    /// amplitude `wave` m/s and period 12.7 s.
-    fn with_trend(curve: &[f64], fps: f64, ramp: f64, wave: f64) -> Vec<f64> {
-        let n = curve.len() as f64;
-        curve
-            .iter()
-            .enumerate()
-            .map(|(f, v)| {
-                let t = f as f64 / fps;
-                v + ramp * f as f64 / n + wave * (2.0 * std::f64::consts::PI * t / 12.7).sin()
-            })
-            .collect()
-    }
-
     #[test]
-    fn a_slow_trend_does_not_hide_the_beat_from_40_to_200_bpm() {
-        // The beat's own swing is 2.3 m/s peak to peak; the trend's 6 m/s ramp and ±2 m/s
-        // sinusoid are larger (a dancer who travels faster and faster, and slows).
-        let mut bpm = MIN_BPM;
-        while bpm <= MAX_BPM {
-            for fps in [30.0, 120.0] {
-                let s = with_trend(&beat_curve(bpm, 0.13, fps, 24.0), fps, 6.0, 2.0);
-                let t = kinematic_tempo(&s, fps, None);
-                assert!(
-                    t.is_some_and(|t| (t / bpm - 1.0).abs() < 0.01),
-                    "{bpm} BPM at {fps} fps: {t:?}"
-                );
-            }
-            bpm *= 1.0721; // 24 tempi from 40 to 200 BPM, none on a round lag
-        }
-    }
-
-    #[test]
-    fn detrending_removes_a_ramp_and_keeps_the_beat() {
-        let fps = 60.0;
-        let ramp: Vec<f64> = (0..600).map(|f| 0.01 * f as f64).collect();
-        let d = detrend(&ramp, fps);
-        assert_eq!(d.len(), 600 - 2 * 45);
-        assert!(d.iter().all(|x| x.abs() < 1e-9), "{d:?}");
-        // A beat at 40 BPM (the box is exactly one period wide) passes whole.
-        let beat: Vec<f64> = (0..600)
-            .map(|f| (2.0 * std::f64::consts::PI * f as f64 / 90.0).cos())
-            .collect();
-        let d = detrend(&beat, fps);
-        let peak = d.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-        assert!((peak - 1.0).abs() < 0.02, "{peak}");
-    }
-
-    /// A speed curve at `bpm` with a component twice as fast of amplitude `half` (the first's
-    /// is 0.6 m/s): a dancer who marks every beat and, more strongly, every half beat.
-    fn with_half_beats(bpm: f64, half: f64, fps: f64, seconds: f64) -> Vec<f64> {
-        let w = 2.0 * std::f64::consts::PI * bpm / 60.0;
-        (0..(seconds * fps) as usize)
-            .map(|f| {
-                let t = f as f64 / fps;
-                2.0 - 0.6 * (w * t).cos() - half * (2.0 * w * t + 0.4).cos()
-            })
-            .collect()
-    }
-
-    #[test]
-    fn the_octave_level_nearest_the_song_is_chosen() {
+    fn a_song_takes_the_octave_level_of_the_beat_nearest_its_tempo() {
         let fps = 100.0;
         let near = |t: Option<f64>, bpm: f64| t.is_some_and(|t| (t / bpm - 1.0).abs() < 0.01);
-        // 75 BPM with stronger half beats: alone, 75 (the prior and the full period); for a
-        // song at 150 (or 140, or 170), the 150 BPM level; for a song at 75 or 70, 75.
-        let s = with_half_beats(75.0, 1.0, fps, 30.0);
-        let t = kinematic_tempo(&s, fps, None);
-        assert!(near(t, 75.0), "{t:?}");
-        for (music, want) in [(150.0, 150.0), (140.0, 150.0), (170.0, 150.0), (75.0, 75.0)] {
+        let s = beat_curve(82.0, 0.1, fps, 30.0);
+        assert!(near(kinematic_tempo(&s, fps, None), 82.0));
+        for (music, want) in [
+            (82.0, 82.0),
+            (136.0, 164.0),
+            (120.0, 164.0),
+            (110.0, 82.0),
+            (50.0, 41.0),
+            (300.0, 164.0),
+        ] {
             let t = kinematic_tempo(&s, fps, Some(music));
             assert!(near(t, want), "song at {music}: {t:?}, want {want}");
         }
-        let t = kinematic_tempo(&s, fps, Some(70.0));
-        assert!(near(t, 75.0), "{t:?}");
-        // Half beats weak or absent: the finer level divides the beat evenly all the same, and
-        // a song at 150 takes it.
-        for half in [0.45, 0.24, 0.0] {
-            let s = with_half_beats(75.0, half, fps, 30.0);
-            let t = kinematic_tempo(&s, fps, Some(150.0));
-            assert!(near(t, 150.0), "half beats {half}: {t:?}");
-        }
-        // A coarser level needs the motion to come back there: 75 BPM with strong half beats
-        // repeats every 75 BPM beat, and a song at 37.5 BPM (out of range) leaves it at 75;
-        // a song at 40 takes 37.5 only in range, so the nearest level in range, 75, stays.
-        let s = with_half_beats(75.0, 1.0, fps, 30.0);
-        let t = kinematic_tempo(&s, fps, Some(40.0));
-        assert!(near(t, 75.0), "{t:?}");
-        // A motion at 160 BPM repeats every two beats too: for a song at 80, 80; alone, 160
-        // (its fundamental, though the prior weighs 80 more).
-        let s = beat_curve(160.0, 0.1, fps, 30.0);
-        let t = kinematic_tempo(&s, fps, None);
-        assert!(near(t, 160.0), "{t:?}");
-        let t = kinematic_tempo(&s, fps, Some(82.0));
-        assert!(near(t, 80.0), "{t:?}");
-        // A song at 45 BPM takes a 180 BPM motion two octaves down (45, in range).
-        let s = beat_curve(180.0, 0.1, fps, 30.0);
-        let t = kinematic_tempo(&s, fps, Some(45.0));
-        assert!(near(t, 45.0), "{t:?}");
+        // A song that is not a number is no song.
+        assert!(near(kinematic_tempo(&s, fps, Some(f64::NAN)), 82.0));
     }
 
     #[test]

@@ -6,7 +6,7 @@
 //! | `GET /api/state` | | pins, undo/redo depth, last fill, tempo, song length, figure links |
 //! | `GET /api/bars` | | every bar (span, dB, normalised intensity, pin, filled segment), beats |
 //! | `GET /api/candidates` | `?bar=K` | bar K's round, τ, segments left, its six candidates' frames and its liked segments' frames |
-//! | `GET /api/dance` | | the whole dance of the current pins at the scene's fps (generates first) |
+//! | `GET /api/dance` | | the whole dance of the current pins at the scene's fps (generates first), and its figures |
 //! | `GET /api/audio.wav` | | the song as 16-bit WAV |
 //! | `POST /api/search` | `{"bar": K}` | the next relevance-feedback round; as `candidates` |
 //! | `POST /api/start-over` | `{"bar": K}` | bar K's search back to round 0, nothing shown but the likes (kept); as `candidates` |
@@ -184,13 +184,14 @@ fn route(s: &mut Session, method: &str, path: &str, query: &str, b: &[u8]) -> Re
             candidates(s, bar)
         }
         "/api/dance" => {
-            let (frames, start_s) = s.dance_frames().map_err(fail)?;
+            let (frames, start_s, figures) = s.dance_with_figures().map_err(fail)?;
             Ok(Reply::json(
                 200,
                 &DanceAnswer {
                     fps: s.fps(),
                     start_s,
                     frames: &frames,
+                    figures,
                 },
             ))
         }
@@ -333,6 +334,7 @@ struct DanceAnswer<'a> {
     fps: f64,
     start_s: f64,
     frames: &'a Frames,
+    figures: crate::scene::DanceFigures,
 }
 
 /// One candidate (or liked segment) of `GET /api/candidates` and `POST /api/search`.

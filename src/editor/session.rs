@@ -17,7 +17,7 @@ use super::scene::DanceFile;
 use crate::choreo::edit::Edit;
 use crate::choreo::fill::Fill;
 use crate::humanoid::{Model, ModelClip, humanoid24};
-use crate::scene::{load_dance, perform, scene_pins, song_timed_bvh};
+use crate::scene::{DanceFigures, figures, load_dance, perform, scene_pins, song_timed_bvh};
 
 /// The song the edit dances to.
 #[derive(Debug, Clone)]
@@ -188,6 +188,21 @@ impl Session {
     pub fn dance_frames(&mut self) -> Result<(Frames, f64), EditorError> {
         let d = self.dance()?;
         Ok((points(&d.clip, DVec3::ZERO), d.start_s))
+    }
+
+    /// [`Session::dance_frames`] and the dance's figures ([`figures`]: feet in the floor,
+    /// skating and beat alignment against its segments', intensity correlation, seam jerk).
+    pub fn dance_with_figures(&mut self) -> Result<(Frames, f64, DanceFigures), EditorError> {
+        let d = self.dance()?;
+        let fill = self.fill.clone().expect("dance() generates first");
+        let f = figures(
+            &d,
+            self.edit.database(),
+            &fill,
+            self.edit.bars(),
+            &self.song.beats_s,
+        );
+        Ok((points(&d.clip, DVec3::ZERO), d.start_s, f))
     }
 
     fn dance(&mut self) -> Result<crate::choreo::dance::Dance, EditorError> {

@@ -422,6 +422,38 @@ pub fn perform(
     Ok((d, planting))
 }
 
+/// What an animator looks at in a dance (the report's and the editor's figures): its metrics
+/// ([`metrics::dance_metrics`]: beat alignment, seam jerk, skating, foot penetration), its
+/// danced segments' own skating and beat alignment ([`metrics::source_metrics`]), and the
+/// Spearman correlation of the bars' music and motion intensity.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct DanceFigures {
+    /// The dance's metrics.
+    pub metrics: metrics::DanceMetrics,
+    /// The danced segments, each alone at its own timing.
+    pub sources: metrics::SourceMetrics,
+    /// Spearman's ρ of music and motion intensity over the bars.
+    pub intensity_spearman: f64,
+}
+
+/// The [`DanceFigures`] of dance `d` filled as `filled` to `bars` (song beats `beats_s`).
+pub fn figures(
+    d: &dance::Dance,
+    db: &Database,
+    filled: &fill::Fill,
+    bars: &[Bar],
+    beats_s: &[f64],
+) -> DanceFigures {
+    let music_rank = relevance::music_intensity(bars);
+    let motion_rank_db = relevance::motion_intensity(db);
+    let motion_rank: Vec<f64> = filled.segments.iter().map(|&s| motion_rank_db[s]).collect();
+    DanceFigures {
+        metrics: metrics::dance_metrics(d, beats_s, filled),
+        sources: metrics::source_metrics(db, &filled.segments, 1.0 / d.clip.frame_time),
+        intensity_spearman: metrics::spearman(&music_rank, &motion_rank),
+    }
+}
+
 /// Runs a [`DanceScene`] (module docs). Returns the report.
 pub fn run_dance(
     scene: &DanceScene,
@@ -445,11 +477,13 @@ pub fn run_dance(
     let music_rank = relevance::music_intensity(bars);
     let filled = fill::fill(&db, &music_rank, &pins, &scene.fill)?;
     let (d, planting) = perform(scene, &db, &filled.segments, bars, &analysis.beats_s)?;
-    let m = metrics::dance_metrics(&d, &analysis.beats_s, &filled);
-    let sources = metrics::source_metrics(&db, &filled.segments, 1.0 / d.clip.frame_time);
+    let DanceFigures {
+        metrics: m,
+        sources,
+        intensity_spearman,
+    } = figures(&d, &db, &filled, bars, &analysis.beats_s);
     let motion_rank_db = relevance::motion_intensity(&db);
     let motion_rank: Vec<f64> = filled.segments.iter().map(|&s| motion_rank_db[s]).collect();
-    let intensity_spearman = metrics::spearman(&music_rank, &motion_rank);
 
     // motion.bvh at the song's timing: the first frame held from t = 0 to the first bar.
     let (bvh, lead) = song_timed_bvh(&d);

@@ -198,7 +198,12 @@ async function startDance() {
   await playSpan(dance.start_s, end, false);
   playing = true;
   $('play').textContent = '❚❚ Pause';
-  status(`playing ${bars.length} bars`);
+  const f = dance.figures, m = f.metrics, pen = m.foot_penetration;
+  status(`playing ${bars.length} bars · feet under −1 cm in ${(100 * pen.frames_below_fraction).toFixed(1)} % of frames` +
+    ` (deepest ${(100 * pen.deepest_m).toFixed(1)} cm) · skating ${m.foot_skating_m_s.toFixed(2)} m/s` +
+    ` (its segments ${f.sources.foot_skating_m_s.toFixed(2)}) · beat alignment ${m.beat_alignment_score.toFixed(2)}` +
+    ` (its segments ${f.sources.beat_alignment_score.toFixed(2)}) · intensity ρ ${f.intensity_spearman.toFixed(2)}` +
+    ` · seam jerk ${Math.round(m.seam_jerk.mean_rad_s3)} rad/s³ (inside ${Math.round(m.inside_jerk.mean_rad_s3)})`);
 }
 
 function stopDance() {
