@@ -434,6 +434,12 @@ pub struct DanceFigures {
     pub sources: metrics::SourceMetrics,
     /// Spearman's ρ of music and motion intensity over the bars.
     pub intensity_spearman: f64,
+    /// Every bar's music intensity as a percentile rank among the bars.
+    #[serde(skip)]
+    pub music_rank: Vec<f64>,
+    /// Every bar's segment's motion intensity as a percentile rank in the database.
+    #[serde(skip)]
+    pub motion_rank: Vec<f64>,
 }
 
 /// The [`DanceFigures`] of dance `d` filled as `filled` to `bars` (song beats `beats_s`).
@@ -451,6 +457,8 @@ pub fn figures(
         metrics: metrics::dance_metrics(d, beats_s, filled),
         sources: metrics::source_metrics(db, &filled.segments, 1.0 / d.clip.frame_time),
         intensity_spearman: metrics::spearman(&music_rank, &motion_rank),
+        music_rank,
+        motion_rank,
     }
 }
 
@@ -474,16 +482,15 @@ pub fn run_dance(
     } = load_dance(scene, base)?;
     let bars = &bars[..];
     let bars_n = bars.len();
-    let music_rank = relevance::music_intensity(bars);
-    let filled = fill::fill(&db, &music_rank, &pins, &scene.fill)?;
+    let filled = fill::fill(&db, &relevance::music_intensity(bars), &pins, &scene.fill)?;
     let (d, planting) = perform(scene, &db, &filled.segments, bars, &analysis.beats_s)?;
     let DanceFigures {
         metrics: m,
         sources,
         intensity_spearman,
+        music_rank,
+        motion_rank,
     } = figures(&d, &db, &filled, bars, &analysis.beats_s);
-    let motion_rank_db = relevance::motion_intensity(&db);
-    let motion_rank: Vec<f64> = filled.segments.iter().map(|&s| motion_rank_db[s]).collect();
 
     // motion.bvh at the song's timing: the first frame held from t = 0 to the first bar.
     let (bvh, lead) = song_timed_bvh(&d);
