@@ -282,7 +282,7 @@ fn the_salsa_scene_runs_on_the_shared_data() {
     assert_eq!(r["per_bar"][0]["clip"], "acrnn_salsa_01");
     assert_eq!(r["per_bar"][0]["clip_bar"], 2);
     assert_eq!(r["per_bar"][8]["clip"], "acrnn_salsa_03");
-    assert_eq!(r["per_bar"][8]["clip_bar"], 4);
+    assert_eq!(r["per_bar"][8]["clip_bar"], 2);
     check_report(&r, &out, &[(0, seg(0)), (8, seg(8))]);
     std::fs::remove_dir_all(&d).unwrap();
 }

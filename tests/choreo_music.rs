@@ -4,7 +4,7 @@
 
 mod common;
 
-use marionette::choreo::music::beats::f_measure;
+use marionette::choreo::music::eval::f_measure;
 use marionette::choreo::music::synth::{SynthSong, synthesize};
 use marionette::choreo::music::wav::wav_bytes;
 use marionette::choreo::music::{MusicError, MusicParams, analyze};

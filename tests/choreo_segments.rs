@@ -11,7 +11,7 @@ use marionette::choreo::database::{
     BuildParams, ClipOutcome, Database, Manifest, ManifestClip, OnRefusal,
 };
 use marionette::choreo::segments::{
-    Beat, MAX_BPM, MIN_BPM, SegmentError, TempoSource, cut_segments, kinematic_beat,
+    Beat, LEVEL_BPM, MAX_BPM, MIN_BPM, SegmentError, TempoSource, cut_segments, kinematic_beat,
 };
 use marionette::humanoid::{ModelClip, humanoid24};
 
@@ -535,9 +535,15 @@ fn every_shared_clip_gets_a_tempo_in_range_alone_and_for_the_song() {
                 alone.tempo_bpm,
                 matched.tempo_bpm
             );
-            for b in [alone, matched] {
-                assert!((MIN_BPM..=MAX_BPM).contains(&b.tempo_bpm), "{name}: {b:?}");
-            }
+            // Alone, the beat search's range; for the song, its octave levels' range.
+            assert!(
+                (MIN_BPM..=MAX_BPM).contains(&alone.tempo_bpm),
+                "{name}: {alone:?}"
+            );
+            assert!(
+                (LEVEL_BPM.0..=LEVEL_BPM.1).contains(&matched.tempo_bpm),
+                "{name}: {matched:?}"
+            );
             // The song can only move the tempo by whole octaves.
             let octaves = (matched.tempo_bpm / alone.tempo_bpm).log2();
             assert!(

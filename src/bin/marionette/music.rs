@@ -25,8 +25,11 @@ pub struct Args {
     #[arg(long)]
     downbeat: Option<usize>,
     /// Centre of the tempo prior (BPM).
-    #[arg(long, default_value_t = 120.0)]
-    prior_bpm: f64,
+    #[arg(long)]
+    prior_bpm: Option<f64>,
+    /// Width of the tempo prior (octaves, one standard deviation).
+    #[arg(long)]
+    prior_octaves: Option<f64>,
     /// Beats per bar.
     #[arg(long, default_value_t = 4)]
     beats_per_bar: usize,
@@ -43,6 +46,7 @@ struct Report<'a> {
     downbeat: usize,
     downbeat_given: bool,
     beats_s: &'a [f64],
+    downbeats_s: Vec<f64>,
     bars: &'a [Bar],
 }
 
@@ -54,7 +58,12 @@ pub fn music(args: Args) -> Result<()> {
         beats_per_bar: args.beats_per_bar,
         ..MusicParams::default()
     };
-    params.prior.centre_bpm = args.prior_bpm;
+    if let Some(c) = args.prior_bpm {
+        params.prior.centre_bpm = c;
+    }
+    if let Some(o) = args.prior_octaves {
+        params.prior.octaves = o;
+    }
     let a = analyze(&audio.samples, audio.sample_rate, &params)
         .with_context(|| args.song.display().to_string())?;
     if let Some(out) = &args.out {
@@ -75,6 +84,7 @@ pub fn music(args: Args) -> Result<()> {
             downbeat: a.downbeat,
             downbeat_given: a.downbeat_given,
             beats_s: &a.beats_s,
+            downbeats_s: a.downbeats.iter().map(|&i| a.beats_s[i]).collect(),
             bars: &a.bars,
         };
         println!("{}", serde_json::to_string(&r)?);
@@ -86,8 +96,8 @@ pub fn music(args: Args) -> Result<()> {
         a.duration_s, audio.sample_rate, audio.channels
     );
     println!(
-        "tempo       {:.2} BPM (autocorrelation {:.2} BPM, prior centred on {} BPM)",
-        a.tempo_bpm, a.tempo_prior_bpm, args.prior_bpm
+        "tempo       {:.2} BPM (metrical comb {:.2} BPM, prior centred on {} BPM, {} octaves wide)",
+        a.tempo_bpm, a.tempo_prior_bpm, params.prior.centre_bpm, params.prior.octaves
     );
     println!(
         "beats       {} from {:.3} s to {:.3} s",
@@ -96,9 +106,8 @@ pub fn music(args: Args) -> Result<()> {
         a.beats_s.last().copied().unwrap_or(0.0)
     );
     println!(
-        "bars        {} of {} beats, first downbeat = beat {} ({})",
-        a.bars.len(),
-        a.beats_per_bar,
+        "bars        {}, first downbeat = beat {} ({})",
+        a.bars_label(),
         a.downbeat + 1,
         if a.downbeat_given {
             "given"
@@ -106,13 +115,14 @@ pub fn music(args: Args) -> Result<()> {
             "from the signal"
         }
     );
-    println!("bar   start (s)   end (s)   RMS       RMS (dB)");
-    for (k, b) in a.bars.iter().enumerate() {
+    println!("bar   start (s)   end (s)   beats   RMS       RMS (dB)");
+    for ((k, b), beats) in a.bars.iter().enumerate().zip(a.bar_beats()) {
         println!(
-            "{:>3}   {:>9.3} {:>9.3}   {:.5}   {:>7.2}",
+            "{:>3}   {:>9.3} {:>9.3}   {:>5}   {:.5}   {:>7.2}",
             k + 1,
             b.start_s,
             b.end_s,
+            beats,
             b.rms,
             b.rms_db
         );

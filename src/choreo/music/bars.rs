@@ -1,11 +1,18 @@
-//! Bars: groups of `beats_per_bar` beats starting on a downbeat.
+//! Bars: groups of beats starting on a downbeat, `beats_per_bar` of them unless the music
+//! inserts a shorter bar.
 //!
-//! The downbeat phase φ (which of the first `beats_per_bar` beats starts a bar) is chosen from
-//! the signal: bars start where the bass and kick drum come in, so φ maximises the mean
-//! low-band onset strength at the beats i ≡ φ (mod beats_per_bar), each band's strength
-//! normalised by its mean over all beats, plus half the same for the full-band envelope. Or
-//! it is given. Bar k spans beats φ + k·B to φ + (k+1)·B; the last bar, whose closing downbeat
-//! was not tracked, ends one bar's fitted length after its start if the song lasts that long.
+//! Each beat i gets a downbeat evidence e_i: the rank among the beats of its onset strength in
+//! the low band (bass and kick drum come in on the downbeat) plus half that of its full-band
+//! onset strength; z_i is e_i standardised over the song. The downbeats are the bar positions (0 .. B − 1, B = beats per
+//! bar) that maximise Σ_{i: position 0} z_i by dynamic programming (Viterbi) over the beats:
+//! the position advances by one each beat and wraps from B − 1 to 0, and a bar may end early
+//! (a bar of fewer beats, as when a song inserts a 2/4 bar) at a cost of `rephase_sd` (in
+//! units of z: the downbeat evidence of the bars after it must make up for it). The first beat
+//! may sit anywhere in its bar (a pickup). With a given downbeat, or an infinite cost, every
+//! bar has B beats.
+//!
+//! A bar spans from its downbeat to the next; the last bar, whose closing downbeat was not
+//! tracked, ends one bar's fitted length after its start if the song lasts that long.
 
 use serde::{Deserialize, Serialize};
 
@@ -33,50 +40,133 @@ fn at(x: &[f64], f: f64) -> f64 {
     x[lo.min(hi)..hi].iter().fold(0.0, |m, &v| m.max(v))
 }
 
-/// The downbeat phase (0 .. beats_per_bar) of `beat_frames` on `env` (see the module docs).
-pub fn downbeat_phase(env: &OnsetEnvelope, beat_frames: &[f64], beats_per_bar: usize) -> usize {
-    let score = |x: &[f64]| -> Vec<f64> {
+/// The standardised downbeat evidence z_i of each beat (module docs): each feature enters as
+/// its rank among the beats (0 to 1), so that one outlier, as the first onset of a song, does
+/// not outweigh the rest.
+pub fn downbeat_evidence(env: &OnsetEnvelope, beat_frames: &[f64]) -> Vec<f64> {
+    let n = beat_frames.len();
+    let mut e = vec![0.0; n];
+    for (x, weight) in [(&env.low, 1.0), (&env.values, 0.5)] {
         let s: Vec<f64> = beat_frames.iter().map(|&f| at(x, f)).collect();
-        let mean = s.iter().sum::<f64>() / s.len().max(1) as f64;
-        (0..beats_per_bar)
-            .map(|phi| {
-                let v: Vec<f64> = s.iter().skip(phi).step_by(beats_per_bar).copied().collect();
-                let m = v.iter().sum::<f64>() / v.len().max(1) as f64;
-                if mean > 0.0 { m / mean } else { 0.0 }
-            })
-            .collect()
-    };
-    let low = score(&env.low);
-    let full = score(&env.values);
+        let mut order: Vec<usize> = (0..n).collect();
+        order.sort_by(|&a, &b| s[a].total_cmp(&s[b]).then(a.cmp(&b)));
+        for (rank, &i) in order.iter().enumerate() {
+            e[i] += weight * (rank as f64 + 0.5) / n as f64;
+        }
+    }
+    let mean = e.iter().sum::<f64>() / n.max(1) as f64;
+    let sd = (e.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n.max(1) as f64).sqrt();
+    e.iter()
+        .map(|v| if sd > 0.0 { (v - mean) / sd } else { 0.0 })
+        .collect()
+}
+
+/// The indices of the beats that start bars, from the evidence `z` of each beat (see
+/// [`downbeat_evidence`]), `beats_per_bar` and the cost of a short bar (module docs).
+pub fn track_downbeats(z: &[f64], beats_per_bar: usize, rephase_sd: f64) -> Vec<usize> {
+    let (n, b) = (z.len(), beats_per_bar.max(1));
+    if n == 0 {
+        return vec![];
+    }
+    let gain = |i: usize, k: usize| if k == 0 { z[i] } else { 0.0 };
+    let mut score: Vec<f64> = (0..b).map(|k| gain(0, k)).collect();
+    // back[i * b + k]: the position of beat i − 1 on the best path to position k at beat i.
+    let mut back = vec![0usize; n * b];
+    for i in 1..n {
+        let mut next = vec![f64::NEG_INFINITY; b];
+        for k in 0..b {
+            let (from, s) = if k == 0 {
+                // From the bar's last position, or a short bar ending early.
+                (0..b)
+                    .map(|j| {
+                        let cost = if j == b - 1 { 0.0 } else { rephase_sd };
+                        (j, score[j] - cost)
+                    })
+                    .fold(
+                        (b - 1, f64::NEG_INFINITY),
+                        |m, c| if c.1 > m.1 { c } else { m },
+                    )
+            } else {
+                (k - 1, score[k - 1])
+            };
+            next[k] = s + gain(i, k);
+            back[i * b + k] = from;
+        }
+        score = next;
+    }
+    let mut k = (0..b)
+        .max_by(|&x, &y| score[x].total_cmp(&score[y]))
+        .unwrap_or(0);
+    let mut positions = vec![0; n];
+    for i in (0..n).rev() {
+        positions[i] = k;
+        k = back[i * b + k];
+    }
+    (0..n).filter(|&i| positions[i] == 0).collect()
+}
+
+/// Every `beats_per_bar`-th beat of `n` from index `first`.
+pub fn regular_downbeats(first: usize, beats_per_bar: usize, n: usize) -> Vec<usize> {
+    (first..n).step_by(beats_per_bar.max(1)).collect()
+}
+
+/// The downbeat phase (0 .. beats_per_bar) of `beat_frames` on `env`: the phase whose beats
+/// carry the most downbeat evidence on average (every bar of the same length).
+pub fn downbeat_phase(env: &OnsetEnvelope, beat_frames: &[f64], beats_per_bar: usize) -> usize {
+    let z = downbeat_evidence(env, beat_frames);
     (0..beats_per_bar)
-        .max_by(|&a, &b| (low[a] + 0.5 * full[a]).total_cmp(&(low[b] + 0.5 * full[b])))
+        .max_by(|&a, &b| {
+            let m = |phi: usize| {
+                let v: Vec<f64> = z.iter().skip(phi).step_by(beats_per_bar).copied().collect();
+                v.iter().sum::<f64>() / v.len().max(1) as f64
+            };
+            m(a).total_cmp(&m(b))
+        })
         .unwrap_or(0)
 }
 
-/// Bar spans (start, end) in seconds from beat times, the index of the first downbeat, beats
-/// per bar and the song's duration (see the module docs).
+/// Bar spans (start, end) in seconds from beat times, the indices of the beats that start bars
+/// (increasing), beats per bar and the song's duration (see the module docs).
+pub fn bars_from_downbeats(
+    beats_s: &[f64],
+    downbeats: &[usize],
+    beats_per_bar: usize,
+    duration_s: f64,
+) -> Vec<(f64, f64)> {
+    let period = fitted_period(beats_s);
+    let mut out = Vec::new();
+    for (j, &i) in downbeats.iter().enumerate() {
+        let Some(&start) = beats_s.get(i) else { break };
+        let end = match downbeats.get(j + 1) {
+            Some(&next) => beats_s[next],
+            None => match beats_s.get(i + beats_per_bar) {
+                Some(&e) => e,
+                None => start + beats_per_bar as f64 * period,
+            },
+        };
+        if end > duration_s + 1e-9 || !end.is_finite() {
+            break;
+        }
+        out.push((start, end));
+    }
+    out
+}
+
+/// Bar spans of `beats_per_bar` beats each from the downbeat at index `downbeat` (see
+/// [`bars_from_downbeats`]).
 pub fn bars_from_beats(
     beats_s: &[f64],
     downbeat: usize,
     beats_per_bar: usize,
     duration_s: f64,
 ) -> Vec<(f64, f64)> {
-    let period = fitted_period(beats_s);
-    let mut out = Vec::new();
-    let mut i = downbeat;
-    while i + beats_per_bar - 1 < beats_s.len() {
-        let start = beats_s[i];
-        let end = match beats_s.get(i + beats_per_bar) {
-            Some(&e) => e,
-            None => start + beats_per_bar as f64 * period,
-        };
-        if end > duration_s + 1e-9 || !end.is_finite() {
-            break;
-        }
-        out.push((start, end));
-        i += beats_per_bar;
-    }
-    out
+    let d = regular_downbeats(downbeat, beats_per_bar, beats_s.len());
+    // The last bar needs all its beats but its closing downbeat.
+    let whole: Vec<usize> = d
+        .into_iter()
+        .filter(|&i| i + beats_per_bar - 1 < beats_s.len())
+        .collect();
+    bars_from_downbeats(beats_s, &whole, beats_per_bar, duration_s)
 }
 
 #[cfg(test)]
@@ -112,5 +202,31 @@ mod tests {
             low,
         };
         assert_eq!(downbeat_phase(&env, &frames, 4), 3);
+    }
+
+    #[test]
+    fn an_inserted_short_bar_is_followed_and_costs_what_it_says() {
+        // Downbeats every 4 beats from beat 1, then a 2-beat bar at beat 21: from 23 on.
+        let mut truth: Vec<usize> = (1..=21).step_by(4).collect();
+        truth.extend((23..60).step_by(4));
+        let z: Vec<f64> = (0..60)
+            .map(|i| if truth.contains(&i) { 1.0 } else { -0.3 })
+            .collect();
+        assert_eq!(track_downbeats(&z, 4, 4.0), truth);
+        // At an infinite cost every bar keeps its 4 beats: the longer stretch wins.
+        let regular = track_downbeats(&z, 4, f64::INFINITY);
+        assert!(regular.windows(2).all(|w| w[1] - w[0] == 4), "{regular:?}");
+        assert_eq!(regular[0] % 4, 3, "{regular:?}");
+        // A short bar after a single bar of evidence does not pay its cost.
+        let mut z = vec![-0.3; 40];
+        for i in (0..40).step_by(4) {
+            z[i] = 1.0;
+        }
+        z[20] = -0.3;
+        z[22] = 1.0;
+        let d = track_downbeats(&z, 4, 4.0);
+        assert!(d.windows(2).all(|w| w[1] - w[0] == 4), "{d:?}");
+        let bars = bars_from_downbeats(&[0.0, 0.5, 1.0, 1.5, 2.0, 2.5, 3.0], &[0, 4, 6], 4, 10.0);
+        assert_eq!(bars, vec![(0.0, 2.0), (2.0, 3.0), (3.0, 5.0)]);
     }
 }

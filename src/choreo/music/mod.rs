@@ -6,7 +6,9 @@
 //! - [`onsets`]: the onset-strength envelope (spectral flux on a log-magnitude spectrogram);
 //! - [`tempo`]: the tempo (autocorrelation of the envelope weighted by a log-normal tempo prior);
 //! - [`beats`]: beat placement by dynamic programming on the envelope (Ellis 2007);
-//! - [`bars`]: bars of 4 beats with the downbeat phase chosen from the signal or given;
+//! - [`bars`]: bars of 4 beats from downbeats tracked on the bass and the onsets (a shorter bar
+//!   where the song inserts one), or from a given first downbeat;
+//! - [`eval`]: the standard beat, continuity, tempo and downbeat scores against annotations;
 //! - [`intensity`]: each bar's RMS and its level in dB;
 //! - [`synth`]: a drum track with exact ground truth (tempo, beats, bar loudness) for tests and
 //!   the project's own demo song;
@@ -20,6 +22,7 @@ pub mod bars;
 pub mod beats;
 #[cfg(feature = "audio")]
 pub mod decode;
+pub mod eval;
 pub mod intensity;
 pub mod onsets;
 #[cfg(feature = "render")]
@@ -32,7 +35,7 @@ use std::path::PathBuf;
 
 use serde::{Deserialize, Serialize};
 
-pub use bars::{Bar, bars_from_beats, downbeat_phase};
+pub use bars::{Bar, bars_from_beats, bars_from_downbeats, downbeat_evidence, track_downbeats};
 pub use beats::{BeatParams, track_beats};
 pub use intensity::{bar_intensity, rms_db};
 pub use onsets::{OnsetEnvelope, OnsetParams, onset_envelope};
@@ -93,6 +96,16 @@ pub enum MusicError {
         /// Beats needed.
         needed: usize,
     },
+    /// An annotation file is malformed.
+    #[error("{path}: line {line}: {message}")]
+    Annotation {
+        /// The annotation file.
+        path: PathBuf,
+        /// 1-based line.
+        line: usize,
+        /// What was expected.
+        message: String,
+    },
     /// A parameter is out of its range.
     #[error("music parameter {name} = {value}: expected {expected}")]
     Parameter {
@@ -117,9 +130,12 @@ pub struct MusicParams {
     pub beats: BeatParams,
     /// Beats per bar (4 for 4/4).
     pub beats_per_bar: usize,
-    /// Index of the first downbeat among the beats (0 .. beats_per_bar); chosen from the signal
-    /// when `None`.
+    /// Index of the first downbeat among the beats (0 .. beats_per_bar); every bar then has
+    /// `beats_per_bar` beats. Tracked from the signal when `None`.
     pub downbeat: Option<usize>,
+    /// The cost of a bar shorter than `beats_per_bar` in the downbeat tracking, in standard
+    /// deviations of the downbeat evidence ([`bars`]); `inf` for bars all of the same length.
+    pub rephase_sd: f64,
 }
 
 impl Default for MusicParams {
@@ -130,6 +146,7 @@ impl Default for MusicParams {
             beats: BeatParams::default(),
             beats_per_bar: 4,
             downbeat: None,
+            rephase_sd: 8.0,
         }
     }
 }
@@ -143,7 +160,7 @@ pub struct MusicAnalysis {
     pub duration_s: f64,
     /// Tempo (beats per minute): 60 over the least-squares beat period of the tracked beats.
     pub tempo_bpm: f64,
-    /// The tempo the autocorrelation found before tracking (BPM).
+    /// The tempo the metrical comb found before tracking (BPM).
     pub tempo_prior_bpm: f64,
     /// Every beat time (s), increasing.
     pub beats_s: Vec<f64>,
@@ -151,6 +168,8 @@ pub struct MusicAnalysis {
     pub beats_per_bar: usize,
     /// Index in `beats_s` of the first downbeat.
     pub downbeat: usize,
+    /// Indices in `beats_s` of every downbeat (the beats that start bars), increasing.
+    pub downbeats: Vec<usize>,
     /// Whether `downbeat` was given (true) or chosen from the signal (false).
     pub downbeat_given: bool,
     /// The bars of `beats_per_bar` beats with their RMS.
@@ -160,6 +179,39 @@ pub struct MusicAnalysis {
 }
 
 impl MusicAnalysis {
+    /// The number of beats in each bar (its downbeat to the next; the last bar counts its
+    /// beats up to its end).
+    pub fn bar_beats(&self) -> Vec<usize> {
+        self.bars
+            .iter()
+            .map(|b| {
+                let eps = 1e-9;
+                self.beats_s
+                    .iter()
+                    .filter(|&&t| t >= b.start_s - eps && t < b.end_s - eps)
+                    .count()
+                    .max(1)
+            })
+            .collect()
+    }
+
+    /// "N bars of B beats", or "N bars (K of B beats, M shorter)" when the song inserts shorter
+    /// bars.
+    pub fn bars_label(&self) -> String {
+        let counts = self.bar_beats();
+        let full = counts.iter().filter(|&&c| c >= self.beats_per_bar).count();
+        let n = self.bars.len();
+        if full == n {
+            format!("{n} bars of {} beats", self.beats_per_bar)
+        } else {
+            format!(
+                "{n} bars ({full} of {} beats, {} shorter)",
+                self.beats_per_bar,
+                n - full
+            )
+        }
+    }
+
     /// Checks that the song has at least `n` bars (a dance needs one per segment). Error:
     /// [`MusicError::TooShort`] with the song's duration and the length of `n` bars.
     pub fn require_bars(&self, n: usize) -> Result<(), MusicError> {
@@ -239,8 +291,22 @@ pub fn analyze(
     if env.values.iter().all(|&v| v <= 0.0) {
         return Err(MusicError::Silent { peak_db });
     }
+    if params.rephase_sd.is_nan() || params.rephase_sd < 0.0 {
+        return Err(MusicError::Parameter {
+            name: "rephase_sd",
+            value: params.rephase_sd,
+            expected: "a non-negative number or inf",
+        });
+    }
     let tempo = estimate_tempo(&env, &params.prior)?;
-    let beat_frames = track_beats(&env, tempo.period_frames, &params.beats)?;
+    let mut beat_frames = track_beats(&env, tempo.period_frames, &params.beats)?;
+    // A level whose midpoints are as strong as its beats groups two beats (a backbeat).
+    let fastest = 60.0 * env.frame_rate() / params.prior.max_bpm;
+    if tempo.period_frames / 2.0 >= fastest
+        && beats::midpoint_ratio(&env, &beat_frames) >= params.beats.midpoint_ratio
+    {
+        beat_frames = track_beats(&env, tempo.period_frames / 2.0, &params.beats)?;
+    }
     let beats_s: Vec<f64> = beat_frames.iter().map(|&f| env.time_of(f)).collect();
     if beats_s.len() < 2 {
         return Err(MusicError::TooFewBeats {
@@ -249,11 +315,15 @@ pub fn analyze(
         });
     }
     let tempo_bpm = 60.0 / beats::fitted_period(&beats_s);
-    let (downbeat, downbeat_given) = match params.downbeat {
-        Some(d) => (d, true),
-        None => (downbeat_phase(&env, &beat_frames, bpb), false),
+    let (downbeats, downbeat_given) = match params.downbeat {
+        Some(d) => (bars::regular_downbeats(d, bpb, beats_s.len()), true),
+        None => {
+            let z = downbeat_evidence(&env, &beat_frames);
+            (track_downbeats(&z, bpb, params.rephase_sd), false)
+        }
     };
-    let spans = bars_from_beats(&beats_s, downbeat, bpb, duration_s);
+    let downbeat = downbeats.first().copied().unwrap_or(0);
+    let spans = bars_from_downbeats(&beats_s, &downbeats, bpb, duration_s);
     let bars = bar_intensity(samples, sample_rate, &spans);
     Ok(MusicAnalysis {
         sample_rate,
@@ -263,6 +333,7 @@ pub fn analyze(
         beats_s,
         beats_per_bar: bpb,
         downbeat,
+        downbeats,
         downbeat_given,
         bars,
         onsets: env,

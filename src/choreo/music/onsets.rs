@@ -14,6 +14,7 @@
 
 use std::sync::Arc;
 
+use rayon::prelude::*;
 use realfft::{RealFftPlanner, RealToComplex};
 use serde::{Deserialize, Serialize};
 
@@ -180,28 +181,34 @@ pub fn onset_envelope(
         .max(1);
     let mut planner = RealFftPlanner::<f32>::new();
     let fft: Arc<dyn RealToComplex<f32>> = planner.plan_fft_forward(n_fft);
-    let mut input = fft.make_input_vec();
-    let mut spectrum = fft.make_output_vec();
-    let mut scratch = fft.make_scratch_vec();
-    // Band power per frame, frame-major.
+    // Band power per frame, frame-major. Frames are independent: chunks of them run on the
+    // rayon pool, each with its own buffers, so the result does not depend on the threads.
     let mut power = vec![0f32; frames * bands];
     let half = n_fft / 2;
-    for t in 0..frames {
-        let centre = t * hop;
-        for (i, (x, w)) in input.iter_mut().zip(&window).enumerate() {
-            let s = (centre + i).checked_sub(half).and_then(|k| samples.get(k));
-            *x = s.map_or(0.0, |s| s * w);
-        }
-        // The lengths come from the same plan, so processing cannot fail.
-        let _ = fft.process_with_scratch(&mut input, &mut spectrum, &mut scratch);
-        let row = &mut power[t * bands..(t + 1) * bands];
-        for (b, p) in row.iter_mut().enumerate() {
-            *p = spectrum[edges[b]..edges[b + 1]]
-                .iter()
-                .map(|c| c.norm_sqr())
-                .sum();
-        }
-    }
+    const CHUNK: usize = 256;
+    power
+        .par_chunks_mut(CHUNK * bands)
+        .enumerate()
+        .for_each(|(c, rows)| {
+            let mut input = fft.make_input_vec();
+            let mut spectrum = fft.make_output_vec();
+            let mut scratch = fft.make_scratch_vec();
+            for (j, row) in rows.chunks_mut(bands).enumerate() {
+                let centre = (c * CHUNK + j) * hop;
+                for (i, (x, w)) in input.iter_mut().zip(&window).enumerate() {
+                    let s = (centre + i).checked_sub(half).and_then(|k| samples.get(k));
+                    *x = s.map_or(0.0, |s| s * w);
+                }
+                // The lengths come from the same plan, so processing cannot fail.
+                let _ = fft.process_with_scratch(&mut input, &mut spectrum, &mut scratch);
+                for (b, p) in row.iter_mut().enumerate() {
+                    *p = spectrum[edges[b]..edges[b + 1]]
+                        .iter()
+                        .map(|c| c.norm_sqr())
+                        .sum();
+                }
+            }
+        });
     let max = power.iter().fold(0f32, |m, &p| m.max(p)) as f64;
     let gamma = 10f64.powf(params.compression_db / 10.0) / max.max(f64::MIN_POSITIVE);
     let level: Vec<f64> = power.iter().map(|&p| (gamma * p as f64).ln_1p()).collect();

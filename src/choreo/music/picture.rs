@@ -69,11 +69,10 @@ pub fn music_png(
         let root = root
             .titled(
                 &format!(
-                    "{title}: {:.2} BPM, {} beats, {} bars of {}, {:.1} s",
+                    "{title}: {:.2} BPM, {} beats, {}, {:.1} s",
                     analysis.tempo_bpm,
                     analysis.beats_s.len(),
-                    analysis.bars.len(),
-                    analysis.beats_per_bar,
+                    analysis.bars_label(),
                     analysis.duration_s
                 ),
                 ("sans-serif", 24),

@@ -1,14 +1,25 @@
-//! Tempo estimation: the autocorrelation of the onset envelope weighted by a log-normal tempo
-//! prior, with a metrical-level check.
+//! Tempo estimation: a metrical comb over the autocorrelation of the onset envelopes, weighted
+//! by a log-normal tempo prior.
 //!
 //! With x the mean-removed envelope, the unbiased autocorrelation is
-//! r(l) = (1/(N − l)) Σ_t x_t x_{t+l} / r(0), for lags l between 60/max_bpm and 60/min_bpm
-//! seconds. The prior is w(l) = exp(−½ (log₂(bpm(l)/centre_bpm) / octaves)²) (as in the standard
-//! trackers); the period is the local maximum of w·r, refined to a fraction of a frame by a
-//! parabola through r. A periodic envelope correlates as well at twice its period as at its
-//! period, so the prior alone may pick the slower level: when r at half the period is at least
-//! `octave_ratio` of r at the period (a beat half as long is as well supported) and that tempo is
-//! within range, the faster level is taken.
+//! r(l) = (1/(N − l)) Σ_t x_t x_{t+l} / r(0). A beat period l is scored by the periodicity of the
+//! whole metrical grid it implies: the mean of r at its multiples k l within a span of T seconds
+//! (`comb_span_s`, 3 s, about the span over which a listener takes in a beat), taken on the
+//! full-band and the low-band envelope:
+//! S(l) = w(l) · (1/2K) Σ_{k=1..K} [r̂_full(k l) + r̂_low(k l)], K = max(1, ⌊T / l⌋),
+//! where r̂(k l) is the largest r within ±⌈k/2⌉ frames of k l (the multiple's rounding). Every
+//! candidate is scored over the same span, so that no level is credited with periodicity at
+//! longer lags than another. The prior is w(l) = exp(−½ (log₂(bpm(l)/centre_bpm) / octaves)²).
+//!
+//! The comb is what settles the metrical level. A period twice too short (eighth notes taken
+//! for beats) has its odd multiples between the true beats, where a song with any accent on its
+//! beats correlates less; a period twice too long keeps only every other beat's support but
+//! loses nothing, so the comb leans slow, and the prior balances it. The prior is centred on
+//! 100 BPM, the spontaneous tapping tempo of about 600 ms (Fraisse 1982), and is wide (1.5
+//! octaves), so that it tips only what the comb leaves even. Chosen on the 24 development songs
+//! of the POP909 evaluation (`benches/music_real_songs.rs`): the tempo levels there are those of
+//! the written quarter notes, which the ear often taps at twice the rate in a slow ballad. The period is the best S over the range, refined to a fraction of a frame by a
+//! parabola through the full-band r.
 
 use serde::{Deserialize, Serialize};
 
@@ -26,18 +37,18 @@ pub struct TempoPrior {
     pub min_bpm: f64,
     /// Fastest tempo considered (BPM).
     pub max_bpm: f64,
-    /// Take the faster metrical level when r(period/2) ≥ this × r(period).
-    pub octave_ratio: f64,
+    /// The span of lags the comb averages over (s).
+    pub comb_span_s: f64,
 }
 
 impl Default for TempoPrior {
     fn default() -> Self {
         TempoPrior {
-            centre_bpm: 120.0,
-            octaves: 1.0,
+            centre_bpm: 100.0,
+            octaves: 1.5,
             min_bpm: 40.0,
             max_bpm: 240.0,
-            octave_ratio: 0.8,
+            comb_span_s: 3.0,
         }
     }
 }
@@ -85,9 +96,20 @@ fn parabolic(r: &[f64], l: usize) -> (f64, f64) {
     (l as f64 + off, b - 0.25 * (a - c) * off)
 }
 
-/// Estimates the tempo of an onset envelope (see the module docs). Errors: a prior out of
-/// range, an envelope too short for two beats at the slowest tempo considered, an envelope
-/// without any positive autocorrelation peak in the range.
+/// The largest r within ±`tol` frames of lag `x` (0 when out of range).
+fn near(r: &[f64], x: f64, tol: usize) -> f64 {
+    let c = x.round() as usize;
+    let hi = (c + tol + 1).min(r.len());
+    let lo = c.saturating_sub(tol).max(1);
+    if lo >= hi {
+        return 0.0;
+    }
+    r[lo..hi].iter().fold(f64::NEG_INFINITY, |m, &v| m.max(v))
+}
+
+/// Estimates the tempo of an onset envelope (see the module docs). Errors: a prior or comb span
+/// out of range, an envelope too short for two beats at the slowest tempo considered, an
+/// envelope without any positive periodicity in the range.
 pub fn estimate_tempo(
     env: &OnsetEnvelope,
     prior: &TempoPrior,
@@ -110,8 +132,8 @@ pub fn estimate_tempo(
     if !(prior.octaves > 0.0 && prior.octaves.is_finite()) {
         return Err(bad("octaves", prior.octaves, "a positive width"));
     }
-    if !(0.0..=1.0).contains(&prior.octave_ratio) {
-        return Err(bad("octave_ratio", prior.octave_ratio, "0 to 1"));
+    if !(prior.comb_span_s > 0.0 && prior.comb_span_s <= 30.0) {
+        return Err(bad("comb_span_s", prior.comb_span_s, "0 to 30 s"));
     }
     let fps = env.frame_rate();
     let n = env.values.len();
@@ -125,18 +147,33 @@ pub fn estimate_tempo(
             what: "two beats at the slowest tempo considered",
         });
     }
-    let r = autocorrelation(&env.values, max_lag + 1);
+    // Multiples past half the envelope are left out of the comb (too few products to trust).
+    let span = (prior.comb_span_s * fps).round() as usize;
+    let reach = (span.max(max_lag) + span / min_lag + 2)
+        .min(n / 2)
+        .max(max_lag + 1);
+    let full = autocorrelation(&env.values, reach);
+    let low = autocorrelation(&env.low, reach);
     let weight = |l: f64| {
         let z = (60.0 * fps / l / prior.centre_bpm).log2() / prior.octaves;
         (-0.5 * z * z).exp()
     };
     let mut best: Option<(usize, f64)> = None;
-    for l in min_lag.max(1)..=max_lag.min(r.len() - 2) {
-        if r[l] >= r[l - 1] && r[l] >= r[l + 1] && r[l] > 0.0 {
-            let s = r[l] * weight(l as f64);
-            if best.is_none_or(|(_, b)| s > b) {
-                best = Some((l, s));
+    for l in min_lag..=max_lag.min(full.len() - 2) {
+        let mut sum = 0.0;
+        let mut count = 0usize;
+        for k in 1..=(span / l).max(1) {
+            let x = (k * l) as f64;
+            if x + 1.0 >= full.len() as f64 {
+                break;
             }
+            let tol = k.div_ceil(2);
+            sum += near(&full, x, tol) + near(&low, x, tol);
+            count += 2;
+        }
+        let s = weight(l as f64) * sum / count.max(1) as f64;
+        if full[l] > 0.0 && best.is_none_or(|(_, b)| s > b) {
+            best = Some((l, s));
         }
     }
     let Some((l, _)) = best else {
@@ -145,26 +182,11 @@ pub fn estimate_tempo(
             needed: 2,
         });
     };
-    let (mut lag, mut strength) = parabolic(&r, l);
-    // The metrical-level check: halve the period while the half is as well supported.
-    loop {
-        let h = lag / 2.0;
-        if h < min_lag as f64 {
-            break;
-        }
-        let c = h.round() as usize;
-        let k = (c.saturating_sub(1)..=c + 1)
-            .filter(|&k| k >= 1 && k + 1 < r.len())
-            .max_by(|&a, &b| r[a].total_cmp(&r[b]));
-        let Some(k) = k else { break };
-        let (hl, hv) = parabolic(&r, k);
-        if hv >= prior.octave_ratio * strength {
-            lag = hl;
-            strength = hv;
-        } else {
-            break;
-        }
-    }
+    // The comb's lag, moved to the full-band peak within a frame and refined by a parabola.
+    let l = (l.saturating_sub(1).max(1)..=(l + 1).min(full.len() - 2))
+        .max_by(|&a, &b| full[a].total_cmp(&full[b]))
+        .unwrap_or(l);
+    let (lag, strength) = parabolic(&full, l);
     Ok(TempoEstimate {
         bpm: 60.0 * fps / lag,
         period_frames: lag,
@@ -192,11 +214,17 @@ mod tests {
     }
 
     #[test]
-    fn pulse_trains_give_their_tempo_at_every_level() {
+    fn pulse_trains_give_a_metrical_level_of_their_tempo() {
         for bpm in [60.0, 97.3, 120.0, 150.0, 180.0] {
             let env = pulses(6000.0 / bpm, 3000);
             let t = estimate_tempo(&env, &TempoPrior::default()).unwrap();
-            assert!((t.bpm / bpm - 1.0).abs() < 0.01, "{bpm}: {}", t.bpm);
+            // An even pulse has no accent to tell its level, and every multiple of its period
+            // is as periodic: the comb may group 2 or 3 pulses (the prior's choice; `analyze`
+            // then tracks beats twice as fast where the midpoints are as strong as the beats).
+            let level = [1.0, 0.5, 1.0 / 3.0]
+                .into_iter()
+                .find(|k| (t.bpm / (k * bpm) - 1.0).abs() < 0.01);
+            assert!(level.is_some(), "{bpm}: {}", t.bpm);
         }
     }
 
