@@ -21,6 +21,8 @@
 //! the written quarter notes, which the ear often taps at twice the rate in a slow ballad. The period is the best S over the range, refined to a fraction of a frame by a
 //! parabola through the full-band r.
 
+use realfft::RealFftPlanner;
+use realfft::num_complex::Complex;
 use serde::{Deserialize, Serialize};
 
 use super::{MusicError, OnsetEnvelope};
@@ -64,16 +66,31 @@ pub struct TempoEstimate {
     pub strength: f64,
 }
 
-/// Normalised unbiased autocorrelation r(l) of `x` (mean removed) for l in 0..=max_lag.
+/// Normalised unbiased autocorrelation r(l) of `x` (mean removed) for l in 0..=max_lag, by the
+/// Wiener–Khinchin theorem: the inverse FFT of the power spectrum of `x` padded with zeros to at
+/// least twice its length (so that the circular correlation is the linear one), each lag over
+/// its n − l products.
 fn autocorrelation(x: &[f64], max_lag: usize) -> Vec<f64> {
     let n = x.len();
     let mean = x.iter().sum::<f64>() / n as f64;
-    let y: Vec<f64> = x.iter().map(|v| v - mean).collect();
+    let size = (2 * n).next_power_of_two();
+    let mut planner = RealFftPlanner::<f64>::new();
+    let forward = planner.plan_fft_forward(size);
+    let inverse = planner.plan_fft_inverse(size);
+    let mut y = forward.make_input_vec();
+    for (o, v) in y.iter_mut().zip(x) {
+        *o = v - mean;
+    }
+    let mut spectrum = forward.make_output_vec();
+    // The lengths come from the same plans, so processing cannot fail.
+    let _ = forward.process(&mut y, &mut spectrum);
+    for c in spectrum.iter_mut() {
+        *c = Complex::new(c.norm_sqr(), 0.0);
+    }
+    let mut products = inverse.make_output_vec();
+    let _ = inverse.process(&mut spectrum, &mut products);
     let mut r: Vec<f64> = (0..=max_lag.min(n - 1))
-        .map(|l| {
-            let s: f64 = y[..n - l].iter().zip(&y[l..]).map(|(a, b)| a * b).sum();
-            s / (n - l) as f64
-        })
+        .map(|l| products[l] / size as f64 / (n - l) as f64)
         .collect();
     let r0 = r[0];
     if r0 > 0.0 {
@@ -240,6 +257,28 @@ mod tests {
         let env = OnsetEnvelope::at_100_hz(values);
         if let Ok(t) = estimate_tempo(&env, &TempoPrior::default()) {
             assert!(t.strength < 0.2, "{}", t.strength);
+        }
+    }
+
+    #[test]
+    fn the_fft_autocorrelation_is_the_sum_of_products() {
+        let x: Vec<f64> = (0..501)
+            .map(|i| ((i * i) % 17) as f64 + (i as f64 * 0.3).sin())
+            .collect();
+        let r = autocorrelation(&x, 120);
+        let n = x.len();
+        let mean = x.iter().sum::<f64>() / n as f64;
+        let y: Vec<f64> = x.iter().map(|v| v - mean).collect();
+        let direct = |l: usize| {
+            y[..n - l]
+                .iter()
+                .zip(&y[l..])
+                .map(|(a, b)| a * b)
+                .sum::<f64>()
+                / (n - l) as f64
+        };
+        for l in [0, 1, 7, 60, 120] {
+            assert!((r[l] - direct(l) / direct(0)).abs() < 1e-12, "lag {l}");
         }
     }
 }
