@@ -78,10 +78,17 @@ fn main() {
     }
     let ours_s = pop909::median(&ours.iter().map(|t| t.seconds).collect::<Vec<_>>());
     let theirs_s = pop909::median(&theirs.iter().map(|t| t.seconds).collect::<Vec<_>>());
+    let decode_s = pop909::median(
+        &ours
+            .iter()
+            .filter_map(|t| t.decode_seconds)
+            .collect::<Vec<_>>(),
+    );
     println!(
-        "time per song (decode + analysis), median over 40: marionette {:.3} s, librosa {:.3} s: \
-         marionette {:.1}x faster",
+        "time per song (decode + analysis), median over 40: marionette {:.3} s (decoding {:.3} s), \
+         librosa {:.3} s: marionette {:.1}x faster",
         ours_s,
+        decode_s,
         theirs_s,
         theirs_s / ours_s
     );

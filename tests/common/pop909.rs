@@ -129,12 +129,15 @@ pub struct Tracked {
     pub scores: BeatScores,
     /// Wall time of decoding and analysis (s).
     pub seconds: f64,
+    /// The part of `seconds` spent decoding, when measured apart (s).
+    pub decode_seconds: Option<f64>,
 }
 
 /// marionette's analysis (default parameters) of `wav`, decoded and analysed in this process.
 pub fn ours(song: &Song, wav: &Path) -> Tracked {
     let start = Instant::now();
     let audio = decode_file(wav).unwrap_or_else(|e| panic!("{e}"));
+    let decode_seconds = start.elapsed().as_secs_f64();
     let a = analyze(&audio.samples, audio.sample_rate, &MusicParams::default())
         .unwrap_or_else(|e| panic!("{}: {e}", song.id));
     let seconds = start.elapsed().as_secs_f64();
@@ -148,6 +151,7 @@ pub fn ours(song: &Song, wav: &Path) -> Tracked {
             &song.truth.downbeats_s,
         ),
         seconds,
+        decode_seconds: Some(decode_seconds),
     }
 }
 
@@ -190,6 +194,7 @@ pub fn librosa(python: &Path, songs: &[&Song], wavs: &[&Path]) -> Vec<Tracked> {
                     &song.truth.downbeats_s,
                 ),
                 seconds: r["seconds"].as_f64().expect("seconds"),
+                decode_seconds: None,
             }
         })
         .collect()

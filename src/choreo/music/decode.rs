@@ -63,6 +63,8 @@ pub fn decode_file(path: &Path) -> Result<Audio, MusicError> {
         .default_track(TrackType::Audio)
         .ok_or_else(|| dec("no audio track".into()))?;
     let track_id = track.id;
+    // The container's frame count, when it states one, sizes the buffer once.
+    let expected = track.num_frames.unwrap_or(0).min(MAX_SAMPLES as u64) as usize;
     let params = track
         .codec_params
         .as_ref()
@@ -71,7 +73,7 @@ pub fn decode_file(path: &Path) -> Result<Audio, MusicError> {
     let mut decoder = symphonia::default::get_codecs()
         .make_audio_decoder(params, &AudioDecoderOptions::default())
         .map_err(|e| dec(format!("no decoder for its codec ({e})")))?;
-    let mut samples: Vec<f32> = Vec::new();
+    let mut samples: Vec<f32> = Vec::with_capacity(expected);
     let mut interleaved: Vec<f32> = Vec::new();
     let mut rate = 0u32;
     let mut channels = 0usize;
