@@ -54,7 +54,7 @@ fn default_step_margin() -> f64 {
     crate::evolve::fall_fitness::STEP_MARGIN
 }
 fn default_every() -> u64 {
-    10
+    1
 }
 
 /// Evolution of the fall controller for each age group.
@@ -90,7 +90,9 @@ pub struct EvolveFallScene {
     /// and keeps its own `dt_s` (0.5 ms unless set).
     #[serde(default)]
     pub fall: Option<FallConfig>,
-    /// Generations between checkpoints.
+    /// Generations between checkpoints (default 1: every generation, so a killed run loses at
+    /// most the generation in flight; with K, up to the K − 1 generations since the last
+    /// checkpoint as well).
     #[serde(default = "default_every")]
     pub checkpoint_every: u64,
     /// Folder of the checkpoint (default: beside the output folder, `<out>.checkpoint`; for
