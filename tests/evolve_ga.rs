@@ -914,3 +914,45 @@ proptest::proptest! {
         std::fs::remove_dir_all(&dir).ok();
     }
 }
+
+/// The sphere in generation 0; every evaluation of a later generation fails.
+struct FailingAfterStart;
+
+impl Evaluator for FailingAfterStart {
+    fn evaluate(
+        &mut self,
+        generation: u64,
+        genomes: &[Genome],
+        _refine: u32,
+    ) -> Result<Vec<Evaluation>, marionette::evolve::EvolveError> {
+        Ok(genomes
+            .iter()
+            .map(|x| match generation {
+                0 => sphere(x),
+                g => Err(format!("generation {g} fails")),
+            })
+            .collect())
+    }
+}
+
+#[test]
+fn a_child_that_inherits_its_parents_fitness_counts_as_a_successful_evaluation() {
+    // Without crossover and with few mutations most children copy a parent: the few evaluated
+    // all fail, yet they are far from half the generation, so the GA goes on.
+    let cfg = GaConfig {
+        crossover_probability: 0.0,
+        mutation_probability: Some(0.02),
+        elite_check_tolerance: None,
+        ..ga(3, 5)
+    };
+    let mut s = GaState::initial(cfg, sphere_bounds(), &mut FailingAfterStart).unwrap();
+    while !s.done() {
+        s.step(&mut FailingAfterStart).unwrap();
+    }
+    let failed = s.logbook.iter().map(|r| r.failures).collect::<Vec<_>>();
+    assert!(
+        failed[1..].iter().all(|&f| f > 0 && 2 * f <= 18),
+        "{failed:?}"
+    );
+    assert!(s.inherited > 0 && s.stopped.is_none());
+}

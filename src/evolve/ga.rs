@@ -48,9 +48,10 @@ pub struct GaConfig {
     /// next best is checked in turn. `None`: no check. Default 0.10 (issue 14's criterion).
     pub elite_check_tolerance: Option<f64>,
     /// The share of a generation's evaluations that may fail (an unstable simulation, a
-    /// worker's error, a damage negative or not finite): a generation with more failures stops
-    /// the GA at once, naming the first failures ([`GaState::stopped`]). In [0, 1); default
-    /// 0.5.
+    /// worker's error, a damage negative or not finite; a child that inherits a parent's
+    /// fitness counts as that parent's successful evaluation): a generation with more failures
+    /// stops the GA at once, naming the first failures ([`GaState::stopped`]). In [0, 1);
+    /// default 0.5.
     pub max_failed_share: f64,
     /// Seed of every random draw.
     pub seed: u64,
@@ -605,7 +606,10 @@ impl GaState {
             .rev()
             .take_while(|f| f.0 == self.generation)
             .collect();
-        if expected > 0 && failed.len() as f64 > self.config.max_failed_share * expected as f64 {
+        // A child that inherits a parent's fitness counts as that parent's evaluation, which
+        // succeeded.
+        let children = expected + copies;
+        if failed.len() as f64 > self.config.max_failed_share * children as f64 {
             let first: Vec<String> = failed
                 .iter()
                 .rev()
@@ -613,7 +617,7 @@ impl GaState {
                 .map(|(_, i, why)| format!("individual {i}: {why}"))
                 .collect();
             self.stopped = Some(format!(
-                "generation {}: {} of {expected} evaluations failed, more than \
+                "generation {}: {} of {children} evaluations failed, more than \
                  ga.max_failed_share = {} of them; the first: {}",
                 self.generation,
                 failed.len(),
