@@ -120,6 +120,24 @@ impl EvolveFallScene {
         if self.groups.is_empty() || self.seeds.is_empty() {
             return Err(invalid("groups and seeds must not be empty".into()));
         }
+        // A checkpoint holds one run per group and seed (checkpoint::Consistent).
+        for (name, dup) in [
+            (
+                "groups",
+                (1..self.groups.len()).any(|k| self.groups[..k].contains(&self.groups[k])),
+            ),
+            (
+                "seeds",
+                (1..self.seeds.len()).any(|k| self.seeds[..k].contains(&self.seeds[k])),
+            ),
+        ] {
+            if dup {
+                return Err(invalid(format!(
+                    "{name} must not repeat an entry, found groups {:?}, seeds {:?}",
+                    self.groups, self.seeds
+                )));
+            }
+        }
         if !(self.kp_max_scale.is_finite() && self.kp_max_scale > 0.0 && self.kp_max_scale <= 100.0)
         {
             return Err(invalid(format!(
@@ -683,6 +701,25 @@ mod tests {
         assert_eq!(ck("out/t/"), PathBuf::from("out/t.checkpoint"));
         assert_eq!(ck("/tmp/quick"), PathBuf::from("/tmp/quick.checkpoint"));
         assert_eq!(ck("."), PathBuf::from("out/t.checkpoint"));
+    }
+
+    #[test]
+    fn a_seed_or_group_given_twice_is_refused_before_any_work() {
+        let mut s = scene(STEP_MARGIN, 1.0);
+        s.seeds = vec![1, 1];
+        let err = s.config().unwrap_err().to_string();
+        assert!(
+            err.contains("seeds must not repeat") && err.contains("[1, 1]"),
+            "{err}"
+        );
+        let mut s = scene(STEP_MARGIN, 1.0);
+        s.groups = vec![AgeGroup::Adult, AgeGroup::Adult];
+        assert!(
+            s.config()
+                .unwrap_err()
+                .to_string()
+                .contains("groups must not repeat")
+        );
     }
 
     #[test]
