@@ -5,11 +5,14 @@
 //! threads. The ratio of the two rates is the parallel efficiency × 2. These are initial
 //! genomes, whose falls rest sooner than evolved ones: 15 000 / rate understates the paper's
 //! whole GA, which `benches/evolve_run.rs` times itself. Also one GA step alone (selection,
-//! crossover, mutation) without evaluation.
+//! crossover, mutation) without evaluation, and what a checkpoint costs at the size of
+//! `scenes/evolve_fall.ron` at its end (2 groups × 5 seeds, 30 × 42 genes, 501 logbook records
+//! each): written (checked, read back, written atomically) every generation by default.
 //! Run: `cargo bench --bench evolve`.
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use marionette::evolve::{FallProblem, GaConfig, GaState, InProcess};
+use marionette::evolve::{FallProblem, GaConfig, GaState, InProcess, checkpoint};
+use marionette::experiments::evolve_fall::EvolutionRun;
 use marionette::humanoid::ranges::AgeGroup;
 use std::hint::black_box;
 use std::time::Duration;
@@ -45,7 +48,11 @@ fn bench_generation(c: &mut Criterion) {
     g.finish();
     // The GA's own work per generation, with a free evaluation.
     let mut free = InProcess {
-        batch: |g: &[Vec<f64>], _: u32| g.iter().map(|x| Ok(x.iter().sum::<f64>())).collect(),
+        batch: |g: &[Vec<f64>], _: u32| {
+            g.iter()
+                .map(|x| Ok(x.iter().map(|v| v * v).sum::<f64>()))
+                .collect()
+        },
     };
     let base = GaState::initial(cfg, bounds, &mut free).expect("GA");
     c.bench_function("ga_step_operators_only_30x42", |b| {
@@ -56,6 +63,38 @@ fn bench_generation(c: &mut Criterion) {
             black_box(s.generation)
         })
     });
+    // The checkpoint of the scene's ten runs after their 500 generations.
+    let mut runs = Vec::new();
+    for group in [AgeGroup::Elderly, AgeGroup::Adult] {
+        let problem = FallProblem::paper(group);
+        let bounds = problem.bounds().expect("bounds");
+        for seed in 1..=5 {
+            let cfg = GaConfig {
+                population: 30,
+                generations: 500,
+                seed,
+                ..GaConfig::default()
+            };
+            let mut s = GaState::initial(cfg, bounds.clone(), &mut free).expect("GA");
+            while !s.done() {
+                s.step(&mut free).expect("step");
+            }
+            runs.push(EvolutionRun {
+                problem: problem.clone(),
+                state: s,
+            });
+        }
+    }
+    let dir = std::env::temp_dir().join(format!("marionette-bench-ck-{}", std::process::id()));
+    let mut g = c.benchmark_group("checkpoint_save");
+    g.sample_size(20);
+    g.bench_function("evolve_fall_10_runs_30x42_500_generations", |b| {
+        b.iter(|| checkpoint::save(&dir, black_box(&runs)).expect("save"))
+    });
+    g.finish();
+    let bytes = std::fs::metadata(dir.join(checkpoint::FILE)).map_or(0, |m| m.len());
+    println!("checkpoint of the 10 runs: {bytes} bytes");
+    std::fs::remove_dir_all(&dir).ok();
 }
 
 criterion_group!(benches, bench_generation);

@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use marionette::evolve::FallProblem;
+use marionette::evolve::{FallProblem, checkpoint};
 use marionette::humanoid::ranges::AgeGroup;
 
 fn marionette(args: &[&str]) -> std::process::Output {
@@ -201,8 +201,213 @@ fn a_resumed_evolution_ends_where_an_uninterrupted_one_does() {
         .output()
         .unwrap();
     assert!(!out.status.success());
-    assert!(String::from_utf8_lossy(&out.stderr).contains("another scene"));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("seeds: the checkpoint has [1,2], the scene asks [7]"),
+        "{err}"
+    );
     for d in [a, b, ck_a, ck_b] {
+        std::fs::remove_dir_all(d).ok();
+    }
+}
+
+/// `marionette args…`, whatever its exit.
+fn marionette_any(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_marionette"))
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .unwrap()
+}
+
+/// A quick run of the adult group over `seeds` to `generations`, its checkpoint in `ck`, with
+/// `more` overrides; returns what it printed.
+fn quick_run(
+    out: &Path,
+    ck: &Path,
+    seeds: &str,
+    generations: u64,
+    resume: bool,
+    more: &[&str],
+) -> std::process::Output {
+    let (out, ck) = (out.display().to_string(), ck.display().to_string());
+    let (seeds, generations) = (
+        format!("seeds={seeds}"),
+        format!("ga.generations={generations}"),
+    );
+    let ck_set = format!("checkpoint_dir=\"{ck}\"");
+    let mut args = vec!["run", "scenes/evolve_fall.ron", "--out", &out];
+    args.extend(["--set", "groups=[adult]", "--set", "ga.population=6"]);
+    args.extend([
+        "--set",
+        "render.gif=false",
+        "--set",
+        &seeds,
+        "--set",
+        &generations,
+    ]);
+    if resume {
+        args.extend(["--resume", &ck]);
+    } else {
+        args.extend(["--set", &ck_set]);
+    }
+    args.extend(more);
+    marionette_any(&args)
+}
+
+/// Edits the runs of the checkpoint in `ck` as another writer could: the file stays well
+/// formed and, if `reseal`, its checksum is that of the edited content.
+fn edit_checkpoint(ck: &Path, reseal: bool, edit: impl FnOnce(&mut serde_json::Value)) {
+    let file = ck.join(checkpoint::FILE);
+    let mut v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&file).unwrap()).unwrap();
+    edit(&mut v["content"]);
+    let text = if reseal {
+        checkpoint::encode(&v["content"]).unwrap()
+    } else {
+        serde_json::to_string(&v).unwrap()
+    };
+    std::fs::write(&file, text).unwrap();
+}
+
+/// A change to one run of a checkpoint.
+type Edit = fn(&mut serde_json::Value);
+
+fn stderr(o: &std::process::Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+#[test]
+fn a_resume_refuses_another_experiment_or_a_broken_checkpoint_saying_what() {
+    let (out, ck, saved) = (tmp("other"), tmp("other_ck"), tmp("other_saved"));
+    let made = quick_run(&out, &ck, "[3,4]", 1, false, &[]);
+    assert!(made.status.success(), "{}", stderr(&made));
+    std::fs::create_dir_all(&saved).unwrap();
+    std::fs::copy(ck.join("checkpoint.json"), saved.join("checkpoint.json")).unwrap();
+    let restore = || {
+        std::fs::copy(saved.join("checkpoint.json"), ck.join("checkpoint.json")).unwrap();
+    };
+    // Other seeds: refused, naming the setting and both values.
+    let o = quick_run(&out, &ck, "[1,2]", 2, true, &[]);
+    let err = stderr(&o);
+    assert!(!o.status.success(), "resumed seeds [3, 4] as [1, 2]: {err}");
+    assert!(
+        err.contains("seeds") && err.contains("[3,4]") && err.contains("[1,2]"),
+        "{err}"
+    );
+    // Another GA setting: named with both values.
+    let o = quick_run(
+        &out,
+        &ck,
+        "[3,4]",
+        2,
+        true,
+        &["--set", "ga.mutation_eta=30.0"],
+    );
+    let err = stderr(&o);
+    assert!(!o.status.success());
+    assert!(
+        err.contains("ga.mutation_eta") && err.contains("20") && err.contains("30"),
+        "{err}"
+    );
+    // Fewer generations than the checkpoint already holds: named as such.
+    let longer = quick_run(&out, &ck, "[3,4]", 2, true, &[]);
+    assert!(longer.status.success(), "{}", stderr(&longer));
+    let o = quick_run(&out, &ck, "[3,4]", 1, true, &[]);
+    let err = stderr(&o);
+    assert!(!o.status.success());
+    assert!(
+        err.contains("ga.generations") && err.contains("generation 2"),
+        "{err}"
+    );
+    // Lists cut by one entry or emptied: refused, never a panic, naming the file, the run and
+    // the list.
+    let cuts: [(&str, Edit); 4] = [
+        ("fitness", |r| {
+            drop(r["state"]["fitness"].as_array_mut().unwrap().pop())
+        }),
+        ("population", |r| {
+            drop(r["state"]["population"].as_array_mut().unwrap().pop())
+        }),
+        ("bounds", |r| {
+            drop(r["state"]["bounds"]["hi"].as_array_mut().unwrap().pop())
+        }),
+        ("population", |r| {
+            for k in ["population", "fitness", "checked"] {
+                r["state"][k] = serde_json::json!([]);
+            }
+        }),
+    ];
+    for (what, cut) in cuts {
+        restore();
+        edit_checkpoint(&ck, true, |runs| cut(&mut runs[1]));
+        let o = quick_run(&out, &ck, "[3,4]", 2, true, &[]);
+        let err = stderr(&o);
+        assert_ne!(o.status.code(), Some(101), "{what}: panicked: {err}");
+        assert!(!o.status.success(), "{what}: accepted");
+        assert!(
+            err.contains("checkpoint.json") && err.contains("adult seed 4") && err.contains(what),
+            "{what}: {err}"
+        );
+    }
+    // Edited values: refused for the checksum unless it was updated, and then for what is
+    // wrong in them.
+    let edits: [(&str, Edit); 4] = [
+        ("seeds: the checkpoint has [3,9]", |r| {
+            r["state"]["config"]["seed"] = serde_json::json!(9)
+        }),
+        ("generation", |r| {
+            r["state"]["generation"] = serde_json::json!(0)
+        }),
+        ("fitness of individual 2 is -1", |r| {
+            r["state"]["fitness"][2] = serde_json::json!(-1.0)
+        }),
+        ("outside its bounds", |r| {
+            r["state"]["population"][1][0] = serde_json::json!(1e308)
+        }),
+    ];
+    for (what, edit) in edits {
+        for reseal in [false, true] {
+            restore();
+            edit_checkpoint(&ck, reseal, |runs| edit(&mut runs[1]));
+            let o = quick_run(&out, &ck, "[3,4]", 2, true, &[]);
+            let err = stderr(&o);
+            assert!(!o.status.success(), "{what}: accepted");
+            let said = if reseal { what } else { "checksum" };
+            assert!(
+                err.contains("checkpoint") && err.contains(said),
+                "{what}: {err}"
+            );
+        }
+    }
+    for d in [out, ck, saved] {
+        std::fs::remove_dir_all(d).ok();
+    }
+}
+
+#[test]
+fn a_generation_of_failed_falls_stops_the_run_and_its_resume_says_why() {
+    let (out, ck) = (tmp("failing"), tmp("failing_ck"));
+    // A step of 50 ms: every genome is refused by the stability check before it runs.
+    let fall = ["--set", r#"fall={"dt_s":0.05}"#];
+    let o = quick_run(&out, &ck, "[1]", 3, false, &fall);
+    let err = stderr(&o);
+    assert!(!o.status.success());
+    assert!(
+        err.contains("generation 0") && err.contains("6 of 6") && err.contains("stability"),
+        "{err}"
+    );
+    assert!(!err.contains("not finite"), "{err}");
+    let line = err
+        .lines()
+        .find(|l| l.contains("6 of 6"))
+        .unwrap()
+        .to_string();
+    let o = quick_run(&out, &ck, "[1]", 3, true, &fall);
+    let again = stderr(&o);
+    assert!(!o.status.success());
+    assert!(again.contains(&line), "first:\n{err}\nresumed:\n{again}");
+    for d in [out, ck] {
         std::fs::remove_dir_all(d).ok();
     }
 }

@@ -51,6 +51,10 @@ pub enum EvolveError {
         /// What went wrong.
         message: String,
     },
+    /// Too many evaluations of a generation failed ([`super::GaConfig::max_failed_share`]):
+    /// the run, the generation and the first failures.
+    #[error("the GA stopped: {0}")]
+    Stopped(String),
 }
 
 /// The result of one evaluation: the damage (lower is fitter) or why the simulation failed.

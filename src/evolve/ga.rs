@@ -13,6 +13,7 @@ use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64;
 use serde::{Deserialize, Serialize};
 
+use super::checkpoint::Consistent;
 use super::evaluator::{Evaluation, Evaluator, EvolveError};
 use super::genome::{Bounds, Genome};
 use super::logbook::GenerationRecord;
@@ -46,6 +47,12 @@ pub struct GaConfig {
     /// through a simulation artefact and gets the worst fitness (logged as a failure), and the
     /// next best is checked in turn. `None`: no check. Default 0.10 (issue 14's criterion).
     pub elite_check_tolerance: Option<f64>,
+    /// The share of a generation's evaluations that may fail (an unstable simulation, a
+    /// worker's error, a damage negative or not finite; a child that inherits a parent's
+    /// fitness counts as that parent's successful evaluation): a generation with more failures
+    /// stops the GA at once, naming the first failures ([`GaState::stopped`]). In [0, 1);
+    /// default 0.5.
+    pub max_failed_share: f64,
     /// Seed of every random draw.
     pub seed: u64,
 }
@@ -62,6 +69,7 @@ impl Default for GaConfig {
             mutation_eta: 20.0,
             elites: 2,
             elite_check_tolerance: Some(0.10),
+            max_failed_share: 0.5,
             seed: 1,
         }
     }
@@ -131,6 +139,12 @@ impl GaConfig {
                 format!("must be a finite fraction ≥ 0 (or None), found {t}"),
             );
         }
+        if !(0.0..1.0).contains(&self.max_failed_share) {
+            return bad(
+                "max_failed_share",
+                format!("must be in [0, 1), found {}", self.max_failed_share),
+            );
+        }
         Ok(())
     }
 }
@@ -179,10 +193,16 @@ pub struct GaState {
     pub logbook: Vec<GenerationRecord>,
     /// Failed evaluations: (generation, index, why).
     pub failures: Vec<(u64, usize, String)>,
+    /// Why the GA stopped: a generation in which more than [`GaConfig::max_failed_share`] of
+    /// the evaluations failed (the generation is closed; every later step refuses with this).
+    #[serde(default)]
+    pub stopped: Option<String>,
 }
 
 impl GaState {
-    /// Generation 0: `config.population` genomes uniform in `bounds`, evaluated.
+    /// Generation 0: `config.population` genomes uniform in `bounds`, evaluated. If more than
+    /// [`GaConfig::max_failed_share`] of them failed, the state is [`Self::stopped`] and every
+    /// step refuses ([`Self::halted`]).
     pub fn initial(
         config: GaConfig,
         bounds: Bounds,
@@ -212,6 +232,7 @@ impl GaState {
             generation_checks: 0,
             logbook: Vec::new(),
             failures: Vec::new(),
+            stopped: None,
         };
         let results = evaluator.evaluate(0, &population, 1)?;
         s.receive(
@@ -223,9 +244,130 @@ impl GaState {
             },
             results,
         )?;
-        s.check_and_close(evaluator)?;
+        if s.stopped.is_some() {
+            s.close();
+        } else {
+            s.check_and_close(evaluator)?;
+        }
         s.initial_best = s.best.as_ref().map(|b| b.0.clone());
         Ok(s)
+    }
+
+    /// `Err(EvolveError::Stopped)` with the cause if the GA has stopped ([`Self::stopped`]).
+    pub fn halted(&self) -> Result<(), EvolveError> {
+        match &self.stopped {
+            Some(why) => Err(EvolveError::Stopped(format!(
+                "seed {}, {why}",
+                self.config.seed
+            ))),
+            None => Ok(()),
+        }
+    }
+
+    /// The whole-state consistency check of a state read from elsewhere (a checkpoint): valid
+    /// settings and bounds, one genome, fitness and check flag per individual, every gene
+    /// finite and within its bounds, every damage finite and ≥ 0, one logbook record per
+    /// generation so far, failures of generations so far. `Err` says what disagrees.
+    pub fn consistency(&self) -> Result<(), String> {
+        self.config.validate().map_err(|e| e.to_string())?;
+        let n = self.config.population;
+        let g = self.generation;
+        if self.population.len() != n {
+            return Err(format!(
+                "population has {} genomes, ga.population is {n}",
+                self.population.len()
+            ));
+        }
+        for (name, len) in [
+            ("fitness", self.fitness.len()),
+            ("checked", self.checked.len()),
+        ] {
+            if len != n {
+                return Err(format!("{name} has {len} entries for a population of {n}"));
+            }
+        }
+        let b = &self.bounds;
+        Bounds::new(b.lo.clone(), b.hi.clone()).map_err(|e| format!("bounds: {e}"))?;
+        let genome = |what: &str, x: &Genome| -> Result<(), String> {
+            if x.len() != b.len() {
+                return Err(format!(
+                    "{what} has {} genes, the bounds {}",
+                    x.len(),
+                    b.len()
+                ));
+            }
+            match (0..x.len()).find(|&k| !(b.lo[k]..=b.hi[k]).contains(&x[k])) {
+                Some(k) => Err(format!(
+                    "{what}: gene {k} = {} is outside its bounds [{}, {}]",
+                    x[k], b.lo[k], b.hi[k]
+                )),
+                None => Ok(()),
+            }
+        };
+        for (i, x) in self.population.iter().enumerate() {
+            genome(&format!("genome {i}"), x)?;
+        }
+        let damage = |d: f64| d.is_finite() && d >= 0.0;
+        if let Some((i, f)) = self
+            .fitness
+            .iter()
+            .enumerate()
+            .find_map(|(i, f)| f.filter(|&d| !damage(d)).map(|d| (i, d)))
+        {
+            return Err(format!(
+                "fitness of individual {i} is {f}, not a damage (finite, ≥ 0)"
+            ));
+        }
+        if let Some((x, f)) = &self.best {
+            genome("best genome", x)?;
+            if !damage(*f) {
+                return Err(format!("best damage is {f}, not a damage (finite, ≥ 0)"));
+            }
+        }
+        if let Some(x) = &self.initial_best {
+            genome("initial best genome", x)?;
+        }
+        if g > self.config.generations {
+            return Err(format!(
+                "generation {g} is past ga.generations = {}",
+                self.config.generations
+            ));
+        }
+        if self.logbook.len() as u64 != g + 1 {
+            return Err(format!(
+                "the logbook has {} records at generation {g} (one per generation 0..={g})",
+                self.logbook.len()
+            ));
+        }
+        if let Some((k, r)) = self
+            .logbook
+            .iter()
+            .enumerate()
+            .find(|(k, r)| r.generation != *k as u64)
+        {
+            return Err(format!(
+                "logbook record {k} is of generation {}",
+                r.generation
+            ));
+        }
+        let logged = self.logbook.last().map_or(0, |r| r.evaluations);
+        if logged != self.evaluations {
+            return Err(format!(
+                "evaluations is {}, the logbook's last record says {logged}",
+                self.evaluations
+            ));
+        }
+        let mut previous = 0;
+        for (fg, i, _) in &self.failures {
+            if *fg > g || *fg < previous || *i >= n {
+                return Err(format!(
+                    "failures: an entry of generation {fg}, individual {i}, at generation {g} \
+                     with a population of {n} (entries in generation order)"
+                ));
+            }
+            previous = *fg;
+        }
+        Ok(())
     }
 
     /// True once the configured number of generations has run.
@@ -253,6 +395,7 @@ impl GaState {
     /// and [`Self::close`]. A caller running several GAs can take the phases itself to evaluate
     /// all their broods in one batch (the same bits).
     pub fn step(&mut self, evaluator: &mut dyn Evaluator) -> Result<(), EvolveError> {
+        self.halted()?;
         let brood = self.breed();
         let todo = brood.to_evaluate();
         let results = if todo.is_empty() {
@@ -261,6 +404,10 @@ impl GaState {
             evaluator.evaluate(brood.generation, &todo, 1)?
         };
         self.receive(brood, results)?;
+        if self.stopped.is_some() {
+            self.close();
+            return self.halted();
+        }
         self.check_and_close(evaluator)
     }
 
@@ -395,8 +542,10 @@ impl GaState {
 
     /// Takes a brood and the evaluations of its children to evaluate
     /// ([`Brood::to_evaluate`], in order): the population (elites first) of the brood's
-    /// generation, failures logged. The generation is closed by [`Self::close`] after the elite
-    /// check.
+    /// generation, failures logged (a damage that is negative or not finite is a failure). The
+    /// generation is closed by [`Self::close`] after the elite check; if more than
+    /// [`GaConfig::max_failed_share`] of the evaluations failed, the GA is [`Self::stopped`]
+    /// (the caller closes the generation and goes no further).
     pub fn receive(&mut self, brood: Brood, results: Vec<Evaluation>) -> Result<(), EvolveError> {
         let copies = brood.copies();
         let expected = brood.children.len() - copies;
@@ -429,10 +578,14 @@ impl GaState {
                 .next()
                 .ok_or_else(|| EvolveError::Evaluator("fewer results than genomes".into()))?;
             let f = match r {
-                Ok(d) if d.is_finite() => Some(d),
+                Ok(d) if d.is_finite() && d >= 0.0 => Some(d),
                 Ok(d) => {
-                    self.failures
-                        .push((self.generation, offset + k, format!("damage {d}")));
+                    let why = if d.is_finite() {
+                        format!("damage {d} is negative")
+                    } else {
+                        format!("damage {d} is not finite")
+                    };
+                    self.failures.push((self.generation, offset + k, why));
                     None
                 }
                 Err(why) => {
@@ -447,6 +600,31 @@ impl GaState {
         self.population = pop;
         self.fitness = fit;
         self.checked = checked;
+        let failed: Vec<&(u64, usize, String)> = self
+            .failures
+            .iter()
+            .rev()
+            .take_while(|f| f.0 == self.generation)
+            .collect();
+        // A child that inherits a parent's fitness counts as that parent's evaluation, which
+        // succeeded.
+        let children = expected + copies;
+        if failed.len() as f64 > self.config.max_failed_share * children as f64 {
+            let first: Vec<String> = failed
+                .iter()
+                .rev()
+                .take(3)
+                .map(|(_, i, why)| format!("individual {i}: {why}"))
+                .collect();
+            self.stopped = Some(format!(
+                "generation {}: {} of {children} evaluations failed, more than \
+                 ga.max_failed_share = {} of them; the first: {}",
+                self.generation,
+                failed.len(),
+                self.config.max_failed_share,
+                first.join("; ")
+            ));
+        }
         Ok(())
     }
 
@@ -536,10 +714,16 @@ impl GaState {
     }
 }
 
+impl Consistent for GaState {
+    fn consistency(&self) -> Result<(), String> {
+        GaState::consistency(self).map_err(|m| format!("seed {}: {m}", self.config.seed))
+    }
+}
+
 /// Whether an elite check holds: the re-evaluation `r` of an individual of damage `d` is finite
 /// and within `|D_fine − D| ≤ tol · |D|`.
 fn check_holds(d: f64, r: &Evaluation, tol: f64) -> bool {
-    matches!(r, Ok(fine) if fine.is_finite() && (fine - d).abs() <= tol * d.abs())
+    matches!(r, Ok(fine) if fine.is_finite() && *fine >= 0.0 && (fine - d).abs() <= tol * d.abs())
 }
 
 /// An elite passing unchanged into a brood.

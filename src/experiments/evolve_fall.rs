@@ -23,6 +23,73 @@ pub struct EvolutionRun {
     pub state: GaState,
 }
 
+impl EvolutionRun {
+    /// The run's name in messages: age group and seed, e.g. `adult seed 3`.
+    pub fn name(&self) -> String {
+        format!(
+            "{} seed {}",
+            self.problem.age_group.name(),
+            self.state.config.seed
+        )
+    }
+}
+
+/// The runs of a checkpoint: each run's state consistent ([`GaState::consistency`]) with the
+/// bounds of its problem, no run twice, all at the same generation.
+impl checkpoint::Consistent for [EvolutionRun] {
+    fn consistency(&self) -> Result<(), String> {
+        for (k, r) in self.iter().enumerate() {
+            let name = r.name();
+            r.state
+                .consistency()
+                .map_err(|m| format!("run {name}: {m}"))?;
+            match r.problem.bounds() {
+                Ok(b) if b == r.state.bounds => {}
+                Ok(_) => {
+                    return Err(format!(
+                        "run {name}: the bounds differ from those of its problem"
+                    ));
+                }
+                Err(e) => return Err(format!("run {name}: problem: {e}")),
+            }
+            if self[..k].iter().any(|o| o.name() == name) {
+                return Err(format!("run {name} is there twice"));
+            }
+            if let Some(first) = self.first()
+                && first.state.generation != r.state.generation
+            {
+                return Err(format!(
+                    "run {name} is at generation {}, run {} at generation {}: the runs advance \
+                     together",
+                    r.state.generation,
+                    first.name(),
+                    first.state.generation
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+impl checkpoint::Consistent for Vec<EvolutionRun> {
+    fn consistency(&self) -> Result<(), String> {
+        self.as_slice().consistency()
+    }
+}
+
+/// `Err(EvolveError::Stopped)` naming the first run whose GA stopped ([`GaState::stopped`]) and
+/// why.
+pub fn halted(runs: &[EvolutionRun]) -> Result<(), EvolveError> {
+    match runs.iter().find(|r| r.state.stopped.is_some()) {
+        Some(r) => Err(EvolveError::Stopped(format!(
+            "{}, {}",
+            r.name(),
+            r.state.stopped.as_deref().unwrap_or_default()
+        ))),
+        None => Ok(()),
+    }
+}
+
 /// Where and how often the runs are checkpointed.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Checkpointing {
@@ -44,7 +111,8 @@ pub struct EvolveConfig {
 }
 
 /// Starts every (problem, seed) run: generation 0 drawn and evaluated, `evaluators[p]`
-/// evaluating problem `p`.
+/// evaluating problem `p`. A run whose GA stopped in generation 0 ([`GaState::stopped`]) is the
+/// last started: [`advance`] then refuses with its cause.
 pub fn start(
     config: &EvolveConfig,
     evaluators: &mut [Box<dyn Evaluator>],
@@ -71,10 +139,14 @@ pub fn start(
                 ..config.ga.clone()
             };
             let state = GaState::initial(ga, bounds.clone(), evaluators[p].as_mut())?;
+            let stopped = state.stopped.is_some();
             runs.push(EvolutionRun {
                 problem: problem.clone(),
                 state,
             });
+            if stopped {
+                return Ok(runs);
+            }
         }
     }
     Ok(runs)
@@ -85,7 +157,10 @@ pub fn start(
 /// after each generation. `evaluator_of(run)` names the index of the run's evaluator. The
 /// broods of all runs sharing an evaluator are evaluated in one batch (and so are their elite
 /// checks), so the cores stay busy past the end of any one run's generation; every run gets
-/// the bits it would get alone ([`GaState::step`]).
+/// the bits it would get alone ([`GaState::step`]). When a run's GA stops (more than
+/// `ga.max_failed_share` of a generation's evaluations failed), the generation is closed in
+/// every run, checkpointed, and the cause returned ([`halted`]); runs read from a stopped
+/// checkpoint are refused with the same cause.
 pub fn advance(
     runs: &mut [EvolutionRun],
     evaluators: &mut [Box<dyn Evaluator>],
@@ -100,6 +175,15 @@ pub fn advance(
             message: format!("evaluator {e} of {}", evaluators.len()),
         });
     }
+    let stop = |runs: &[EvolutionRun]| -> Result<(), EvolveError> {
+        if halted(runs).is_err()
+            && let Some(c) = checkpointing
+        {
+            checkpoint::save(&c.dir, runs)?;
+        }
+        halted(runs)
+    };
+    stop(runs)?;
     loop {
         let active: Vec<usize> = (0..runs.len()).filter(|&i| !runs[i].state.done()).collect();
         if active.is_empty() {
@@ -113,6 +197,13 @@ pub fn advance(
         let results = evaluate_by_owner(evaluators, &owner, generation, &parts, Batch::Children)?;
         for ((i, brood), r) in broods.into_iter().zip(results) {
             runs[i].state.receive(brood, r)?;
+        }
+        if halted(runs).is_err() {
+            for &i in &active {
+                runs[i].state.close();
+            }
+            progress(runs);
+            return stop(runs);
         }
         // The elite checks, round by round, one batch per evaluator per round.
         loop {

@@ -20,7 +20,7 @@ use crate::evolve::{
     Evaluator, FallProblem, GaConfig, InProcessFalls, JsonLines, checkpoint, logbook,
 };
 use crate::experiments::evolve_fall::{
-    Checkpointing, EvolutionRun, EvolveConfig, GroupOutcome, advance, best_falls, outcomes,
+    Checkpointing, EvolutionRun, EvolveConfig, GroupOutcome, advance, best_falls, halted, outcomes,
     problem_index, start,
 };
 use crate::experiments::fall::{FallConfig, FallResult, simulate_fall};
@@ -54,7 +54,7 @@ fn default_step_margin() -> f64 {
     crate::evolve::fall_fitness::STEP_MARGIN
 }
 fn default_every() -> u64 {
-    10
+    1
 }
 
 /// Evolution of the fall controller for each age group.
@@ -90,7 +90,9 @@ pub struct EvolveFallScene {
     /// and keeps its own `dt_s` (0.5 ms unless set).
     #[serde(default)]
     pub fall: Option<FallConfig>,
-    /// Generations between checkpoints.
+    /// Generations between checkpoints (default 1: every generation, so a killed run loses at
+    /// most the generation in flight; with K, up to the K − 1 generations since the last
+    /// checkpoint as well).
     #[serde(default = "default_every")]
     pub checkpoint_every: u64,
     /// Folder of the checkpoint (default: beside the output folder, `<out>.checkpoint`; for
@@ -117,6 +119,24 @@ impl EvolveFallScene {
     pub fn config(&self) -> Result<EvolveConfig, SceneError> {
         if self.groups.is_empty() || self.seeds.is_empty() {
             return Err(invalid("groups and seeds must not be empty".into()));
+        }
+        // A checkpoint holds one run per group and seed (checkpoint::Consistent).
+        for (name, dup) in [
+            (
+                "groups",
+                (1..self.groups.len()).any(|k| self.groups[..k].contains(&self.groups[k])),
+            ),
+            (
+                "seeds",
+                (1..self.seeds.len()).any(|k| self.seeds[..k].contains(&self.seeds[k])),
+            ),
+        ] {
+            if dup {
+                return Err(invalid(format!(
+                    "{name} must not repeat an entry, found groups {:?}, seeds {:?}",
+                    self.groups, self.seeds
+                )));
+            }
         }
         if !(self.kp_max_scale.is_finite() && self.kp_max_scale > 0.0 && self.kp_max_scale <= 100.0)
         {
@@ -307,6 +327,138 @@ pub fn default_checkpoint_dir(scene: &EvolveFallScene, out_dir: &Path) -> PathBu
     }
 }
 
+/// `Ok` if the checkpoint's `runs` continue the experiment `config` asks for: the same age
+/// groups and seeds in the same order, the same problem for each group and every GA setting
+/// the same but `generations`, which may grow (not below the generation the checkpoint is at);
+/// else which setting differs and how.
+fn resumable(runs: &[EvolutionRun], config: &EvolveConfig) -> Result<(), String> {
+    let distinct = |items: Vec<serde_json::Value>| {
+        let mut out: Vec<serde_json::Value> = Vec::new();
+        for i in items {
+            if !out.contains(&i) {
+                out.push(i);
+            }
+        }
+        serde_json::Value::Array(out)
+    };
+    let had_groups = distinct(runs.iter().map(|r| to_json(&r.problem.age_group)).collect());
+    let groups = distinct(
+        config
+            .problems
+            .iter()
+            .map(|p| to_json(&p.age_group))
+            .collect(),
+    );
+    let had_seeds = distinct(runs.iter().map(|r| to_json(&r.state.config.seed)).collect());
+    let seeds = to_json(&config.seeds);
+    for (name, had, asked) in [("groups", had_groups, groups), ("seeds", had_seeds, seeds)] {
+        if had != asked {
+            return Err(format!(
+                "{name}: the checkpoint has {had}, the scene asks {asked}"
+            ));
+        }
+    }
+    let wanted: Vec<String> = config
+        .problems
+        .iter()
+        .flat_map(|p| {
+            config
+                .seeds
+                .iter()
+                .map(move |s| format!("{} seed {s}", p.age_group.name()))
+        })
+        .collect();
+    let held: Vec<String> = runs.iter().map(EvolutionRun::name).collect();
+    if held != wanted {
+        return Err(format!(
+            "runs: the checkpoint holds [{}], the scene asks [{}]",
+            held.join(", "),
+            wanted.join(", ")
+        ));
+    }
+    for r in runs {
+        let Some(p) = config
+            .problems
+            .iter()
+            .find(|p| p.age_group == r.problem.age_group)
+        else {
+            continue;
+        };
+        let mut diff = Vec::new();
+        differences(
+            &format!("{}, problem", r.name()),
+            &to_json(&r.problem),
+            &to_json(p),
+            &mut diff,
+        );
+        let ga = GaConfig {
+            seed: r.state.config.seed,
+            generations: r.state.config.generations,
+            ..config.ga.clone()
+        };
+        differences("ga", &to_json(&r.state.config), &to_json(&ga), &mut diff);
+        if !diff.is_empty() {
+            let more = diff.len().saturating_sub(3);
+            diff.truncate(3);
+            let mut why = diff.join("; ");
+            if more > 0 {
+                why.push_str(&format!("; and {more} more"));
+            }
+            return Err(why);
+        }
+        if r.state.generation > config.ga.generations {
+            return Err(format!(
+                "ga.generations: the checkpoint is already at generation {}, the scene asks {} \
+                 (ga.generations may grow, not fall below the checkpoint's generation)",
+                r.state.generation, config.ga.generations
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// `v` as a JSON value (`null` if it cannot be one).
+fn to_json<T: Serialize + ?Sized>(v: &T) -> serde_json::Value {
+    serde_json::to_value(v).unwrap_or(serde_json::Value::Null)
+}
+
+/// Each leaf where `had` (the checkpoint's) and `asked` (the scene's) differ, as
+/// `path: the checkpoint has …, the scene asks …`.
+fn differences(
+    path: &str,
+    had: &serde_json::Value,
+    asked: &serde_json::Value,
+    out: &mut Vec<String>,
+) {
+    use serde_json::Value;
+    match (had, asked) {
+        (Value::Object(a), Value::Object(b)) => {
+            for (k, va) in a {
+                differences(
+                    &format!("{path}.{k}"),
+                    va,
+                    b.get(k).unwrap_or(&Value::Null),
+                    out,
+                );
+            }
+            for (k, vb) in b.iter().filter(|(k, _)| !a.contains_key(*k)) {
+                differences(&format!("{path}.{k}"), &Value::Null, vb, out);
+            }
+        }
+        (Value::Array(a), Value::Array(b)) if a.len() == b.len() => {
+            for (k, (va, vb)) in a.iter().zip(b).enumerate() {
+                differences(&format!("{path}[{k}]"), va, vb, out);
+            }
+        }
+        _ if had != asked => {
+            out.push(format!(
+                "{path}: the checkpoint has {had}, the scene asks {asked}"
+            ));
+        }
+        _ => {}
+    }
+}
+
 /// Runs an [`EvolveFallScene`] whose outputs are written into `out` (the staging folder of the
 /// output folder `out_dir`, [`super::run`]); returns the report.
 pub fn run_evolve(
@@ -326,23 +478,13 @@ pub fn run_evolve(
         Some(_) => {
             let mut runs: Vec<EvolutionRun> =
                 checkpoint::load(&ck_dir).map_err(|e| invalid(e.to_string()))?;
-            // The same experiment, possibly asked to run longer.
-            let same = runs.len() == config.problems.len() * config.seeds.len()
-                && runs.iter().all(|r| {
-                    config.problems.contains(&r.problem)
-                        && GaConfig {
-                            seed: r.state.config.seed,
-                            generations: r.state.config.generations,
-                            ..config.ga.clone()
-                        } == r.state.config
-                        && r.state.generation <= config.ga.generations
-                });
-            if !same {
-                return Err(invalid(format!(
-                    "resume: the checkpoint in {} was made by another scene (groups, seeds, GA or fall differ)",
+            halted(&runs).map_err(|e| invalid(e.to_string()))?;
+            resumable(&runs, &config).map_err(|why| {
+                invalid(format!(
+                    "resume: the checkpoint in {} was made with other settings: {why}",
                     ck_dir.display()
-                )));
-            }
+                ))
+            })?;
             for r in &mut runs {
                 r.state.config.generations = config.ga.generations;
             }
@@ -559,6 +701,25 @@ mod tests {
         assert_eq!(ck("out/t/"), PathBuf::from("out/t.checkpoint"));
         assert_eq!(ck("/tmp/quick"), PathBuf::from("/tmp/quick.checkpoint"));
         assert_eq!(ck("."), PathBuf::from("out/t.checkpoint"));
+    }
+
+    #[test]
+    fn a_seed_or_group_given_twice_is_refused_before_any_work() {
+        let mut s = scene(STEP_MARGIN, 1.0);
+        s.seeds = vec![1, 1];
+        let err = s.config().unwrap_err().to_string();
+        assert!(
+            err.contains("seeds must not repeat") && err.contains("[1, 1]"),
+            "{err}"
+        );
+        let mut s = scene(STEP_MARGIN, 1.0);
+        s.groups = vec![AgeGroup::Adult, AgeGroup::Adult];
+        assert!(
+            s.config()
+                .unwrap_err()
+                .to_string()
+                .contains("groups must not repeat")
+        );
     }
 
     #[test]
