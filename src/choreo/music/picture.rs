@@ -105,17 +105,21 @@ pub fn music_png(
             PathElement::new(vec![(t, lo), (t, hi)], blue)
         }))
         .map_err(err)?;
+        // Number the bars where a number fits after the previous one (about 7 px a digit on
+        // the plot's ~1300 px): every bar while they fit, and no number over a short bar's.
+        let s_per_px = t_end / cols as f64;
+        let mut free_from = f64::NEG_INFINITY;
         for (k, b) in analysis.bars.iter().enumerate() {
             c.draw_series(std::iter::once(PathElement::new(
                 vec![(b.start_s, -peak * 1.08), (b.start_s, peak * 1.15)],
                 bar.stroke_width(1),
             )))
             .map_err(err)?;
-            // Number every bar while they fit, else every n-th.
-            let every = (analysis.bars.len() / 60).max(1);
-            if k % every == 0 {
+            let label = format!("{}", k + 1);
+            if b.start_s >= free_from {
+                free_from = b.start_s + (7.0 * label.len() as f64 + 4.0) * s_per_px;
                 c.draw_series(std::iter::once(Text::new(
-                    format!("{}", k + 1),
+                    label,
                     (b.start_s, peak * 1.14),
                     ("sans-serif", 12).into_font().color(&bar),
                 )))
