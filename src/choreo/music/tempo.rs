@@ -143,8 +143,12 @@ pub fn estimate_tempo(
             "10 ≤ min_bpm < max_bpm ≤ 600",
         ));
     }
-    if !(prior.centre_bpm > 0.0 && prior.centre_bpm.is_finite()) {
-        return Err(bad("centre_bpm", prior.centre_bpm, "a positive tempo"));
+    if !(prior.min_bpm..=prior.max_bpm).contains(&prior.centre_bpm) {
+        return Err(bad(
+            "centre_bpm",
+            prior.centre_bpm,
+            "a tempo within min_bpm to max_bpm",
+        ));
     }
     if !(prior.octaves > 0.0 && prior.octaves.is_finite()) {
         return Err(bad("octaves", prior.octaves, "a positive width"));
