@@ -603,6 +603,80 @@ mod tests {
     use super::*;
     use glam::{DQuat, DVec3};
 
+    /// The project's four bars at 120 BPM as a database, built in memory.
+    fn bars_db(tempo_bpm: f64, params: &BuildParams) -> Result<Database, SegmentError> {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/clips/dance_bars.ron");
+        let clip = load_model_clip(&path).unwrap();
+        let beat = Beat {
+            tempo_bpm,
+            first_beat_s: 0.0,
+            source: TempoSource::Manifest,
+        };
+        Database::from_clips(&[("bars".into(), clip, Some(beat))], params)
+    }
+
+    #[test]
+    fn an_inconsistent_database_is_refused_naming_the_segment_and_never_written() {
+        let db = bars_db(120.0, &BuildParams::default()).unwrap();
+        assert_eq!(db.validate(), Ok(()));
+        let mut bad = db.clone();
+        bad.segments[3].clip = 2;
+        let e = bad.validate().unwrap_err();
+        assert!(
+            e.contains("segment 3") && e.contains("names source 2"),
+            "{e}"
+        );
+        let mut bad = db.clone();
+        bad.model = "robot12".into();
+        assert!(bad.validate().unwrap_err().contains("robot12"));
+        let mut bad = db.clone();
+        bad.eros_weights.pop();
+        assert!(bad.validate().unwrap_err().contains("eros_weights holds 3"));
+        let mut bad = db.clone();
+        bad.segments[1].intensity = f64::NAN;
+        let dir = std::env::temp_dir().join(format!("marionette-db-nan-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("db.json");
+        let e = bad.save(&path).unwrap_err().to_string();
+        assert!(e.contains("segment 1") && e.contains("intensity"), "{e}");
+        assert!(!path.exists(), "a database its reader refuses was written");
+        db.save(&path).unwrap();
+        assert_eq!(Database::load(&path).unwrap(), db);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn tempi_and_bar_frames_out_of_bounds_are_refused_before_cutting() {
+        for tempo in [1e9, 1e5, 10.0, f64::NAN] {
+            let e = bars_db(tempo, &BuildParams::default())
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains("20 to 400 BPM"), "{tempo}: {e}");
+        }
+        for bar_frames in [0, 1, 1025, 4_000_000_000] {
+            let params = BuildParams {
+                bar_frames,
+                ..BuildParams::default()
+            };
+            let e = bars_db(120.0, &params).unwrap_err().to_string();
+            assert!(e.contains("bar_frames") && e.contains("2 to 1024"), "{e}");
+        }
+        let clip = |window: Option<(f64, f64)>, tempo_bpm: Option<f64>| Manifest {
+            format_version: 1,
+            clips: vec![ManifestClip {
+                file: "a.bvh".into(),
+                tempo_bpm,
+                first_beat_s: None,
+                window,
+            }],
+        };
+        assert_eq!(clip(Some((1.0, 2.0)), Some(120.0)).check(), Ok(()));
+        let e = clip(Some((f64::NAN, 10.0)), None).check().unwrap_err();
+        assert!(e.contains("clip 1 (a.bvh): window is (NaN, 10)"), "{e}");
+        let e = clip(None, Some(1e9)).check().unwrap_err();
+        assert!(e.contains("tempo_bpm is 1000000000 BPM"), "{e}");
+    }
+
     #[test]
     fn a_clip_is_set_on_its_floor_whatever_height_it_came_at() {
         let model = humanoid24();

@@ -250,6 +250,19 @@ mod tests {
     }
 
     #[test]
+    fn a_prior_centred_outside_the_tempi_considered_is_refused() {
+        let env = pulses(50.0, 3000);
+        for centre_bpm in [1e9, 300.0, 20.0, f64::NAN] {
+            let prior = TempoPrior {
+                centre_bpm,
+                ..TempoPrior::default()
+            };
+            let e = estimate_tempo(&env, &prior).unwrap_err().to_string();
+            assert!(e.contains("centre_bpm"), "{centre_bpm}: {e}");
+        }
+    }
+
+    #[test]
     fn noise_without_pulse_is_weak() {
         let mut s = 7u64;
         let values: Vec<f64> = (0..3000)
