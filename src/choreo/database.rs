@@ -104,14 +104,7 @@ impl Manifest {
                     "{clip}: first_beat_s is {f} s, not a finite time ≥ 0 s"
                 ));
             }
-            if let Some((a, b)) = c.window {
-                if !(a.is_finite() && b.is_finite() && 0.0 <= a && a < b) {
-                    return Err(format!(
-                        "{clip}: window is ({a}, {b}) s, not a finite (start, end) with \
-                         0 ≤ start < end"
-                    ));
-                }
-            }
+            check_window(c.window).map_err(|e| format!("{clip}: {e}"))?;
         }
         Ok(())
     }
@@ -166,6 +159,17 @@ impl Manifest {
     }
 }
 
+/// `Ok` when `window` is none or a finite (start, end) with 0 ≤ start < end, else what is
+/// wrong.
+fn check_window(window: Option<(f64, f64)>) -> Result<(), String> {
+    match window {
+        Some((a, b)) if !(a.is_finite() && b.is_finite() && 0.0 <= a && a < b) => Err(format!(
+            "window is ({a}, {b}) s, not a finite (start, end) with 0 ≤ start < end"
+        )),
+        _ => Ok(()),
+    }
+}
+
 /// Whether a .ron file reads as a manifest.
 fn is_manifest(p: &Path) -> bool {
     crate::io::read_text(p)
@@ -181,6 +185,10 @@ fn clip_segments(
     index: usize,
     params: &BuildParams,
 ) -> Result<(Source, Vec<Segment>), SegmentError> {
+    check_window(c.window).map_err(|message| SegmentError::Manifest {
+        path: name.to_string(),
+        message,
+    })?;
     let mut clip = load_model_clip(&c.file)?;
     if let Some((a, b)) = c.window {
         clip = clip.window(a, b).ok_or_else(|| SegmentError::Manifest {
@@ -344,10 +352,6 @@ impl Database {
         mut progress: impl FnMut(usize, ClipOutcome<'_>),
     ) -> Result<Database, SegmentError> {
         params.check()?;
-        manifest.check().map_err(|message| SegmentError::Manifest {
-            path: "manifest".into(),
-            message,
-        })?;
         let mut sources = vec![];
         let mut skipped = vec![];
         let mut segments = vec![];
