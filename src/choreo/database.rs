@@ -439,7 +439,7 @@ impl Database {
     /// `Ok` when the database is one this build can dance: made on humanoid24, its build
     /// parameters within bounds, every segment naming one of its sources, with
     /// `params.bar_frames` frames of humanoid24's DOFs and points, every source's segment
-    /// count matching, an Eros weight per segment and every number finite (JSON has no NaN:
+    /// count matching, an Eros weight per principal axis and every number finite (JSON has no NaN:
     /// a database holding one could not be read back). Otherwise what is wrong, naming the
     /// segment or source.
     pub fn validate(&self) -> Result<(), String> {
@@ -510,6 +510,19 @@ impl Database {
             if let Some(k) = s.root_rotation.iter().position(|q| !q.is_finite()) {
                 return Err(format!("{seg}: root_rotation[{k}] is not a finite number"));
             }
+            let axes = self.eros_weights.len();
+            let dim = self.segments[0].eros.vectors.first().map_or(0, Vec::len);
+            if s.eros.values.len() != axes
+                || s.eros.vectors.len() != axes
+                || s.eros.vectors.iter().any(|v| v.len() != dim)
+            {
+                return Err(format!(
+                    "{seg}: eros holds {} values and {} axes, the database {axes} Eros weights \
+                     (and axes of {dim} values)",
+                    s.eros.values.len(),
+                    s.eros.vectors.len()
+                ));
+            }
             if s.eros.vectors.iter().any(|v| finite(v).is_some()) {
                 return Err(format!(
                     "{seg}: eros.vectors holds a number that is not finite"
@@ -538,13 +551,6 @@ impl Database {
                     src.fps, src.beat.tempo_bpm, src.beat.first_beat_s, src.window
                 ));
             }
-        }
-        if self.eros_weights.len() != self.segments.len() {
-            return Err(format!(
-                "eros_weights holds {} values for {} segments",
-                self.eros_weights.len(),
-                self.segments.len()
-            ));
         }
         if let Some(k) = finite(&self.eros_weights) {
             return Err(format!("eros_weights[{k}] is not a finite number"));
@@ -635,7 +641,11 @@ mod tests {
         assert!(bad.validate().unwrap_err().contains("robot12"));
         let mut bad = db.clone();
         bad.eros_weights.pop();
-        assert!(bad.validate().unwrap_err().contains("eros_weights holds 3"));
+        let e = bad.validate().unwrap_err();
+        assert!(
+            e.contains("segment 0") && e.contains("15 Eros weights"),
+            "{e}"
+        );
         let mut bad = db.clone();
         bad.segments[1].intensity = f64::NAN;
         let dir = std::env::temp_dir().join(format!("marionette-db-nan-{}", std::process::id()));
