@@ -291,3 +291,259 @@ fn dance_db_skips_what_it_cannot_use_and_says_why() {
     assert!(text.contains("for a song at 58.00 BPM"), "{text}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// `marionette` with `args`, killed and failed after `secs` seconds (a hang is a failure,
+/// never a test left running).
+fn run_within(args: &[&std::ffi::OsStr], secs: u64) -> std::process::Output {
+    use std::process::Stdio;
+    let mut child = Command::new(env!("CARGO_BIN_EXE_marionette"))
+        .args(args)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = std::time::Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if start.elapsed().as_secs() >= secs {
+            child.kill().unwrap();
+            let _ = child.wait();
+            panic!("marionette {args:?} still running after {secs} s");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    child.wait_with_output().unwrap()
+}
+
+/// A fresh temporary folder for one test.
+fn fresh_dir(name: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("marionette-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// A manifest in `dir` of the project's four bars with `fields` added to the clip.
+fn bars_manifest(dir: &std::path::Path, fields: &str) -> std::path::PathBuf {
+    let clip = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/clips/dance_bars.ron");
+    let manifest = dir.join("manifest.ron");
+    std::fs::write(
+        &manifest,
+        format!(
+            "(format_version: 1, clips: [(file: {:?}, {fields})])",
+            clip.display().to_string()
+        ),
+    )
+    .unwrap();
+    manifest
+}
+
+/// Issue 38, point 3: a database whose segment names a missing source, whose counts disagree
+/// or that was made on another model is refused by `dance info` and by `marionette run` alike
+/// (exit 1, never a panic), naming the file, the segment and what is wrong.
+#[test]
+fn a_database_naming_a_missing_source_or_another_model_is_refused_by_info_and_run() {
+    let dir = fresh_dir("dance-db-invalid");
+    let manifest = bars_manifest(&dir, "tempo_bpm: 120.0, first_beat_s: 0.0");
+    let good = dir.join("good.json");
+    let out = run_within(
+        &[
+            "dance".as_ref(),
+            "db".as_ref(),
+            manifest.as_os_str(),
+            "--out".as_ref(),
+            good.as_os_str(),
+        ],
+        120,
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let db: serde_json::Value = serde_json::from_slice(&std::fs::read(&good).unwrap()).unwrap();
+    let edited = |name: &str, edit: &dyn Fn(&mut serde_json::Value)| {
+        let mut v = db.clone();
+        edit(&mut v);
+        let p = dir.join(name);
+        std::fs::write(&p, serde_json::to_vec(&v).unwrap()).unwrap();
+        p
+    };
+    let cases = [
+        (
+            edited("missing_source.json", &|v| {
+                v["segments"][2]["clip"] = 7.into()
+            }),
+            vec!["segment 2", "names source 7", "1 source"],
+        ),
+        (
+            edited("other_model.json", &|v| v["model"] = "robot12".into()),
+            vec!["made on model \"robot12\"", "humanoid24 only"],
+        ),
+        (
+            edited("short_angles.json", &|v| {
+                v["segments"][1]["angles"].as_array_mut().unwrap().pop();
+            }),
+            vec!["segment 1", "angles holds"],
+        ),
+        (
+            edited("count.json", &|v| v["sources"][0]["segments"] = 9.into()),
+            vec!["source 0", "says 9 segment(s), but 4"],
+        ),
+    ];
+    for (path, expected) in &cases {
+        let file = path.file_name().unwrap().to_str().unwrap();
+        let info = run_within(&["dance".as_ref(), "info".as_ref(), path.as_os_str()], 60);
+        let err = String::from_utf8_lossy(&info.stderr);
+        assert_eq!(info.status.code(), Some(1), "dance info {file}: {err}");
+        assert!(err.contains(file), "{err}");
+        for e in expected {
+            assert!(err.contains(e), "dance info {file}: {e:?} not in {err}");
+        }
+        let scene = dir.join(format!("{file}.scene.ron"));
+        std::fs::write(
+            &scene,
+            format!(
+                "Dance(format_version: 1, name: \"bad\", song: Synth(bpm: 120.0, bars: 4, \
+                 bar_levels_db: [-20.0, -20.0, -20.0, -20.0], snr_db: None, lead_in_s: 0.5, \
+                 tail_s: 0.5, seed: 1), database: File({:?}), pins: [], \
+                 dance: (fps: 30.0, seam_frames: 5), render: (gif: false, gif_fps: 15.0))",
+                path.display().to_string()
+            ),
+        )
+        .unwrap();
+        let outdir = dir.join(format!("{file}.out"));
+        let run = run_within(
+            &[
+                "run".as_ref(),
+                scene.as_os_str(),
+                "--out".as_ref(),
+                outdir.as_os_str(),
+            ],
+            120,
+        );
+        let err = String::from_utf8_lossy(&run.stderr);
+        assert_eq!(run.status.code(), Some(1), "run on {file}: {err}");
+        assert!(err.contains(file), "{err}");
+        for e in expected {
+            assert!(err.contains(e), "run on {file}: {e:?} not in {err}");
+        }
+        assert!(!outdir.exists());
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Issue 38, point 4: tempi and bar sizes out of bounds are refused at once, naming the field
+/// or option, its value and the accepted range (a manifest tempo of 1e9 BPM used to hang
+/// `dance db`, 100,000 BPM wrote 97 MB, `--bar-frames 4000000000` aborted on a 32 GB
+/// allocation, `music --prior-bpm 1e9` reported a tempo outside the documented range).
+#[test]
+fn sizes_and_tempi_out_of_bounds_are_refused_before_any_work() {
+    let dir = fresh_dir("dance-bounds");
+    let db = dir.join("db.json");
+    for (tempo, shown) in [("1e9", "1000000000"), ("100000.0", "100000"), ("5.0", "5")] {
+        let manifest = bars_manifest(&dir, &format!("tempo_bpm: {tempo}"));
+        let out = run_within(
+            &[
+                "dance".as_ref(),
+                "db".as_ref(),
+                manifest.as_os_str(),
+                "--out".as_ref(),
+                db.as_os_str(),
+            ],
+            20,
+        );
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "tempo {tempo}: {err}");
+        assert!(
+            err.contains("manifest.ron")
+                && err.contains("tempo_bpm")
+                && err.contains(&format!("{shown} BPM"))
+                && err.contains("20 to 400 BPM"),
+            "tempo {tempo}: {err}"
+        );
+        assert!(!db.exists());
+    }
+    let manifest = bars_manifest(&dir, "tempo_bpm: 120.0");
+    for (option, value, range) in [
+        ("--bar-frames", "4000000000", "2 to 1024"),
+        ("--bar-frames", "1", "2 to 1024"),
+        ("--music-bpm", "1e9", "20 to 400 BPM"),
+    ] {
+        let out = run_within(
+            &[
+                "dance".as_ref(),
+                "db".as_ref(),
+                manifest.as_os_str(),
+                "--out".as_ref(),
+                db.as_os_str(),
+                option.as_ref(),
+                value.as_ref(),
+            ],
+            20,
+        );
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{option} {value}: {err}");
+        assert!(
+            err.contains(option) && err.contains(range),
+            "{option} {value}: {err}"
+        );
+        assert!(!db.exists());
+    }
+    let t = marionette::choreo::music::synth::synthesize(
+        &marionette::choreo::music::synth::SynthSong {
+            bars: 4,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let song = dir.join("song.wav");
+    std::fs::write(&song, wav_bytes(&t.samples, 1, t.sample_rate).unwrap()).unwrap();
+    for value in ["1e9", "10"] {
+        let out = run_within(
+            &[
+                "music".as_ref(),
+                song.as_os_str(),
+                "--prior-bpm".as_ref(),
+                value.as_ref(),
+            ],
+            30,
+        );
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "--prior-bpm {value}: {err}");
+        assert!(
+            err.contains("--prior-bpm") && err.contains("40 to 240 BPM"),
+            "--prior-bpm {value}: {err}"
+        );
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Issue 38, point 5a: a manifest window holding NaN is refused before anything is written
+/// (it used to be written as `null`, and `dance info` then called the file "not a dance
+/// database").
+#[test]
+fn a_window_that_is_not_finite_is_refused_before_writing() {
+    let dir = fresh_dir("dance-nan-window");
+    let db = dir.join("db.json");
+    for window in ["(NaN, 10.0)", "(0.0, inf)", "(3.0, 1.0)"] {
+        let manifest = bars_manifest(&dir, &format!("tempo_bpm: 120.0, window: {window}"));
+        let out = run_within(
+            &[
+                "dance".as_ref(),
+                "db".as_ref(),
+                manifest.as_os_str(),
+                "--out".as_ref(),
+                db.as_os_str(),
+            ],
+            60,
+        );
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "window {window}: {err}");
+        assert!(
+            err.contains("manifest.ron") && err.contains("window") && err.contains("clip 1"),
+            "window {window}: {err}"
+        );
+        assert!(!db.exists(), "window {window}: a database was written");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -22,7 +22,9 @@ use serde::{Deserialize, Serialize};
 
 use super::eros::eros_weights;
 pub use super::segments::BuildParams;
-use super::segments::{Beat, Segment, SegmentError, TempoSource, cut_segments, kinematic_beat};
+use super::segments::{
+    Beat, Segment, SegmentError, TempoSource, check_tempo, cut_segments, kinematic_beat,
+};
 use crate::humanoid::{ModelClip, humanoid24};
 
 /// Newest manifest format this build reads.
@@ -74,11 +76,37 @@ impl Manifest {
                 message: "the manifest lists no clips".into(),
             });
         }
+        if let Err(message) = m.check() {
+            return Err(SegmentError::Manifest {
+                path: origin,
+                message,
+            });
+        }
         let dir = path.parent().unwrap_or(Path::new("."));
         for c in &mut m.clips {
             c.file = dir.join(&c.file);
         }
         Ok(m)
+    }
+
+    /// `Ok` when every clip's numbers are usable: a tempo within
+    /// [`super::segments::TEMPO_RANGE_BPM`], a finite first beat ≥ 0 s and a finite window
+    /// (start, end) with 0 ≤ start < end; else what is wrong, naming the clip (by its place
+    /// and file) and the field.
+    pub fn check(&self) -> Result<(), String> {
+        for (i, c) in self.clips.iter().enumerate() {
+            let clip = format!("clip {} ({})", i + 1, c.file.display());
+            if let Some(t) = c.tempo_bpm {
+                check_tempo("tempo_bpm", t).map_err(|e| format!("{clip}: {e}"))?;
+            }
+            if let Some(f) = c.first_beat_s.filter(|f| !(f.is_finite() && *f >= 0.0)) {
+                return Err(format!(
+                    "{clip}: first_beat_s is {f} s, not a finite time ≥ 0 s"
+                ));
+            }
+            check_window(c.window).map_err(|e| format!("{clip}: {e}"))?;
+        }
+        Ok(())
     }
 
     /// Every .bvh and keyframed .ron clip of a folder (sorted by name; .ron manifests skipped),
@@ -131,6 +159,17 @@ impl Manifest {
     }
 }
 
+/// `Ok` when `window` is none or a finite (start, end) with 0 ≤ start < end, else what is
+/// wrong.
+fn check_window(window: Option<(f64, f64)>) -> Result<(), String> {
+    match window {
+        Some((a, b)) if !(a.is_finite() && b.is_finite() && 0.0 <= a && a < b) => Err(format!(
+            "window is ({a}, {b}) s, not a finite (start, end) with 0 ≤ start < end"
+        )),
+        _ => Ok(()),
+    }
+}
+
 /// Whether a .ron file reads as a manifest.
 fn is_manifest(p: &Path) -> bool {
     crate::io::read_text(p)
@@ -146,6 +185,10 @@ fn clip_segments(
     index: usize,
     params: &BuildParams,
 ) -> Result<(Source, Vec<Segment>), SegmentError> {
+    check_window(c.window).map_err(|message| SegmentError::Manifest {
+        path: name.to_string(),
+        message,
+    })?;
     let mut clip = load_model_clip(&c.file)?;
     if let Some((a, b)) = c.window {
         clip = clip.window(a, b).ok_or_else(|| SegmentError::Manifest {
@@ -308,12 +351,7 @@ impl Database {
         on_refusal: OnRefusal,
         mut progress: impl FnMut(usize, ClipOutcome<'_>),
     ) -> Result<Database, SegmentError> {
-        if params.bar_frames < 2 {
-            return Err(SegmentError::Manifest {
-                path: "build parameters".into(),
-                message: format!("bar_frames must be at least 2, found {}", params.bar_frames),
-            });
-        }
+        params.check()?;
         let mut sources = vec![];
         let mut skipped = vec![];
         let mut segments = vec![];
@@ -356,6 +394,7 @@ impl Database {
                 message: "no clip to build a dance database from".into(),
             });
         }
+        params.check()?;
         let mut sources = vec![];
         let mut segments = vec![];
         for (i, (name, clip, beat)) in clips.iter().enumerate() {
@@ -397,15 +436,145 @@ impl Database {
         serde_json::to_vec(self).expect("a database serialises")
     }
 
-    /// Writes the database (compact JSON) atomically: nothing is left half-written.
+    /// `Ok` when the database is one this build can dance: made on humanoid24, its build
+    /// parameters within bounds, every segment naming one of its sources, with
+    /// `params.bar_frames` frames of humanoid24's DOFs and points, every source's segment
+    /// count matching, an Eros weight per principal axis and every number finite (JSON has no NaN:
+    /// a database holding one could not be read back). Otherwise what is wrong, naming the
+    /// segment or source.
+    pub fn validate(&self) -> Result<(), String> {
+        if self.model != "humanoid24" {
+            return Err(format!(
+                "the database was made on model {:?}; this build dances on humanoid24 only",
+                self.model
+            ));
+        }
+        self.params.check().map_err(|e| match e {
+            SegmentError::Manifest { message, .. } => format!("params: {message}"),
+            e => e.to_string(),
+        })?;
+        let model = humanoid24();
+        let dofs = model.dofs.len();
+        let points = model.skeleton().point_parents().len();
+        let links = points - 1;
+        let n = self.params.bar_frames;
+        let finite = |v: &[f64]| v.iter().position(|x| !x.is_finite());
+        let finite3 = |v: &[glam::DVec3]| v.iter().position(|x| !x.is_finite());
+        let mut counts = vec![0usize; self.sources.len()];
+        for (i, s) in self.segments.iter().enumerate() {
+            let seg = format!("segment {i} (bar {} of source {})", s.bar, s.clip);
+            let Some(c) = counts.get_mut(s.clip) else {
+                return Err(format!(
+                    "{seg} names source {}, but the database has {} source(s)",
+                    s.clip,
+                    self.sources.len()
+                ));
+            };
+            *c += 1;
+            let lengths = [
+                ("root_translation", s.root_translation.len(), n),
+                ("root_rotation", s.root_rotation.len(), n),
+                ("angles", s.angles.len(), n * dofs),
+                ("first_directions", s.first_directions.len(), links),
+                ("last_directions", s.last_directions.len(), links),
+                ("first_velocities", s.first_velocities.len(), points),
+                ("last_velocities", s.last_velocities.len(), points),
+            ];
+            for (field, got, want) in lengths {
+                if got != want {
+                    return Err(format!(
+                        "{seg}: {field} holds {got} values, {want} expected ({n} frames of \
+                         humanoid24's {dofs} DOFs and {points} points)"
+                    ));
+                }
+            }
+            if !(s.start_s.is_finite() && s.end_s.is_finite() && s.start_s < s.end_s) {
+                return Err(format!(
+                    "{seg}: the bar spans {} to {} s, not a finite start before its end",
+                    s.start_s, s.end_s
+                ));
+            }
+            let bad = [
+                ("intensity", finite(std::slice::from_ref(&s.intensity))),
+                ("angles", finite(&s.angles)),
+                ("root_translation", finite3(&s.root_translation)),
+                ("first_directions", finite3(&s.first_directions)),
+                ("last_directions", finite3(&s.last_directions)),
+                ("first_velocities", finite3(&s.first_velocities)),
+                ("last_velocities", finite3(&s.last_velocities)),
+                ("eros.values", finite(&s.eros.values)),
+            ];
+            if let Some((field, Some(k))) = bad.into_iter().find(|(_, k)| k.is_some()) {
+                return Err(format!("{seg}: {field}[{k}] is not a finite number"));
+            }
+            if let Some(k) = s.root_rotation.iter().position(|q| !q.is_finite()) {
+                return Err(format!("{seg}: root_rotation[{k}] is not a finite number"));
+            }
+            let axes = self.eros_weights.len();
+            let dim = self.segments[0].eros.vectors.first().map_or(0, Vec::len);
+            if s.eros.values.len() != axes
+                || s.eros.vectors.len() != axes
+                || s.eros.vectors.iter().any(|v| v.len() != dim)
+            {
+                return Err(format!(
+                    "{seg}: eros holds {} values and {} axes, the database {axes} Eros weights \
+                     (and axes of {dim} values)",
+                    s.eros.values.len(),
+                    s.eros.vectors.len()
+                ));
+            }
+            if s.eros.vectors.iter().any(|v| finite(v).is_some()) {
+                return Err(format!(
+                    "{seg}: eros.vectors holds a number that is not finite"
+                ));
+            }
+        }
+        for (k, (src, &got)) in self.sources.iter().zip(&counts).enumerate() {
+            let name = format!("source {k} ({})", src.file);
+            if src.segments != got {
+                return Err(format!(
+                    "{name} says {} segment(s), but {got} segment(s) name it",
+                    src.segments
+                ));
+            }
+            let window_ok = src
+                .window
+                .is_none_or(|(a, b)| a.is_finite() && b.is_finite());
+            let numbers_ok = src.fps.is_finite()
+                && src.fps > 0.0
+                && src.beat.tempo_bpm.is_finite()
+                && src.beat.first_beat_s.is_finite();
+            if !(window_ok && numbers_ok) {
+                return Err(format!(
+                    "{name}: fps {}, tempo {} BPM, first beat {} s, window {:?}: a number is \
+                     not finite (or fps not positive)",
+                    src.fps, src.beat.tempo_bpm, src.beat.first_beat_s, src.window
+                ));
+            }
+        }
+        if let Some(k) = finite(&self.eros_weights) {
+            return Err(format!("eros_weights[{k}] is not a finite number"));
+        }
+        Ok(())
+    }
+
+    /// Writes the database (compact JSON) atomically: nothing is left half-written. A
+    /// database that [`Database::validate`] refuses (its own reader would) is not written.
     pub fn save(&self, path: &Path) -> Result<(), SegmentError> {
+        self.validate()
+            .map_err(|message| SegmentError::InvalidDatabase {
+                path: format!("{} (not written)", path.display()),
+                message,
+            })?;
         crate::io::write_atomic(path, &self.to_json()).map_err(|e| SegmentError::Load {
             path: path.display().to_string(),
             source: Box::new(e.into()),
         })
     }
 
-    /// Reads a database written by [`Database::save`].
+    /// Reads a database written by [`Database::save`] and checks it ([`Database::validate`]):
+    /// one that is inconsistent or made on another model is refused, naming the file, the
+    /// segment or source and what is wrong.
     pub fn load(path: &Path) -> Result<Database, SegmentError> {
         let origin = path.display().to_string();
         let bytes = std::fs::read(path).map_err(|e| SegmentError::Load {
@@ -425,6 +594,11 @@ impl Database {
                 ),
             });
         }
+        db.validate()
+            .map_err(|message| SegmentError::InvalidDatabase {
+                path: origin,
+                message,
+            })?;
         Ok(db)
     }
 
@@ -438,6 +612,84 @@ impl Database {
 mod tests {
     use super::*;
     use glam::{DQuat, DVec3};
+
+    /// The project's four bars at 120 BPM as a database, built in memory.
+    fn bars_db(tempo_bpm: f64, params: &BuildParams) -> Result<Database, SegmentError> {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/clips/dance_bars.ron");
+        let clip = load_model_clip(&path).unwrap();
+        let beat = Beat {
+            tempo_bpm,
+            first_beat_s: 0.0,
+            source: TempoSource::Manifest,
+        };
+        Database::from_clips(&[("bars".into(), clip, Some(beat))], params)
+    }
+
+    #[test]
+    fn an_inconsistent_database_is_refused_naming_the_segment_and_never_written() {
+        let db = bars_db(120.0, &BuildParams::default()).unwrap();
+        assert_eq!(db.validate(), Ok(()));
+        let mut bad = db.clone();
+        bad.segments[3].clip = 2;
+        let e = bad.validate().unwrap_err();
+        assert!(
+            e.contains("segment 3") && e.contains("names source 2"),
+            "{e}"
+        );
+        let mut bad = db.clone();
+        bad.model = "robot12".into();
+        assert!(bad.validate().unwrap_err().contains("robot12"));
+        let mut bad = db.clone();
+        bad.eros_weights.pop();
+        let e = bad.validate().unwrap_err();
+        assert!(
+            e.contains("segment 0") && e.contains("15 Eros weights"),
+            "{e}"
+        );
+        let mut bad = db.clone();
+        bad.segments[1].intensity = f64::NAN;
+        let dir = std::env::temp_dir().join(format!("marionette-db-nan-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("db.json");
+        let e = bad.save(&path).unwrap_err().to_string();
+        assert!(e.contains("segment 1") && e.contains("intensity"), "{e}");
+        assert!(!path.exists(), "a database its reader refuses was written");
+        db.save(&path).unwrap();
+        assert_eq!(Database::load(&path).unwrap(), db);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn tempi_and_bar_frames_out_of_bounds_are_refused_before_cutting() {
+        for tempo in [1e9, 1e5, 10.0, f64::NAN] {
+            let e = bars_db(tempo, &BuildParams::default())
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains("20 to 400 BPM"), "{tempo}: {e}");
+        }
+        for bar_frames in [0, 1, 1025, 4_000_000_000] {
+            let params = BuildParams {
+                bar_frames,
+                ..BuildParams::default()
+            };
+            let e = bars_db(120.0, &params).unwrap_err().to_string();
+            assert!(e.contains("bar_frames") && e.contains("2 to 1024"), "{e}");
+        }
+        let clip = |window: Option<(f64, f64)>, tempo_bpm: Option<f64>| Manifest {
+            format_version: 1,
+            clips: vec![ManifestClip {
+                file: "a.bvh".into(),
+                tempo_bpm,
+                first_beat_s: None,
+                window,
+            }],
+        };
+        assert_eq!(clip(Some((1.0, 2.0)), Some(120.0)).check(), Ok(()));
+        let e = clip(Some((f64::NAN, 10.0)), None).check().unwrap_err();
+        assert!(e.contains("clip 1 (a.bvh): window is (NaN, 10)"), "{e}");
+        let e = clip(None, Some(1e9)).check().unwrap_err();
+        assert!(e.contains("tempo_bpm is 1000000000 BPM"), "{e}");
+    }
 
     #[test]
     fn a_clip_is_set_on_its_floor_whatever_height_it_came_at() {

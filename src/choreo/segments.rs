@@ -23,6 +23,29 @@ use crate::humanoid::ModelClip;
 /// Counts (beats) per segment: one bar of 4/4.
 pub const BEATS_PER_BAR: usize = 4;
 
+/// The tempi a clip's beat or a song may have (BPM, both ends included): a tempo given in a
+/// manifest, a song's tempo (`--music-bpm`) or a scene's. Outside it a bar is shorter than
+/// 0.6 s or longer than 12 s, no dance a database is built for.
+pub const TEMPO_RANGE_BPM: (f64, f64) = (20.0, 400.0);
+
+/// The frames every bar may be resampled to ([`BuildParams::bar_frames`], both ends included):
+/// at least 2 (a first and a last frame), at most 1024 (32 times the default, a bar of 3 s at
+/// 340 fps; each segment's size grows with it).
+pub const BAR_FRAMES_RANGE: (usize, usize) = (2, 1024);
+
+/// `Ok` when `bpm` is a tempo within [`TEMPO_RANGE_BPM`], else what is wrong with `what` (the
+/// option or field that gave it).
+pub fn check_tempo(what: &str, bpm: f64) -> Result<(), String> {
+    let (lo, hi) = TEMPO_RANGE_BPM;
+    if bpm.is_finite() && (lo..=hi).contains(&bpm) {
+        Ok(())
+    } else {
+        Err(format!(
+            "{what} is {bpm} BPM, outside the accepted range {lo} to {hi} BPM"
+        ))
+    }
+}
+
 /// Slowest tempo the kinematic beat looks for, beats per minute.
 pub const MIN_BPM: f64 = 60.0;
 
@@ -96,6 +119,15 @@ pub enum SegmentError {
     NoUsableClip {
         /// Every clip and why it was refused.
         skipped: Vec<super::database::Skipped>,
+    },
+    /// A database whose content is inconsistent or not for this build: a segment naming a
+    /// missing source, another model, lengths that disagree, a number that is not finite.
+    #[error("{path}: {message}")]
+    InvalidDatabase {
+        /// The file (or "database" when it is not yet written).
+        path: String,
+        /// What is wrong, naming the segment or source.
+        message: String,
     },
     /// A database file that could not be read or is not a database.
     #[error("{path}: not a dance database: {message}")]
@@ -310,6 +342,32 @@ pub struct BuildParams {
     pub music_bpm: Option<f64>,
 }
 
+impl BuildParams {
+    /// `Ok` when every parameter is within its bounds ([`BAR_FRAMES_RANGE`], a song tempo
+    /// within [`TEMPO_RANGE_BPM`], finite weights), else an error naming the parameter, its
+    /// value and the accepted range. Checked before any clip is read.
+    pub fn check(&self) -> Result<(), SegmentError> {
+        let bad = |message: String| SegmentError::Manifest {
+            path: "build parameters".into(),
+            message,
+        };
+        let (lo, hi) = BAR_FRAMES_RANGE;
+        if !(lo..=hi).contains(&self.bar_frames) {
+            return Err(bad(format!(
+                "bar_frames is {}, outside the accepted range {lo} to {hi}",
+                self.bar_frames
+            )));
+        }
+        if let Some(m) = self.music_bpm {
+            check_tempo("music_bpm", m).map_err(bad)?;
+        }
+        if let Some((i, a)) = self.alpha.iter().enumerate().find(|(_, a)| !a.is_finite()) {
+            return Err(bad(format!("alpha[{i}] is {a}, not a finite weight")));
+        }
+        Ok(())
+    }
+}
+
 impl Default for BuildParams {
     /// 32 frames per bar, unit weights, 16 Eros axes, no song tempo.
     fn default() -> BuildParams {
@@ -454,17 +512,17 @@ pub fn cut_segments(
     params: &BuildParams,
 ) -> Result<Vec<Segment>, SegmentError> {
     let (bar_frames, alpha) = (params.bar_frames, &params.alpha);
-    let usable = beat.tempo_bpm.is_finite()
-        && beat.tempo_bpm > 0.0
-        && beat.first_beat_s.is_finite()
-        && beat.first_beat_s >= 0.0;
-    if !usable {
+    params.check()?;
+    check_tempo("the tempo", beat.tempo_bpm).map_err(|message| SegmentError::Tempo {
+        clip: name.to_string(),
+        message,
+    })?;
+    if !(beat.first_beat_s.is_finite() && beat.first_beat_s >= 0.0) {
         return Err(SegmentError::Tempo {
             clip: name.to_string(),
             message: format!(
-                "tempo must be a positive number of BPM and the first beat a time ≥ 0 s, found \
-                 {} BPM and {} s",
-                beat.tempo_bpm, beat.first_beat_s
+                "the first beat must be a time ≥ 0 s, found {} s",
+                beat.first_beat_s
             ),
         });
     }

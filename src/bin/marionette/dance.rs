@@ -9,7 +9,7 @@ use std::time::Instant;
 use anyhow::Result;
 
 use marionette::choreo::database::{BuildParams, ClipOutcome, Database, Manifest, OnRefusal};
-use marionette::choreo::segments::TempoSource;
+use marionette::choreo::segments::{BAR_FRAMES_RANGE, TempoSource, check_tempo};
 
 // The command's arguments (its help text is on `Command::Dance`).
 #[derive(clap::Args)]
@@ -66,8 +66,14 @@ pub fn dance(a: Args) -> Result<()> {
             music_bpm,
             strict,
         } => {
-            if let Some(m) = music_bpm.filter(|m| !(m.is_finite() && *m > 0.0)) {
-                anyhow::bail!("--music-bpm must be a positive number of BPM, found {m}");
+            let (lo, hi) = BAR_FRAMES_RANGE;
+            if !(lo..=hi).contains(&bar_frames) {
+                anyhow::bail!(
+                    "--bar-frames is {bar_frames}, outside the accepted range {lo} to {hi}"
+                );
+            }
+            if let Some(m) = music_bpm {
+                check_tempo("--music-bpm", m).map_err(anyhow::Error::msg)?;
             }
             let manifest = Manifest::from_path(&input)?;
             let n = manifest.clips.len();

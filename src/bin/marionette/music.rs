@@ -24,7 +24,7 @@ pub struct Args {
     /// Which of the first beats is the first downbeat (0-based); chosen from the signal if absent.
     #[arg(long)]
     downbeat: Option<usize>,
-    /// Centre of the tempo prior (BPM).
+    /// Centre of the tempo prior (BPM), within the tempi considered (40 to 240 BPM).
     #[arg(long)]
     prior_bpm: Option<f64>,
     /// Width of the tempo prior (octaves, one standard deviation).
@@ -52,18 +52,25 @@ struct Report<'a> {
 
 /// Runs `music`: analyses the song, prints the report (or JSON) and draws the picture.
 pub fn music(args: Args) -> Result<()> {
-    let audio = decode_file(&args.song)?;
     let mut params = MusicParams {
         downbeat: args.downbeat,
         beats_per_bar: args.beats_per_bar,
         ..MusicParams::default()
     };
     if let Some(c) = args.prior_bpm {
+        let (lo, hi) = (params.prior.min_bpm, params.prior.max_bpm);
+        if !(c.is_finite() && (lo..=hi).contains(&c)) {
+            anyhow::bail!(
+                "--prior-bpm is {c} BPM, outside the accepted range {lo} to {hi} BPM (the tempi \
+                 the analysis considers)"
+            );
+        }
         params.prior.centre_bpm = c;
     }
     if let Some(o) = args.prior_octaves {
         params.prior.octaves = o;
     }
+    let audio = decode_file(&args.song)?;
     let a = analyze(&audio.samples, audio.sample_rate, &params)
         .with_context(|| args.song.display().to_string())?;
     if let Some(out) = &args.out {

@@ -143,8 +143,12 @@ pub fn estimate_tempo(
             "10 ≤ min_bpm < max_bpm ≤ 600",
         ));
     }
-    if !(prior.centre_bpm > 0.0 && prior.centre_bpm.is_finite()) {
-        return Err(bad("centre_bpm", prior.centre_bpm, "a positive tempo"));
+    if !(prior.min_bpm..=prior.max_bpm).contains(&prior.centre_bpm) {
+        return Err(bad(
+            "centre_bpm",
+            prior.centre_bpm,
+            "a tempo within min_bpm to max_bpm",
+        ));
     }
     if !(prior.octaves > 0.0 && prior.octaves.is_finite()) {
         return Err(bad("octaves", prior.octaves, "a positive width"));
@@ -242,6 +246,19 @@ mod tests {
                 .into_iter()
                 .find(|k| (t.bpm / (k * bpm) - 1.0).abs() < 0.01);
             assert!(level.is_some(), "{bpm}: {}", t.bpm);
+        }
+    }
+
+    #[test]
+    fn a_prior_centred_outside_the_tempi_considered_is_refused() {
+        let env = pulses(50.0, 3000);
+        for centre_bpm in [1e9, 300.0, 20.0, f64::NAN] {
+            let prior = TempoPrior {
+                centre_bpm,
+                ..TempoPrior::default()
+            };
+            let e = estimate_tempo(&env, &prior).unwrap_err().to_string();
+            assert!(e.contains("centre_bpm"), "{centre_bpm}: {e}");
         }
     }
 
