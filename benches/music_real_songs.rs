@@ -11,6 +11,8 @@ mod pop909;
 
 use std::path::PathBuf;
 
+use marionette::choreo::music::eval::median;
+
 fn main() {
     if std::env::args().any(|a| a == "--list") {
         return;
@@ -76,9 +78,9 @@ fn main() {
         println!("  {}", pop909::line("marionette", &pick(&ours)));
         println!("  {}", pop909::line("librosa", &pick(&theirs)));
     }
-    let ours_s = pop909::median(&ours.iter().map(|t| t.seconds).collect::<Vec<_>>());
-    let theirs_s = pop909::median(&theirs.iter().map(|t| t.seconds).collect::<Vec<_>>());
-    let decode_s = pop909::median(
+    let ours_s = median(&ours.iter().map(|t| t.seconds).collect::<Vec<_>>());
+    let theirs_s = median(&theirs.iter().map(|t| t.seconds).collect::<Vec<_>>());
+    let decode_s = median(
         &ours
             .iter()
             .filter_map(|t| t.decode_seconds)

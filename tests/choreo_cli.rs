@@ -1,6 +1,7 @@
 //! `marionette music` on a song the test synthesizes and writes as WAV: the text report, the
 //! JSON object other tools read, the picture, and a clear error for a file that is not audio.
 
+use std::path::Path;
 use std::process::Command;
 
 use marionette::choreo::music::synth::{SynthSong, synthesize};
@@ -292,6 +293,19 @@ fn dance_db_skips_what_it_cannot_use_and_says_why() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// `marionette dance db INPUT --out DB EXTRA…`, killed after `secs` (see [`run_within`]).
+fn dance_db(input: &Path, db: &Path, extra: &[&str], secs: u64) -> std::process::Output {
+    let mut args: Vec<&std::ffi::OsStr> = vec![
+        "dance".as_ref(),
+        "db".as_ref(),
+        input.as_os_str(),
+        "--out".as_ref(),
+        db.as_os_str(),
+    ];
+    args.extend(extra.iter().map(|a| std::ffi::OsStr::new(*a)));
+    run_within(&args, secs)
+}
+
 /// `marionette` with `args`, killed and failed after `secs` seconds (a hang is a failure,
 /// never a test left running).
 fn run_within(args: &[&std::ffi::OsStr], secs: u64) -> std::process::Output {
@@ -345,16 +359,7 @@ fn a_database_naming_a_missing_source_or_another_model_is_refused_by_info_and_ru
     let dir = fresh_dir("dance-db-invalid");
     let manifest = bars_manifest(&dir, "tempo_bpm: 120.0, first_beat_s: 0.0");
     let good = dir.join("good.json");
-    let out = run_within(
-        &[
-            "dance".as_ref(),
-            "db".as_ref(),
-            manifest.as_os_str(),
-            "--out".as_ref(),
-            good.as_os_str(),
-        ],
-        120,
-    );
+    let out = dance_db(&manifest, &good, &[], 120);
     assert!(
         out.status.success(),
         "{}",
@@ -442,16 +447,7 @@ fn sizes_and_tempi_out_of_bounds_are_refused_before_any_work() {
     let db = dir.join("db.json");
     for (tempo, shown) in [("1e9", "1000000000"), ("100000.0", "100000"), ("5.0", "5")] {
         let manifest = bars_manifest(&dir, &format!("tempo_bpm: {tempo}"));
-        let out = run_within(
-            &[
-                "dance".as_ref(),
-                "db".as_ref(),
-                manifest.as_os_str(),
-                "--out".as_ref(),
-                db.as_os_str(),
-            ],
-            20,
-        );
+        let out = dance_db(&manifest, &db, &[], 20);
         let err = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(1), "tempo {tempo}: {err}");
         assert!(
@@ -469,18 +465,7 @@ fn sizes_and_tempi_out_of_bounds_are_refused_before_any_work() {
         ("--bar-frames", "1", "2 to 1024"),
         ("--music-bpm", "1e9", "20 to 400 BPM"),
     ] {
-        let out = run_within(
-            &[
-                "dance".as_ref(),
-                "db".as_ref(),
-                manifest.as_os_str(),
-                "--out".as_ref(),
-                db.as_os_str(),
-                option.as_ref(),
-                value.as_ref(),
-            ],
-            20,
-        );
+        let out = dance_db(&manifest, &db, &[option, value], 20);
         let err = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(1), "{option} {value}: {err}");
         assert!(
@@ -527,16 +512,7 @@ fn a_window_that_is_not_finite_is_refused_before_writing() {
     let db = dir.join("db.json");
     for window in ["(NaN, 10.0)", "(0.0, inf)", "(3.0, 1.0)"] {
         let manifest = bars_manifest(&dir, &format!("tempo_bpm: 120.0, window: {window}"));
-        let out = run_within(
-            &[
-                "dance".as_ref(),
-                "db".as_ref(),
-                manifest.as_os_str(),
-                "--out".as_ref(),
-                db.as_os_str(),
-            ],
-            60,
-        );
+        let out = dance_db(&manifest, &db, &[], 60);
         let err = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(1), "window {window}: {err}");
         assert!(

@@ -214,21 +214,6 @@ pub fn means(rows: &[BeatScores]) -> [f64; 6] {
     ]
 }
 
-/// The median of `xs`.
-pub fn median(xs: &[f64]) -> f64 {
-    let mut v = xs.to_vec();
-    v.sort_by(f64::total_cmp);
-    let k = v.len();
-    if k == 0 {
-        return f64::NAN;
-    }
-    if k % 2 == 1 {
-        v[k / 2]
-    } else {
-        0.5 * (v[k / 2 - 1] + v[k / 2])
-    }
-}
-
 /// One line of the table: a tracker's means over a set of songs.
 pub fn line(name: &str, rows: &[BeatScores]) -> String {
     let [f, cmlt, amlt, a1, a2, df] = means(rows);

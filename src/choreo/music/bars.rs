@@ -33,7 +33,7 @@ pub struct Bar {
 }
 
 /// Strength of `x` at beat frame `f`: its maximum within ±2 frames.
-fn at(x: &[f64], f: f64) -> f64 {
+pub(super) fn at(x: &[f64], f: f64) -> f64 {
     let c = f.round() as usize;
     let lo = c.saturating_sub(2);
     let hi = (c + 3).min(x.len());
@@ -110,21 +110,6 @@ pub fn regular_downbeats(first: usize, beats_per_bar: usize, n: usize) -> Vec<us
     (first..n).step_by(beats_per_bar.max(1)).collect()
 }
 
-/// The downbeat phase (0 .. beats_per_bar) of `beat_frames` on `env`: the phase whose beats
-/// carry the most downbeat evidence on average (every bar of the same length).
-pub fn downbeat_phase(env: &OnsetEnvelope, beat_frames: &[f64], beats_per_bar: usize) -> usize {
-    let z = downbeat_evidence(env, beat_frames);
-    (0..beats_per_bar)
-        .max_by(|&a, &b| {
-            let m = |phi: usize| {
-                let v: Vec<f64> = z.iter().skip(phi).step_by(beats_per_bar).copied().collect();
-                v.iter().sum::<f64>() / v.len().max(1) as f64
-            };
-            m(a).total_cmp(&m(b))
-        })
-        .unwrap_or(0)
-}
-
 /// Bar spans (start, end) in seconds from beat times, the indices of the beats that start bars
 /// (increasing), beats per bar and the song's duration (see the module docs).
 pub fn bars_from_downbeats(
@@ -152,23 +137,6 @@ pub fn bars_from_downbeats(
     out
 }
 
-/// Bar spans of `beats_per_bar` beats each from the downbeat at index `downbeat` (see
-/// [`bars_from_downbeats`]).
-pub fn bars_from_beats(
-    beats_s: &[f64],
-    downbeat: usize,
-    beats_per_bar: usize,
-    duration_s: f64,
-) -> Vec<(f64, f64)> {
-    let d = regular_downbeats(downbeat, beats_per_bar, beats_s.len());
-    // The last bar needs all its beats but its closing downbeat.
-    let whole: Vec<usize> = d
-        .into_iter()
-        .filter(|&i| i + beats_per_bar - 1 < beats_s.len())
-        .collect();
-    bars_from_downbeats(beats_s, &whole, beats_per_bar, duration_s)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -176,12 +144,13 @@ mod tests {
     #[test]
     fn bars_group_beats_from_the_downbeat_and_the_last_is_extrapolated() {
         let beats: Vec<f64> = (0..11).map(|i| 0.5 * i as f64).collect();
-        let bars = bars_from_beats(&beats, 1, 4, 10.0);
-        assert_eq!(bars, vec![(0.5, 2.5), (2.5, 4.5)]);
-        // Nine beats after the phase: the third bar's end 5.0 + 2.0 is past a 6.8 s song.
-        assert_eq!(bars_from_beats(&beats, 1, 4, 6.8).len(), 2);
-        let bars = bars_from_beats(&beats[..10], 2, 4, 10.0);
-        assert_eq!(bars, vec![(1.0, 3.0), (3.0, 5.0)]);
+        let downbeats = regular_downbeats(1, 4, beats.len());
+        assert_eq!(downbeats, vec![1, 5, 9]);
+        // The last bar, from beat 9 without its closing downbeat, is one fitted bar long.
+        let bars = bars_from_downbeats(&beats, &downbeats, 4, 10.0);
+        assert_eq!(bars, vec![(0.5, 2.5), (2.5, 4.5), (4.5, 6.5)]);
+        // Its end 6.5 is past a 6.4 s song: it is left out.
+        assert_eq!(bars_from_downbeats(&beats, &downbeats, 4, 6.4).len(), 2);
     }
 
     #[test]
@@ -201,7 +170,8 @@ mod tests {
             values,
             low,
         };
-        assert_eq!(downbeat_phase(&env, &frames, 4), 3);
+        let z = downbeat_evidence(&env, &frames);
+        assert_eq!(track_downbeats(&z, 4, f64::INFINITY)[0], 3);
     }
 
     #[test]

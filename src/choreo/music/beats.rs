@@ -179,12 +179,7 @@ fn local_score(values: &[f64], period: f64) -> Vec<f64> {
 /// and the midpoints do not, near 1 or above when the midpoints are beats too. 0 for fewer than
 /// two beats.
 pub fn midpoint_ratio(env: &OnsetEnvelope, frames: &[f64]) -> f64 {
-    let at = |f: f64| {
-        let c = f.round() as usize;
-        let (lo, hi) = (c.saturating_sub(2), (c + 3).min(env.values.len()));
-        let m = |x: &[f64]| x[lo.min(hi)..hi].iter().fold(0.0f64, |m, &v| m.max(v));
-        m(&env.values) + m(&env.low)
-    };
+    let at = |f: f64| super::bars::at(&env.values, f) + super::bars::at(&env.low, f);
     if frames.len() < 2 {
         return 0.0;
     }

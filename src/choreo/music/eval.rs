@@ -249,20 +249,22 @@ pub fn continuity(estimated: &[f64], reference: &[f64]) -> Continuity {
     }
 }
 
+/// The median of `xs` (NaN when empty).
+pub fn median(xs: &[f64]) -> f64 {
+    let mut v = xs.to_vec();
+    v.sort_by(f64::total_cmp);
+    let k = v.len();
+    match k {
+        0 => f64::NAN,
+        _ if k % 2 == 1 => v[k / 2],
+        _ => 0.5 * (v[k / 2 - 1] + v[k / 2]),
+    }
+}
+
 /// The tempo (BPM) of annotated beats: 60 over their median interval (NaN for fewer than two).
 pub fn reference_tempo(reference: &[f64]) -> f64 {
-    let mut iv: Vec<f64> = reference.windows(2).map(|w| w[1] - w[0]).collect();
-    if iv.is_empty() {
-        return f64::NAN;
-    }
-    iv.sort_by(f64::total_cmp);
-    let k = iv.len();
-    let median = if k % 2 == 1 {
-        iv[k / 2]
-    } else {
-        0.5 * (iv[k / 2 - 1] + iv[k / 2])
-    };
-    60.0 / median
+    let iv: Vec<f64> = reference.windows(2).map(|w| w[1] - w[0]).collect();
+    60.0 / median(&iv)
 }
 
 /// Acc1: `estimated_bpm` within [`TEMPO_TOLERANCE`] of `reference_bpm`.

@@ -35,7 +35,7 @@ use std::path::PathBuf;
 
 use serde::{Deserialize, Serialize};
 
-pub use bars::{Bar, bars_from_beats, bars_from_downbeats, downbeat_evidence, track_downbeats};
+pub use bars::{Bar, bars_from_downbeats, downbeat_evidence, track_downbeats};
 pub use beats::{BeatParams, track_beats};
 pub use intensity::{bar_intensity, rms_db};
 pub use onsets::{OnsetEnvelope, OnsetParams, onset_envelope};
