@@ -2,9 +2,8 @@
 //! scene (the clips and song it was tuned on) and on a dance from clips kept out of all tuning
 //! (`dance_more`) to another song: no foot in the floor, no more skating than its sources, its
 //! intensity following the music's, seams (Σ C, the paper's measure) no costlier than the
-//! paper's fill by more than 1.2×, and every clip of the folder used or named as skipped. Beat
-//! alignment at least its sources' is asserted on the salsa dance; on the held-out dance it is
-//! printed with the seam jerk (measured 0.373 against the sources' 0.384: not met there).
+//! paper's fill by more than 1.2×, every clip of the folder used or named as skipped, and beat
+//! alignment at least its sources'. The seam jerk is printed beside the paper's fill's.
 
 mod common;
 
@@ -35,13 +34,7 @@ fn f(v: &serde_json::Value) -> f64 {
 }
 
 /// The checks on a dance's report, and the seams against the paper's fill (κ = 0).
-fn check(
-    what: &str,
-    r: &serde_json::Value,
-    paper: &serde_json::Value,
-    folder: &Path,
-    beats_at_least_the_sources: bool,
-) {
+fn check(what: &str, r: &serde_json::Value, paper: &serde_json::Value, folder: &Path) {
     let m = &r["metrics"];
     let pen = &m["foot_penetration"];
     let src = &m["sources"];
@@ -68,12 +61,10 @@ fn check(
         f(&m["foot_skating_m_s"]) <= 1.1 * f(&src["foot_skating_m_s"]),
         "{what}: skates more than its sources"
     );
-    if beats_at_least_the_sources {
-        assert!(
-            f(&m["beat_alignment_score"]) >= f(&src["beat_alignment_score"]),
-            "{what}: beats off the music"
-        );
-    }
+    assert!(
+        f(&m["beat_alignment_score"]) >= f(&src["beat_alignment_score"]),
+        "{what}: beats off the music"
+    );
     assert!(f(&m["intensity_spearman"]) >= 0.6, "{what}: intensity");
     let (cost, cost_paper) = (
         f(&m["transition_cost"]),
@@ -127,7 +118,7 @@ fn the_salsa_dance_stands_on_the_floor_lands_on_the_beat_and_follows_the_music()
         &["render.gif=false", "fill.intensity_weight=0"],
         &d.join("paper"),
     );
-    check("salsa", &r, &paper, &folder, true);
+    check("salsa", &r, &paper, &folder);
     std::fs::remove_dir_all(&d).unwrap();
 }
 
@@ -165,7 +156,6 @@ fn a_dance_from_clips_kept_out_of_tuning_passes_the_same_checks() {
         &r,
         &paper,
         &folder,
-        false,
     );
     std::fs::remove_dir_all(&d).unwrap();
 }

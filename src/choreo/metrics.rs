@@ -218,6 +218,7 @@ pub fn source_metrics(db: &Database, segments: &[usize], fps: f64) -> SourceMetr
         fps,
         seam_frames: 0,
         beat_warp: false,
+        seam: super::dance::Seam::Spline,
     };
     let (mut skate_sum, mut skate_n, mut bas_sum, mut count) = (0.0, 0.0, 0.0, 0usize);
     for &s in segments {

@@ -20,7 +20,7 @@ use glam::{DQuat, DVec3};
 use rand::{Rng, RngExt, SeedableRng};
 use serde::{Deserialize, Serialize};
 
-use crate::choreo::dance::{DanceError, DanceParams, assemble};
+use crate::choreo::dance::{DanceError, DanceParams, Seam, assemble};
 use crate::choreo::database::{BuildParams, DATABASE_VERSION, Database, Source};
 use crate::choreo::eros::eros_weights;
 use crate::choreo::fill::{FillError, FillParams, Pins, check, fill_with_table};
@@ -69,7 +69,7 @@ pub struct DanceFillConfig {
 
 impl Default for DanceFillConfig {
     /// 16 bars of 2 s, 40 pin sets of 3 pins, 30 fps, 5 seam frames, the paper's uniform
-    /// resize (no beat warp: Fig. 5 measures the paper's assembly), seed 1.
+    /// resize and seam spline (no beat warp: Fig. 5 measures the paper's assembly), seed 1.
     fn default() -> DanceFillConfig {
         DanceFillConfig {
             bars: 16,
@@ -79,6 +79,7 @@ impl Default for DanceFillConfig {
             fill: FillParams::paper(),
             dance: DanceParams {
                 beat_warp: false,
+                seam: Seam::Spline,
                 ..DanceParams::default()
             },
             seed: 1,
