@@ -556,3 +556,90 @@ fn clients_that_stall_hold_no_one_else_up() {
     assert_eq!(post(a, "/api/generate", "{}")["fill"]["segments"][3], 5);
     ed.stop();
 }
+
+/// Issue 36: the song is sent bar by bar (`?bar=K`) as mono 16-bit WAV at 22.05 kHz, the bars'
+/// pieces tiling the whole song's samples; a bar out of range is a clear 400. After a Set (or
+/// Undo) the unpinned bars' fills are marked stale until the next Generate.
+#[test]
+fn the_song_is_sent_by_bar_and_stale_fills_are_marked_until_generate() {
+    let (ed, _) = start("by-bar");
+    let a = ed.addr();
+    let bars = get(a, "/api/bars");
+    let list = bars["bars"].as_array().unwrap();
+    let whole = request(a, "GET", "/api/audio.wav", None).body;
+    let mut joined = vec![];
+    for k in 0..list.len() {
+        let w = request(a, "GET", &format!("/api/audio.wav?bar={k}"), None);
+        assert_eq!(w.status, 200);
+        assert_eq!(&w.body[..4], b"RIFF");
+        assert_eq!(
+            u32::from_le_bytes(w.body[24..28].try_into().unwrap()),
+            22_050
+        );
+        assert_eq!(u16::from_le_bytes(w.body[22..24].try_into().unwrap()), 1);
+        let span = list[k]["end_s"].as_f64().unwrap() - list[k]["start_s"].as_f64().unwrap();
+        assert!(((w.body.len() - 44) as f64 / 2.0 / 22_050.0 - span).abs() < 1e-4);
+        joined.extend_from_slice(&w.body[44..]);
+    }
+    let first = (list[0]["start_s"].as_f64().unwrap() * 22_050.0).round() as usize;
+    assert_eq!(joined, whole[44 + 2 * first..44 + 2 * first + joined.len()]);
+    for (q, says) in [
+        (
+            "bar=12",
+            "bar 12 is out of range (the song has 12 bars, 0 to 11)",
+        ),
+        ("bar=x", "`bar=x` is not an index"),
+        ("bars=1", "`bar` is missing"),
+    ] {
+        let r = request(a, "GET", &format!("/api/audio.wav?{q}"), None);
+        assert_eq!(r.status, 400, "{q}");
+        assert!(r.text().contains(says), "{q}: {}", r.text());
+    }
+
+    let stale = |a| {
+        let b = get(a, "/api/bars");
+        let per: Vec<bool> = b["bars"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x["stale"].as_bool().unwrap())
+            .collect();
+        (b["stale"].as_bool().unwrap(), per)
+    };
+    assert_eq!(stale(a), (false, vec![false; 12]));
+    post(a, "/api/set", r#"{"bar": 3, "segment": 2}"#);
+    let (any, per) = stale(a);
+    assert!(any);
+    assert!(!per[3], "a pinned bar is not stale");
+    assert!(per.iter().enumerate().all(|(k, &s)| s == (k != 3)));
+    post(a, "/api/generate", "{}");
+    assert_eq!(stale(a), (false, vec![false; 12]));
+    post(a, "/api/undo", "{}");
+    assert!(stale(a).0, "Undo changes the pins: stale again");
+    post(a, "/api/generate", "{}");
+    assert!(!stale(a).0);
+    ed.stop();
+}
+
+/// Issue 36: each candidate names its clip by file stem and bar, and says how it fits the bar:
+/// the bar's loudness rank, the segment's intensity rank, rel = 1 − |difference|, W's unit.
+#[test]
+fn candidates_carry_the_clip_name_and_their_fit_to_the_bar() {
+    let (ed, _) = start("fit");
+    let a = ed.addr();
+    let c = post(a, "/api/search", r#"{"bar": 4}"#);
+    let loud = c["loudness_rank"].as_f64().unwrap();
+    assert!((0.0..=1.0).contains(&loud));
+    assert_eq!(c["intensity_unit"], "m/s");
+    for m in c["candidates"].as_array().unwrap() {
+        let source = m["source"].as_str().unwrap();
+        let stem = std::path::Path::new(source).file_stem().unwrap();
+        assert_eq!(m["name"].as_str().unwrap(), stem.to_str().unwrap());
+        assert!(!m["name"].as_str().unwrap().contains('/'));
+        let rank = m["intensity_rank"].as_f64().unwrap();
+        assert!((0.0..=1.0).contains(&rank));
+        let rel = m["relevance"].as_f64().unwrap();
+        assert!((rel - (1.0 - (loud - rank).abs())).abs() < 1e-12);
+    }
+    ed.stop();
+}
