@@ -14,13 +14,11 @@
 mod common;
 mod editor_fixture;
 
-use std::io::{BufRead, BufReader, Write};
-use std::net::SocketAddr;
+use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Stdio};
-use std::time::Instant;
+use std::process::{Child, Command};
 
-use editor_fixture::{assert_bvh_lasts_the_bars, get, scene_on};
+use editor_fixture::{assert_bvh_lasts_the_bars, get, scene_on, start_editor};
 use marionette::choreo::augment::augment;
 use marionette::choreo::database::{BuildParams, Database, Manifest, OnRefusal};
 use marionette::editor::session::Session;
@@ -61,34 +59,6 @@ fn browser() -> Option<PathBuf> {
         missing.join(", ")
     );
     None
-}
-
-/// `marionette edit SCENE --port 0` started; its child process, URL, address and the seconds
-/// until it printed the URL (loading the scene and building the transition table).
-fn start_editor(scene: &Path) -> (Child, String, SocketAddr, f64) {
-    let t0 = Instant::now();
-    let mut child = Command::new(env!("CARGO_BIN_EXE_marionette"))
-        .args(["edit", scene.to_str().unwrap(), "--port", "0"])
-        .stdout(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut line = String::new();
-    BufReader::new(child.stdout.take().unwrap())
-        .read_line(&mut line)
-        .unwrap();
-    let startup_s = t0.elapsed().as_secs_f64();
-    let url = line
-        .trim()
-        .strip_prefix("dance editor: ")
-        .unwrap_or_else(|| panic!("no URL printed: {line:?}"))
-        .to_string();
-    let addr: SocketAddr = url
-        .trim_start_matches("http://")
-        .trim_end_matches('/')
-        .parse()
-        .unwrap();
-    assert!(addr.ip().is_loopback());
-    (child, url, addr, startup_s)
 }
 
 /// The folder of the browser tests' screenshots and numbers.

@@ -123,6 +123,8 @@ pub struct Editor {
     addr: SocketAddr,
     stop: Arc<AtomicBool>,
     dispatcher: JoinHandle<()>,
+    session: Arc<Mutex<Session>>,
+    in_flight: Arc<InFlight>,
 }
 
 impl Editor {
@@ -157,7 +159,12 @@ impl Editor {
         let stop = Arc::new(AtomicBool::new(false));
         let in_flight = Arc::new(InFlight::default());
         let dispatcher = {
-            let (server, stop) = (server.clone(), stop.clone());
+            let (server, stop, session, in_flight) = (
+                server.clone(),
+                stop.clone(),
+                session.clone(),
+                in_flight.clone(),
+            );
             std::thread::spawn(move || {
                 while !stop.load(Ordering::Relaxed) {
                     let Ok(Some(rq)) = server.recv_timeout(Duration::from_millis(100)) else {
@@ -183,6 +190,8 @@ impl Editor {
             addr,
             stop,
             dispatcher,
+            session,
+            in_flight,
         })
     }
 
@@ -206,6 +215,38 @@ impl Editor {
         self.stop.store(true, Ordering::Relaxed);
         let _ = self.dispatcher.join();
         drop(self.server);
+    }
+
+    /// Stops taking requests and waits for those being answered: up to `grace` for every one
+    /// to end (a client stalled mid-body may never end), then for the session, so that an
+    /// action holding it — a Save writing the scene — is finished before this returns. Returns
+    /// how many requests were still waiting for their clients.
+    pub fn shutdown(self, grace: Duration) -> usize {
+        self.stop.store(true, Ordering::Relaxed);
+        let _ = self.dispatcher.join();
+        let until = std::time::Instant::now() + grace;
+        let mut n = self
+            .in_flight
+            .count
+            .lock()
+            .unwrap_or_else(|e| e.into_inner());
+        while *n > 0 {
+            let left = until.saturating_duration_since(std::time::Instant::now());
+            if left.is_zero() {
+                break;
+            }
+            n = self
+                .in_flight
+                .done
+                .wait_timeout(n, left)
+                .unwrap_or_else(|e| e.into_inner())
+                .0;
+        }
+        let stuck = *n;
+        drop(n);
+        drop(self.session.lock().unwrap_or_else(|e| e.into_inner()));
+        drop(self.server);
+        stuck
     }
 }
 
