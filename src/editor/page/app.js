@@ -36,7 +36,7 @@ let views = [];
 let dance = null; // { fps, start_s, frames, figures }: the last dance fetched
 let danceView = null;
 // Every candidate card shares one camera: orbit or zoom one and all follow, kept across rounds.
-const cardCam = { yaw: 0.5, pitch: 0.2, dist: 3.6 };
+const cardCam = { yaw: 0.5, pitch: 0.2, dist: 4.2 };
 const timeline = new Timeline($('timeline'), (k, e) => pickBar(k, e));
 
 // ---- the transport ----
@@ -180,7 +180,8 @@ async function startAt(from) {
 async function play() {
   audio.firstSound = { t: performance.now(), gen: transport.gen + 1 };
   await startAt(transport.pos);
-  if (!dance) loadDance();
+  // A dance made for other pins (a Set, Unpin, Undo or Redo since) is made again.
+  if (!dance || stale) loadDance();
 }
 
 function pause() {
@@ -351,8 +352,8 @@ function fillCards(box, c, list, pin) {
       await refresh();
       status(`bar ${c.bar} pinned to #${m.segment}`);
     });
-    row.append(info, like, set);
-    card.append(canvas, name, row);
+    row.append(like, set);
+    card.append(canvas, name, info, row);
     box.append(card);
     const v = new StickView(canvas, figure, cardCam);
     v.frames = m.frames;
