@@ -1,21 +1,13 @@
 // Drives the dance editor's page in headless Chromium (tests/editor_browser.rs runs it):
 // node editor.mjs URL SCREENSHOT_DIR
 // Prints one JSON line of what the page showed; exits non-zero on any failed check.
-import { chromium } from 'playwright-core';
+import { launch } from './launch.mjs';
 import { join } from 'node:path';
 
 const [url, shots] = process.argv.slice(2);
 const fail = (msg) => { console.error('FAIL: ' + msg); process.exit(1); };
 
-const browser = await chromium.launch({
-  executablePath: process.env.CHROMIUM || '/usr/bin/chromium',
-  headless: true,
-  args: [
-    '--headless', '--no-sandbox', '--disable-gpu', '--disable-background-networking',
-    '--disable-component-update', '--no-first-run', '--autoplay-policy=no-user-gesture-required',
-  ],
-  // Playwright gives every launch a fresh temporary profile (the --user-data-dir of STACK.md).
-});
+const browser = await launch();
 const errors = [];
 try {
   const page = await browser.newPage({ viewport: { width: 1280, height: 860 } });

@@ -8,20 +8,13 @@
 // MODE "long" (a song of 200 bars, device scale factor 2): the timeline's bar numbers do not
 // overlap; Play from bar 150 sounds within 200 ms of the click.
 // Prints one JSON line of what it measured; exits non-zero on any failed check.
-import { chromium } from 'playwright-core';
+import { launch } from './launch.mjs';
 import { join } from 'node:path';
 
 const [url, shots, mode] = process.argv.slice(2);
 const fail = (msg) => { console.error('FAIL: ' + msg); process.exit(1); };
 
-const browser = await chromium.launch({
-  executablePath: process.env.CHROMIUM || '/usr/bin/chromium',
-  headless: true,
-  args: [
-    '--headless', '--no-sandbox', '--disable-gpu', '--disable-background-networking',
-    '--disable-component-update', '--no-first-run', '--autoplay-policy=no-user-gesture-required',
-  ],
-});
+const browser = await launch();
 const errors = [];
 try {
   const page = await browser.newPage({
