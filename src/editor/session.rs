@@ -346,8 +346,8 @@ mod tests {
         assert_eq!((rate, whole.len()), (22_050, 44_100));
         let (a, _) = tone.span(0.3, 0.7);
         let (b, _) = tone.span(0.7, 1.3);
-        assert_eq!(a.len() + b.len(), 13_230);
-        assert_eq!([a, b].concat(), whole[6_615..19_845]);
+        assert_eq!(a.len() + b.len(), 22_050);
+        assert_eq!([a, b].concat(), whole[6_615..28_665]);
         let peak = whole.iter().fold(0f32, |m, s| m.max(s.abs()));
         assert!((peak - 1.0).abs() < 0.01, "{peak}");
         let high = song(
