@@ -278,7 +278,8 @@ fn dance_scene_copy(name: &str) -> PathBuf {
 /// Issue 36: Set, Undo, Redo, Unpin and Generate during Play leave no page error and the song
 /// time running; a click on a bar while playing seeks there; a loop keeps the song time in its
 /// bar; after Pause the playhead stands and the candidates move; a Set marks the other fills
-/// stale until Generate; the song reaches the page bar by bar, under 4 MB for the 16 bars.
+/// stale until Generate; repeated segments are marked; a drag scrubs; the song reaches the page
+/// bar by bar, under 4 MB for the 16 bars and first heard within 200 ms of Play.
 #[test]
 fn playback_survives_every_action_seeks_loops_and_pauses_with_live_previews() {
     let Some(chromium) = browser() else { return };

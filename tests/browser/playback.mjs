@@ -4,7 +4,9 @@
 // MODE "actions" (a short dance): Play from the selected bar; Set, Undo, Redo, Unpin and
 // Generate while playing, without a page error and with the song time still running; a click on
 // a bar while playing seeks there; a loop keeps the song time inside its bar; after Pause the
-// playhead stands still and the candidates still move; the song arrives bar by bar.
+// playhead stands still and the candidates still move; a Set marks the other fills stale until
+// Generate; the bars whose segment is danced twice are marked; a drag scrubs; the song arrives
+// bar by bar.
 // MODE "long" (a song of 200 bars, device scale factor 2): the timeline's bar numbers do not
 // overlap; Play from bar 150 sounds within 200 ms of the click.
 // Prints one JSON line of what it measured; exits non-zero on any failed check.
@@ -24,8 +26,9 @@ try {
   page.on('pageerror', (e) => errors.push(String(e)));
   page.on('console', (m) => { if (m.type() === 'error') errors.push(m.text() + ' ' + (m.location().url || '')); });
   const audio = []; // bytes of every song piece received
-  page.on('response', async (r) => {
-    if (r.url().includes('/api/audio.wav')) audio.push((await r.body()).length);
+  page.on('response', (r) => {
+    // A piece still arriving when the browser closes is not counted (nor an error).
+    if (r.url().includes('/api/audio.wav')) r.body().then((b) => audio.push(b.length), () => {});
   });
   const checkErrors = (when) => { if (errors.length) fail(`page errors ${when}: ` + errors.join(' | ')); };
   await page.goto(url);
@@ -140,12 +143,38 @@ try {
   await waitStatus('generated');
   if ((await page.textContent('#timeline-note')) !== '') fail('stale note kept after Generate');
 
-  // Play the dance to its end from bar 0: every piece of the song arrives once.
+  // The bars whose segment is danced more than once are the ones marked.
+  const after = (await (await page.request.get(url + 'api/bars')).json()).bars;
+  const count = new Map();
+  for (const x of after) count.set(x.pin ?? x.filled, (count.get(x.pin ?? x.filled) || 0) + 1);
+  const want = after.map((x, k) => (count.get(x.pin ?? x.filled) > 1 ? k : null)).filter((k) => k !== null);
+  const marked = await page.evaluate(() => window.editor.timeline.repeated);
+  if (marked.join() !== want.join()) fail(`repeated segments marked on bars ${marked}, danced twice or more on bars ${want}`);
+
+  // A drag from bar 4 to bar 6 while paused scrubs: the playhead passes bar 5 and stops in bar
+  // 6; nothing plays and the selected bar stays.
+  const xOf = (k) => box.x + 8 + (box.w - 16) * ((k + 0.5) / bars.length);
+  await page.mouse.move(xOf(4), box.y + box.h / 2);
+  await page.mouse.down();
+  const passed = [];
+  for (let i = 1; i <= 10; i++) {
+    await page.mouse.move(xOf(4) + (xOf(6) - xOf(4)) * i / 10, box.y + box.h / 2);
+    passed.push(await songTime());
+  }
+  await page.mouse.up();
+  await page.waitForTimeout(200);
+  const scrubbed = await songTime();
+  if (!passed.some((t) => t >= bars[5].start_s && t < bars[5].end_s)) fail(`the scrub never passed bar 5: ${passed}`);
+  if (!(scrubbed >= bars[6].start_s && scrubbed < bars[6].end_s)) fail(`the scrub ended at ${scrubbed} s, not in bar 6`);
+  if (await playing()) fail('a scrub while paused started playback');
+  if ((await page.textContent('#bar-title')) !== 'Bar 9') fail('a scrub picked a bar');
+
   await clickBar(0);
   await page.waitForFunction(() => document.getElementById('bar-title').textContent === 'Bar 0', null, { timeout: 10000 });
   checkErrors('at the end');
+  await page.waitForTimeout(300); // the last pieces asked for arrive
   const bytes = audio.reduce((x, y) => x + y, 0);
-  console.log(JSON.stringify({ first_sound_ms: firstSoundMs, audio_pieces: audio.length, audio_bytes: bytes, loop_samples: samples.length, loop_wraps: wraps, status_while_playing: danceShown }));
+  console.log(JSON.stringify({ repeated: marked, first_sound_ms: firstSoundMs, audio_pieces: audio.length, audio_bytes: bytes, loop_samples: samples.length, loop_wraps: wraps, status_while_playing: danceShown }));
 } finally {
   await browser.close();
 }

@@ -37,7 +37,7 @@ let dance = null; // { fps, start_s, frames, figures }: the last dance fetched
 let danceView = null;
 // Every candidate card shares one camera: orbit or zoom one and all follow, kept across rounds.
 const cardCam = { yaw: 0.5, pitch: 0.2, dist: 4.2 };
-const timeline = new Timeline($('timeline'), (k, e) => pickBar(k, e));
+const timeline = new Timeline($('timeline'), (k, e) => pickBar(k, e), (t, phase) => scrub(t, phase));
 
 // ---- the transport ----
 // playing: song time = from + (clock() − t0), wrapped into the loop; stopped: song time = pos.
@@ -239,6 +239,21 @@ function pickBar(k, e) {
     return;
   }
   selectBar(k);
+}
+
+// A drag along the timeline moves the playhead (the dance view follows); playback, paused for
+// the drag, goes on from where it ends.
+let scrubResume = false;
+function scrub(t, phase) {
+  if (phase === 'start') {
+    scrubResume = transport.playing;
+    if (transport.playing) pause();
+  }
+  transport.pos = t;
+  if (phase === 'end') {
+    if (scrubResume) startAt(t);
+    else status(`playhead at ${t.toFixed(2)} s (bar ${barOf(t)})`);
+  }
 }
 
 async function selectBar(k) {

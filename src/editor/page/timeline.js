@@ -6,8 +6,9 @@
 const STEPS = [1, 2, 5, 10, 20, 50, 100, 200, 500, 1000];
 
 export class Timeline {
-  // `onPick(k, event)`: a bar was clicked.
-  constructor(canvas, onPick) {
+  // `onPick(k, event)`: a bar was clicked; `onScrub(t, phase)`: the pointer was dragged along
+  // the timeline to song time t (phase 'start', 'move' or 'end').
+  constructor(canvas, onPick, onScrub = () => {}) {
     this.canvas = canvas;
     this.bars = [];
     this.beats = [];
@@ -15,10 +16,38 @@ export class Timeline {
     this.loop = null; // { a, b }: bars a..=b
     this.playhead = null; // song time (s)
     this.labels = []; // the bar numbers drawn: { text, x0, x1 } in CSS pixels (for tests)
+    this.repeated = []; // the bars whose segment is danced in another bar too
+    const px = (e) => e.offsetX * (canvas.width / canvas.clientWidth);
+    let drag = null;
+    canvas.addEventListener('pointerdown', (e) => {
+      drag = { x: e.offsetX, moved: false };
+      canvas.setPointerCapture(e.pointerId);
+    });
+    canvas.addEventListener('pointermove', (e) => {
+      if (!drag || !this.bars.length) return;
+      if (!drag.moved && Math.abs(e.offsetX - drag.x) < 4) return;
+      if (!drag.moved) { drag.moved = true; onScrub(this.timeAt(px(e)), 'start'); }
+      onScrub(this.timeAt(px(e)), 'move');
+    });
+    canvas.addEventListener('pointerup', (e) => {
+      if (drag && drag.moved) onScrub(this.timeAt(px(e)), 'end');
+      drag = drag && drag.moved ? { after: true } : null;
+    });
     canvas.addEventListener('click', (e) => {
-      const k = this.barAt(e.offsetX * (canvas.width / canvas.clientWidth));
+      // A drag ends in a click too: it was a scrub, not a pick.
+      if (drag && drag.after) { drag = null; return; }
+      drag = null;
+      const k = this.barAt(px(e));
       if (k !== null) onPick(k, e);
     });
+  }
+
+  // The song time at canvas pixel `px`, within the bars.
+  timeAt(px) {
+    const [a, b] = this.span();
+    const m = 8 * this.dpr();
+    const u = Math.min(1, Math.max(0, (px - m) / (this.canvas.width - 2 * m)));
+    return Math.min(a + u * (b - a), b - 1e-6);
   }
 
   set(bars, beats) { this.bars = bars; this.beats = beats; this.draw(); }
@@ -66,6 +95,13 @@ export class Timeline {
     const fillStep = Timeline.step(fillW, perBar, 6 * r);
     const pinW = g.measureText('PIN').width + 6 * r;
     this.labels = [];
+    // A segment danced in more than one bar: a red mark under each of those bars.
+    const uses = new Map();
+    for (const b of this.bars) {
+      const seg = b.pin ?? b.filled;
+      if (seg !== null) uses.set(seg, (uses.get(seg) || 0) + 1);
+    }
+    this.repeated = [];
     if (this.loop) {
       const x0 = this.x(this.bars[this.loop.a].start_s), x1 = this.x(this.bars[this.loop.b].end_s);
       g.fillStyle = 'rgba(129, 199, 132, 0.25)';
@@ -121,6 +157,11 @@ export class Timeline {
           g.fillStyle = '#0e1014';
           g.fillRect(x0 + gap, top, x1 - x0 - 2 * gap, 4 * r);
         }
+      }
+      if ((uses.get(b.pin ?? b.filled) || 0) > 1) {
+        this.repeated.push(k);
+        g.fillStyle = '#ef5b7b';
+        g.fillRect(x0 + 3 * gap, bottom + 5 * r, x1 - x0 - 6 * gap, 2 * r);
       }
       if ((b.filled !== null || pinned) && k % fillStep === 0) {
         g.fillStyle = b.stale ? '#8a6a3a' : '#9aa0a6';
