@@ -14,13 +14,11 @@
 mod common;
 mod editor_fixture;
 
-use std::io::{BufRead, BufReader, Write};
-use std::net::SocketAddr;
+use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Stdio};
-use std::time::Instant;
+use std::process::{Child, Command};
 
-use editor_fixture::{assert_bvh_lasts_the_bars, get, scene_on};
+use editor_fixture::{assert_bvh_lasts_the_bars, get, scene_on, start_editor};
 use marionette::choreo::augment::augment;
 use marionette::choreo::database::{BuildParams, Database, Manifest, OnRefusal};
 use marionette::editor::session::Session;
@@ -61,34 +59,6 @@ fn browser() -> Option<PathBuf> {
         missing.join(", ")
     );
     None
-}
-
-/// `marionette edit SCENE --port 0` started; its child process, URL, address and the seconds
-/// until it printed the URL (loading the scene and building the transition table).
-fn start_editor(scene: &Path) -> (Child, String, SocketAddr, f64) {
-    let t0 = Instant::now();
-    let mut child = Command::new(env!("CARGO_BIN_EXE_marionette"))
-        .args(["edit", scene.to_str().unwrap(), "--port", "0"])
-        .stdout(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut line = String::new();
-    BufReader::new(child.stdout.take().unwrap())
-        .read_line(&mut line)
-        .unwrap();
-    let startup_s = t0.elapsed().as_secs_f64();
-    let url = line
-        .trim()
-        .strip_prefix("dance editor: ")
-        .unwrap_or_else(|| panic!("no URL printed: {line:?}"))
-        .to_string();
-    let addr: SocketAddr = url
-        .trim_start_matches("http://")
-        .trim_end_matches('/')
-        .parse()
-        .unwrap();
-    assert!(addr.ip().is_loopback());
-    (child, url, addr, startup_s)
 }
 
 /// The folder of the browser tests' screenshots and numbers.
@@ -288,5 +258,83 @@ fn latency_of_search_generate_and_first_load_on_2000_segments() {
         generate.len(),
         summary(&generate),
         summary(&generate_server),
+    );
+}
+
+/// A copy of `scenes/dance.ron` (16 bars) in a fresh folder.
+fn dance_scene_copy(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("marionette-editor-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("dance.ron");
+    std::fs::copy(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/dance.ron"),
+        &path,
+    )
+    .unwrap();
+    path
+}
+
+/// Issue 36: Set, Undo, Redo, Unpin and Generate during Play leave no page error and the song
+/// time running; a click on a bar while playing seeks there; a loop keeps the song time in its
+/// bar; after Pause the playhead stands and the candidates move; a Set marks the other fills
+/// stale until Generate; repeated segments are marked; a drag scrubs; the song reaches the page
+/// bar by bar, under 4 MB for the 16 bars and first heard within 200 ms of Play.
+#[test]
+fn playback_survives_every_action_seeks_loops_and_pauses_with_live_previews() {
+    let Some(chromium) = browser() else { return };
+    let path = dance_scene_copy("playback");
+    let (mut child, url, addr, _) = start_editor(&path);
+    let shots = shots();
+    let seen = node(
+        "playback.mjs",
+        &[Path::new(&url), &shots, Path::new("actions")],
+        &chromium,
+        &mut child,
+    );
+    let whole = editor_fixture::request(addr, "GET", "/api/audio.wav", None)
+        .body
+        .len();
+    let _ = child.kill();
+    let _ = child.wait();
+    let bytes = seen["audio_bytes"].as_u64().unwrap() as usize;
+    let first = seen["first_sound_ms"].as_f64().unwrap();
+    println!(
+        "16-bar dance: the song sent in {} pieces, {bytes} bytes (the whole song at 22.05 kHz: \
+         {whole} bytes); first sound {first:.1} ms after Play",
+        seen["audio_pieces"]
+    );
+    assert!(bytes > 0 && bytes < 4_000_000, "{bytes} bytes of song");
+    assert!(first < 200.0, "first sound {first} ms after Play");
+}
+
+/// Issue 36: a song of 200 bars (6 min 40 s) at device scale factor 2 — the timeline's bar
+/// numbers (from 0) never overlap, and Play from bar 150 sounds within 200 ms of the click.
+#[test]
+fn a_200_bar_timeline_reads_at_scale_2_and_sounds_within_200_ms() {
+    let Some(chromium) = browser() else { return };
+    let path = editor_fixture::scene("long", 6, 10, 200);
+    let (mut child, url, _, _) = start_editor(&path);
+    let shots = shots();
+    let seen = node(
+        "playback.mjs",
+        &[Path::new(&url), &shots, Path::new("long")],
+        &chromium,
+        &mut child,
+    );
+    let _ = child.kill();
+    let _ = child.wait();
+    let first = seen["first_sound_ms"].as_f64().unwrap();
+    let bytes = seen["audio_bytes"].as_u64().unwrap();
+    println!(
+        "200 bars ({:.0} s of song): {} bar numbers drawn; first sound {first:.1} ms after Play \
+         at bar 150, {bytes} bytes of song fetched by then",
+        seen["song_s"].as_f64().unwrap(),
+        seen["labels"]
+    );
+    assert!(first < 200.0, "first sound {first} ms after Play");
+    assert!(
+        bytes < 1_000_000,
+        "{bytes} bytes fetched to start at bar 150"
     );
 }

@@ -4,10 +4,10 @@
 //! | route | body / query | answer |
 //! |---|---|---|
 //! | `GET /api/state` | | pins, undo/redo depth, last fill, tempo, song length, figure links |
-//! | `GET /api/bars` | | every bar (span, dB, normalised intensity, pin, filled segment), beats |
+//! | `GET /api/bars` | | every bar (span, dB, normalised intensity, pin, filled segment, whether that fill is stale), beats |
 //! | `GET /api/candidates` | `?bar=K` | bar K's round, τ, segments left, its six candidates' frames and its liked segments' frames |
 //! | `GET /api/dance` | | the whole dance of the current pins at the scene's fps (generates first), and its figures |
-//! | `GET /api/audio.wav` | | the song as 16-bit WAV |
+//! | `GET /api/audio.wav` | `?bar=K` (optional) | bar K's span of the song (without `bar`, the whole song) as mono 16-bit WAV at most 22.05 kHz ([`crate::editor::session::Song::span`]) |
 //! | `POST /api/search` | `{"bar": K}` | the next relevance-feedback round; as `candidates` |
 //! | `POST /api/start-over` | `{"bar": K}` | bar K's search back to round 0, nothing shown but the likes (kept); as `candidates` |
 //! | `POST /api/search-params` | `{"tau0": x, "tau_decay": y}` (either) | τ_0 and decay for every bar's next rounds; the search parameters |
@@ -31,7 +31,7 @@ use serde::{Deserialize, Serialize};
 use serde_json::{Value, json};
 
 use super::EditorError;
-use super::session::{Frames, Session};
+use super::session::{Frames, Session, Song};
 use crate::choreo::edit::EditError;
 
 /// An HTTP answer.
@@ -196,15 +196,13 @@ fn route(s: &mut Session, method: &str, path: &str, query: &str, b: &[u8]) -> Re
             ))
         }
         "/api/audio.wav" => {
-            let song = s.song();
-            let wav = crate::choreo::music::wav::wav_bytes(&song.samples, 1, song.sample_rate)
-                .ok_or_else(|| Reply::error(500, "the song does not fit a WAV file"))?;
-            Ok(Reply {
-                status: 200,
-                content_type: "audio/wav",
-                body: wav,
-                download: None,
-            })
+            let spans: Vec<(f64, f64)> = s
+                .edit()
+                .bars()
+                .iter()
+                .map(|b| (b.start_s, b.end_s))
+                .collect();
+            audio(s.song(), &spans, query)
         }
         "/api/search" => {
             let BarBody { bar } = body(b)?;
@@ -280,6 +278,37 @@ fn route(s: &mut Session, method: &str, path: &str, query: &str, b: &[u8]) -> Re
     }
 }
 
+/// `GET /api/audio.wav` over `song` and its bars' spans `bars` (s), `query` without its `?`:
+/// bar K's piece of the song (`bar=K`) or, with no query, the whole song, as mono 16-bit WAV at
+/// most 22.05 kHz ([`Song::span`]). It needs no session: the server answers it without the
+/// session's lock, so the song never waits behind a Generate.
+pub fn audio(song: &Song, bars: &[(f64, f64)], query: &str) -> Result<Reply, Reply> {
+    let (from_s, to_s) = if query.is_empty() {
+        (0.0, f64::INFINITY)
+    } else {
+        let bar = query_index(query, "bar")?;
+        *bars.get(bar).ok_or_else(|| {
+            Reply::error(
+                400,
+                &format!(
+                    "query: bar {bar} is out of range (the song has {} bars, 0 to {})",
+                    bars.len(),
+                    bars.len().saturating_sub(1)
+                ),
+            )
+        })?
+    };
+    let (samples, rate) = song.span(from_s, to_s);
+    let wav = crate::choreo::music::wav::wav_bytes(&samples, 1, rate)
+        .ok_or_else(|| Reply::error(500, "the song does not fit a WAV file"))?;
+    Ok(Reply {
+        status: 200,
+        content_type: "audio/wav",
+        body: wav,
+        download: None,
+    })
+}
+
 fn state(s: &Session) -> Value {
     let e = s.edit();
     let st = e.state();
@@ -309,6 +338,7 @@ fn state(s: &Session) -> Value {
 fn bars(s: &Session) -> Value {
     let e = s.edit();
     let fill = s.fill().map(|f| &f.segments);
+    let stale = s.fill_is_stale();
     let list: Vec<Value> = e
         .bars()
         .iter()
@@ -321,11 +351,12 @@ fn bars(s: &Session) -> Value {
                 "intensity": e.music_intensity()[k],
                 "pin": e.pins().get(&k),
                 "filled": fill.and_then(|f| f.get(k)),
+                "stale": stale && !e.pins().contains_key(&k),
                 "round": e.state().searches[k].round,
             })
         })
         .collect();
-    json!({ "bars": list, "beats_s": s.song().beats_s })
+    json!({ "bars": list, "beats_s": s.song().beats_s, "stale": stale })
 }
 
 /// `GET /api/dance`.
@@ -344,7 +375,13 @@ struct Candidate<'a> {
     liked: bool,
     intensity: f64,
     source: Option<&'a str>,
+    /// The source clip's file stem ("acrnn_salsa_01" for ".../acrnn_salsa_01.bvh").
+    name: Option<&'a str>,
     source_bar: usize,
+    /// The segment's W as a percentile rank among the database's segments, in [0, 1].
+    intensity_rank: f64,
+    /// rel(q, m) = 1 − |bar's loudness rank − segment's intensity rank| (eq. 1).
+    relevance: f64,
     frames: Frames,
 }
 
@@ -354,6 +391,10 @@ struct Candidates<'a> {
     bar: usize,
     start_s: f64,
     end_s: f64,
+    /// The bar's loudness (RMS dB) as a percentile rank among the song's bars, in [0, 1].
+    loudness_rank: f64,
+    /// The unit of W: m/s when every weight α_i is 1.
+    intensity_unit: &'static str,
     /// Rounds run (the k of the next round).
     round: usize,
     /// τ of the next round, τ_0·decay^k.
@@ -376,14 +417,20 @@ fn candidates(s: &Session, bar: usize) -> Result<Reply, Reply> {
     let search = e.bar_search(bar).map_err(|e| fail(e.into()))?;
     let b = e.bars()[bar];
     let db = e.database();
+    let loudness = e.music_intensity()[bar];
     let card = |seg: usize| -> Result<Candidate, Reply> {
         let m = &db.segments[seg];
+        let source = db.sources.get(m.clip).map(|c| c.file.as_str());
+        let rank = s.motion_intensity()[seg];
         Ok(Candidate {
             segment: seg,
             liked: search.liked.contains(&seg),
             intensity: m.intensity,
-            source: db.sources.get(m.clip).map(|c| c.file.as_str()),
+            source,
+            name: source.and_then(|f| std::path::Path::new(f).file_stem()?.to_str()),
             source_bar: m.bar,
+            intensity_rank: rank,
+            relevance: crate::choreo::relevance::rel(loudness, rank),
             frames: s.segment_frames(seg).map_err(fail)?,
         })
     };
@@ -394,6 +441,12 @@ fn candidates(s: &Session, bar: usize) -> Result<Reply, Reply> {
             bar,
             start_s: b.start_s,
             end_s: b.end_s,
+            loudness_rank: loudness,
+            intensity_unit: if db.params.alpha.iter().all(|&a| a == 1.0) {
+                "m/s"
+            } else {
+                "α-weighted m/s"
+            },
             round: search.round,
             tau: p.tau(search.round),
             tau0: p.tau0,

@@ -33,7 +33,7 @@ use std::time::Duration;
 
 use super::EditorError;
 use super::api::{Reply, handle};
-use super::session::Session;
+use super::session::{Session, Song};
 
 /// The default port of `marionette edit`.
 pub const DEFAULT_PORT: u16 = 8765;
@@ -72,6 +72,13 @@ const ASSETS: [(&str, &str, &[u8]); 5] = [
         include_bytes!("page/style.css"),
     ),
 ];
+
+/// The song and its bars' spans (s), fixed for a session: `GET /api/audio.wav` is answered from
+/// them without the session's lock, so the song never waits behind a Generate or a dance.
+struct SongPieces {
+    song: Arc<Song>,
+    bars: Vec<(f64, f64)>,
+}
 
 /// How many requests are being answered, and a signal when one is done.
 #[derive(Default)]
@@ -116,6 +123,8 @@ pub struct Editor {
     addr: SocketAddr,
     stop: Arc<AtomicBool>,
     dispatcher: JoinHandle<()>,
+    session: Arc<Mutex<Session>>,
+    in_flight: Arc<InFlight>,
 }
 
 impl Editor {
@@ -137,11 +146,25 @@ impl Editor {
                 message: "not an IP socket".into(),
             })?;
         let server = Arc::new(server);
+        let song = Arc::new(SongPieces {
+            song: session.shared_song(),
+            bars: session
+                .edit()
+                .bars()
+                .iter()
+                .map(|b| (b.start_s, b.end_s))
+                .collect(),
+        });
         let session = Arc::new(Mutex::new(session));
         let stop = Arc::new(AtomicBool::new(false));
         let in_flight = Arc::new(InFlight::default());
         let dispatcher = {
-            let (server, stop) = (server.clone(), stop.clone());
+            let (server, stop, session, in_flight) = (
+                server.clone(),
+                stop.clone(),
+                session.clone(),
+                in_flight.clone(),
+            );
             std::thread::spawn(move || {
                 while !stop.load(Ordering::Relaxed) {
                     let Ok(Some(rq)) = server.recv_timeout(Duration::from_millis(100)) else {
@@ -150,14 +173,14 @@ impl Editor {
                     let Some(slot) = in_flight.acquire(&stop) else {
                         break;
                     };
-                    let session = session.clone();
+                    let (session, song) = (session.clone(), song.clone());
                     // Should the system refuse a thread, the request is dropped (tiny_http
                     // answers 500).
                     let _ = std::thread::Builder::new()
                         .name("editor-request".into())
                         .spawn(move || {
                             let _slot = slot;
-                            serve(rq, &session, addr.port());
+                            serve(rq, &session, &song, addr.port());
                         });
                 }
             })
@@ -167,6 +190,8 @@ impl Editor {
             addr,
             stop,
             dispatcher,
+            session,
+            in_flight,
         })
     }
 
@@ -190,6 +215,38 @@ impl Editor {
         self.stop.store(true, Ordering::Relaxed);
         let _ = self.dispatcher.join();
         drop(self.server);
+    }
+
+    /// Stops taking requests and waits for those being answered: up to `grace` for every one
+    /// to end (a client stalled mid-body may never end), then for the session, so that an
+    /// action holding it — a Save writing the scene — is finished before this returns. Returns
+    /// how many requests were still waiting for their clients.
+    pub fn shutdown(self, grace: Duration) -> usize {
+        self.stop.store(true, Ordering::Relaxed);
+        let _ = self.dispatcher.join();
+        let until = std::time::Instant::now() + grace;
+        let mut n = self
+            .in_flight
+            .count
+            .lock()
+            .unwrap_or_else(|e| e.into_inner());
+        while *n > 0 {
+            let left = until.saturating_duration_since(std::time::Instant::now());
+            if left.is_zero() {
+                break;
+            }
+            n = self
+                .in_flight
+                .done
+                .wait_timeout(n, left)
+                .unwrap_or_else(|e| e.into_inner())
+                .0;
+        }
+        let stuck = *n;
+        drop(n);
+        drop(self.session.lock().unwrap_or_else(|e| e.into_inner()));
+        drop(self.server);
+        stuck
     }
 }
 
@@ -239,7 +296,12 @@ fn header_values<'a>(rq: &'a tiny_http::Request, name: &'static str) -> Vec<&'a 
         .collect()
 }
 
-fn answer(rq: &mut tiny_http::Request, session: &Mutex<Session>, port: u16) -> Reply {
+fn answer(
+    rq: &mut tiny_http::Request,
+    session: &Mutex<Session>,
+    song: &SongPieces,
+    port: u16,
+) -> Reply {
     let hosts = header_values(rq, "Host");
     if hosts.len() != 1 || !loopback_host(hosts[0]) {
         return Reply::error(
@@ -256,6 +318,15 @@ fn answer(rq: &mut tiny_http::Request, session: &Mutex<Session>, port: u16) -> R
     let method = rq.method().as_str().to_string();
     let url = rq.url().to_string();
     let (path, query) = url.split_once('?').unwrap_or((&url, ""));
+    if path == "/api/audio.wav"
+        && method == "GET"
+        && rq.body_length().unwrap_or(0) == 0
+        && header_values(rq, "Transfer-Encoding").is_empty()
+    {
+        return match super::api::audio(&song.song, &song.bars, query) {
+            Ok(r) | Err(r) => r,
+        };
+    }
     if path.starts_with("/api/") {
         if rq.body_length().is_some_and(|n| n > MAX_BODY) {
             return Reply::error(413, &format!("request body over {MAX_BODY} bytes"));
@@ -299,9 +370,9 @@ fn header(name: &str, value: &str) -> Option<tiny_http::Header> {
     tiny_http::Header::from_bytes(name.as_bytes(), value.as_bytes()).ok()
 }
 
-fn serve(mut rq: tiny_http::Request, session: &Mutex<Session>, port: u16) {
+fn serve(mut rq: tiny_http::Request, session: &Mutex<Session>, song: &SongPieces, port: u16) {
     let t0 = std::time::Instant::now();
-    let r = answer(&mut rq, session, port);
+    let r = answer(&mut rq, session, song, port);
     let server_ms = t0.elapsed().as_secs_f64() * 1e3;
     let mut resp = tiny_http::Response::from_data(r.body).with_status_code(r.status);
     let headers = [

@@ -32,13 +32,60 @@ pub struct Song {
     pub beats_s: Vec<f64>,
 }
 
+/// The highest sample rate the page is sent the song at (Hz): mono 16-bit at 22.05 kHz is
+/// 44.1 kB a second, a 2 s bar 88 kB.
+pub const AUDIO_RATE: u32 = 22_050;
+
+impl Song {
+    /// The song's mono samples from `from_s` to `to_s` (clamped to the song) at
+    /// `min(sample_rate, AUDIO_RATE)` Hz, and that rate. A higher rate is reduced by averaging
+    /// the input samples around each output sample's time (a box filter one output sample
+    /// wide, which also keeps the reduction from folding high frequencies back in). Sample i
+    /// of the span is the song at `round(from_s · rate) + i` output samples: spans that meet
+    /// (bar k's end, bar k + 1's start) tile the song without a gap or an overlap.
+    pub fn span(&self, from_s: f64, to_s: f64) -> (Vec<f32>, u32) {
+        let sr = self.sample_rate.max(1);
+        let rate = sr.min(AUDIO_RATE);
+        let n_in = self.samples.len();
+        let song_s = n_in as f64 / sr as f64;
+        let (a, b) = (from_s.clamp(0.0, song_s), to_s.clamp(0.0, song_s));
+        let (i0, i1) = (
+            (a * rate as f64).round() as usize,
+            (b * rate as f64).round() as usize,
+        );
+        if rate == sr {
+            let (i0, i1) = (i0.min(n_in), i1.min(n_in));
+            return (self.samples[i0..i1.max(i0)].to_vec(), rate);
+        }
+        let ratio = sr as f64 / rate as f64;
+        let out = (i0..i1.max(i0))
+            .map(|i| {
+                let centre = i as f64 * ratio;
+                let lo = ((centre - ratio / 2.0).round().max(0.0) as usize).min(n_in);
+                let hi = ((centre + ratio / 2.0).round() as usize).clamp(lo, n_in);
+                if hi == lo {
+                    0.0
+                } else {
+                    self.samples[lo..hi].iter().sum::<f32>() / (hi - lo) as f32
+                }
+            })
+            .collect();
+        (out, rate)
+    }
+}
+
 /// The editor's state (module docs).
 pub struct Session {
     edit: Edit,
     file: DanceFile,
-    song: Song,
+    song: Arc<Song>,
     model: Model,
     fill: Option<Fill>,
+    /// The pins the last fill was made for: when they differ from the edit's, the unpinned
+    /// bars' fills are stale until the next Generate.
+    fill_pins: std::collections::BTreeMap<usize, usize>,
+    /// Every segment's normalised motion intensity (percentile rank of W in the database).
+    motion: Vec<f64>,
 }
 
 /// Stick-figure frames: per frame, every drawable point (joints then end sites), metres rounded
@@ -69,18 +116,22 @@ impl Session {
         state.undo.clear();
         let edit = Edit::with_index(edit.database().clone(), edit.index().clone(), state)?;
         let fill = edit.generate()?;
-        let song = Song {
+        let fill_pins = edit.pins().clone();
+        let motion = crate::choreo::relevance::motion_intensity(edit.database());
+        let song = Arc::new(Song {
             samples: inputs.samples,
             sample_rate: inputs.sample_rate,
             tempo_bpm: inputs.analysis.tempo_bpm,
             beats_s: inputs.analysis.beats_s,
-        };
+        });
         Ok(Session {
             edit,
             file,
             song,
             model: humanoid24(),
             fill: Some(fill),
+            fill_pins,
+            motion,
         })
     }
 
@@ -99,9 +150,26 @@ impl Session {
         &self.song
     }
 
+    /// The song, shared: the server sends its pieces without holding the session.
+    pub fn shared_song(&self) -> Arc<Song> {
+        self.song.clone()
+    }
+
     /// The last fill ([`Session::generate`]; the scene's own from the start).
     pub fn fill(&self) -> Option<&Fill> {
         self.fill.as_ref()
+    }
+
+    /// Whether the last fill was made for other pins than the edit's (a Set, Unpin, Undo or
+    /// Redo since): its unpinned bars are then stale until the next Generate.
+    pub fn fill_is_stale(&self) -> bool {
+        &self.fill_pins != self.edit.pins()
+    }
+
+    /// Every segment's normalised motion intensity: the percentile rank of its W among the
+    /// database's segments ([`crate::choreo::relevance::motion_intensity`]).
+    pub fn motion_intensity(&self) -> &[f64] {
+        &self.motion
     }
 
     /// The scene file the session saves to.
@@ -163,6 +231,7 @@ impl Session {
     /// session opened and kept).
     pub fn generate(&mut self) -> Result<&Fill, EditorError> {
         let f = self.edit.generate()?;
+        self.fill_pins = self.edit.pins().clone();
         Ok(self.fill.insert(f))
     }
 
@@ -248,4 +317,50 @@ fn points(clip: &ModelClip, origin: DVec3) -> Frames {
                 .collect()
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn song(rate: u32, f: impl Fn(f64) -> f32, seconds: f64) -> Song {
+        let n = (seconds * rate as f64) as usize;
+        Song {
+            samples: (0..n).map(|i| f(i as f64 / rate as f64)).collect(),
+            sample_rate: rate,
+            tempo_bpm: 120.0,
+            beats_s: vec![],
+        }
+    }
+
+    /// A 44.1 kHz song is sent at 22.05 kHz: spans tile, a 440 Hz tone keeps its level, and a
+    /// tone above the new Nyquist frequency (11.025 kHz) is damped, not folded back at full level.
+    #[test]
+    fn spans_are_reduced_to_22khz_and_tile() {
+        let tone = song(
+            44_100,
+            |t| (2.0 * std::f64::consts::PI * 440.0 * t).sin() as f32,
+            2.0,
+        );
+        let (whole, rate) = tone.span(0.0, f64::INFINITY);
+        assert_eq!((rate, whole.len()), (22_050, 44_100));
+        let (a, _) = tone.span(0.3, 0.7);
+        let (b, _) = tone.span(0.7, 1.3);
+        assert_eq!(a.len() + b.len(), 22_050);
+        assert_eq!([a, b].concat(), whole[6_615..28_665]);
+        let peak = whole.iter().fold(0f32, |m, s| m.max(s.abs()));
+        assert!((peak - 1.0).abs() < 0.01, "{peak}");
+        let high = song(
+            44_100,
+            |t| (2.0 * std::f64::consts::PI * 20_000.0 * t).sin() as f32,
+            1.0,
+        );
+        let (h, _) = high.span(0.0, 1.0);
+        let rms = (h.iter().map(|s| s * s).sum::<f32>() / h.len() as f32).sqrt();
+        assert!(rms < 0.2, "20 kHz after the reduction: rms {rms}");
+        // A 22.05 kHz song is sent as it is; a span past the end is cut at the end.
+        let low = song(22_050, |t| t as f32, 1.0);
+        assert_eq!(low.span(0.5, 9.0).0, low.samples[11_025..]);
+        assert!(low.span(5.0, 9.0).0.is_empty());
+    }
 }

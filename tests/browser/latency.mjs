@@ -6,17 +6,12 @@
 // also the server's own time from its Server-Timing header. Prints one
 // JSON line of every measurement; these are measurements, not checks: only correctness
 // (six candidates, every bar filled) fails the script.
-import { chromium } from 'playwright-core';
+import { launch } from './launch.mjs';
 
 const [url] = process.argv.slice(2);
 const fail = (msg) => { console.error('FAIL: ' + msg); process.exit(1); };
 
-const browser = await chromium.launch({
-  executablePath: process.env.CHROMIUM || '/usr/bin/chromium',
-  headless: true,
-  args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-background-networking',
-    '--disable-component-update', '--no-first-run'],
-});
+const browser = await launch();
 try {
   const page = await browser.newPage({ viewport: { width: 1280, height: 860 } });
   const errors = [];

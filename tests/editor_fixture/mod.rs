@@ -3,10 +3,12 @@
 
 #![allow(dead_code)] // each test file uses some of these
 
-use std::io::{Read, Write};
+use std::io::{BufRead, BufReader, Read, Write};
 use std::net::{SocketAddr, TcpStream};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
 use std::time::Duration;
+use std::time::Instant;
 
 use marionette::choreo::database::Database;
 use marionette::experiments::dance_fill::generated_database;
@@ -179,4 +181,34 @@ pub fn assert_bvh_lasts_the_bars(addr: SocketAddr, bvh: &str) -> usize {
         "{frames} frames for {span} s at 30 fps"
     );
     frames
+}
+
+/// `marionette edit SCENE --port 0` started; its child process, URL, address and the seconds
+/// until it printed the URL (loading the scene and building the transition table). Its stdout
+/// and stderr are piped (the test reads stderr, if it wants to, once the child has ended).
+pub fn start_editor(scene: &Path) -> (Child, String, SocketAddr, f64) {
+    let t0 = Instant::now();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_marionette"))
+        .args(["edit", scene.to_str().unwrap(), "--port", "0"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut line = String::new();
+    BufReader::new(child.stdout.take().unwrap())
+        .read_line(&mut line)
+        .unwrap();
+    let startup_s = t0.elapsed().as_secs_f64();
+    let url = line
+        .trim()
+        .strip_prefix("dance editor: ")
+        .unwrap_or_else(|| panic!("no URL printed: {line:?}"))
+        .to_string();
+    let addr: SocketAddr = url
+        .trim_start_matches("http://")
+        .trim_end_matches('/')
+        .parse()
+        .unwrap();
+    assert!(addr.ip().is_loopback());
+    (child, url, addr, startup_s)
 }

@@ -1,16 +1,16 @@
 // A stick figure on a 2D canvas with an orbit camera: drag to orbit, wheel to zoom.
 // Points are metres, y up; `parents[i]` joins point i to its parent (null for the pelvis).
+// The camera ({ yaw, pitch, dist }) may be shared: views given the same object orbit and zoom
+// together, and a view rebuilt with it keeps the orbit and zoom the user chose.
 
 const COLOURS = { l: '#4fc3f7', r: '#f0a030', c: '#e6e6e6' };
 
 export class StickView {
-  constructor(canvas, figure) {
+  constructor(canvas, figure, cam = { yaw: 0.5, pitch: 0.2, dist: 3.6 }) {
     this.canvas = canvas;
     this.ctx = canvas.getContext('2d');
     this.figure = figure; // { parents, sides, head }
-    this.yaw = 0.5;
-    this.pitch = 0.2;
-    this.dist = 3.6;
+    this.cam = cam;
     this.target = [0, 0.9, 0];
     let drag = null;
     canvas.addEventListener('pointerdown', (e) => {
@@ -29,6 +29,13 @@ export class StickView {
       this.dist = Math.max(1.0, Math.min(20, this.dist * Math.exp(e.deltaY * 0.001)));
     }, { passive: false });
   }
+
+  get yaw() { return this.cam.yaw; }
+  set yaw(v) { this.cam.yaw = v; }
+  get pitch() { return this.cam.pitch; }
+  set pitch(v) { this.cam.pitch = v; }
+  get dist() { return this.cam.dist; }
+  set dist(v) { this.cam.dist = v; }
 
   // World point → [x, y, depth] on the canvas, or null behind the camera.
   project(p, w, h) {
@@ -50,7 +57,7 @@ export class StickView {
     const c = this.canvas;
     const dpr = window.devicePixelRatio || 1;
     const w = Math.round(c.clientWidth * dpr) || c.width, h = Math.round(c.clientHeight * dpr) || c.height;
-    const key = [points, follow, this.yaw, this.pitch, this.dist, w, h];
+    const key = [points, follow, this.target[0], this.target[2], this.yaw, this.pitch, this.dist, w, h];
     if (this.drawn && key.every((v, i) => v === this.drawn[i])) return;
     this.drawn = key;
     if (c.width !== w || c.height !== h) { c.width = w; c.height = h; }
