@@ -119,38 +119,28 @@ fn a_passive_drop_at_2_ms_gains_no_energy() {
     );
 }
 
-/// The damage `Σ w_i f_i` of the paper's pushed fall of `group` stepped by `pipeline::step`
-/// from its settled start for 3 s with `integrator` at `dt`, past the stability check; or the
-/// step's error.
-fn stepped_damage(group: AgeGroup, integrator: Integrator, dt: f64) -> Result<f64, StepError> {
-    stepped_damage_with(group, false, integrator, dt)
-}
-
-/// [`stepped_damage`], with `strongest` the PD gains the GA's strongest genome has from the
-/// start (`k_p` at its bound on every DOF, the stance its key pose).
-fn stepped_damage_with(
-    group: AgeGroup,
-    strongest: bool,
-    integrator: Integrator,
-    dt: f64,
-) -> Result<f64, StepError> {
-    let cfg = FallConfig::paper(group);
-    let ch = build_fall(&cfg).unwrap();
-    let body = &ch.physics.body.body;
+/// The damage `Σ w_i f_i` of the fall `cfg` stepped by `pipeline::step` with `integrator` at
+/// `dt` for its duration from its settled start (settled at 0.5 ms by the explicit step), the
+/// controller switching to the key pose at its reaction time as in the fall scene: past the
+/// stability check, so any scheme and step can be tried. The step's error if it blew up.
+fn stepped_damage(cfg: &FallConfig, integrator: Integrator, dt: f64) -> Result<f64, StepError> {
+    let mut cfg = cfg.clone();
+    cfg.integrator = EXPLICIT;
+    cfg.dt_s = 5e-4;
+    let mut ch = build_fall(&cfg).unwrap();
+    let body = ch.physics.body.body.clone();
     let mut pd = ch.pd.0.clone();
-    if strongest {
-        pd.kp = strength_kp_max(group, 1.0);
-    }
-    let forces = Forces {
-        pd: Some(&pd),
-        external: &ch.external.0,
-        ..passive(&ch)
-    };
     let mut state = ch.physics.state.0.clone();
     let mut ws = StepWorkspace::new(&body.model);
     let mut monitor = StepMonitor::new(body.link_names.len(), body.dof_v.len());
     let settings = StepSettings { integrator, dt };
     for _ in 0..(cfg.duration_s / dt).round() as usize {
+        ch.controller.apply(state.time_s, &mut pd);
+        let forces = Forces {
+            pd: Some(&pd),
+            external: &ch.external.0,
+            ..passive(&ch)
+        };
         pipeline::step(
             &body.model,
             settings,
@@ -166,6 +156,15 @@ fn stepped_damage_with(
         .zip(&monitor.contact.peak)
         .map(|(l, f)| cfg.damage_weights.get(l).copied().unwrap_or(1.0) * f)
         .sum())
+}
+
+/// The paper's fall of `group` with the GA's strongest genome: `k_p` at its bound on every DOF
+/// (the gains the GA's step is chosen for), in the stance and the reaction alike.
+fn strongest(group: AgeGroup) -> FallConfig {
+    let mut cfg = FallConfig::paper(group);
+    cfg.kp = strength_kp_max(group, 1.0);
+    cfg.stance_kp = cfg.kp.clone();
+    cfg
 }
 
 #[test]
@@ -184,21 +183,21 @@ fn at_2_ms_the_pushed_fall_runs_linearised_where_the_check_refuses_the_explicit_
         for (name, r) in [
             (
                 "explicit, paper gains, 2 ms",
-                stepped_damage(group, EXPLICIT, 2e-3),
+                stepped_damage(&FallConfig::paper(group), EXPLICIT, 2e-3),
             ),
             (
                 "explicit, paper gains, 0.5 ms",
-                stepped_damage(group, EXPLICIT, 5e-4),
+                stepped_damage(&FallConfig::paper(group), EXPLICIT, 5e-4),
             ),
             (
                 "linearised, paper gains, 2 ms",
-                stepped_damage(group, LINEARISED, 2e-3),
+                stepped_damage(&FallConfig::paper(group), LINEARISED, 2e-3),
             ),
         ] {
             println!("{group:?}, {name}: damage {r:?}");
             assert!(r.is_ok());
         }
-        let strong = |i, dt| stepped_damage_with(group, true, i, dt);
+        let strong = |i, dt| stepped_damage(&strongest(group), i, dt);
         let explicit = strong(EXPLICIT, 2e-3);
         let linearised = strong(LINEARISED, 2e-3);
         let fine = strong(EXPLICIT, 2.5e-4);
@@ -239,50 +238,6 @@ fn random_genomes(problem: &FallProblem, n: usize, seed: u64) -> Vec<Genome> {
                 .collect()
         })
         .collect()
-}
-
-/// The damage of `genome` on `problem` stepped by `pipeline::step` with `integrator` at `dt`
-/// for 3 s from the fall's settled start (settled at 0.5 ms by the explicit step), the
-/// controller switching to the key pose at its reaction time as in the fall scene: past the
-/// stability check, so any scheme and step can be tried. The step's error if it blew up.
-fn genome_damage(
-    problem: &FallProblem,
-    genome: &[f64],
-    integrator: Integrator,
-    dt: f64,
-) -> Result<f64, StepError> {
-    let mut cfg = problem.config(genome);
-    cfg.integrator = EXPLICIT;
-    cfg.dt_s = 5e-4;
-    let mut ch = build_fall(&cfg).unwrap();
-    let body = ch.physics.body.body.clone();
-    let mut pd = ch.pd.0.clone();
-    let mut state = ch.physics.state.0.clone();
-    let mut ws = StepWorkspace::new(&body.model);
-    let mut monitor = StepMonitor::new(body.link_names.len(), body.dof_v.len());
-    let settings = StepSettings { integrator, dt };
-    for _ in 0..(cfg.duration_s / dt).round() as usize {
-        ch.controller.apply(state.time_s, &mut pd);
-        let forces = Forces {
-            pd: Some(&pd),
-            external: &ch.external.0,
-            ..passive(&ch)
-        };
-        pipeline::step(
-            &body.model,
-            settings,
-            &forces,
-            &mut state,
-            &mut ws,
-            &mut monitor,
-        )?;
-    }
-    Ok(body
-        .link_names
-        .iter()
-        .zip(&monitor.contact.peak)
-        .map(|(l, f)| cfg.damage_weights.get(l).copied().unwrap_or(1.0) * f)
-        .sum())
 }
 
 /// The relative damage moves `(D(h) − D(h/2)) / D(h/2)` of `genomes` on `problem`, sorted
@@ -329,8 +284,8 @@ fn on_random_genomes_the_2_ms_damage_moves_less_than_the_explicit_steps_when_hal
         let mut blew_up = 0;
         for g in &genomes {
             match (
-                genome_damage(&problem, g, EXPLICIT, 2e-3),
-                genome_damage(&problem, g, EXPLICIT, 1e-3),
+                stepped_damage(&problem.config(g), EXPLICIT, 2e-3),
+                stepped_damage(&problem.config(g), EXPLICIT, 1e-3),
             ) {
                 (Ok(c), Ok(f)) => stepped.push((c - f) / f),
                 _ => blew_up += 1,
