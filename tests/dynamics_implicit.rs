@@ -158,12 +158,11 @@ fn stepped_damage(cfg: &FallConfig, integrator: Integrator, dt: f64) -> Result<f
         .sum())
 }
 
-/// The paper's fall of `group` with the GA's strongest genome: `k_p` at its bound on every DOF
-/// (the gains the GA's step is chosen for), in the stance and the reaction alike.
+/// The paper's fall of `group` with the GA's strongest genome: from the reaction time `k_p` at
+/// its bound on every DOF (the gains the GA's step is chosen for), the key pose the stance.
 fn strongest(group: AgeGroup) -> FallConfig {
     let mut cfg = FallConfig::paper(group);
     cfg.kp = strength_kp_max(group, 1.0);
-    cfg.stance_kp = cfg.kp.clone();
     cfg
 }
 
