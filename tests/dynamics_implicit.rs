@@ -307,7 +307,7 @@ fn on_random_genomes_the_2_ms_damage_moves_less_than_the_explicit_steps_when_hal
         all.push((group, moves, stepped));
     }
     // Measured (see the printed figures): the linearised step at 2 ms does not hold every
-    // random genome within 10 % (the aim; a quarter of the adult genomes move more),
+    // random genome within 10 % (the aim; 7 of the 32 adult genomes move more),
     // but it holds the typical one within 5 % and never does worse than the explicit step at
     // the same 2 ms past its check.
     for (group, moves, stepped) in all {

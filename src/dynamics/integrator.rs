@@ -39,7 +39,7 @@ pub enum Integrator {
     /// Semi-implicit Euler with every stiff force linearised and taken implicitly:
     /// `(M + h D + h² K) Δv = h (f − h K v)` with `K`, `D` the stiffness and damping of the PD
     /// terms, of the joint limits past their range, of the joint friction and of the pushing
-    /// floor corners (1 evaluation per step; [`super::linearly_implicit`]).
+    /// (and sticking) floor corners (1 evaluation per step; [`super::linearly_implicit`]).
     LinearlyImplicitEuler,
 }
 

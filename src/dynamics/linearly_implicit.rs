@@ -1,6 +1,7 @@
 //! The linearly implicit (semi-implicit, "Rosenbrock–Euler") step of stiff springs and dampers:
 //! every force `f(q, v)` that is stiff — PD control, the joint model past its range and its
-//! friction inside it, the floor's penalty springs and dampers on the corners that push — is
+//! friction inside it, the floor's penalty springs and dampers on the corners that push and
+//! the friction springs of the corners that stick — is
 //! replaced by its linearisation at the step end,
 //!
 //! `f(q + h v', v') ≈ f(q, v) − K h v' − D (v' − v)`, with `K = −∂f/∂q`, `D = −∂f/∂v`,
@@ -19,8 +20,9 @@
 //! `J_b` the body's Jacobian): `Jᵀ (h c + h² k) J` is an inertia `h (c + h k) j jᵀ` added to the
 //! body in the ABA (the same O(n) device as the contact's implicit damping, exact in exact
 //! arithmetic: the ABA solves `H + Σ J_bᵀ I_c J_b` as CRBA + Cholesky would), and the
-//! force correction `−h k ż j` ([`corner`]). The friction (tangential) spring stays explicit:
-//! it is soft (per kg) and capped by the cone.
+//! force correction `−h k ż j` ([`corner`]). A sticking corner's friction spring and damper
+//! are taken the same way along both tangents of the floor; a slipping corner's friction (the
+//! cone's `μ f_n`) stays explicit.
 //!
 //! The force the step applies is the linearised one; the contact monitor and the damage keep
 //! sampling the force law `f(q, v)` at the step starts, as with the explicit schemes.

@@ -117,6 +117,14 @@ impl Default for ContactParams {
     }
 }
 
+/// Two unit vectors that with the unit normal `n` make an orthonormal basis.
+#[inline(always)]
+fn tangents(n: DVec3) -> [DVec3; 2] {
+    let a = if n.x.abs() < 0.9 { DVec3::X } else { DVec3::Y };
+    let t1 = (a - n * n.dot(a)).normalize();
+    [t1, n.cross(t1)]
+}
+
 /// What a step takes implicitly of the floor's normal force, over a step of `h` seconds: its
 /// damping ([`ContactParams::implicit_damping`]) and, with `stiffness`, its spring too
 /// ([`linearly_implicit`]).
@@ -255,6 +263,15 @@ impl ContactModel {
         ft
     }
 
+    /// The friction force of [`Self::tangential_force`] before the cone's clip.
+    #[inline(always)]
+    fn stuck_force(&self, link: usize, xd: DVec3, zd: f64, stretch: DVec3) -> DVec3 {
+        let p = &self.params;
+        let m = self.masses[link];
+        let vt = xd - p.floor_normal * zd;
+        -stretch * (p.tangential_stiffness_per_kg * m) - vt * (p.tangential_damping_per_kg * m)
+    }
+
     /// The contact force of link `i` (body coordinates), its total normal force (N) and its
     /// deepest corner penetration (m, ≥ 0) for the state in `data`, with the friction anchors
     /// `anchors` (its 8 corners). With `UPDATE` the anchors are first brought to this state: a
@@ -265,7 +282,8 @@ impl ContactModel {
     /// ([`ContactParams::implicit_damping`]): `ic` (body coordinates) gains `h c j jᵀ`,
     /// `j = [p × n; n]` the floor normal as a unit force at the corner `p`; with
     /// `f.stiffness` its spring too: `ic` gains `h (c + h k) j jᵀ` and the force `−h k ż j`
-    /// ([`linearly_implicit::corner`]).
+    /// ([`linearly_implicit::corner`]), and a sticking corner's friction spring and damper
+    /// the same along both floor tangents.
     #[inline(always)]
     fn link_contact<const UPDATE: bool>(
         &self,
@@ -355,6 +373,21 @@ impl ContactModel {
                     let (w, df) = linearly_implicit::corner(imp.h, k_c, c_c, zd);
                     ic.sub_outer(j, -w);
                     f_body += j * df;
+                    // A sticking corner's friction spring and damper along both tangents, the
+                    // same way (a slipping one's force is the cone's, not linearised).
+                    if UPDATE && anchors[k].is_some() && ft == self.stuck_force(i, xd, zd, stretch)
+                    {
+                        let (kt, ct) = (
+                            p.tangential_stiffness_per_kg * m,
+                            p.tangential_damping_per_kg * m,
+                        );
+                        for t in tangents(n) {
+                            let jt = ForceVec::at_point(rot.transpose() * t, cl);
+                            let (w, df) = linearly_implicit::corner(imp.h, kt, ct, t.dot(xd));
+                            ic.sub_outer(jt, -w);
+                            f_body += jt * df;
+                        }
+                    }
                 } else {
                     // I + h c j jᵀ.
                     ic.sub_outer(j, -imp.h * c_c);
