@@ -6,7 +6,10 @@
 //!   exact chart rate `ż = dexp⁻¹(z, ω)`, which keeps 4th order on SO(3) (Munthe-Kaas RKMK);
 //! - semi-implicit Euler `v' = v + h q̈(q, v)`, `q' = q ⊞ h ż(q, v')`, optionally
 //!   with joint damping taken implicitly: `(H + h·diag(d)) q̈ = τ(q, v) − C`, the linearly
-//!   implicit step of `τ = −d v'`, so stiff friction and PD damping gains do not force tiny steps.
+//!   implicit step of `τ = −d v'`, so stiff friction and PD damping gains do not force tiny steps;
+//! - linearly implicit Euler: the same update with the stiffness *and* damping of the PD, the
+//!   joint model and the floor taken implicitly, `(H + h D + h² K) q̈ = f − C − h K v`
+//!   ([`super::linearly_implicit`]), stable at steps the stiff springs forbid the others.
 //!
 //! Semi-implicit Euler is *not* symplectic here. It is symplectic for a separable Hamiltonian in
 //! canonical coordinates (constant mass matrix, momentum `p` updated before `q`); this body steps
@@ -33,6 +36,11 @@ pub enum Integrator {
         /// Take joint damping implicitly (solve with `H + h·diag(d)`).
         implicit_damping: bool,
     },
+    /// Semi-implicit Euler with every stiff force linearised and taken implicitly:
+    /// `(M + h D + h² K) Δv = h (f − h K v)` with `K`, `D` the stiffness and damping of the PD
+    /// terms, of the joint limits past their range, of the joint friction and of the pushing
+    /// (and sticking) floor corners (1 evaluation per step; [`super::linearly_implicit`]).
+    LinearlyImplicitEuler,
 }
 
 /// The acceleration function `q̈ = f(t, q, v)` a scheme integrates.
@@ -50,6 +58,22 @@ pub trait Dynamics {
         implicit_dt: Option<f64>,
         qdd: &mut [f64],
     ) -> Result<(), Self::Error>;
+
+    /// The acceleration of a linearly implicit step of `h` seconds: with the force's
+    /// stiffness `K = −∂f/∂q` and damping `D = −∂f/∂v` at `(q, v)`, it solves
+    /// `(H + h D + h² K) q̈ = f(q, v) − C − h K v`, so that `v' = v + h q̈` is the velocity at
+    /// which the linearised force `f(q + h v', v')` acts ([`super::linearly_implicit`]). A
+    /// dynamics that knows no stiffness takes its damping implicitly only (the default).
+    fn acceleration_linearised(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+        h: f64,
+        qdd: &mut [f64],
+    ) -> Result<(), Self::Error> {
+        self.acceleration(t, q, v, Some(h), qdd)
+    }
 }
 
 /// Buffers of the integrators, sized once from the model (no allocation per step).
@@ -99,6 +123,11 @@ pub fn step<D: Dynamics>(
         Integrator::SemiImplicitEuler { implicit_damping } => {
             let implicit = implicit_damping.then_some(h);
             semi_implicit_euler_step(model, ws, dynamics, t, implicit, h, (q, v))
+        }
+        Integrator::LinearlyImplicitEuler => {
+            dynamics.acceleration_linearised(t, q, v, h, &mut ws.kv[0])?;
+            semi_implicit_euler_advance(model, ws, h, (q, v));
+            Ok(())
         }
     }
 }

@@ -24,6 +24,7 @@ pub mod integrator;
 pub mod joint;
 pub mod kinematics;
 pub mod lanes;
+pub mod linearly_implicit;
 pub mod model;
 pub mod pipeline;
 pub mod rnea;

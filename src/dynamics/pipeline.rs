@@ -19,12 +19,15 @@
 use super::aba::aba_passes;
 use super::aba_lanes::{LaneData, LaneInput, lanes_inline};
 use super::data::Data;
-use super::forces::contact::{ContactModel, ContactSample, ContactState, ContactStats};
+use super::forces::contact::{
+    ContactModel, ContactSample, ContactState, ContactStats, ImplicitFloor,
+};
 use super::forces::external::{ExternalForce, apply_external};
 use super::forces::limits::JointRanges;
 use super::forces::pd::PdTargets;
 use super::integrator::{self, Dynamics, Integrator, IntegratorWorkspace};
 use super::kinematics::kinematics;
+use super::linearly_implicit;
 use super::model::Model;
 use super::spatial::{ArticulatedInertia, ForceVec};
 
@@ -145,6 +148,8 @@ pub struct EvalScratch {
     pub tau: Vec<f64>,
     /// Joint damping coefficients (nv).
     pub damping: Vec<f64>,
+    /// Joint stiffness coefficients `−∂τ/∂θ` (nv), for the linearly implicit step.
+    pub stiffness: Vec<f64>,
     /// Armature `h·d` (nv).
     pub armature: Vec<f64>,
     /// Angles (nv).
@@ -183,6 +188,7 @@ impl StepWorkspace {
                 f_ext: vec![ForceVec::ZERO; nb],
                 tau: vec![0.0; nv],
                 damping: vec![0.0; nv],
+                stiffness: vec![0.0; nv],
                 armature: vec![0.0; nv],
                 angles: vec![0.0; nv],
                 reference: vec![0.0; nv],
@@ -408,7 +414,8 @@ fn limits_stage(
 
 /// Stage 3: anchors and contact forces at the step start, per-link statistics; with
 /// [`ContactParams::implicit_damping`](super::forces::contact::ContactParams::implicit_damping)
-/// and semi-implicit Euler, the implicit inertias of the touching links for the step.
+/// and semi-implicit Euler, or with linearly implicit Euler, the implicit inertias of the
+/// touching links for the step.
 #[inline(always)]
 fn contact_stage(
     forces: &Forces,
@@ -422,14 +429,25 @@ fn contact_stage(
     e.f_ext.fill(ForceVec::ZERO);
     e.implicit.clear();
     if let Some(cm) = forces.contact {
-        let implicit = cm.params.implicit_damping
-            && matches!(settings.integrator, Integrator::SemiImplicitEuler { .. });
+        let implicit = match settings.integrator {
+            Integrator::LinearlyImplicitEuler => Some(ImplicitFloor {
+                h: dt,
+                stiffness: true,
+            }),
+            Integrator::SemiImplicitEuler { .. } if cm.params.implicit_damping => {
+                Some(ImplicitFloor {
+                    h: dt,
+                    stiffness: false,
+                })
+            }
+            _ => None,
+        };
         cm.update_and_apply_implicit(
             &e.data,
             &mut state.anchors,
             &mut e.f_ext,
             &mut monitor.sample,
-            implicit.then_some((dt, &mut e.implicit)),
+            implicit.map(|f| (f, &mut e.implicit)),
         );
         monitor
             .contact
@@ -561,6 +579,34 @@ impl Dynamics for Evaluation<'_> {
         implicit_dt: Option<f64>,
         qdd: &mut [f64],
     ) -> Result<(), StepError> {
+        let implicit = implicit_dt.map_or(Implicit::Explicit, Implicit::Damping);
+        self.evaluate(t, q, v, implicit, qdd)
+    }
+
+    #[inline(always)]
+    fn acceleration_linearised(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+        h: f64,
+        qdd: &mut [f64],
+    ) -> Result<(), StepError> {
+        self.evaluate(t, q, v, Implicit::Linearised(h), qdd)
+    }
+}
+
+impl Evaluation<'_> {
+    /// `q̈` at `(t, q, v)` with the forces taken as `implicit` says.
+    #[inline(always)]
+    fn evaluate(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+        implicit: Implicit,
+        qdd: &mut [f64],
+    ) -> Result<(), StepError> {
         let arm = prepare(
             self.model,
             self.forces,
@@ -569,7 +615,7 @@ impl Dynamics for Evaluation<'_> {
             t,
             q,
             v,
-            implicit_dt,
+            implicit,
         );
         let ws = &mut *self.ws;
         let arm = arm.then_some(&ws.armature[..]);
@@ -585,9 +631,21 @@ impl Dynamics for Evaluation<'_> {
     }
 }
 
+/// What an evaluation takes implicitly over a step of `h` seconds.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Implicit {
+    /// Nothing: every force at `(q, v)`.
+    Explicit,
+    /// The joint damping (armature `h d`).
+    Damping(f64),
+    /// The joint forces' stiffness and damping ([`linearly_implicit::joint`]).
+    Linearised(f64),
+}
+
 /// The force evaluation before the ABA: kinematics and contact forces (unless the step-start
 /// stages left them), external forces, angles, PD and joint-model torques and, with
-/// `implicit_dt = Some(h)`, the armature `h·d`; returns whether the armature applies.
+/// `implicit`, the armature (`h·d`, or `h d + h² k` with the torques corrected by `−h k v`);
+/// returns whether the armature applies.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 fn prepare(
@@ -598,7 +656,7 @@ fn prepare(
     t: f64,
     q: &[f64],
     v: &[f64],
-    implicit_dt: Option<f64>,
+    implicit: Implicit,
 ) -> bool {
     let at_start = ws.step_start_ready;
     // The implicit contact damping belongs to the step-start evaluation only.
@@ -626,6 +684,7 @@ fn prepare(
     if (forces.pd.is_some() || forces.limits.is_some()) && !start_angles {
         read_angles(model, forces, q, &mut ws.reference, &mut ws.angles);
     }
+    let linearised = matches!(implicit, Implicit::Linearised(_));
     for (d, &k) in forces.dofs.iter().enumerate() {
         let (th, thd) = (ws.angles[k], v[k]);
         let (mut tau, mut damp) = (0.0, 0.0);
@@ -633,6 +692,15 @@ fn prepare(
             (tau, damp) = ws.pd_start[d];
         } else if let Some(pd) = forces.pd {
             (tau, damp) = pd.torque(d, th, thd);
+        }
+        if linearised {
+            let mut stiff = forces
+                .pd
+                .map_or(0.0, |pd| linearly_implicit::pd_stiffness(pd, d, tau));
+            if let Some(l) = forces.limits {
+                stiff += linearly_implicit::limit_stiffness(l, d, th);
+            }
+            ws.stiffness[k] = stiff;
         }
         if let Some(l) = forces.limits {
             let (t2, d2) = l.torque(d, th, thd);
@@ -642,14 +710,23 @@ fn prepare(
         ws.tau[k] = tau;
         ws.damping[k] = damp;
     }
-    match implicit_dt {
-        Some(h) => {
+    match implicit {
+        Implicit::Damping(h) => {
             for k in 0..ws.armature.len() {
                 ws.armature[k] = h * ws.damping[k];
             }
             true
         }
-        None => false,
+        Implicit::Linearised(h) => {
+            for k in 0..ws.armature.len() {
+                let (arm, tau) =
+                    linearly_implicit::joint(h, ws.tau[k], ws.damping[k], ws.stiffness[k], v[k]);
+                ws.armature[k] = arm;
+                ws.tau[k] = tau;
+            }
+            true
+        }
+        Implicit::Explicit => false,
     }
 }
 
@@ -749,7 +826,11 @@ fn step_lanes_stages(
         }
     };
     let h = settings.dt;
-    let implicit_dt = implicit_damping.then_some(h);
+    let implicit = if implicit_damping {
+        Implicit::Damping(h)
+    } else {
+        Implicit::Explicit
+    };
     for b in bodies.iter_mut() {
         let (forces, state, ws, monitor) = (&b.forces, &mut *b.state, &mut *b.ws, &mut *b.monitor);
         position_stage(model, state, ws);
@@ -766,7 +847,7 @@ fn step_lanes_stages(
             t,
             q,
             v,
-            implicit_dt,
+            implicit,
         );
     }
     lanes_inline(

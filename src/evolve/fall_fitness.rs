@@ -158,16 +158,18 @@ pub const STEP_MARGIN: f64 = 0.8;
 /// stiffest mode of the strongest genome (k_p = `kp_max` on every DOF; θ_d does not change the
 /// standing bound) through [`crate::dynamics::stability`], times `margin` (a fraction of that
 /// bound in (0, 1]; the GA's default is [`STEP_MARGIN`]), rounded down to a multiple of 50 µs
-/// ([`STEP_QUANTA_PER_S`]); `fall.dt_s` when nothing is stiff.
+/// ([`STEP_QUANTA_PER_S`]); `fall.dt_s` when nothing is stiff or the fall's scheme has no
+/// bound.
 pub fn stable_step_for(fall: &FallConfig, kp_max: &[f64], margin: f64) -> Result<f64, SimError> {
     let mut strongest = fall.clone();
     strongest.kp = kp_max.to_vec();
     Ok(
         match crate::experiments::fall::stiffest_mode_of_config(&strongest)? {
-            Some(m) => {
+            // A scheme without a bound (linearly implicit Euler) keeps the fall's step.
+            Some(m) if m.bound_s.is_finite() => {
                 (margin * m.bound_s * STEP_QUANTA_PER_S).floor().max(1.0) / STEP_QUANTA_PER_S
             }
-            None => fall.dt_s,
+            _ => fall.dt_s,
         },
     )
 }

@@ -16,6 +16,7 @@
 //! they only hold a corner where it touched and are capped by the friction cone.
 
 use crate::dynamics::data::Data;
+use crate::dynamics::linearly_implicit;
 use crate::dynamics::spatial::{ArticulatedInertia, ForceVec, transpose_mul};
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
@@ -114,6 +115,25 @@ impl Default for ContactParams {
             implicit_damping: false,
         }
     }
+}
+
+/// Two unit vectors that with the unit normal `n` make an orthonormal basis.
+#[inline(always)]
+fn tangents(n: DVec3) -> [DVec3; 2] {
+    let a = if n.x.abs() < 0.9 { DVec3::X } else { DVec3::Y };
+    let t1 = (a - n * n.dot(a)).normalize();
+    [t1, n.cross(t1)]
+}
+
+/// What a step takes implicitly of the floor's normal force, over a step of `h` seconds: its
+/// damping ([`ContactParams::implicit_damping`]) and, with `stiffness`, its spring too
+/// ([`linearly_implicit`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ImplicitFloor {
+    /// The step (s).
+    pub h: f64,
+    /// Take the spring implicitly too.
+    pub stiffness: bool,
 }
 
 /// Contact state carried between steps: the friction anchor of each corner in contact.
@@ -243,22 +263,34 @@ impl ContactModel {
         ft
     }
 
+    /// The friction force of [`Self::tangential_force`] before the cone's clip.
+    #[inline(always)]
+    fn stuck_force(&self, link: usize, xd: DVec3, zd: f64, stretch: DVec3) -> DVec3 {
+        let p = &self.params;
+        let m = self.masses[link];
+        let vt = xd - p.floor_normal * zd;
+        -stretch * (p.tangential_stiffness_per_kg * m) - vt * (p.tangential_damping_per_kg * m)
+    }
+
     /// The contact force of link `i` (body coordinates), its total normal force (N) and its
     /// deepest corner penetration (m, ≥ 0) for the state in `data`, with the friction anchors
     /// `anchors` (its 8 corners). With `UPDATE` the anchors are first brought to this state: a
     /// corner that left the floor loses its anchor, a new contact anchors where it touches, and a
     /// corner whose spring would leave the friction cone drags its anchor to the cone's edge
-    /// (slip). Also returns the power the normal forces absorb (W). With `implicit = Some((h,
-    /// ic))` each pushing corner's normal damper is taken implicitly over a step `h`
+    /// (slip). Also returns the power the normal forces absorb (W). With `implicit = Some((f,
+    /// ic))` each pushing corner's normal damper is taken implicitly over the step `f.h`
     /// ([`ContactParams::implicit_damping`]): `ic` (body coordinates) gains `h c j jᵀ`,
-    /// `j = [p × n; n]` the floor normal as a unit force at the corner `p`.
+    /// `j = [p × n; n]` the floor normal as a unit force at the corner `p`; with
+    /// `f.stiffness` its spring too: `ic` gains `h (c + h k) j jᵀ` and the force `−h k ż j`
+    /// ([`linearly_implicit::corner`]), and a sticking corner's friction spring and damper
+    /// the same along both floor tangents.
     #[inline(always)]
     fn link_contact<const UPDATE: bool>(
         &self,
         data: &Data,
         i: usize,
         anchors: &mut [Option<DVec3>],
-        mut implicit: Option<(f64, &mut ArticulatedInertia)>,
+        mut implicit: Option<(ImplicitFloor, &mut ArticulatedInertia)>,
     ) -> (ForceVec, f64, f64, f64) {
         let p = &self.params;
         let n = p.floor_normal;
@@ -332,12 +364,34 @@ impl ContactModel {
             power -= fnorm * zd;
             let f_world = n * fnorm + ft;
             f_body += ForceVec::at_point(rot.transpose() * f_world, cl);
-            if let Some((h, ic)) = implicit.as_mut()
+            if let Some((imp, ic)) = implicit.as_mut()
                 && fnorm > 0.0
             {
-                // I + h c j jᵀ.
                 let j = ForceVec::at_point(rot.transpose() * n, cl);
-                ic.sub_outer(j, -*h * c_c);
+                if imp.stiffness {
+                    // I + h (c + h k) j jᵀ, and the force at the step end's position.
+                    let (w, df) = linearly_implicit::corner(imp.h, k_c, c_c, zd);
+                    ic.sub_outer(j, -w);
+                    f_body += j * df;
+                    // A sticking corner's friction spring and damper along both tangents, the
+                    // same way (a slipping one's force is the cone's, not linearised).
+                    if UPDATE && anchors[k].is_some() && ft == self.stuck_force(i, xd, zd, stretch)
+                    {
+                        let (kt, ct) = (
+                            p.tangential_stiffness_per_kg * m,
+                            p.tangential_damping_per_kg * m,
+                        );
+                        for t in tangents(n) {
+                            let jt = ForceVec::at_point(rot.transpose() * t, cl);
+                            let (w, df) = linearly_implicit::corner(imp.h, kt, ct, t.dot(xd));
+                            ic.sub_outer(jt, -w);
+                            f_body += jt * df;
+                        }
+                    }
+                } else {
+                    // I + h c j jᵀ.
+                    ic.sub_outer(j, -imp.h * c_c);
+                }
             }
         }
         (f_body, normal, depth, power)
@@ -379,11 +433,12 @@ impl ContactModel {
         self.update_and_apply_implicit(data, state, f_ext, sample, None);
     }
 
-    /// [`update_and_apply`](Self::update_and_apply) with the normal damping taken implicitly
-    /// over a step of `implicit = Some((h, added))` seconds
-    /// ([`ContactParams::implicit_damping`]): `added` is cleared, then holds per touching link
-    /// its implicit inertia `Σ h c j jᵀ` (body coordinates) for
-    /// [`aba_passes`](crate::dynamics::aba::aba_passes); `f_ext` gets the forces at the state.
+    /// [`update_and_apply`](Self::update_and_apply) with the normal force taken implicitly
+    /// as `implicit = Some((f, added))` says ([`ImplicitFloor`]: the damping, and with
+    /// `f.stiffness` the spring too): `added` is cleared, then holds per touching link
+    /// its implicit inertia `Σ h c j jᵀ` or `Σ h (c + h k) j jᵀ` (body coordinates) for
+    /// [`aba_passes`](crate::dynamics::aba::aba_passes); `f_ext` gets the forces at the state
+    /// (with the spring, plus each pushing corner's `−h k ż j`).
     #[inline(always)]
     pub fn update_and_apply_implicit(
         &self,
@@ -391,7 +446,7 @@ impl ContactModel {
         state: &mut ContactState,
         f_ext: &mut [ForceVec],
         sample: &mut ContactSample,
-        mut implicit: Option<(f64, &mut Vec<(usize, ArticulatedInertia)>)>,
+        mut implicit: Option<(ImplicitFloor, &mut Vec<(usize, ArticulatedInertia)>)>,
     ) {
         let mut deepest: f64 = 0.0;
         let n = self.params.floor_normal;
