@@ -17,7 +17,11 @@ fuzz_target!(|data: &[u8]| {
         Ok(s) => s,
         Err(SceneError::Ron(e)) => {
             let lines = text.split('\n').count();
-            assert!(e.line >= 1 && e.line <= lines + 1, "line {} of {lines}: {e}", e.line);
+            assert!(
+                e.line >= 1 && e.line <= lines + 1,
+                "line {} of {lines}: {e}",
+                e.line
+            );
             assert!(e.to_string().starts_with("fuzz.ron:"), "{e}");
             return;
         }
@@ -31,8 +35,14 @@ fuzz_target!(|data: &[u8]| {
         Ok(s) => {
             let _ = validate(&s);
         }
-        Err(SceneError::Override { assignment, message }) => {
-            assert!(sets.contains(&assignment), "{assignment:?} is not one of {sets:?}");
+        Err(SceneError::Override {
+            assignment,
+            message,
+        }) => {
+            assert!(
+                sets.contains(&assignment),
+                "{assignment:?} is not one of {sets:?}"
+            );
             assert!(!message.is_empty());
         }
         Err(e) => assert!(!e.to_string().is_empty()),

@@ -15,7 +15,11 @@ fuzz_target!(|data: &[u8]| {
             g.iter()
                 .map(|x| {
                     let s: f64 = x.iter().sum();
-                    if s.is_finite() { Ok(s) } else { Err("not finite".into()) }
+                    if s.is_finite() {
+                        Ok(s)
+                    } else {
+                        Err("not finite".into())
+                    }
                 })
                 .collect()
         })
@@ -23,8 +27,15 @@ fuzz_target!(|data: &[u8]| {
     let out = String::from_utf8(out).expect("replies are UTF-8");
     for line in out.lines() {
         let v: serde_json::Value = serde_json::from_str(line).expect("each reply is JSON");
-        let tag = v.as_object().and_then(|o| o.keys().next()).cloned().unwrap_or_default();
-        assert!(["damage", "error", "done"].contains(&tag.as_str()), "{line}");
+        let tag = v
+            .as_object()
+            .and_then(|o| o.keys().next())
+            .cloned()
+            .unwrap_or_default();
+        assert!(
+            ["damage", "error", "done"].contains(&tag.as_str()),
+            "{line}"
+        );
     }
     if let Err(e) = r {
         let e = e.to_string();
