@@ -166,3 +166,94 @@ pub fn parse_ron<T: serde::de::DeserializeOwned>(text: &str, origin: &str) -> Re
             message: e.code.to_string(),
         })
 }
+
+/// Deserializes a map, refusing a key given twice (serde's maps keep the last value silently:
+/// a weight written twice would keep only its second value). Use with
+/// `#[serde(deserialize_with = "crate::io::unique_keys")]`.
+pub fn unique_keys<'de, D, K, V>(d: D) -> Result<std::collections::BTreeMap<K, V>, D::Error>
+where
+    D: serde::Deserializer<'de>,
+    K: serde::Deserialize<'de> + Ord + std::fmt::Debug,
+    V: serde::Deserialize<'de>,
+{
+    struct Unique<K, V>(std::marker::PhantomData<(K, V)>);
+    impl<'de, K, V> serde::de::Visitor<'de> for Unique<K, V>
+    where
+        K: serde::Deserialize<'de> + Ord + std::fmt::Debug,
+        V: serde::Deserialize<'de>,
+    {
+        type Value = std::collections::BTreeMap<K, V>;
+        fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+            f.write_str("a map with each key once")
+        }
+        fn visit_map<A: serde::de::MapAccess<'de>>(
+            self,
+            mut map: A,
+        ) -> Result<Self::Value, A::Error> {
+            let mut out = std::collections::BTreeMap::new();
+            while let Some((k, v)) = map.next_entry::<K, V>()? {
+                if out.contains_key(&k) {
+                    return Err(serde::de::Error::custom(format!(
+                        "the key {k:?} is given twice"
+                    )));
+                }
+                out.insert(k, v);
+            }
+            Ok(out)
+        }
+    }
+    d.deserialize_map(Unique(std::marker::PhantomData))
+}
+
+/// [`unique_keys`] for an optional map.
+pub fn unique_keys_opt<'de, D, K, V>(
+    d: D,
+) -> Result<Option<std::collections::BTreeMap<K, V>>, D::Error>
+where
+    D: serde::Deserializer<'de>,
+    K: serde::Deserialize<'de> + Ord + std::fmt::Debug,
+    V: serde::Deserialize<'de>,
+{
+    struct Wrap<K, V>(std::collections::BTreeMap<K, V>);
+    impl<'de, K, V> serde::Deserialize<'de> for Wrap<K, V>
+    where
+        K: serde::Deserialize<'de> + Ord + std::fmt::Debug,
+        V: serde::Deserialize<'de>,
+    {
+        fn deserialize<E: serde::Deserializer<'de>>(d: E) -> Result<Self, E::Error> {
+            unique_keys(d).map(Wrap)
+        }
+    }
+    Ok(<Option<Wrap<K, V>> as serde::Deserialize>::deserialize(d)?.map(|w| w.0))
+}
+
+#[cfg(test)]
+mod unique_keys_tests {
+    use std::collections::BTreeMap;
+
+    #[derive(serde::Deserialize, Debug)]
+    struct W {
+        #[serde(rename = "w", deserialize_with = "super::unique_keys")]
+        _w: BTreeMap<String, f64>,
+        #[serde(default, deserialize_with = "super::unique_keys_opt")]
+        o: Option<BTreeMap<String, f64>>,
+    }
+
+    #[test]
+    fn a_key_given_twice_is_refused_with_its_place() {
+        let e = super::parse_ron::<W>("(w: {\"knee\": 1.0, \"hip\": 2.0, \"knee\": 3.0})", "f.ron")
+            .unwrap_err();
+        assert!(e.message.contains("the key \"knee\" is given twice"), "{e}");
+        assert_eq!(e.line, 1, "{e}");
+        let e = super::parse_ron::<W>("(w: {}, o: {\"a\": 1.0, \"a\": 1.0})", "f.ron").unwrap_err();
+        assert!(e.message.contains("\"a\" is given twice"), "{e}");
+        let ok = super::parse_ron::<W>("(w: {\"a\": 1.0}, o: {\"b\": 2.0})", "f.ron").unwrap();
+        assert_eq!(ok.o.unwrap()["b"], 2.0);
+        assert!(
+            super::parse_ron::<W>("(w: {})", "f.ron")
+                .unwrap()
+                .o
+                .is_none()
+        );
+    }
+}

@@ -523,3 +523,33 @@ fn a_window_that_is_not_finite_is_refused_before_writing() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// Point 10 of issue 38: `marionette music … | head` panicked on the closed pipe.
+#[test]
+fn music_into_a_closed_pipe_ends_quietly() {
+    let dir = fresh_dir("music-pipe");
+    let t = synthesize(&SynthSong {
+        bars: 8,
+        ..SynthSong::default()
+    })
+    .unwrap();
+    let path = dir.join("song.wav");
+    std::fs::write(&path, wav_bytes(&t.samples, 1, t.sample_rate).unwrap()).unwrap();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_marionette"))
+        .args(["music", path.to_str().unwrap()])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    // The reader goes away before the first line is printed (the analysis takes longer than
+    // this), as `head` does once it has its lines: every line then meets a closed pipe.
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !err.contains("panicked") && !err.contains("Broken pipe"),
+        "{err}"
+    );
+    assert!(out.status.success(), "{:?}: {err}", out.status);
+    std::fs::remove_dir_all(&dir).ok();
+}

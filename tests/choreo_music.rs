@@ -236,3 +236,122 @@ fn bar_rms_follows_20_db_contrasts_on_a_steady_grid() {
         });
     }
 }
+
+/// Point 10 of issue 38: a cut file was analysed in part without a word, and a corrupt file,
+/// even a directory, was "not a WAV, OGG/Vorbis or MP3 file".
+#[cfg(feature = "audio")]
+#[test]
+fn decoding_names_each_failure_and_warns_how_much_of_a_cut_file_was_read() {
+    use marionette::choreo::music::decode::decode_file;
+    let dir = std::env::temp_dir().join(format!("marionette-decode-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let t = synthesize(&SynthSong {
+        bpm: 120.0,
+        bars: 4,
+        ..SynthSong::default()
+    })
+    .unwrap();
+    let whole = wav_bytes(&t.samples, 1, t.sample_rate).unwrap();
+    let full = dir.join("whole.wav");
+    std::fs::write(&full, &whole).unwrap();
+    let a = decode_file(&full).unwrap();
+    assert_eq!(a.warning, None);
+    // Cut at 40 %: analysed, with a warning saying how much was read.
+    let cut = dir.join("cut.wav");
+    std::fs::write(&cut, &whole[..whole.len() * 2 / 5]).unwrap();
+    let a = decode_file(&cut).unwrap();
+    let w = a.warning.clone().expect("no warning for a cut file");
+    let total_s = t.samples.len() as f64 / t.sample_rate as f64;
+    assert!(
+        w.contains(&format!("of the {total_s:.2} s its header states")) && w.contains("cut short"),
+        "{w}"
+    );
+    assert!(w.contains("(40 %)"), "{w}");
+    assert!(
+        (a.duration_s() - 0.4 * total_s).abs() < 0.01,
+        "{}",
+        a.duration_s()
+    );
+    let msg = |p: &std::path::Path| decode_file(p).unwrap_err().to_string();
+    let e = msg(&dir);
+    assert!(e.contains("is a directory"), "{e}");
+    let empty = dir.join("empty.wav");
+    std::fs::write(&empty, b"").unwrap();
+    assert!(msg(&empty).contains("empty (0 bytes)"), "{}", msg(&empty));
+    // A WAV whose header is garbage after its RIFF tag.
+    let corrupt = dir.join("corrupt.wav");
+    let mut bytes = whole[..64].to_vec();
+    bytes[8..16].copy_from_slice(b"XXXXXXXX");
+    std::fs::write(&corrupt, &bytes).unwrap();
+    let e = msg(&corrupt);
+    assert!(
+        e.contains("a WAV (RIFF) file") && e.contains("corrupt"),
+        "{e}"
+    );
+    // A format the build does not read, named from its first bytes.
+    let flac = dir.join("song.flac");
+    std::fs::write(&flac, b"fLaC\0\0\0\x22 and then some bytes").unwrap();
+    let e = msg(&flac);
+    assert!(
+        e.contains("a FLAC file") && e.contains("unsupported format"),
+        "{e}"
+    );
+    // A WAV in a codec the build does not decode (MPEG audio in WAV, format tag 0x55).
+    let mpeg = dir.join("mpeg.wav");
+    let mut bytes = whole.clone();
+    bytes[20..22].copy_from_slice(&0x55u16.to_le_bytes());
+    std::fs::write(&mpeg, &bytes).unwrap();
+    let e = msg(&mpeg);
+    assert!(
+        e.contains("mpeg.wav") && e.contains("unsupported codec"),
+        "{e}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Point 9 of issue 38: a song at −100 dB SNR (pure noise) was danced to random beats. Now it
+/// is refused, saying why and how to force it; a noisy but rhythmic song still passes.
+#[test]
+fn a_song_of_pure_noise_is_refused_as_having_no_beat() {
+    for seed in 0..3 {
+        let noise = synthesize(&SynthSong {
+            snr_db: Some(-100.0),
+            bars: 16,
+            seed,
+            ..SynthSong::default()
+        })
+        .unwrap();
+        let e = analyze(&noise.samples, noise.sample_rate, &MusicParams::default()).unwrap_err();
+        assert!(matches!(e, MusicError::NoBeat { .. }), "seed {seed}: {e}");
+        assert!(
+            e.to_string().contains("no beat structure")
+                && e.to_string().contains("min_beat_strength"),
+            "{e}"
+        );
+        // Forced, it is analysed.
+        let any = MusicParams {
+            min_beat_strength: 0.0,
+            ..MusicParams::default()
+        };
+        assert!(analyze(&noise.samples, noise.sample_rate, &any).is_ok());
+    }
+    let noisy = synthesize(&SynthSong {
+        snr_db: Some(-10.0),
+        bars: 16,
+        ..SynthSong::default()
+    })
+    .unwrap();
+    let a = analyze(&noisy.samples, noisy.sample_rate, &MusicParams::default()).unwrap();
+    assert!((a.tempo_bpm / 120.0 - 1.0).abs() < 0.02, "{}", a.tempo_bpm);
+    let bad = MusicParams {
+        min_beat_strength: 1.5,
+        ..MusicParams::default()
+    };
+    assert!(matches!(
+        analyze(&noisy.samples, noisy.sample_rate, &bad),
+        Err(MusicError::Parameter {
+            name: "min_beat_strength",
+            ..
+        })
+    ));
+}

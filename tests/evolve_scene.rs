@@ -411,3 +411,42 @@ fn a_generation_of_failed_falls_stops_the_run_and_its_resume_says_why() {
         std::fs::remove_dir_all(d).ok();
     }
 }
+
+/// Point 6 of issue 38: a worker that never answered hung the run forever, with no line on the
+/// terminal.
+#[test]
+fn a_silent_worker_stops_the_run_at_the_timeout_saying_who_and_what_it_said() {
+    let (out, ck) = (tmp("silent"), tmp("silent_ck"));
+    let silent = r#"evaluator={"Command":["sh","-c","echo starting >&2; cat > /dev/null"]}"#;
+    let t0 = std::time::Instant::now();
+    let o = quick_run(
+        &out,
+        &ck,
+        "[1]",
+        2,
+        false,
+        &["--set", silent, "--set", "worker_timeout_s=1.5"],
+    );
+    let err = stderr(&o);
+    assert!(!o.status.success(), "{err}");
+    assert!(t0.elapsed().as_secs() < 30, "{:?}", t0.elapsed());
+    assert!(
+        err.contains("waiting for the worker `sh -c echo starting"),
+        "{err}"
+    );
+    assert!(
+        err.contains("answered 0 of the 6 genomes of generation 0 in 1.5 s, the batch timeout"),
+        "{err}"
+    );
+    assert!(err.contains("on stderr \"starting\""), "{err}");
+    let o = quick_run(&out, &ck, "[1]", 2, false, &["--set", "worker_timeout_s=0"]);
+    let err = stderr(&o);
+    assert!(!o.status.success());
+    assert!(
+        err.contains("worker_timeout_s must be in (0, 604800] seconds, found 0"),
+        "{err}"
+    );
+    for d in [out, ck] {
+        std::fs::remove_dir_all(d).ok();
+    }
+}

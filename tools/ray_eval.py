@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Evaluate marionette GA generations on a Ray cluster.
 
-This program speaks marionette's JSON-lines evaluation protocol (marionette-eval/2) on its own
+This program speaks marionette's JSON-lines evaluation protocol (marionette-eval/3) on its own
 standard input and output, exactly as `marionette eval --stdin` does, so the engine's GA uses it
 as an evaluator (scene field `evaluator: Command(["python3", "tools/ray_eval.py"])`) while the GA
 loop, its checkpoints and its bits stay in the engine. Behind it, each Ray actor holds one
@@ -27,7 +27,28 @@ import shutil
 import subprocess
 import sys
 
-PROTOCOL = "marionette-eval/2"
+PROTOCOL = "marionette-eval/3"
+
+
+def refuse(where, line, why):
+    """Ends this program with an error naming the line, as the engine's own worker does."""
+    sys.exit(f"ray_eval: {where}: {why} (in {line.strip()[:120]!r})")
+
+
+def message(line, where, tags):
+    """The (tag, body) of a protocol line: one key among `tags` holding an object."""
+    try:
+        msg = json.loads(line)
+    except json.JSONDecodeError as e:
+        refuse(where, line, f"column {e.colno}: {e.msg}")
+    if not isinstance(msg, dict) or len(msg) != 1:
+        refuse(where, line, f"expected one message, one of {sorted(tags)}")
+    (tag, body), = msg.items()
+    if tag not in tags:
+        refuse(where, line, f"unknown message `{tag}`, expected one of {sorted(tags)}")
+    if not isinstance(body, dict):
+        refuse(where, line, f"field `{tag}`: expected an object, found {body!r}")
+    return tag, body
 
 
 def find_worker(given):
@@ -49,6 +70,7 @@ def make_actor_class(ray):
         """One long-lived `marionette eval --stdin` process."""
 
         def __init__(self, binary, header_line):
+            self.binary = binary
             self.proc = subprocess.Popen(
                 [binary, "eval", "--stdin"],
                 stdin=subprocess.PIPE,
@@ -63,14 +85,16 @@ def make_actor_class(ray):
             """Sends genome lines, then the batch end; returns the reply lines."""
             for line in lines:
                 self.proc.stdin.write(line)
-            self.proc.stdin.write('{"evaluate":true}\n')
+            self.proc.stdin.write(json.dumps({"evaluate": {"count": len(lines)}}) + "\n")
             self.proc.stdin.flush()
             replies = []
             while True:
                 reply = self.proc.stdout.readline()
                 if not reply:
-                    raise RuntimeError("marionette eval worker closed its output")
-                if json.loads(reply).get("done") is not None:
+                    raise RuntimeError(
+                        f"{self.binary} eval --stdin closed its output after {len(replies)} "
+                        f"of {len(lines)} replies (exit status {self.proc.poll()})")
+                if "done" in json.loads(reply):
                     return replies
                 replies.append(reply)
 
@@ -94,6 +118,8 @@ def main():
 
     header_line = sys.stdin.readline()
     header = json.loads(header_line)
+    if not isinstance(header, dict) or set(header) != {"protocol", "problem"}:
+        refuse("request line 1", header_line, "expected the header {\"protocol\", \"problem\"}")
     if header.get("protocol") != PROTOCOL:
         sys.exit(f"ray_eval: protocol {header.get('protocol')!r} is not {PROTOCOL!r}")
 
@@ -107,24 +133,29 @@ def main():
     actors = [Worker.remote(binary, header_line) for _ in range(n_actors)]
 
     batch = []
-    for line in sys.stdin:
+    for number, line in enumerate(sys.stdin, start=2):
         if not line.strip():
             continue
-        msg = json.loads(line)
-        if "genes" in msg:
+        # The workers check each genome line's fields; this checks the batch's shape.
+        tag, body = message(line, f"request line {number}", {"genome", "evaluate"})
+        if tag == "genome":
             batch.append(line if line.endswith("\n") else line + "\n")
             continue
-        if msg.get("evaluate"):
-            # Contiguous chunks, one per actor; replies carry their index.
-            k = max(1, -(-len(batch) // len(actors)))
-            chunks = [batch[i:i + k] for i in range(0, len(batch), k)]
-            futures = [a.evaluate.remote(c) for a, c in zip(actors, chunks)]
-            replies = [r for rs in ray.get(futures) for r in rs]
-            replies.sort(key=lambda r: json.loads(r)["index"])
-            out = "".join(replies) + json.dumps({"done": len(batch)}) + "\n"
-            sys.stdout.write(out)
-            sys.stdout.flush()
-            batch = []
+        if body.get("count") != len(batch) or len(body) != 1:
+            refuse(f"request line {number}", line,
+                   f"field `evaluate.count`: the batch holds {len(batch)} genomes")
+        # Contiguous chunks, one per actor; replies carry their index.
+        k = max(1, -(-len(batch) // len(actors)))
+        chunks = [batch[i:i + k] for i in range(0, len(batch), k)]
+        futures = [a.evaluate.remote(c) for a, c in zip(actors, chunks)]
+        replies = [r for rs in ray.get(futures) for r in rs]
+        replies.sort(key=lambda r: next(iter(json.loads(r).values()))["index"])
+        out = "".join(replies) + json.dumps({"done": {"count": len(batch)}}) + "\n"
+        sys.stdout.write(out)
+        sys.stdout.flush()
+        batch = []
+    if batch:
+        sys.exit(f"ray_eval: the input ended inside a batch of {len(batch)} genomes")
     ray.get([a.close.remote() for a in actors])
     ray.shutdown()
 

@@ -35,6 +35,7 @@ pub const DATABASE_VERSION: u32 = 1;
 
 /// One clip of a manifest.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct ManifestClip {
     /// The clip (.bvh, or a keyframed .ron clip), relative to the manifest's folder.
     pub file: PathBuf,
@@ -49,8 +50,10 @@ pub struct ManifestClip {
     pub window: Option<(f64, f64)>,
 }
 
-/// A manifest: the clips a database is built from.
+/// A manifest: the clips a database is built from. A field it does not know (a misspelt
+/// `tempo:`) is refused, not ignored.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Manifest {
     /// Format version (1).
     pub format_version: u32,
@@ -170,11 +173,19 @@ fn check_window(window: Option<(f64, f64)>) -> Result<(), String> {
     }
 }
 
-/// Whether a .ron file reads as a manifest.
+/// Whether a .ron file has a manifest's shape (a version and a list of clips, whatever their
+/// fields: a manifest with a misspelt field is still one, refused when loaded as such).
 fn is_manifest(p: &Path) -> bool {
+    #[derive(Deserialize)]
+    struct Shape {
+        #[serde(rename = "format_version")]
+        _version: u32,
+        #[serde(rename = "clips")]
+        _clips: Vec<serde::de::IgnoredAny>,
+    }
     crate::io::read_text(p)
         .ok()
-        .is_some_and(|t| crate::io::parse_ron::<Manifest>(&t, "").is_ok())
+        .is_some_and(|t| crate::io::parse_ron::<Shape>(&t, "").is_ok())
 }
 
 /// One manifest clip loaded, windowed, given its beat and cut into bars as the database's
@@ -623,6 +634,37 @@ mod tests {
             source: TempoSource::Manifest,
         };
         Database::from_clips(&[("bars".into(), clip, Some(beat))], params)
+    }
+
+    /// Point 9 of issue 38: a misspelt `tempo:` was ignored and the detected tempo used.
+    #[test]
+    fn a_manifest_field_it_does_not_know_is_refused_naming_it() {
+        let dir = std::env::temp_dir().join(format!("marionette-manifest-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let m = dir.join("manifest.ron");
+        std::fs::write(
+            &m,
+            "(format_version: 1, clips: [(file: \"a.bvh\", tempo: Some(120.0))])",
+        )
+        .unwrap();
+        let e = Manifest::load(&m).unwrap_err().to_string();
+        assert!(e.contains("tempo") && e.contains("manifest.ron:1:"), "{e}");
+        assert!(e.contains("tempo_bpm"), "names the fields it knows: {e}");
+        std::fs::write(
+            &m,
+            "(format_version: 1, clips: [(file: \"a.bvh\")], song: 1)",
+        )
+        .unwrap();
+        assert!(Manifest::load(&m).unwrap_err().to_string().contains("song"));
+        // Still a manifest to a folder listing, not a clip.
+        assert!(is_manifest(&m));
+        std::fs::write(
+            &m,
+            "(format_version: 1, clips: [(file: \"a.bvh\", tempo_bpm: 120.0)])",
+        )
+        .unwrap();
+        assert_eq!(Manifest::load(&m).unwrap().clips[0].tempo_bpm, Some(120.0));
+        std::fs::remove_dir_all(&dir).ok();
     }
 
     #[test]

@@ -45,6 +45,7 @@ pub struct Key {
     pub t: f64,
     /// DOF angles at this key, degrees (anatomical sign).
     #[serde(default)]
+    #[serde(deserialize_with = "crate::io::unique_keys")]
     pub dofs: BTreeMap<String, f64>,
     /// Root position along +Z (forward), metres.
     #[serde(default)]

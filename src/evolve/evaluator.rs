@@ -4,19 +4,24 @@
 //! cluster (`tools/ray_eval.py`) evaluates generations while the GA loop, its checkpoints and
 //! its bits stay in the engine.
 //!
-//! The protocol, one JSON object per line:
-//! 1. client → worker, once: `{"protocol": "marionette-eval/2", "problem": {…}}` (the problem,
+//! The protocol, one JSON object per line, each message after the header tagged by its one key:
+//! 1. client → worker, once: `{"protocol": "marionette-eval/3", "problem": {…}}` (the problem,
 //!    e.g. a [`FallProblem`](super::fall_fitness::FallProblem));
-//! 2. per batch, client → worker: `{"index": i, "genes": [x, …], "refine": k}` for each genome
-//!    (`refine` as in [`Evaluator::evaluate`]; absent means 1), then `{"evaluate": true}`;
-//! 3. worker → client: `{"index": i, "damage": d}` or `{"index": i, "error": "why"}` for each,
-//!    then `{"done": n}`.
+//! 2. per batch, client → worker: `{"genome": {"index": i, "genes": [x, …], "refine": k}}` for
+//!    each genome (`refine` as in [`Evaluator::evaluate`]; absent means 1), then
+//!    `{"evaluate": {"count": n}}`, `n` the number of genomes sent;
+//! 3. worker → client: `{"damage": {"index": i, "value": d}}` or
+//!    `{"error": {"index": i, "message": "why"}}` for each, then `{"done": {"count": n}}`.
 //!
-//! Numbers travel as shortest round-trip decimals, so genes and damages cross bit for bit.
+//! Both sides refuse what they do not understand: an unknown message or field, a wrong type, a
+//! line with two messages, counts that disagree; the error names the line, the column and the
+//! field. Numbers travel as shortest round-trip decimals, so genes and damages cross bit for bit.
 
-use std::io::{BufRead, BufReader, Write};
-use std::process::{Child, ChildStdin, ChildStdout, Command, Stdio};
+use std::io::{BufRead, BufReader, Read, Write};
+use std::process::{Child, Command, Stdio};
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex, mpsc};
+use std::time::{Duration, Instant};
 
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -27,7 +32,9 @@ use super::genome::Genome;
 /// The protocol's name and version.
 /// Version 2 added `refine`; a version-1 worker would ignore it and answer at the problem's
 /// own resolution, so the version is checked.
-pub const PROTOCOL: &str = "marionette-eval/2";
+/// Version 3 tagged each message by its key and refuses unknown fields (a version-2 line is
+/// refused as an unknown message).
+pub const PROTOCOL: &str = "marionette-eval/3";
 
 /// Why a run could not go on.
 #[derive(Debug, thiserror::Error)]
@@ -208,24 +215,38 @@ pub fn par_map(genomes: &[Genome], f: impl Fn(&[f64]) -> Evaluation + Sync) -> V
     genomes.par_iter().map(|g| f(g)).collect()
 }
 
+/// The first line, client → worker: the protocol and the problem.
 #[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 struct Header {
     protocol: String,
     problem: serde_json::Value,
 }
 
+/// A genome to evaluate (`{"genome": {…}}`).
 #[derive(Serialize, Deserialize)]
-#[serde(untagged)]
+#[serde(deny_unknown_fields)]
+struct GenomeLine {
+    index: usize,
+    genes: Vec<f64>,
+    #[serde(default = "unrefined", skip_serializing_if = "is_unrefined")]
+    refine: u32,
+}
+
+/// The end of a batch (`{"evaluate": {"count": n}}`) or of its replies (`{"done": {…}}`):
+/// how many genomes it held.
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct BatchEnd {
+    count: usize,
+}
+
+/// A line client → worker after the header, tagged by its one key.
+#[derive(Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
 enum Request {
-    Genome {
-        index: usize,
-        genes: Vec<f64>,
-        #[serde(default = "unrefined", skip_serializing_if = "is_unrefined")]
-        refine: u32,
-    },
-    Evaluate {
-        evaluate: bool,
-    },
+    Genome(GenomeLine),
+    Evaluate(BatchEnd),
 }
 
 fn unrefined() -> u32 {
@@ -236,19 +257,120 @@ fn is_unrefined(k: &u32) -> bool {
     *k == 1
 }
 
+/// A genome's damage (`{"damage": {…}}`).
 #[derive(Serialize, Deserialize)]
-#[serde(untagged)]
-enum Reply {
-    Damage { index: usize, damage: f64 },
-    Error { index: usize, error: String },
-    Done { done: usize },
+#[serde(deny_unknown_fields)]
+struct DamageLine {
+    index: usize,
+    value: f64,
 }
 
-/// Drives a worker process over the JSON-lines protocol.
+/// Why a genome could not be evaluated (`{"error": {…}}`).
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ErrorLine {
+    index: usize,
+    message: String,
+}
+
+/// A line worker → client, tagged by its one key.
+#[derive(Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+enum Reply {
+    Damage(DamageLine),
+    Error(ErrorLine),
+    Done(BatchEnd),
+}
+
+/// Parses `text`, line `line` of a protocol stream (`what`: "request", "reply"), as `T`: an
+/// error names the line, the column, the field and what was expected.
+fn parse_line<T: serde::de::DeserializeOwned>(
+    text: &str,
+    what: &str,
+    line: usize,
+) -> Result<T, String> {
+    let located = |path: &str, e: &serde_json::Error| {
+        let message = e.to_string();
+        let suffix = format!(" at line {} column {}", e.line(), e.column());
+        let message = message.strip_suffix(&suffix).unwrap_or(&message);
+        let field = match path {
+            "" | "." => String::new(),
+            p => format!(", field `{p}`"),
+        };
+        format!(
+            "{what} line {line}, column {}{field}: {message} (in {})",
+            e.column(),
+            shorten(text)
+        )
+    };
+    let mut de = serde_json::Deserializer::from_str(text);
+    let value: T = serde_path_to_error::deserialize(&mut de).map_err(|e| {
+        let path = e.path().to_string();
+        located(&path, e.inner())
+    })?;
+    de.end().map_err(|e| located("", &e))?;
+    Ok(value)
+}
+
+/// `text` cut to 120 characters, for messages.
+fn shorten(text: &str) -> String {
+    let text = text.trim();
+    match text.char_indices().nth(120) {
+        Some((i, _)) => format!("{}…", &text[..i]),
+        None => text.to_string(),
+    }
+}
+
+/// Default batch timeout of a [`JsonLines`] worker, seconds (a generation of the paper's
+/// falls takes seconds to a few minutes).
+pub const DEFAULT_BATCH_TIMEOUT_S: f64 = 600.0;
+
+/// Longest wait between two progress lines while a worker is silent.
+const PROGRESS_EVERY: Duration = Duration::from_secs(10);
+
+/// The last line a worker wrote on each of its outputs, and why its input broke.
+#[derive(Default)]
+struct LastSaid {
+    stdout: Option<String>,
+    stderr: Option<String>,
+    stdin_error: Option<String>,
+}
+
+impl LastSaid {
+    fn describe(&self) -> String {
+        let mut parts = Vec::new();
+        if let Some(s) = &self.stdout {
+            parts.push(format!("on stdout {s:?}"));
+        }
+        if let Some(s) = &self.stderr {
+            parts.push(format!("on stderr {s:?}"));
+        }
+        let said = if parts.is_empty() {
+            "it said nothing".to_string()
+        } else {
+            format!("it last said {}", parts.join(" and "))
+        };
+        match &self.stdin_error {
+            Some(e) => format!("{said}; its input broke: {e}"),
+            None => said,
+        }
+    }
+}
+
+/// Drives a worker process over the JSON-lines protocol. A batch that the worker does not
+/// answer in full within the timeout ([`Self::with_timeout`], default
+/// [`DEFAULT_BATCH_TIMEOUT_S`]) stops the worker and fails, naming the worker and what it last
+/// said; while waiting, a progress line goes to standard error every few seconds. The worker's
+/// standard error is passed through to this process's.
 pub struct JsonLines {
     child: Child,
-    stdin: ChildStdin,
-    stdout: BufReader<ChildStdout>,
+    name: String,
+    to_worker: Option<mpsc::Sender<Vec<u8>>>,
+    from_worker: mpsc::Receiver<Option<String>>,
+    last: Arc<Mutex<LastSaid>>,
+    timeout: Duration,
+    lines_read: usize,
+    broken: Option<String>,
 }
 
 impl JsonLines {
@@ -256,99 +378,249 @@ impl JsonLines {
     /// sends it `problem`.
     pub fn start(mut command: Command, problem: &impl Serialize) -> Result<Self, EvolveError> {
         let err = |m: String| EvolveError::Evaluator(m);
+        let name = std::iter::once(command.get_program())
+            .chain(command.get_args())
+            .map(|a| a.to_string_lossy().into_owned())
+            .collect::<Vec<_>>()
+            .join(" ");
         let mut child = command
             .stdin(Stdio::piped())
             .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
             .spawn()
-            .map_err(|e| err(format!("cannot start {command:?}: {e}")))?;
-        let stdin = child.stdin.take().ok_or_else(|| err("no stdin".into()))?;
-        let stdout = BufReader::new(child.stdout.take().ok_or_else(|| err("no stdout".into()))?);
+            .map_err(|e| err(format!("cannot start the worker `{name}`: {e}")))?;
+        let (stdin, stdout, stderr) =
+            match (child.stdin.take(), child.stdout.take(), child.stderr.take()) {
+                (Some(i), Some(o), Some(e)) => (i, o, e),
+                _ => return Err(err(format!("the worker `{name}` has no pipes"))),
+            };
+        let last = Arc::new(Mutex::new(LastSaid::default()));
+        let lock = |l: &Arc<Mutex<LastSaid>>| {
+            let l = l.clone();
+            move |f: &dyn Fn(&mut LastSaid)| f(&mut l.lock().unwrap_or_else(|e| e.into_inner()))
+        };
+        // Writes on a thread of its own: a worker that stops reading blocks it, not the GA.
+        let (to_worker, inbox) = mpsc::channel::<Vec<u8>>();
+        let note = lock(&last);
+        std::thread::spawn(move || {
+            let mut stdin = stdin;
+            for block in inbox {
+                if let Err(e) = stdin.write_all(&block).and_then(|_| stdin.flush()) {
+                    let e = e.to_string();
+                    note(&|l| l.stdin_error = Some(e.clone()));
+                    return;
+                }
+            }
+        });
+        let (outbox, from_worker) = mpsc::channel::<Option<String>>();
+        let note = lock(&last);
+        std::thread::spawn(move || {
+            let mut stdout = BufReader::new(stdout);
+            loop {
+                let mut line = String::new();
+                match (&mut stdout).take(MAX_LINE as u64 + 1).read_line(&mut line) {
+                    Ok(n) if n > 0 => {
+                        let said = shorten(&line);
+                        note(&|l| l.stdout = Some(said.clone()));
+                        if outbox.send(Some(line)).is_err() {
+                            return;
+                        }
+                    }
+                    _ => {
+                        let _ = outbox.send(None);
+                        return;
+                    }
+                }
+            }
+        });
+        let note = lock(&last);
+        std::thread::spawn(move || {
+            for line in BufReader::new(stderr).lines() {
+                let Ok(line) = line else { return };
+                let _ = writeln!(std::io::stderr(), "{line}");
+                if !line.trim().is_empty() {
+                    let said = shorten(&line);
+                    note(&|l| l.stderr = Some(said.clone()));
+                }
+            }
+        });
         let mut me = Self {
             child,
-            stdin,
-            stdout,
+            name,
+            to_worker: Some(to_worker),
+            from_worker,
+            last,
+            timeout: Duration::from_secs_f64(DEFAULT_BATCH_TIMEOUT_S),
+            lines_read: 0,
+            broken: None,
         };
         let header = Header {
             protocol: PROTOCOL.into(),
             problem: serde_json::to_value(problem).map_err(|e| err(e.to_string()))?,
         };
-        me.send(&header)?;
+        let mut line = serde_json::to_string(&header).map_err(|e| err(e.to_string()))?;
+        line.push('\n');
+        me.send(line);
         Ok(me)
     }
 
-    fn send(&mut self, v: &impl Serialize) -> Result<(), EvolveError> {
-        let mut line =
-            serde_json::to_string(v).map_err(|e| EvolveError::Evaluator(e.to_string()))?;
-        line.push('\n');
-        self.stdin
-            .write_all(line.as_bytes())
-            .map_err(|e| EvolveError::Evaluator(format!("worker stdin: {e}")))
+    /// The same worker, a batch that it has not answered in full after `timeout` failing.
+    pub fn with_timeout(mut self, timeout: Duration) -> Self {
+        self.timeout = timeout;
+        self
+    }
+
+    /// Hands `text` to the writing thread (a write that fails is found by the reply that then
+    /// never comes, and named by [`LastSaid`]).
+    fn send(&mut self, text: String) {
+        if let Some(t) = &self.to_worker {
+            let _ = t.send(text.into_bytes());
+        }
+    }
+
+    /// Stops the worker after `why` and remembers that it failed.
+    fn fail(&mut self, why: String) -> EvolveError {
+        let _ = self.child.kill();
+        // The threads see the pipes close; give the last words a moment to arrive.
+        std::thread::sleep(Duration::from_millis(50));
+        let said = self
+            .last
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .describe();
+        let message = format!("the worker `{}` {why}; {said}", self.name);
+        self.broken = Some(message.clone());
+        EvolveError::Evaluator(message)
+    }
+
+    /// The worker's exit status once it has ended (waiting up to a second), for messages.
+    fn exit_status(&mut self) -> String {
+        for _ in 0..20 {
+            if let Ok(Some(s)) = self.child.try_wait() {
+                return format!("it ended with {s}");
+            }
+            std::thread::sleep(Duration::from_millis(50));
+        }
+        "it is still running".into()
     }
 }
 
 impl Evaluator for JsonLines {
     fn evaluate(
         &mut self,
-        _: u64,
+        generation: u64,
         genomes: &[Genome],
         refine: u32,
     ) -> Result<Vec<Evaluation>, EvolveError> {
+        if let Some(why) = &self.broken {
+            return Err(EvolveError::Evaluator(format!("failed before: {why}")));
+        }
+        let err = |m: String| EvolveError::Evaluator(m);
+        let mut text = String::new();
         for (index, g) in genomes.iter().enumerate() {
-            self.send(&Request::Genome {
+            let line = Request::Genome(GenomeLine {
                 index,
                 genes: g.clone(),
                 refine,
-            })?;
+            });
+            text.push_str(&serde_json::to_string(&line).map_err(|e| err(e.to_string()))?);
+            text.push('\n');
         }
-        self.send(&Request::Evaluate { evaluate: true })?;
-        self.stdin
-            .flush()
-            .map_err(|e| EvolveError::Evaluator(format!("worker stdin: {e}")))?;
-        let mut out: Vec<Option<Evaluation>> = vec![None; genomes.len()];
-        let mut line = String::new();
+        let end = Request::Evaluate(BatchEnd {
+            count: genomes.len(),
+        });
+        text.push_str(&serde_json::to_string(&end).map_err(|e| err(e.to_string()))?);
+        text.push('\n');
+        self.send(text);
+        let n = genomes.len();
+        let mut out: Vec<Option<Evaluation>> = vec![None; n];
+        let mut got = 0;
+        let started = Instant::now();
+        let tick = (self.timeout / 3).min(PROGRESS_EVERY);
+        let mut next_note = started + tick;
         loop {
-            line.clear();
-            let n = self
-                .stdout
-                .read_line(&mut line)
-                .map_err(|e| EvolveError::Evaluator(format!("worker stdout: {e}")))?;
-            if n == 0 {
-                return Err(EvolveError::Evaluator(
-                    "the worker closed its output".into(),
-                ));
+            let now = Instant::now();
+            let deadline = started + self.timeout;
+            if now >= deadline {
+                return Err(self.fail(format!(
+                    "answered {got} of the {n} genomes of generation {generation} in {:.1} s, \
+                     the batch timeout, and was stopped",
+                    self.timeout.as_secs_f64()
+                )));
             }
-            let reply: Reply = serde_json::from_str(line.trim()).map_err(|e| {
-                EvolveError::Evaluator(format!("bad reply line {:?}: {e}", line.trim()))
-            })?;
-            let (index, r) = match reply {
-                Reply::Done { .. } => break,
-                Reply::Damage { index, damage } => (index, Ok(damage)),
-                Reply::Error { index, error } => (index, Err(error)),
+            let line = match self.from_worker.recv_timeout(next_note.min(deadline) - now) {
+                Ok(Some(line)) => line,
+                Ok(None) | Err(mpsc::RecvTimeoutError::Disconnected) => {
+                    let status = self.exit_status();
+                    return Err(self.fail(format!(
+                        "closed its output after {got} of the {n} replies of generation \
+                         {generation} ({status})"
+                    )));
+                }
+                Err(mpsc::RecvTimeoutError::Timeout) => {
+                    if Instant::now() >= next_note {
+                        let _ = writeln!(
+                            std::io::stderr(),
+                            "waiting for the worker `{}`: {got} of {n} replies of generation \
+                             {generation} after {:.1} s (it is stopped at {:.1} s)",
+                            self.name,
+                            started.elapsed().as_secs_f64(),
+                            self.timeout.as_secs_f64()
+                        );
+                        next_note += tick;
+                    }
+                    continue;
+                }
             };
-            let slot = out.get_mut(index).ok_or_else(|| {
-                EvolveError::Evaluator(format!("reply for index {index} of {}", genomes.len()))
-            })?;
-            *slot = Some(r);
+            self.lines_read += 1;
+            if line.trim().is_empty() {
+                continue;
+            }
+            let reply: Reply = match parse_line(line.trim_end(), "reply", self.lines_read) {
+                Ok(r) => r,
+                Err(e) => return Err(self.fail(format!("sent a bad {e}"))),
+            };
+            let (index, r) = match reply {
+                Reply::Done(BatchEnd { count }) if count == n && got == n => break,
+                Reply::Done(BatchEnd { count }) => {
+                    return Err(self.fail(format!(
+                        "ended generation {generation} with {{\"done\": {{\"count\": {count}}}}} \
+                         after {got} of its {n} replies"
+                    )));
+                }
+                Reply::Damage(d) => (d.index, Ok(d.value)),
+                Reply::Error(e) => (e.index, Err(e.message)),
+            };
+            match out.get_mut(index) {
+                Some(slot @ None) => *slot = Some(r),
+                Some(Some(_)) => {
+                    return Err(self.fail(format!(
+                        "replied twice for genome {index} of generation {generation}"
+                    )));
+                }
+                None => {
+                    return Err(self.fail(format!(
+                        "replied for genome {index}, past the {n} of generation {generation}"
+                    )));
+                }
+            }
+            got += 1;
         }
-        out.into_iter()
-            .enumerate()
-            .map(|(i, r)| {
-                r.ok_or_else(|| EvolveError::Evaluator(format!("no reply for genome {i}")))
-            })
-            .collect()
+        Ok(out.into_iter().flatten().collect())
     }
 }
 
 impl Drop for JsonLines {
     fn drop(&mut self) {
-        // Closing stdin ends the worker; wait so no zombie is left.
-        let _ = self.stdin.flush();
+        // Closing its input ends a worker; one that lingers is stopped. Waiting leaves no
+        // zombie.
+        self.to_worker = None;
         let _ = self.child.kill();
         let _ = self.child.wait();
     }
 }
 
-/// Longest request line the worker accepts (bytes).
+/// Longest protocol line accepted (bytes).
 pub const MAX_LINE: usize = 1 << 20;
 
 /// Largest refinement a worker accepts (a fall at 1/64 of its step already takes 64 times as
@@ -357,7 +629,9 @@ pub const MAX_REFINE: u32 = 64;
 
 /// The worker side: reads the header, builds the evaluator of its problem with `make`, then
 /// answers batches until its input ends (a batch mixing refinements is evaluated per
-/// refinement).
+/// refinement). A line it does not understand (an unknown message or field, a wrong type, a
+/// batch end whose count is not the batch's) ends it with an error naming the line, the column
+/// and the field.
 pub fn serve<R: BufRead, W: Write, E: Fn(&[Genome], u32) -> Vec<Evaluation>>(
     input: R,
     mut output: W,
@@ -369,7 +643,7 @@ pub fn serve<R: BufRead, W: Write, E: Fn(&[Genome], u32) -> Vec<Evaluation>>(
         .next()
         .ok_or_else(|| err("no header line".into()))?
         .map_err(|e| err(e.to_string()))?;
-    let header: Header = serde_json::from_str(&first).map_err(|e| err(format!("header: {e}")))?;
+    let header: Header = parse_line(&first, "request", 1).map_err(err)?;
     if header.protocol != PROTOCOL {
         return Err(err(format!(
             "protocol '{}' is not '{PROTOCOL}'",
@@ -379,30 +653,44 @@ pub fn serve<R: BufRead, W: Write, E: Fn(&[Genome], u32) -> Vec<Evaluation>>(
     let eval = make(header.problem).map_err(|e| err(format!("problem: {e}")))?;
     let mut batch: Vec<(usize, Genome, u32)> = Vec::new();
     for (k, line) in lines.enumerate() {
-        let line = line.map_err(|e| err(e.to_string()))?;
+        let at = k + 2;
+        let line = line.map_err(|e| err(format!("request line {at}: {e}")))?;
         if line.len() > MAX_LINE {
-            return Err(err(format!("line {} longer than {MAX_LINE} bytes", k + 2)));
+            return Err(err(format!(
+                "request line {at} longer than {MAX_LINE} bytes"
+            )));
         }
         if line.trim().is_empty() {
             continue;
         }
-        match serde_json::from_str::<Request>(&line)
-            .map_err(|e| err(format!("line {}: {e}", k + 2)))?
-        {
-            Request::Genome {
+        match parse_line::<Request>(&line, "request", at).map_err(err)? {
+            Request::Genome(GenomeLine {
                 index,
                 genes,
                 refine,
-            } => {
+            }) => {
                 if !(1..=MAX_REFINE).contains(&refine) {
                     return Err(err(format!(
-                        "line {}: refine must be 1..={MAX_REFINE}, found {refine}",
-                        k + 2
+                        "request line {at}, field `genome.refine`: must be 1..={MAX_REFINE}, \
+                         found {refine}"
+                    )));
+                }
+                if batch.iter().any(|b| b.0 == index) {
+                    return Err(err(format!(
+                        "request line {at}, field `genome.index`: genome {index} given twice \
+                         in a batch"
                     )));
                 }
                 batch.push((index, genes, refine))
             }
-            Request::Evaluate { .. } => {
+            Request::Evaluate(BatchEnd { count }) => {
+                if count != batch.len() {
+                    return Err(err(format!(
+                        "request line {at}, field `evaluate.count`: the batch holds {} \
+                         genomes, found {count}",
+                        batch.len()
+                    )));
+                }
                 let mut results: Vec<Option<Evaluation>> = vec![None; batch.len()];
                 let mut levels: Vec<u32> = batch.iter().map(|b| b.2).collect();
                 levels.sort_unstable();
@@ -417,25 +705,24 @@ pub fn serve<R: BufRead, W: Write, E: Fn(&[Genome], u32) -> Vec<Evaluation>>(
                 }
                 let mut text = String::new();
                 for ((index, _, _), r) in batch.iter().zip(results) {
+                    let index = *index;
                     let r = r.unwrap_or_else(|| Err("not evaluated".into()));
                     let reply = match r {
-                        Ok(damage) if damage.is_finite() => Reply::Damage {
-                            index: *index,
-                            damage,
-                        },
-                        Ok(damage) => Reply::Error {
-                            index: *index,
-                            error: format!("damage {damage}"),
-                        },
-                        Err(error) => Reply::Error {
-                            index: *index,
-                            error,
-                        },
+                        Ok(value) if value.is_finite() && value >= 0.0 => {
+                            Reply::Damage(DamageLine { index, value })
+                        }
+                        Ok(value) => Reply::Error(ErrorLine {
+                            index,
+                            message: format!("damage {value} is negative or not finite"),
+                        }),
+                        Err(message) => Reply::Error(ErrorLine { index, message }),
                     };
                     text.push_str(&serde_json::to_string(&reply).map_err(|e| err(e.to_string()))?);
                     text.push('\n');
                 }
-                text.push_str(&format!("{{\"done\":{}}}\n", batch.len()));
+                let done = Reply::Done(BatchEnd { count: batch.len() });
+                text.push_str(&serde_json::to_string(&done).map_err(|e| err(e.to_string()))?);
+                text.push('\n');
                 output
                     .write_all(text.as_bytes())
                     .and_then(|_| output.flush())
@@ -444,5 +731,248 @@ pub fn serve<R: BufRead, W: Write, E: Fn(&[Genome], u32) -> Vec<Evaluation>>(
             }
         }
     }
+    if !batch.is_empty() {
+        return Err(err(format!(
+            "the input ended inside a batch of {} genomes (no {{\"evaluate\": …}} line)",
+            batch.len()
+        )));
+    }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Runs [`serve`] on `lines` (after a header) with an evaluator giving each genome the
+    /// sum of its genes times its refinement: the output, or the error.
+    fn serve_lines(lines: &[&str]) -> Result<String, String> {
+        let mut input = format!("{{\"protocol\":\"{PROTOCOL}\",\"problem\":null}}\n");
+        for l in lines {
+            input.push_str(l);
+            input.push('\n');
+        }
+        let mut out = Vec::new();
+        serve(input.as_bytes(), &mut out, |_| {
+            Ok(|g: &[Genome], refine: u32| {
+                g.iter()
+                    .map(|x| Ok(x.iter().sum::<f64>() * refine as f64))
+                    .collect()
+            })
+        })
+        .map_err(|e| e.to_string())?;
+        Ok(String::from_utf8(out).unwrap())
+    }
+
+    #[test]
+    fn a_batch_is_answered_in_tagged_lines() {
+        let out = serve_lines(&[
+            r#"{"genome": {"index": 0, "genes": [1.5, 2]}}"#,
+            r#"{"genome": {"index": 1, "genes": [1], "refine": 2}}"#,
+            r#"{"evaluate": {"count": 2}}"#,
+        ])
+        .unwrap();
+        assert_eq!(
+            out,
+            "{\"damage\":{\"index\":0,\"value\":3.5}}\n{\"damage\":{\"index\":1,\"value\":2.0}}\n\
+             {\"done\":{\"count\":2}}\n"
+        );
+    }
+
+    /// Point 7 of issue 38: each of these was evaluated (or silently dropped) by protocol 2.
+    #[test]
+    fn what_the_worker_does_not_understand_is_refused_with_line_column_and_field() {
+        let genome = r#"{"genome": {"index": 0, "genes": [1]}}"#;
+        for (lines, wanted) in [
+            // A misspelt field.
+            (
+                vec![r#"{"genome": {"index": 0, "genes": [1], "refin": 2}}"#],
+                vec![
+                    "request line 2",
+                    "column",
+                    "unknown field `refin`",
+                    "`refine`",
+                ],
+            ),
+            // The batch end as protocol 2 wrote it, or as false.
+            (
+                vec![genome, r#"{"evaluate": false}"#],
+                vec![
+                    "request line 3",
+                    "field `evaluate`",
+                    "invalid type: boolean `false`",
+                ],
+            ),
+            (
+                vec![genome, r#"{"evaluate": true}"#],
+                vec!["request line 3", "invalid type: boolean `true`"],
+            ),
+            // Two messages in one line.
+            (
+                vec![r#"{"genome": {"index": 0, "genes": [1]}, "evaluate": {"count": 1}}"#],
+                vec!["request line 2", "column"],
+            ),
+            // A wrong type, named with its field.
+            (
+                vec![r#"{"genome": {"index": "zero", "genes": [1]}}"#],
+                vec![
+                    "request line 2, column",
+                    "field `genome.index`",
+                    "invalid type: string \"zero\"",
+                ],
+            ),
+            (
+                vec![r#"{"genome": {"index": 0, "genes": [1, "x"]}}"#],
+                vec!["field `genome.genes[1]`", "invalid type: string \"x\""],
+            ),
+            // Protocol 2's untagged genome line.
+            (
+                vec![r#"{"index": 0, "genes": [1]}"#],
+                vec!["request line 2", "unknown variant `index`", "`genome`"],
+            ),
+            // Counts that disagree, a genome given twice, a batch never ended.
+            (
+                vec![genome, r#"{"evaluate": {"count": 2}}"#],
+                vec!["field `evaluate.count`", "holds 1 genomes, found 2"],
+            ),
+            (vec![genome, genome], vec!["genome 0 given twice"]),
+            (vec![genome], vec!["ended inside a batch of 1"]),
+            (
+                vec![r#"{"genome": {"index": 0, "genes": [1], "refine": 0}}"#],
+                vec!["field `genome.refine`", "found 0"],
+            ),
+        ] {
+            let e = serve_lines(&lines).expect_err(&format!("{lines:?} was accepted"));
+            for w in wanted {
+                assert!(e.contains(w), "{lines:?}: {e:?} lacks {w:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn a_header_with_an_unknown_field_or_another_protocol_is_refused() {
+        let mut out = Vec::new();
+        let make = |_| Ok(|_: &[Genome], _: u32| Vec::new());
+        let e = serve(
+            &b"{\"protocol\":\"marionette-eval/3\",\"problem\":null,\"seed\":1}\n"[..],
+            &mut out,
+            make,
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("unknown field `seed`"), "{e}");
+        let e = serve(
+            &b"{\"protocol\":\"marionette-eval/2\",\"problem\":null}\n"[..],
+            &mut out,
+            make,
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("'marionette-eval/2' is not"), "{e}");
+    }
+
+    #[test]
+    fn a_negative_or_unfinished_damage_is_an_error_line() {
+        let mut out = Vec::new();
+        serve(
+            format!(
+                "{{\"protocol\":\"{PROTOCOL}\",\"problem\":null}}\n\
+                 {{\"genome\":{{\"index\":0,\"genes\":[]}}}}\n{{\"evaluate\":{{\"count\":1}}}}\n"
+            )
+            .as_bytes(),
+            &mut out,
+            |_| Ok(|_: &[Genome], _: u32| vec![Ok(-5.0)]),
+        )
+        .unwrap();
+        let out = String::from_utf8(out).unwrap();
+        assert!(
+            out.starts_with("{\"error\":{\"index\":0,\"message\":\"damage -5"),
+            "{out}"
+        );
+    }
+
+    fn shell(script: &str) -> Command {
+        let mut c = Command::new("sh");
+        c.args(["-c", script]);
+        c
+    }
+
+    /// Point 6 of issue 38: a worker that never answers hung the GA forever.
+    #[test]
+    fn a_silent_worker_is_stopped_at_the_timeout_and_named_with_what_it_last_said() {
+        let mut w = JsonLines::start(
+            shell("echo 'loading the model' >&2; cat > /dev/null"),
+            &serde_json::Value::Null,
+        )
+        .unwrap()
+        .with_timeout(Duration::from_millis(600));
+        let t0 = Instant::now();
+        let e = w.evaluate(7, &[vec![1.0]], 1).unwrap_err().to_string();
+        assert!(t0.elapsed() < Duration::from_secs(5), "{:?}", t0.elapsed());
+        assert!(e.contains("sh -c echo"), "{e}");
+        assert!(
+            e.contains("answered 0 of the 1 genomes of generation 7"),
+            "{e}"
+        );
+        assert!(e.contains("the batch timeout"), "{e}");
+        assert!(e.contains("on stderr \"loading the model\""), "{e}");
+        // The next batch fails at once, with the same cause.
+        let again = w.evaluate(8, &[vec![1.0]], 1).unwrap_err().to_string();
+        assert!(
+            again.contains("failed before") && again.contains("generation 7"),
+            "{again}"
+        );
+    }
+
+    #[test]
+    fn a_worker_that_dies_is_named_with_its_status_and_last_words() {
+        let mut w = JsonLines::start(
+            shell("read header; read genome; echo '{\"damage\":{\"index\":0,\"value\":1}}'; echo 'out of memory' >&2; exit 3"),
+            &serde_json::Value::Null,
+        )
+        .unwrap();
+        let e = w
+            .evaluate(2, &[vec![1.0], vec![2.0]], 1)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("closed its output after 1 of the 2 replies"),
+            "{e}"
+        );
+        assert!(e.contains("exit status: 3"), "{e}");
+        assert!(e.contains("on stderr \"out of memory\""), "{e}");
+        assert!(e.contains("on stdout \"{\\\"damage\\\""), "{e}");
+    }
+
+    #[test]
+    fn bad_replies_are_refused_with_line_column_and_field() {
+        for (reply, wanted) in [
+            (
+                r#"{"damage": {"index": 0, "value": 1, "unit": "N"}}"#,
+                "unknown field `unit`",
+            ),
+            (
+                r#"{"damage": {"index": 0, "value": "1"}}"#,
+                "field `damage.value`",
+            ),
+            (r#"{"index": 0, "damage": 1}"#, "unknown variant `index`"),
+            (r#"{"damage": {"index": 5, "value": 1}}"#, "past the 1"),
+            (r#"{"done": {"count": 1}}"#, "after 0 of its 1 replies"),
+        ] {
+            let mut w = JsonLines::start(
+                shell(&format!(
+                    "read header; read genome; read end; echo '{reply}'; sleep 5"
+                )),
+                &serde_json::Value::Null,
+            )
+            .unwrap();
+            let e = w.evaluate(0, &[vec![1.0]], 1).unwrap_err().to_string();
+            assert!(e.contains(wanted), "{reply}: {e}");
+            assert!(
+                !reply.starts_with("{\"damage\": {\"index\": 0, \"value\": 1,")
+                    || e.contains("reply line 1, column"),
+                "{e}"
+            );
+        }
+    }
 }

@@ -23,6 +23,7 @@ pub struct RangeTable {
     /// The group's name, e.g. `elderly`.
     pub name: String,
     /// `(lower, upper)` in degrees per DOF name.
+    #[serde(deserialize_with = "crate::io::unique_keys")]
     pub ranges: BTreeMap<String, (f64, f64)>,
 }
 

@@ -70,6 +70,7 @@ pub struct Mapping {
     /// Joint names whose presence identifies this skeleton (all must be present).
     pub detect: Vec<String>,
     /// Landmark → source joint name, or `"<joint>:end"` for its End Site.
+    #[serde(deserialize_with = "crate::io::unique_keys")]
     pub landmarks: BTreeMap<String, String>,
 }
 
@@ -275,6 +276,22 @@ fn rest_globals(skeleton: &Skeleton) -> Vec<Transform> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Point 9 of issue 38: a landmark given twice kept its last joint without a word.
+    #[test]
+    fn a_landmark_given_twice_is_refused() {
+        let text = include_str!("builtin/bandai.ron").replace(
+            "\"waist\": \"Spine\",",
+            "\"waist\": \"Spine\", \"pelvis\": \"Spine\",",
+        );
+        let e = Mapping::parse(&text, "bandai2.ron")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("bandai2.ron:") && e.contains("\"pelvis\" is given twice"),
+            "{e}"
+        );
+    }
 
     #[test]
     fn builtins_are_parsed_once() {

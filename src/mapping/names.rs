@@ -140,6 +140,7 @@ pub fn normalise(name: &str, prefixes: &[Vec<String>]) -> NormalName {
 struct SynonymsFile {
     format_version: u32,
     prefixes: Vec<String>,
+    #[serde(deserialize_with = "crate::io::unique_keys")]
     landmarks: BTreeMap<String, Vec<String>>,
 }
 

@@ -111,6 +111,7 @@ pub struct ActiveKneeKickScene {
     /// A key pose the PD switches to at the release (degrees per DOF name; others 0), as the
     /// falling paper's fall controller; `None` keeps following the primitives.
     #[serde(default)]
+    #[serde(deserialize_with = "crate::io::unique_keys_opt")]
     pub key_pose_deg: Option<BTreeMap<String, f64>>,
     /// Simulated time (s).
     pub duration_s: f64,
@@ -118,6 +119,7 @@ pub struct ActiveKneeKickScene {
     pub dt_s: f64,
     /// Damage weight per link (links not named weigh 1).
     #[serde(default)]
+    #[serde(deserialize_with = "crate::io::unique_keys")]
     pub damage_weights: BTreeMap<String, f64>,
     /// Pictures.
     #[serde(default)]

@@ -247,6 +247,9 @@ fn load_song(src: &SongSource, base: &Path) -> Result<Song, SceneError> {
             #[cfg(feature = "audio")]
             {
                 let a = crate::choreo::music::decode::decode_file(&path)?;
+                if let Some(w) = &a.warning {
+                    eprintln!("warning: {}: {w}", path.display());
+                }
                 Ok(Song {
                     samples: a.samples,
                     sample_rate: a.sample_rate,

@@ -56,6 +56,9 @@ fn default_step_margin() -> f64 {
 fn default_every() -> u64 {
     1
 }
+fn default_worker_timeout() -> f64 {
+    crate::evolve::evaluator::DEFAULT_BATCH_TIMEOUT_S
+}
 
 /// Evolution of the fall controller for each age group.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -105,6 +108,12 @@ pub struct EvolveFallScene {
     /// Who evaluates.
     #[serde(default)]
     pub evaluator: EvaluatorChoice,
+    /// Seconds a `Command` worker may take over one batch (a generation, or a round of elite
+    /// checks) before the run stops with an error naming it (default
+    /// [`crate::evolve::evaluator::DEFAULT_BATCH_TIMEOUT_S`], 600; at most a week). Shapes
+    /// no result, so a resume may change it.
+    #[serde(default = "default_worker_timeout")]
+    pub worker_timeout_s: f64,
     /// Pictures.
     #[serde(default)]
     pub render: PrimitiveRender,
@@ -143,6 +152,15 @@ impl EvolveFallScene {
             return Err(invalid(format!(
                 "kp_max_scale must be in (0, 100], found {}",
                 self.kp_max_scale
+            )));
+        }
+        if !(self.worker_timeout_s.is_finite()
+            && self.worker_timeout_s > 0.0
+            && self.worker_timeout_s <= 7.0 * 86_400.0)
+        {
+            return Err(invalid(format!(
+                "worker_timeout_s must be in (0, 604800] seconds, found {}",
+                self.worker_timeout_s
             )));
         }
         if !(self.step_margin.is_finite() && self.step_margin > 0.0 && self.step_margin <= 1.0) {
@@ -198,7 +216,11 @@ impl EvolveFallScene {
                         let mut c = Command::new(prog);
                         c.args(args);
                         Ok(Box::new(
-                            JsonLines::start(c, p).map_err(|e| invalid(e.to_string()))?,
+                            JsonLines::start(c, p)
+                                .map_err(|e| invalid(e.to_string()))?
+                                .with_timeout(std::time::Duration::from_secs_f64(
+                                    self.worker_timeout_s,
+                                )),
                         ))
                     }
                 }
@@ -689,6 +711,7 @@ mod tests {
             checkpoint_dir: None,
             resume: None,
             evaluator: EvaluatorChoice::InProcess,
+            worker_timeout_s: default_worker_timeout(),
             render: PrimitiveRender::default(),
         }
     }

@@ -70,10 +70,13 @@ impl Default for Body {
 #[serde(deny_unknown_fields, default)]
 pub struct Controller {
     /// Key pose θ_d, degrees.
+    #[serde(deserialize_with = "crate::io::unique_keys")]
     pub key_pose_deg: BTreeMap<String, f64>,
     /// Proportional gains k_p, N·m/rad.
+    #[serde(deserialize_with = "crate::io::unique_keys")]
     pub kp: BTreeMap<String, f64>,
     /// Derivative gains k_v, N·m·s/rad.
+    #[serde(deserialize_with = "crate::io::unique_keys")]
     pub kv: BTreeMap<String, f64>,
     /// Time the reaction toward the key pose starts, seconds.
     pub start_s: Option<f64>,
@@ -123,6 +126,7 @@ pub struct FallScene {
     pub controller_file: Option<String>,
     /// Damage weight w_i per link (links not named keep the default; the head is protected most).
     #[serde(default)]
+    #[serde(deserialize_with = "crate::io::unique_keys")]
     pub damage_weights: BTreeMap<String, f64>,
     /// Floor contact parameters (scales on the published tissue gains, friction, floor).
     #[serde(default)]

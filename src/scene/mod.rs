@@ -250,10 +250,54 @@ pub fn apply_overrides(scene: &Scene, assignments: &[String]) -> Result<Scene, S
             None => new,
         };
     }
-    serde_json::from_value(value).map_err(|e| SceneError::Override {
-        assignment: assignments.join(" "),
-        message: e.to_string(),
-    })
+    let scene: Scene = serde_path_to_error::deserialize(value).map_err(|e| {
+        // The field, written as an assignment's path (the scene kind left out).
+        let field = e
+            .path()
+            .iter()
+            .skip(1)
+            .map(|s| match s {
+                serde_path_to_error::Segment::Seq { index } => index.to_string(),
+                s => s.to_string(),
+            })
+            .collect::<Vec<_>>()
+            .join(".");
+        let message = e.inner().to_string();
+        // The last assignment that set this field or a field holding it.
+        let setter = assignments.iter().rev().find(|a| {
+            let p = a.split_once('=').map_or(a.as_str(), |(p, _)| p);
+            field == p || field.starts_with(&format!("{p}.")) || p.starts_with(&format!("{field}."))
+        });
+        match setter {
+            Some(a) => SceneError::Override {
+                assignment: a.clone(),
+                message: format!("field `{field}`: {message}"),
+            },
+            // Not a field any --set touched: the scene's own value, which survives its trip
+            // through JSON only when it is finite.
+            None => SceneError::Invalid(format!(
+                "field `{field}` of the scene itself (no --set names it): {message}{}",
+                if message.contains("null") {
+                    "; a NaN or infinite number in the scene file reads as null here: \
+                     write a finite number"
+                } else {
+                    ""
+                }
+            )),
+        }
+    })?;
+    if let Some(a) = assignments.iter().rev().find(|a| {
+        a.split_once('=')
+            .is_some_and(|(p, _)| p.trim() == "format_version")
+    }) {
+        crate::io::check_version("--set", scene.format_version(), FORMAT_VERSION).map_err(|e| {
+            SceneError::Override {
+                assignment: a.clone(),
+                message: e.to_string(),
+            }
+        })?;
+    }
+    Ok(scene)
 }
 
 /// The value of an override: JSON if it parses, else a list `[a, b, …]` whose items are
@@ -536,6 +580,46 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("render.gif_fps=fast"), "{e}");
+        // Point 10 of issue 38: each type error names its own assignment and field only.
+        let e = apply_overrides(
+            &s,
+            &[
+                "render.gif=false".into(),
+                "render.gif_fps=fast".into(),
+                "name=\"ok\"".into(),
+            ],
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.starts_with("--set render.gif_fps=fast: field `render.gif_fps`"),
+            "{e}"
+        );
+        assert!(e.contains("invalid type: string \"fast\""), "{e}");
+        assert!(!e.contains("name=") && !e.contains("gif=false"), "{e}");
+        // Point 9: a format version set on the command line is checked as the file's is.
+        for v in ["2", "0"] {
+            let e = apply_overrides(&s, &[format!("format_version={v}")])
+                .unwrap_err()
+                .to_string();
+            assert!(
+                e.starts_with(&format!("--set format_version={v}:"))
+                    && e.contains("is not one this build reads"),
+                "{e}"
+            );
+        }
+        assert!(apply_overrides(&s, &["format_version=1".into()]).is_ok());
+        // Point 10: a NaN in the file is the file's, not the --set's.
+        let nan = SCENE.replace("model:", "render: (gif_fps: NaN),\n    model:");
+        let s = Scene::parse(&nan, "t.ron").unwrap();
+        let e = apply_overrides(&s, &["name=x".into()])
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("field `render.gif_fps` of the scene itself") && e.contains("NaN"),
+            "{e}"
+        );
+        assert!(!e.starts_with("--set"), "{e}");
         let newer = SCENE.replace("format_version: 1", "format_version: 7");
         assert!(
             Scene::parse(&newer, "t.ron")

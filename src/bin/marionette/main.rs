@@ -2,6 +2,18 @@
 //!
 //! This file parses the arguments, dispatches to one module per command and prints errors.
 
+/// `println!` for every command: when standard output is closed early (`marionette music
+/// song.ogg | head`), the program ends quietly with success instead of panicking; another
+/// write error ends it with that error.
+macro_rules! println {
+    ($($t:tt)*) => {{
+        use std::io::Write as _;
+        if let Err(e) = writeln!(std::io::stdout().lock(), $($t)*) {
+            crate::stdout_failed(e)
+        }
+    }};
+}
+
 mod body;
 mod common;
 mod dance;
@@ -54,6 +66,16 @@ enum Command {
     /// Write the articulated fall21 body (links, joints, axes, ranges, masses, centres of mass,
     /// inertias, contact boxes) as URDF and/or MJCF for an age group, height and mass.
     Body(body::Args),
+}
+
+/// Ends the program after a failed write to standard output: quietly when the reader went
+/// away (a broken pipe), else with the error.
+fn stdout_failed(e: std::io::Error) -> ! {
+    if e.kind() == std::io::ErrorKind::BrokenPipe {
+        std::process::exit(0);
+    }
+    eprintln!("error: writing to standard output: {e}");
+    std::process::exit(1)
 }
 
 fn main() -> ExitCode {

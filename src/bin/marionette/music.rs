@@ -71,6 +71,9 @@ pub fn music(args: Args) -> Result<()> {
         params.prior.octaves = o;
     }
     let audio = decode_file(&args.song)?;
+    if let Some(w) = &audio.warning {
+        eprintln!("warning: {}: {w}", args.song.display());
+    }
     let a = analyze(&audio.samples, audio.sample_rate, &params)
         .with_context(|| args.song.display().to_string())?;
     if let Some(out) = &args.out {

@@ -22,6 +22,10 @@ pub struct Audio {
     pub sample_rate: u32,
     /// Channels in the file.
     pub channels: usize,
+    /// Set when the file ended before its header said (a cut download): how much was read,
+    /// e.g. "read 3.20 s of the 10.00 s its header states (32 %): the file is cut short". The
+    /// part read is analysed; the caller shows the warning.
+    pub warning: Option<String>,
 }
 
 impl Audio {
@@ -34,18 +38,69 @@ impl Audio {
 /// Most mono samples [`decode_file`] keeps (two hours at 48 kHz, 1.4 GB of f32).
 pub const MAX_SAMPLES: usize = 2 * 3600 * 48_000;
 
+/// What the first bytes of a file say it is, for messages ("a WAV (RIFF) file"), if known.
+fn container_of(head: &[u8]) -> Option<&'static str> {
+    if head.starts_with(b"RIFF") || head.starts_with(b"RIFX") || head.starts_with(b"RF64") {
+        Some("a WAV (RIFF) file")
+    } else if head.starts_with(b"OggS") {
+        Some("an OGG file")
+    } else if head.starts_with(b"ID3")
+        || (head.len() > 1 && head[0] == 0xFF && head[1] & 0xE0 == 0xE0)
+    {
+        Some("an MP3 file")
+    } else if head.starts_with(b"fLaC") {
+        Some("a FLAC file")
+    } else if head.len() >= 8 && &head[4..8] == b"ftyp" {
+        Some("an MP4/M4A file")
+    } else {
+        None
+    }
+}
+
 /// Decodes the song at `path` (WAV, OGG/Vorbis or MP3, by content, the extension as a hint) and
-/// mixes it to mono. Errors: an unreadable file, a format or codec symphonia does not read, no
-/// audio track, a corrupt stream, a song longer than [`MAX_SAMPLES`], no samples at all.
+/// mixes it to mono. Each error says which case it is: a directory, an empty or unreadable
+/// file, a format this build does not read (naming the one the first bytes show), a corrupt
+/// header, an unsupported codec, no audio track, a corrupt stream, a song longer than
+/// [`MAX_SAMPLES`], no samples at all. A file cut short is decoded as far as it goes, with
+/// [`Audio::warning`] saying how much was read.
 pub fn decode_file(path: &Path) -> Result<Audio, MusicError> {
     let dec = |message: String| MusicError::Decode {
         path: path.to_path_buf(),
         message,
     };
-    let file = File::open(path).map_err(|reason| MusicError::Io {
+    if path.is_dir() {
+        return Err(dec("it is a directory, not a song file".into()));
+    }
+    let mut file = File::open(path).map_err(|reason| MusicError::Io {
         path: path.to_path_buf(),
         reason,
     })?;
+    let mut head = [0u8; 12];
+    let n = {
+        use std::io::{Read, Seek};
+        let mut n = 0;
+        while n < head.len() {
+            match file.read(&mut head[n..]) {
+                Ok(0) => break,
+                Ok(k) => n += k,
+                Err(reason) => {
+                    return Err(MusicError::Io {
+                        path: path.to_path_buf(),
+                        reason,
+                    });
+                }
+            }
+        }
+        file.rewind().map_err(|reason| MusicError::Io {
+            path: path.to_path_buf(),
+            reason,
+        })?;
+        n
+    };
+    if n == 0 {
+        return Err(dec("the file is empty (0 bytes)".into()));
+    }
+    let kind = container_of(&head[..n]);
     let mss = MediaSourceStream::new(Box::new(file), Default::default());
     let mut hint = Hint::new();
     if let Some(ext) = path.extension().and_then(|e| e.to_str()) {
@@ -58,7 +113,29 @@ pub fn decode_file(path: &Path) -> Result<Audio, MusicError> {
             FormatOptions::default(),
             MetadataOptions::default(),
         )
-        .map_err(|e| dec(format!("not a WAV, OGG/Vorbis or MP3 file ({e})")))?;
+        .map_err(|e| {
+            dec(match (kind, &e) {
+                (
+                    Some(k @ ("a WAV (RIFF) file" | "an OGG file" | "an MP3 file")),
+                    SymphoniaError::Unsupported(what),
+                ) => {
+                    format!("{k} in an unsupported codec or variant ({what})")
+                }
+                (kind, _) => match kind {
+                    Some(k @ ("a WAV (RIFF) file" | "an OGG file" | "an MP3 file")) => {
+                        format!("{k} by its first bytes, but its header is corrupt or cut ({e})")
+                    }
+                    Some(k) => format!(
+                        "{k} by its first bytes: an unsupported format (WAV, OGG/Vorbis and MP3 \
+                     are read) ({e})"
+                    ),
+                    None => format!(
+                        "not a WAV, OGG/Vorbis or MP3 file: its first bytes are {:02x?} ({e})",
+                        &head[..n]
+                    ),
+                },
+            })
+        })?;
     let track = format
         .default_track(TrackType::Audio)
         .ok_or_else(|| dec("no audio track".into()))?;
@@ -72,19 +149,33 @@ pub fn decode_file(path: &Path) -> Result<Audio, MusicError> {
         .ok_or_else(|| dec("the audio track has no codec parameters".into()))?;
     let mut decoder = symphonia::default::get_codecs()
         .make_audio_decoder(params, &AudioDecoderOptions::default())
-        .map_err(|e| dec(format!("no decoder for its codec ({e})")))?;
+        .map_err(|e| {
+            dec(format!(
+                "unsupported codec {:?} in {} ({e})",
+                params.codec,
+                kind.unwrap_or("the file")
+            ))
+        })?;
     let mut samples: Vec<f32> = Vec::with_capacity(expected);
     let mut interleaved: Vec<f32> = Vec::new();
     let mut rate = 0u32;
     let mut channels = 0usize;
+    let mut cut = false;
+    let mut damaged = 0usize;
     loop {
         let packet = match format.next_packet() {
             Ok(Some(p)) => p,
             Ok(None) => break,
             Err(SymphoniaError::IoError(e)) if e.kind() == std::io::ErrorKind::UnexpectedEof => {
+                cut = true;
                 break;
             }
-            Err(e) => return Err(dec(format!("reading packets: {e}"))),
+            Err(e) => {
+                return Err(dec(format!(
+                    "corrupt stream after {:.2} s ({e})",
+                    samples.len() as f64 / rate.max(1) as f64
+                )));
+            }
         };
         if packet.track_id != track_id {
             continue;
@@ -92,7 +183,10 @@ pub fn decode_file(path: &Path) -> Result<Audio, MusicError> {
         let buf = match decoder.decode(&packet) {
             Ok(b) => b,
             // A damaged packet is skipped, as players do.
-            Err(SymphoniaError::DecodeError(_)) => continue,
+            Err(SymphoniaError::DecodeError(_)) => {
+                damaged += 1;
+                continue;
+            }
             Err(e) => return Err(dec(format!("decoding: {e}"))),
         };
         let spec = buf.spec();
@@ -123,11 +217,39 @@ pub fn decode_file(path: &Path) -> Result<Audio, MusicError> {
         );
     }
     if samples.is_empty() {
-        return Err(dec("no audio samples in the file".into()));
+        return Err(dec(if damaged > 0 {
+            format!("a corrupt stream: none of its {damaged} packets decodes")
+        } else if cut {
+            "cut short before its first sample".into()
+        } else {
+            "no audio samples in the file".into()
+        }));
+    }
+    let read_s = samples.len() as f64 / rate as f64;
+    let short = expected > 0 && samples.len() < expected;
+    let mut warning = (cut || short).then(|| {
+        if expected > 0 {
+            let total_s = expected as f64 / rate as f64;
+            format!(
+                "read {read_s:.2} s of the {total_s:.2} s its header states ({:.0} %): the file \
+                 is cut short; the part read is analysed",
+                100.0 * samples.len() as f64 / expected as f64
+            )
+        } else {
+            format!("the file ends in the middle of a packet: read {read_s:.2} s, analysed")
+        }
+    });
+    if damaged > 0 {
+        let d = format!("{damaged} damaged packet(s) skipped");
+        warning = Some(match warning {
+            Some(w) => format!("{w}; {d}"),
+            None => d,
+        });
     }
     Ok(Audio {
         samples,
         sample_rate: rate,
         channels,
+        warning,
     })
 }

@@ -96,6 +96,22 @@ pub enum MusicError {
         /// Beats needed.
         needed: usize,
     },
+    /// The onset envelope has no beat structure: its autocorrelation at the best beat period is
+    /// below [`MusicParams::min_beat_strength`] (noise, or a song without a pulse).
+    #[error(
+        "no beat structure found: the onsets repeat at the best beat period ({bpm:.1} BPM) with \
+         strength {strength:.3}, below {threshold} (pure noise gives under 0.06, the project's \
+         real songs 0.55 to 0.87); the song is refused rather than danced to random beats \
+         (set music.min_beat_strength lower to analyse it anyway)"
+    )]
+    NoBeat {
+        /// Normalised autocorrelation of the onset envelope at the period found.
+        strength: f64,
+        /// The tempo of that period (BPM).
+        bpm: f64,
+        /// The least strength accepted.
+        threshold: f64,
+    },
     /// An annotation file is malformed.
     #[error("{path}: line {line}: {message}")]
     Annotation {
@@ -136,6 +152,11 @@ pub struct MusicParams {
     /// The cost of a bar shorter than `beats_per_bar` in the downbeat tracking, in standard
     /// deviations of the downbeat evidence ([`bars`]); `inf` for bars all of the same length.
     pub rephase_sd: f64,
+    /// Least beat strength (the onset envelope's normalised autocorrelation at the beat period,
+    /// 0 to 1) of a song analysed; below it the song is refused ([`MusicError::NoBeat`]).
+    /// Default 0.15: 32 s of white noise measures 0.005 to 0.053, a synthesized song at
+    /// −10 dB SNR 0.26 to 0.43, the project's real songs 0.55 to 0.87. 0 accepts any song.
+    pub min_beat_strength: f64,
 }
 
 impl Default for MusicParams {
@@ -147,6 +168,7 @@ impl Default for MusicParams {
             beats_per_bar: 4,
             downbeat: None,
             rephase_sd: 8.0,
+            min_beat_strength: 0.15,
         }
     }
 }
@@ -298,7 +320,21 @@ pub fn analyze(
             expected: "a non-negative number or inf",
         });
     }
+    if !(0.0..=1.0).contains(&params.min_beat_strength) {
+        return Err(MusicError::Parameter {
+            name: "min_beat_strength",
+            value: params.min_beat_strength,
+            expected: "0 to 1",
+        });
+    }
     let tempo = estimate_tempo(&env, &params.prior)?;
+    if tempo.strength < params.min_beat_strength {
+        return Err(MusicError::NoBeat {
+            strength: tempo.strength,
+            bpm: tempo.bpm,
+            threshold: params.min_beat_strength,
+        });
+    }
     let mut beat_frames = track_beats(&env, tempo.period_frames, &params.beats)?;
     // A level whose midpoints are as strong as its beats groups two beats (a backbeat).
     let fastest = 60.0 * env.frame_rate() / params.prior.max_bpm;

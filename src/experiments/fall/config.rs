@@ -69,6 +69,7 @@ pub struct FallConfig {
     /// Floor contact parameters.
     pub contact: ContactParams,
     /// Damage weight w_i per link name (links not listed weigh 1).
+    #[serde(deserialize_with = "crate::io::unique_keys")]
     pub damage_weights: BTreeMap<String, f64>,
     /// Frames recorded per second.
     pub record_hz: f64,
