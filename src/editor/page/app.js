@@ -193,6 +193,12 @@ function pause() {
   status(`paused at ${transport.pos.toFixed(2)} s (bar ${barOf(transport.pos)}) · the candidates keep looping bar ${selected ?? '–'} silently`);
 }
 
+// Metres as centimetres to one decimal, without a negative zero ("−0.0" reads as a depth).
+function cm(m) {
+  const v = Math.round(1000 * m) / 10;
+  return (v === 0 ? 0 : v).toFixed(1);
+}
+
 function showPlaying() {
   const loop = transport.loop ? ` · looping bars ${transport.loop.a}–${transport.loop.b}` : '';
   const sound = transport.audible ? '' : ' (no sound)';
@@ -202,7 +208,7 @@ function showPlaying() {
 function figuresText(f) {
   const m = f.metrics, pen = m.foot_penetration;
   return `feet under −1 cm in ${(100 * pen.frames_below_fraction).toFixed(1)} % of frames` +
-    ` (deepest ${(100 * pen.deepest_m).toFixed(1)} cm) · skating ${m.foot_skating_m_s.toFixed(2)} m/s` +
+    ` (deepest ${cm(pen.deepest_m)} cm) · skating ${m.foot_skating_m_s.toFixed(2)} m/s` +
     ` (its segments ${f.sources.foot_skating_m_s.toFixed(2)}) · beat alignment ${m.beat_alignment_score.toFixed(2)}` +
     ` (its segments ${f.sources.beat_alignment_score.toFixed(2)}) · intensity ρ ${f.intensity_spearman.toFixed(2)}` +
     ` · seam jerk ${Math.round(m.seam_jerk.mean_rad_s3)} rad/s³ (inside ${Math.round(m.inside_jerk.mean_rad_s3)})`;
