@@ -671,10 +671,10 @@ fn acceleration_fade(tau: f64) -> f64 {
 /// extrapolated to s by the parabola through its last three frames (value p̂, velocity v̂ and
 /// acceleration â per frame); the next one has the value x_s and the one-sided velocity
 /// v_s = (−3x_s + 4x_{s+1} − x_{s+2}) / 2 and acceleration a_s = x_s − 2x_{s+1} + x_{s+2}.
-/// With J = x_s − p̂, V = v_s − v̂ and A = a_s − â, the frames before s get
-/// + ½ (J b(τ) + V w c(τ) + A w² e(τ)) and those from s on the same with a minus sign,
-/// τ = (f − s) / w ([`offset_fade`], [`velocity_fade`], [`acceleration_fade`]). Both sides then
-/// meet at s with the mean of their positions, velocities and accelerations, and the window's
+/// With J = x_s − p̂, V = v_s − v̂ and A = a_s − â, the frames before s get the offset
+/// ½ (J b(τ) + V w c(τ) + A w² e(τ)) and those from s on its negative, τ = (f − s) / w
+/// ([`offset_fade`], [`velocity_fade`], [`acceleration_fade`]). Both sides then meet at s with
+/// the mean of their positions, velocities and accelerations, and the window's
 /// ends keep their frames' position, velocity and acceleration.
 fn offset_seam(src: &ModelClip, out: &mut ModelClip, s: usize, w: usize) {
     let d = src.dof_count();
