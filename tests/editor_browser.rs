@@ -9,7 +9,8 @@
 //! 2,000-segment database (`tests/browser/latency.mjs`; printed and written to
 //! `target/editor-browser/latency.json`, never asserted). Screenshots go to
 //! `target/editor-browser/`. Needs `/usr/bin/chromium` (or `$CHROMIUM`) and `npm ci` in
-//! `tests/browser`: skipped with a SKIPPED line when absent, a failure under CI.
+//! `tests/browser`: ignored with that reason when absent (`cfg(tool_browser)`, `build.rs`), a
+//! failure under CI.
 
 mod common;
 mod editor_fixture;
@@ -88,6 +89,10 @@ fn node(script: &str, args: &[&Path], chromium: &Path, child: &mut Child) -> ser
 }
 
 #[test]
+#[cfg_attr(
+    not(tool_browser),
+    ignore = "needs Chromium, Node and tests/browser/node_modules (installed by .ci/run)"
+)]
 fn the_page_searches_sets_generates_plays_saves_and_exports_in_chromium() {
     let Some(chromium) = browser() else { return };
     // A copy of the project's own dance scene (Save writes it back).
@@ -188,6 +193,10 @@ fn the_page_searches_sets_generates_plays_saves_and_exports_in_chromium() {
 }
 
 #[test]
+#[cfg_attr(
+    not(tool_browser),
+    ignore = "needs Chromium, Node and tests/browser/node_modules (installed by .ci/run)"
+)]
 fn latency_of_search_generate_and_first_load_on_2000_segments() {
     let Some(chromium) = browser() else { return };
     // The 2,000-segment database of benches/choreo_fill.rs: the shared dance clips (or, without
@@ -281,6 +290,10 @@ fn dance_scene_copy(name: &str) -> PathBuf {
 /// stale until Generate; repeated segments are marked; a drag scrubs; the song reaches the page
 /// bar by bar, under 4 MB for the 16 bars and first heard within 200 ms of Play.
 #[test]
+#[cfg_attr(
+    not(tool_browser),
+    ignore = "needs Chromium, Node and tests/browser/node_modules (installed by .ci/run)"
+)]
 fn playback_survives_every_action_seeks_loops_and_pauses_with_live_previews() {
     let Some(chromium) = browser() else { return };
     let path = dance_scene_copy("playback");
@@ -311,6 +324,10 @@ fn playback_survives_every_action_seeks_loops_and_pauses_with_live_previews() {
 /// Issue 36: a song of 200 bars (6 min 40 s) at device scale factor 2 — the timeline's bar
 /// numbers (from 0) never overlap, and Play from bar 150 sounds within 200 ms of the click.
 #[test]
+#[cfg_attr(
+    not(tool_browser),
+    ignore = "needs Chromium, Node and tests/browser/node_modules (installed by .ci/run)"
+)]
 fn a_200_bar_timeline_reads_at_scale_2_and_sounds_within_200_ms() {
     let Some(chromium) = browser() else { return };
     let path = editor_fixture::scene("long", 6, 10, 200);

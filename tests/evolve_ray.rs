@@ -11,6 +11,10 @@ use marionette::evolve::{FallProblem, GaConfig, GaState, InProcess, JsonLines};
 use marionette::humanoid::ranges::AgeGroup;
 
 #[test]
+#[cfg_attr(
+    not(tool_python),
+    ignore = "needs the Python environment .venv (made by .ci/run) or MARIONETTE_PYTHON"
+)]
 fn a_run_on_a_local_ray_cluster_matches_the_in_process_run_bit_for_bit() {
     let Some(python) = common::python_with(&["ray"]) else {
         return;

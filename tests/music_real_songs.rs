@@ -24,8 +24,9 @@ fn renderer_or_skip() -> Option<()> {
 
 #[test]
 #[cfg_attr(
-    not(shared_data),
-    ignore = "needs the shared data: set MARIONETTE_DATA (default ../shared/data)"
+    not(all(shared_data, tool_python, tool_fluidsynth)),
+    ignore = "needs the shared data (MARIONETTE_DATA), the Python environment .venv and \
+              fluidsynth with its soundfont (.ci/run makes and installs them)"
 )]
 fn held_out_songs_beats_tempo_and_bars_beside_librosa() {
     let Some(dir) = common::data_path("pop909") else {
@@ -103,6 +104,10 @@ fn lcg(seed: &mut u64) -> f64 {
 }
 
 #[test]
+#[cfg_attr(
+    not(tool_python),
+    ignore = "needs the Python environment .venv (made by .ci/run) or MARIONETTE_PYTHON"
+)]
 fn the_scores_agree_with_mir_eval() {
     let Some(python) = common::python_with(&["mir_eval"]) else {
         return;
