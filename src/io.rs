@@ -30,7 +30,39 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     if result.is_err() {
         let _ = std::fs::remove_file(&tmp);
     }
+    if result.is_ok() {
+        remove_stale_temporaries(dir, name);
+    }
     result
+}
+
+/// Removes the temporary files `.NAME.tmpPID-N` of `dir` that a process killed between its write
+/// and its rename left behind (a checkpoint saved every generation would gather one per kill):
+/// those of a process that no longer runs, as `/proc` tells; nothing where there is no `/proc`.
+fn remove_stale_temporaries(dir: &Path, name: &std::ffi::OsStr) {
+    let proc_fs = Path::new("/proc");
+    if !proc_fs.join("self").exists() {
+        return;
+    }
+    let prefix = format!(".{}.tmp", name.to_string_lossy());
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let file = entry.file_name();
+        let Some(rest) = file.to_str().and_then(|f| f.strip_prefix(&prefix)) else {
+            continue;
+        };
+        let Some((pid, n)) = rest.split_once('-') else {
+            continue;
+        };
+        let (Ok(pid), Ok(_)) = (pid.parse::<u32>(), n.parse::<u64>()) else {
+            continue;
+        };
+        if pid != std::process::id() && !proc_fs.join(pid.to_string()).exists() {
+            let _ = std::fs::remove_file(entry.path());
+        }
+    }
 }
 
 /// The motion data folder: `$MARIONETTE_DATA`, else `../shared/data`; a relative path is taken
@@ -54,6 +86,27 @@ pub fn data_dir() -> PathBuf {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_dead_writers_temporary_is_removed_by_the_next_write() {
+        let dir = std::env::temp_dir().join(format!("marionette-io-stale-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        // PID 4194305 is above Linux's largest (2^22): never a running process.
+        let dead = dir.join(".checkpoint.json.tmp4194305-3");
+        let other = dir.join(".other.json.tmp4194305-3");
+        std::fs::write(&dead, b"half").unwrap();
+        std::fs::write(&other, b"half").unwrap();
+        write_atomic(&dir.join("checkpoint.json"), b"whole").unwrap();
+        if Path::new("/proc/self").exists() {
+            assert!(!dead.exists(), "the dead writer's temporary is left");
+        }
+        assert!(other.exists(), "another file's temporary was touched");
+        assert_eq!(
+            std::fs::read(dir.join("checkpoint.json")).unwrap(),
+            b"whole"
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 
     #[test]
     fn writes_whole_file_and_leaves_no_temporary() {
