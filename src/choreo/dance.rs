@@ -607,37 +607,51 @@ fn log(q: DQuat) -> DVec3 {
 /// Rewrites frames [s − w, s + w) of `out` by the natural cubic spline through the
 /// [`SEAM_KNOTS`] frames of `src` on each side of the window (module docs).
 fn rewrite_seam(src: &ModelClip, out: &mut ModelClip, s: usize, w: usize) {
-    let d = src.dof_count();
     let knots: Vec<usize> = (s - w - SEAM_KNOTS..s - w)
         .chain(s + w..s + w + SEAM_KNOTS)
         .collect();
     let x: Vec<f64> = knots.iter().map(|&f| f as f64).collect();
     let at: Vec<f64> = (s - w..s + w).map(|f| f as f64).collect();
     let mut y = vec![0.0; knots.len()];
-    let mut channel = |value: &dyn Fn(usize) -> f64| -> Vec<f64> {
+    let channel = |value: Values| -> Vec<f64> {
         for (v, &f) in y.iter_mut().zip(&knots) {
             *v = value(f);
         }
         spline_at(&x, &y, &at)
     };
+    rewrite_window(src, out, s - w..s + w, channel);
+}
+
+/// One channel's value at any frame of the source clip.
+type Values<'a> = &'a dyn Fn(usize) -> f64;
+
+/// Rewrites the frames `window` of `out` channel by channel: every DOF angle, every root
+/// coordinate, and the root orientation as the rotation vectors log(q_a⁻¹ q) relative to the
+/// frame q_a before the window (q = q_a exp(r), each on q_a's hemisphere), each channel's new
+/// values over the window given by `channel` from its values in `src` at any frame.
+fn rewrite_window(
+    src: &ModelClip,
+    out: &mut ModelClip,
+    window: std::ops::Range<usize>,
+    mut channel: impl FnMut(Values) -> Vec<f64>,
+) {
+    let d = src.dof_count();
     for j in 0..d {
         let v = channel(&|f| src.angles[f * d + j]);
-        for (k, f) in (s - w..s + w).enumerate() {
+        for (k, f) in window.clone().enumerate() {
             out.angles[f * d + j] = v[k];
         }
     }
     for c in 0..3 {
         let v = channel(&|f| src.root_translation[f][c]);
-        for (k, f) in (s - w..s + w).enumerate() {
+        for (k, f) in window.clone().enumerate() {
             out.root_translation[f][c] = v[k];
         }
     }
-    // Orientation: the same spline of the rotation vectors relative to the last frame before
-    // the window, q = q_a exp(r).
-    let qa = src.root_rotation[s - w - 1];
+    let qa = src.root_rotation[window.start - 1];
     let rel = |f: usize| log(qa.inverse() * src.root_rotation[f]);
     let r: Vec<Vec<f64>> = (0..3).map(|c| channel(&|f| rel(f)[c])).collect();
-    for (k, f) in (s - w..s + w).enumerate() {
+    for (k, f) in window.enumerate() {
         let v = DVec3::new(r[0][k], r[1][k], r[2][k]);
         out.root_rotation[f] = (qa * DQuat::from_scaled_axis(v)).normalize();
     }
@@ -677,10 +691,8 @@ fn acceleration_fade(tau: f64) -> f64 {
 /// the mean of their positions, velocities and accelerations, and the window's
 /// ends keep their frames' position, velocity and acceleration.
 fn offset_seam(src: &ModelClip, out: &mut ModelClip, s: usize, w: usize) {
-    let d = src.dof_count();
-    let frames = s - w..s + w;
     let half = w as f64;
-    let shift = |value: &dyn Fn(usize) -> f64| -> Vec<f64> {
+    let shift = |value: Values| -> Vec<f64> {
         let (p1, p2, p3) = (value(s - 1), value(s - 2), value(s - 3));
         let ahead = 3.0 * p1 - 3.0 * p2 + p3;
         let v_before = 0.5 * (5.0 * p1 - 8.0 * p2 + 3.0 * p3);
@@ -689,8 +701,7 @@ fn offset_seam(src: &ModelClip, out: &mut ModelClip, s: usize, w: usize) {
         let v_after = 0.5 * (-3.0 * x0 + 4.0 * x1 - x2);
         let a_after = x0 - 2.0 * x1 + x2;
         let (jump, dv, da) = (x0 - ahead, v_after - v_before, a_after - a_before);
-        frames
-            .clone()
+        (s - w..s + w)
             .map(|f| {
                 let side = if f < s { 1.0 } else { -1.0 };
                 let tau = (f as f64 - s as f64) / half;
@@ -703,27 +714,7 @@ fn offset_seam(src: &ModelClip, out: &mut ModelClip, s: usize, w: usize) {
             })
             .collect()
     };
-    for j in 0..d {
-        let v = shift(&|f| src.angles[f * d + j]);
-        for (k, f) in frames.clone().enumerate() {
-            out.angles[f * d + j] = v[k];
-        }
-    }
-    for c in 0..3 {
-        let v = shift(&|f| src.root_translation[f][c]);
-        for (k, f) in frames.clone().enumerate() {
-            out.root_translation[f][c] = v[k];
-        }
-    }
-    // Orientation: the same on the rotation vectors relative to the last frame before the
-    // window, q = q_a exp(r).
-    let qa = src.root_rotation[s - w - 1];
-    let rel = |f: usize| log(qa.inverse() * src.root_rotation[f]);
-    let r: Vec<Vec<f64>> = (0..3).map(|c| shift(&|f| rel(f)[c])).collect();
-    for (k, f) in frames.clone().enumerate() {
-        let v = DVec3::new(r[0][k], r[1][k], r[2][k]);
-        out.root_rotation[f] = (qa * DQuat::from_scaled_axis(v)).normalize();
-    }
+    rewrite_window(src, out, s - w..s + w, shift);
 }
 
 #[cfg(test)]
