@@ -488,3 +488,103 @@ fn inspect_finds_the_primitive_scenes_flights_in_their_outputs() {
         }
     }
 }
+
+/// The headline lines of every report under `dir` (one folder a scene), by scene name.
+fn headlines(dir: &std::path::Path) -> Vec<(String, Vec<String>)> {
+    let mut out = Vec::new();
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path().join("report.json");
+        if !path.is_file() {
+            continue; // the evolution's checkpoint folder
+        }
+        let report: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+        let lines = report["headline"]
+            .as_array()
+            .unwrap_or_else(|| panic!("{}: no headline", path.display()))
+            .iter()
+            .map(|l| l.as_str().unwrap().to_string())
+            .collect();
+        out.push((report["scene"].as_str().unwrap().to_string(), lines));
+    }
+    out
+}
+
+#[test]
+fn run_sums_up_each_scene_in_a_few_lines_from_its_report() {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let scene = |name: &str| root.join(format!("scenes/{name}.ron"));
+    // The README's main command: three scenes in one run, one folder each under --out.
+    let tour = temp("tour");
+    let out = bin()
+        .arg("run")
+        .args(["jumping_knee_kick", "dance", "evolve_fall_quick"].map(scene))
+        .arg("--out")
+        .arg(&tour)
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(text.lines().count() <= 40, "{text}");
+    assert_eq!(text.matches("done in").count(), 3, "{text}");
+    // The other scene kinds, and --set refused with several scenes.
+    let rest = temp("rest");
+    let (code, _, err) = run_cli(&[
+        "run".as_ref(),
+        scene("fall").as_os_str(),
+        scene("high_jump").as_os_str(),
+        "--set".as_ref(),
+        "render.gif=false".as_ref(),
+    ]);
+    assert_eq!(code, Some(1));
+    assert!(err.contains("apply to one scene"), "{err}");
+    let out = bin()
+        .arg("run")
+        .args(["show_normal_jump", "high_jump", "fall", "active_knee_kick"].map(scene))
+        .arg("--out")
+        .arg(&rest)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let printed = headlines(&tour);
+    for (name, lines) in &printed {
+        for line in lines {
+            assert!(
+                text.contains(&format!("  {line}\n")),
+                "{name}: {line} not printed"
+            );
+        }
+    }
+    let mut all = printed;
+    all.extend(headlines(&rest));
+    assert_eq!(all.len(), 7);
+    for (name, lines) in &all {
+        assert!(!lines.is_empty(), "{name}");
+        for line in lines {
+            // Every figure named is in the report (a renamed field would show as "(no …)").
+            assert!(!line.contains("in the report)"), "{name}: {line}");
+        }
+    }
+    // The evolution's lines carry its own numbers: the best damage fell in both groups.
+    let evolve = &all
+        .iter()
+        .find(|(n, _)| n == "evolve_fall_quick")
+        .unwrap()
+        .1;
+    for group in ["elderly", "adult"] {
+        let line = evolve
+            .iter()
+            .find(|l| l.starts_with(&format!("{group}: best damage")))
+            .unwrap_or_else(|| panic!("{evolve:?}"));
+        let n: Vec<f64> = line.split(' ').filter_map(|w| w.parse().ok()).collect();
+        assert!(n[1] < n[0], "{line}");
+    }
+}

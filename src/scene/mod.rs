@@ -14,6 +14,7 @@ mod output;
 mod primitives;
 mod show;
 mod source;
+mod summary;
 
 pub use active::{ActiveCharacter, ActiveKneeKickScene, run_active_knee_kick};
 pub use dance::{
@@ -28,6 +29,7 @@ pub use primitives::{
 };
 pub use show::{RenderSettings, ShowScene, run_show};
 pub use source::{ClipSource, LoadedMotion, data_dir, load_motion, resolve_path};
+pub use summary::headline;
 
 use std::path::{Path, PathBuf};
 
@@ -475,6 +477,10 @@ pub fn run(scene: &Scene, base: &Path, out_dir: &Path) -> Result<serde_json::Val
     if let Some(o) = report.as_object_mut() {
         o.insert("scene".into(), scene.name().into());
         o.insert("wall_time_s".into(), started.elapsed().as_secs_f64().into());
+    }
+    let lines = headline(scene, &report);
+    if let Some(o) = report.as_object_mut() {
+        o.insert("headline".into(), lines.into());
     }
     write_output(
         &tmp.join("report.json"),

@@ -58,7 +58,8 @@ enum Command {
     /// Open a dance edit scene (song, database, pins) in the browser editor on 127.0.0.1:
     /// prints its URL and serves until interrupted.
     Edit(edit::Args),
-    /// Run a scene file; outputs go to one folder (default out/<scene name>/) with report.json.
+    /// Run scene files one after the other; each writes one folder (default out/<scene name>/)
+    /// with report.json, and prints its headline figures and where its pictures are.
     Run(run::Args),
     /// Evaluate fall genomes for a GA over the JSON-lines protocol (`--stdin`): the worker a
     /// cluster runs.
