@@ -553,3 +553,86 @@ fn music_into_a_closed_pipe_ends_quietly() {
     assert!(out.status.success(), "{:?}: {err}", out.status);
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Issue 38: a manifest clip may name its landmark mapping (`mapping: "FILE.ron"`, relative to
+/// the manifest), which `dance db` uses instead of the one it finds: the mapping `marionette
+/// mapping` writes gives the same database as finding it, a mapping with the legs' sides
+/// swapped gives other segments, and a missing mapping file is an error naming it.
+#[test]
+fn dance_db_takes_a_clip_s_mapping_from_the_manifest() {
+    let dir = std::env::temp_dir().join(format!("marionette-dance-map-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let clip = marionette::clips::KeyframeClip::load(&root.join("scenes/clips/dance_bars.ron"))
+        .unwrap()
+        .to_model_clip();
+    marionette::bvh::write_file(&clip.to_clip().to_bvh(), &dir.join("bars.bvh")).unwrap();
+    let bin = || Command::new(env!("CARGO_BIN_EXE_marionette"));
+    let out = bin()
+        .arg("mapping")
+        .arg(dir.join("bars.bvh"))
+        .arg("--out")
+        .arg(dir.join("map.ron"))
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // The same mapping with the legs' sides swapped.
+    let text = std::fs::read_to_string(dir.join("map.ron")).unwrap();
+    let mut swapped = String::new();
+    for line in text.lines() {
+        let line = match line.split_once(": ") {
+            Some((key, value)) if key.contains("_hip") || key.contains("_knee") => {
+                let value = if value.contains("left_") {
+                    value.replacen("left_", "right_", 1)
+                } else {
+                    value.replacen("right_", "left_", 1)
+                };
+                format!("{key}: {value}")
+            }
+            _ => line.to_string(),
+        };
+        swapped.push_str(&line);
+        swapped.push('\n');
+    }
+    assert_ne!(swapped, text);
+    std::fs::write(dir.join("swapped.ron"), swapped).unwrap();
+    // A database per manifest: the segments' JSON, or the error.
+    let build = |mapping: Option<&str>| {
+        let name = mapping.unwrap_or("found");
+        let manifest = dir.join(format!("{name}.manifest.ron"));
+        let field = mapping.map_or(String::new(), |m| format!(", mapping: {m:?}"));
+        std::fs::write(
+            &manifest,
+            format!(
+                "(format_version: 1, clips: [(file: \"bars.bvh\", tempo_bpm: 120.0, first_beat_s: 0.0{field})])"
+            ),
+        )
+        .unwrap();
+        let db = dir.join(format!("{name}.json"));
+        let out = bin()
+            .args(["dance", "db", "--strict"])
+            .arg(&manifest)
+            .arg("--out")
+            .arg(&db)
+            .output()
+            .unwrap();
+        if !out.status.success() {
+            return Err(String::from_utf8_lossy(&out.stderr).into_owned());
+        }
+        let v: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&db).unwrap()).unwrap();
+        Ok(v["segments"].clone())
+    };
+    let found = build(None).unwrap();
+    assert_eq!(found.as_array().map(Vec::len), Some(4));
+    assert_eq!(build(Some("map.ron")).unwrap(), found);
+    assert_ne!(build(Some("swapped.ron")).unwrap(), found);
+    let e = build(Some("nowhere.ron")).unwrap_err();
+    assert!(e.contains("nowhere.ron"), "{e}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -37,6 +37,7 @@ fn one_clip(file: PathBuf, tempo_bpm: Option<f64>, window: Option<(f64, f64)>) -
             tempo_bpm,
             first_beat_s: tempo_bpm.map(|_| 0.0),
             window,
+            mapping: None,
         }],
     }
 }

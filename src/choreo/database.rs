@@ -48,6 +48,10 @@ pub struct ManifestClip {
     /// The part of the clip to use, (start, end) seconds.
     #[serde(default)]
     pub window: Option<(f64, f64)>,
+    /// The landmark mapping of a BVH clip (RON, as `marionette mapping` writes it), relative
+    /// to the manifest's folder; absent, the mapping is found from the skeleton.
+    #[serde(default)]
+    pub mapping: Option<PathBuf>,
 }
 
 /// A manifest: the clips a database is built from. A field it does not know (a misspelt
@@ -88,6 +92,7 @@ impl Manifest {
         let dir = path.parent().unwrap_or(Path::new("."));
         for c in &mut m.clips {
             c.file = dir.join(&c.file);
+            c.mapping = c.mapping.as_ref().map(|f| dir.join(f));
         }
         Ok(m)
     }
@@ -147,6 +152,7 @@ impl Manifest {
                     tempo_bpm: None,
                     first_beat_s: None,
                     window: None,
+                    mapping: None,
                 })
                 .collect(),
         })
@@ -200,7 +206,7 @@ fn clip_segments(
         path: name.to_string(),
         message,
     })?;
-    let mut clip = load_model_clip(&c.file)?;
+    let mut clip = load_model_clip_with(&c.file, c.mapping.as_deref())?;
     if let Some((a, b)) = c.window {
         clip = clip.window(a, b).ok_or_else(|| SegmentError::Manifest {
             path: name.to_string(),
@@ -240,7 +246,16 @@ fn clip_segments(
 /// humanoid24's own proportions with its root path scaled by the ratio of the leg lengths
 /// ([`crate::mapping::onto_model`]), or a keyframed .ron clip; set on its floor ([`grounded`]).
 pub fn load_model_clip(path: &Path) -> Result<ModelClip, SegmentError> {
-    load_unground(path).map(grounded)
+    load_unground(path, None).map(grounded)
+}
+
+/// [`load_model_clip`] with the BVH clip's landmark mapping read from `mapping` (a RON file)
+/// when given, instead of found from its skeleton.
+pub fn load_model_clip_with(
+    path: &Path,
+    mapping: Option<&Path>,
+) -> Result<ModelClip, SegmentError> {
+    load_unground(path, mapping).map(grounded)
 }
 
 /// `clip` with its root moved vertically so that its floor is at y = 0: the floor is the one
@@ -261,7 +276,7 @@ pub fn grounded(mut clip: ModelClip) -> ModelClip {
     clip
 }
 
-fn load_unground(path: &Path) -> Result<ModelClip, SegmentError> {
+fn load_unground(path: &Path, mapping: Option<&Path>) -> Result<ModelClip, SegmentError> {
     let load = |e: crate::Error| SegmentError::Load {
         path: path.display().to_string(),
         source: Box::new(e),
@@ -276,7 +291,13 @@ fn load_unground(path: &Path) -> Result<ModelClip, SegmentError> {
     }
     let (bvh, _warnings) = crate::bvh::parse_file(path).map_err(|e| load(e.into()))?;
     let clip = crate::skeleton::Clip::from_bvh(&bvh, None).map_err(|e| load(e.into()))?;
-    let mapping = crate::mapping::Mapping::detect_clip(&clip).map_err(|e| load(e.into()))?;
+    let mapping = match mapping {
+        Some(file) => crate::mapping::Mapping::load(file).map_err(|e| SegmentError::Load {
+            path: file.display().to_string(),
+            source: Box::new(e.into()),
+        })?,
+        None => crate::mapping::Mapping::detect_clip(&clip).map_err(|e| load(e.into()))?,
+    };
     let model = humanoid24();
     let mapped = crate::mapping::retarget(&clip, &mapping, &model).map_err(|e| load(e.into()))?;
     // The source's angles on humanoid24 itself, the root path scaled with the legs, so that
@@ -724,6 +745,7 @@ mod tests {
                 tempo_bpm,
                 first_beat_s: None,
                 window,
+                mapping: None,
             }],
         };
         assert_eq!(clip(Some((1.0, 2.0)), Some(120.0)).check(), Ok(()));

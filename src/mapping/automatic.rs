@@ -749,7 +749,7 @@ impl AutoMapping {
         let mut s = format!(
             "// Mapping of {title} onto the engine's models, found automatically (names and \
              structure).\n// Each landmark names a source joint or \"<joint>:end\" (its End \
-             Site); edit and pass it with --mapping.\n"
+             Site); edit and pass it with --mapping (or as a dance manifest clip's `mapping:`).\n"
         );
         for n in &self.notes {
             s.push_str(&format!("// {n}\n"));

@@ -105,7 +105,7 @@ pub enum MappingError {
     /// Neither a built-in mapping nor the automatic detection fits: not a humanoid (or not
     /// standing in the frame looked at).
     #[error(
-        "no mapping for this skeleton (root '{root}'): no built-in mapping fits and it was not recognised as a humanoid: {reason}. Write a mapping (marionette mapping FILE.bvh --out my.ron gives a start when the figure is a humanoid) and pass it with --mapping"
+        "no mapping for this skeleton (root '{root}'): no built-in mapping fits and it was not recognised as a humanoid: {reason}. Write a mapping (marionette mapping FILE.bvh --out my.ron gives a start when the figure is a humanoid) and give it to the command: --mapping FILE, or `mapping: \"FILE\"` beside the clip in a dance manifest"
     )]
     NotHumanoid {
         /// The skeleton's root joint.

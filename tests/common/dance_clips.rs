@@ -131,6 +131,7 @@ pub fn generated_database(name: &str, clips: usize) -> (Database, PathBuf) {
             tempo_bpm: Some(tempo(c)),
             first_beat_s: Some(0.0),
             window: None,
+            mapping: None,
         });
     }
     let m = Manifest {
