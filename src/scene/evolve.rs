@@ -16,12 +16,10 @@ use super::fall::{Controller, write_falls};
 use super::primitives::PrimitiveRender;
 use super::{SceneError, write_output};
 use crate::evolve::ga::ELITE_CHECK;
-use crate::evolve::{
-    Evaluator, FallProblem, GaConfig, InProcessFalls, JsonLines, checkpoint, logbook,
-};
+use crate::evolve::{Evaluator, GaConfig, JsonLines, checkpoint, logbook};
 use crate::experiments::evolve_fall::{
-    Checkpointing, EvolutionRun, EvolveConfig, GroupOutcome, advance, best_falls, halted, outcomes,
-    problem_index, start,
+    Checkpointing, EvolutionRun, EvolveConfig, FallProblem, GroupOutcome, InProcessFalls, advance,
+    best_falls, halted, outcomes, problem_index, start,
 };
 use crate::experiments::fall::{FallConfig, FallResult, simulate_fall};
 use crate::humanoid::fall21;
@@ -51,7 +49,7 @@ fn default_kp_scale() -> f64 {
     1.0
 }
 fn default_step_margin() -> f64 {
-    crate::evolve::fall_fitness::STEP_MARGIN
+    crate::experiments::evolve_fall::STEP_MARGIN
 }
 fn default_every() -> u64 {
     1
@@ -82,13 +80,13 @@ pub struct EvolveFallScene {
     #[serde(default = "default_kp_scale")]
     pub kp_max_scale: f64,
     /// The GA's time step as a fraction of the stability bound of the strongest genome, in
-    /// (0, 1] (default [`crate::evolve::fall_fitness::STEP_MARGIN`], 0.8): larger is faster
+    /// (0, 1] (default [`crate::experiments::evolve_fall::STEP_MARGIN`], 0.8): larger is faster
     /// and less accurate; the elite check (`ga.elite_check_tolerance`) rejects individuals that
     /// win through the step. Ignored when `fall` is given (it keeps its own `dt_s`).
     #[serde(default = "default_step_margin")]
     pub step_margin: f64,
     /// The fall every genome is tried on, per field (default: the paper's push of the age
-    /// group at the GA's step, [`crate::evolve::fall_fitness::stable_step_for`]; its
+    /// group at the GA's step, [`crate::experiments::evolve_fall::stable_step_for`]; its
     /// key pose and k_p are the genes). A fall given here takes the group's ranges and strength
     /// and keeps its own `dt_s` (0.5 ms unless set).
     #[serde(default)]
@@ -695,7 +693,7 @@ pub fn run_evolve(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::evolve::fall_fitness::{STEP_MARGIN, stable_step_for, strength_kp_max};
+    use crate::experiments::evolve_fall::{STEP_MARGIN, stable_step_for, strength_kp_max};
 
     fn scene(step_margin: f64, kp_max_scale: f64) -> EvolveFallScene {
         EvolveFallScene {

@@ -7,8 +7,8 @@ use std::io::{BufReader, BufWriter};
 
 use anyhow::{Result, bail};
 
-use marionette::evolve::FallProblem;
 use marionette::evolve::evaluator::serve;
+use marionette::experiments::evolve_fall::FallProblem;
 
 // The command's arguments (its help text is on `Command::Eval`).
 #[derive(clap::Args)]

@@ -1,16 +1,25 @@
 //! The falling paper's evolution (SPEC §3, paper §5–6) as an experiment: for each age group and
 //! each seed, a GA evolves the key pose θ_d and stiffness k_p of every DOF to minimise the damage
 //! of the pushed fall; the runs advance generation by generation together, checkpointing every K
-//! generations, and report per group the initial and final damage over seeds.
+//! generations, and report per group the initial and final damage over seeds. The problem a
+//! genome is tried on ([`FallProblem`]) and its in-process evaluator ([`InProcessFalls`]) live
+//! here, above the GA kernel ([`crate::evolve`]) that knows no fall.
+
+mod in_process;
+mod problem;
+
+pub use in_process::InProcessFalls;
+pub use problem::{
+    FallProblem, FallStarts, KP_SATURATION_RAD, ProblemError, STEP_MARGIN, STEP_QUANTA_PER_S,
+    SettleCache, stable_step_for, strength_kp_max,
+};
 
 use std::path::PathBuf;
 
 use serde::{Deserialize, Serialize};
 
 use crate::evolve::ga::{Brood, ELITE_CHECK_REFINE};
-use crate::evolve::{
-    Evaluation, Evaluator, EvolveError, FallProblem, GaConfig, GaState, Genome, checkpoint,
-};
+use crate::evolve::{Evaluation, Evaluator, EvolveError, GaConfig, GaState, Genome, checkpoint};
 use crate::experiments::fall::{FallConfig, FallResult, SimError, simulate_fall};
 use crate::humanoid::ranges::AgeGroup;
 
