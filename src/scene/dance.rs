@@ -28,7 +28,7 @@ use crate::choreo::music::{Bar, MusicAnalysis, MusicParams, analyze};
 use crate::choreo::relevance;
 use crate::choreo::search::SearchParams;
 use crate::choreo::segments::{Beat, TempoSource};
-use crate::render::{Plot, Series, Track, View, animation_gif, filmstrip_at_png, plot};
+use crate::render::{Figure, Plot, Series, Track, View, animation_gif, filmstrip_at_png, plot};
 
 /// Where the song comes from.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -507,7 +507,7 @@ pub fn run_dance(
     // Pictures of the dance itself (frame 0 at the first bar).
     let dclip = d.clip.to_clip();
     let frames = dclip.point_frames();
-    let figure = dclip.skeleton.figure();
+    let figure = Figure::of(&dclip.skeleton);
     let track = Track {
         figure: &figure,
         frames: &frames,
