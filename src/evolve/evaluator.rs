@@ -534,16 +534,22 @@ pub const MAX_LINE: usize = 1 << 20;
 /// long).
 pub const MAX_REFINE: u32 = 64;
 
-/// The worker side: reads the header, builds the evaluator of its problem with `make`, then
-/// answers batches until its input ends (a batch mixing refinements is evaluated per
+/// The worker side: reads the header, reads its problem as a `P` and builds the evaluator of
+/// it with `make`, then answers batches until its input ends (a batch mixing refinements is evaluated per
 /// refinement). A line it does not understand (an unknown message or field, a wrong type, a
 /// batch end whose count is not the batch's) ends it with an error naming the line, the column
 /// and the field.
-pub fn serve<R: BufRead, W: Write, E: Fn(&[Genome], u32) -> Vec<Evaluation>>(
+pub fn serve<P, R, W, E>(
     input: R,
     mut output: W,
-    make: impl FnOnce(serde_json::Value) -> Result<E, String>,
-) -> Result<(), EvolveError> {
+    make: impl FnOnce(P) -> Result<E, String>,
+) -> Result<(), EvolveError>
+where
+    P: serde::de::DeserializeOwned,
+    R: BufRead,
+    W: Write,
+    E: Fn(&[Genome], u32) -> Vec<Evaluation>,
+{
     let err = |m: String| EvolveError::Evaluator(m);
     let mut lines = input.lines();
     let first = lines
@@ -557,7 +563,10 @@ pub fn serve<R: BufRead, W: Write, E: Fn(&[Genome], u32) -> Vec<Evaluation>>(
             header.protocol
         )));
     }
-    let eval = make(header.problem).map_err(|e| err(format!("problem: {e}")))?;
+    let eval = serde_json::from_value(header.problem)
+        .map_err(|e| e.to_string())
+        .and_then(make)
+        .map_err(|e| err(format!("problem: {e}")))?;
     let mut batch: Vec<(usize, Genome, u32)> = Vec::new();
     for (k, line) in lines.enumerate() {
         let at = k + 2;
@@ -660,7 +669,7 @@ mod tests {
             input.push('\n');
         }
         let mut out = Vec::new();
-        serve(input.as_bytes(), &mut out, |_| {
+        serve(input.as_bytes(), &mut out, |_: serde_json::Value| {
             Ok(|g: &[Genome], refine: u32| {
                 g.iter()
                     .map(|x| Ok(x.iter().sum::<f64>() * refine as f64))
@@ -759,7 +768,7 @@ mod tests {
     #[test]
     fn a_header_with_an_unknown_field_or_another_protocol_is_refused() {
         let mut out = Vec::new();
-        let make = |_| Ok(|_: &[Genome], _: u32| Vec::new());
+        let make = |_: serde_json::Value| Ok(|_: &[Genome], _: u32| Vec::new());
         let e = serve(
             &b"{\"protocol\":\"marionette-eval/3\",\"problem\":null,\"seed\":1}\n"[..],
             &mut out,
@@ -788,7 +797,7 @@ mod tests {
             )
             .as_bytes(),
             &mut out,
-            |_| Ok(|_: &[Genome], _: u32| vec![Ok(-5.0)]),
+            |_: serde_json::Value| Ok(|_: &[Genome], _: u32| vec![Ok(-5.0)]),
         )
         .unwrap();
         let out = String::from_utf8(out).unwrap();

@@ -25,8 +25,7 @@ pub fn eval(args: Args) -> Result<()> {
     }
     let input = BufReader::new(std::io::stdin().lock());
     let output = BufWriter::new(std::io::stdout().lock());
-    serve(input, output, |problem| {
-        let p: FallProblem = serde_json::from_value(problem).map_err(|e| e.to_string())?;
+    serve(input, output, |p: FallProblem| {
         p.bounds().map_err(|e| e.to_string())?;
         Ok(move |genomes: &[Vec<f64>], refine: u32| p.evaluate(genomes, refine))
     })?;
