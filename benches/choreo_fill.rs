@@ -22,10 +22,10 @@ use marionette::choreo::dance::{DanceParams, assemble};
 use marionette::choreo::database::{BuildParams, Database, Manifest, OnRefusal};
 use marionette::choreo::feet::{PlantParams, plant_feet};
 use marionette::choreo::fill::{FillParams, Pins, fill, fill_dijkstra_with_table, fill_with_table};
+use marionette::choreo::generated::generated_database;
 use marionette::choreo::music::Bar;
 use marionette::choreo::relevance::percentile_ranks;
 use marionette::choreo::transition::TransitionTable;
-use marionette::experiments::dance_fill::generated_database;
 
 /// The 2,000-segment database (module docs).
 fn database() -> Database {

@@ -11,8 +11,8 @@
 //! Run: `cargo bench --bench evolve`.
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use marionette::evolve::{FallProblem, GaConfig, GaState, InProcess, checkpoint};
-use marionette::experiments::evolve_fall::EvolutionRun;
+use marionette::evolve::{GaConfig, GaState, InProcess, checkpoint};
+use marionette::experiments::evolve_fall::{EvolutionRun, FallProblem};
 use marionette::humanoid::ranges::AgeGroup;
 use std::hint::black_box;
 use std::time::Duration;

@@ -10,7 +10,8 @@
 //! Run: `cargo bench --bench evolve_run`.
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use marionette::evolve::{FallProblem, GaConfig, GaState, InProcessFalls};
+use marionette::evolve::{GaConfig, GaState};
+use marionette::experiments::evolve_fall::{FallProblem, InProcessFalls};
 use marionette::humanoid::ranges::AgeGroup;
 use std::hint::black_box;
 use std::time::Duration;

@@ -19,9 +19,10 @@
 //! whose falls last longer than the initial one's) instead of the initial population. Besides each fall, it prints the mean damage share per link over the falls and the link
 //! that carries the most damage in the best one.
 
-use marionette::evolve::fall_fitness::{STEP_MARGIN, stable_step_for, strength_kp_max};
-use marionette::evolve::{FallProblem, GaConfig, GaState, InProcess, checkpoint};
-use marionette::experiments::evolve_fall::EvolutionRun;
+use marionette::evolve::{GaConfig, GaState, InProcess, checkpoint};
+use marionette::experiments::evolve_fall::{
+    EvolutionRun, FallProblem, STEP_MARGIN, stable_step_for, strength_kp_max,
+};
 use marionette::experiments::fall::Ranges;
 use marionette::experiments::fall::SettledStart;
 use marionette::experiments::fall::ecs::{ReactionStart, run_parallel_reacting};

@@ -31,6 +31,7 @@ pub mod primitive;
 pub mod render;
 #[cfg(feature = "render")]
 pub mod scene;
+pub mod seed;
 pub mod skeleton;
 
 pub use error::{Error, Result};

@@ -9,11 +9,10 @@ mod common;
 use marionette::choreo::dance::{DanceParams, assemble};
 use marionette::choreo::database::{BuildParams, Database, Manifest, OnRefusal};
 use marionette::choreo::fill::{FillParams, Pins, fill, fill_dijkstra};
+use marionette::choreo::generated::generated_database;
 use marionette::choreo::metrics::dance_metrics;
 use marionette::choreo::music::Bar;
-use marionette::experiments::dance_fill::{
-    DanceFillConfig, DanceFillOutcome, Strategy, generated_database, run,
-};
+use marionette::experiments::dance_fill::{DanceFillConfig, DanceFillOutcome, Strategy, run};
 
 /// The claims of Fig. 5 on an outcome.
 fn check_fig5(o: &DanceFillOutcome, what: &str) {

@@ -8,8 +8,8 @@ use marionette::dynamics::kinematics::mechanical_energy;
 use marionette::dynamics::{
     Data, Forces, Integrator, State, StepError, StepMonitor, StepSettings, StepWorkspace, pipeline,
 };
-use marionette::evolve::fall_fitness::{FallProblem, strength_kp_max};
 use marionette::evolve::genome::Genome;
+use marionette::experiments::evolve_fall::{FallProblem, strength_kp_max};
 use marionette::experiments::fall::{
     FallCharacter, FallConfig, SimError, build_fall, simulate_fall,
 };

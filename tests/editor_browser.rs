@@ -22,8 +22,8 @@ use std::process::{Child, Command};
 use editor_fixture::{assert_bvh_lasts_the_bars, get, scene_on, start_editor};
 use marionette::choreo::augment::augment;
 use marionette::choreo::database::{BuildParams, Database, Manifest, OnRefusal};
+use marionette::choreo::generated::generated_database;
 use marionette::editor::session::Session;
-use marionette::experiments::dance_fill::generated_database;
 
 /// Chromium and the Node modules of `tests/browser`, or `None` after saying what is missing.
 fn browser() -> Option<PathBuf> {

@@ -8,9 +8,9 @@ use std::process::Command;
 
 use marionette::evolve::evaluator::{Evaluation, par_map};
 use marionette::evolve::{
-    Bounds, Evaluator, FallProblem, GaConfig, GaState, Genome, InProcess, InProcessFalls,
-    JsonLines, checkpoint,
+    Bounds, Evaluator, GaConfig, GaState, Genome, InProcess, JsonLines, checkpoint,
 };
+use marionette::experiments::evolve_fall::{FallProblem, InProcessFalls};
 use marionette::humanoid::ranges::AgeGroup;
 
 /// The sphere function Σ (x_i − 1)², its minimum 0 at x = 1.

@@ -7,7 +7,8 @@ mod common;
 use std::path::PathBuf;
 use std::process::Command;
 
-use marionette::evolve::{FallProblem, GaConfig, GaState, InProcess, JsonLines};
+use marionette::evolve::{GaConfig, GaState, InProcess, JsonLines};
+use marionette::experiments::evolve_fall::FallProblem;
 use marionette::humanoid::ranges::AgeGroup;
 
 #[test]

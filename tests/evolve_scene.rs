@@ -4,7 +4,8 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use marionette::evolve::{FallProblem, checkpoint};
+use marionette::evolve::checkpoint;
+use marionette::experiments::evolve_fall::FallProblem;
 use marionette::humanoid::ranges::AgeGroup;
 
 fn marionette(args: &[&str]) -> std::process::Output {

@@ -5,6 +5,7 @@
 use marionette::bvh;
 use marionette::humanoid::Model;
 use marionette::mapping::{Mapping, effector_errors, retarget};
+use marionette::render::Figure;
 use marionette::skeleton::Clip;
 
 mod common;
@@ -40,7 +41,7 @@ fn every_data_file_maps_onto_both_models_and_looks_like_itself() {
             );
             // It renders: a filmstrip of the mapped clip.
             let shown = mapped.to_clip();
-            let figure = shown.skeleton.figure();
+            let figure = Figure::of(&shown.skeleton);
             let frames = shown.point_frames();
             let track = marionette::render::Track {
                 figure: &figure,

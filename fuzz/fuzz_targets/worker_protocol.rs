@@ -10,7 +10,7 @@ fuzz_target!(|data: &[u8]| {
     let mut input = format!("{{\"protocol\":\"{PROTOCOL}\",\"problem\":null}}\n").into_bytes();
     input.extend_from_slice(data);
     let mut out = Vec::new();
-    let r = serve(&input[..], &mut out, |_| {
+    let r = serve(&input[..], &mut out, |_: serde_json::Value| {
         Ok(|g: &[Vec<f64>], _: u32| {
             g.iter()
                 .map(|x| {

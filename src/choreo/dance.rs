@@ -720,7 +720,7 @@ fn offset_seam(src: &ModelClip, out: &mut ModelClip, s: usize, w: usize) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::experiments::dance_fill::generated_database;
+    use crate::choreo::generated::generated_database;
 
     fn bars(n: usize, bar_s: f64, start: f64) -> Vec<Bar> {
         (0..n)

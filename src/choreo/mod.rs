@@ -23,7 +23,8 @@
 //! - [`relevance`]: rel(q, m), music intensity against motion intensity, both as percentile ranks;
 //! - [`search`]: the relevance-feedback search of eqs. (1)–(4), six candidates per round;
 //! - [`edit`]: the stateful edit a server holds (pins, per-bar search, undo/redo, generate);
-//! - [`authored`]: the project's own dance, generated in code at a known tempo.
+//! - [`authored`]: the project's own dance, generated in code at a known tempo;
+//! - [`generated`]: a database of dance clips generated in code (no shared data needed).
 
 pub mod augment;
 pub mod authored;
@@ -34,6 +35,7 @@ pub mod eros;
 pub mod features;
 pub mod feet;
 pub mod fill;
+pub mod generated;
 pub mod metrics;
 pub mod music;
 pub mod relevance;

@@ -541,7 +541,7 @@ mod tests {
 #[cfg(test)]
 mod table_tests {
     use super::*;
-    use crate::experiments::dance_fill::generated_database;
+    use crate::choreo::generated::generated_database;
 
     #[test]
     fn the_table_has_the_costs_of_connection_rounded_to_single_precision() {

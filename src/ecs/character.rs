@@ -166,8 +166,8 @@ pub struct CharacterLog {
 
 /// An animated foot counts as down while its lowest contact corner is within this height of
 /// the animated floor (m): the tolerance the jumps use for a planted foot
-/// ([`crate::experiments::knee_kick::FOOT_DOWN_M`]).
-pub const ANIMATED_FOOT_DOWN_M: f64 = crate::experiments::knee_kick::FOOT_DOWN_M;
+/// ([`crate::humanoid::FOOT_DOWN_M`]).
+pub const ANIMATED_FOOT_DOWN_M: f64 = crate::humanoid::FOOT_DOWN_M;
 
 /// Whether the physical feet are on the floor when the animated ones are: for every foot link,
 /// over the ticks before the first push at which the animated foot is down (its lowest corner

@@ -8,6 +8,8 @@ use rand::SeedableRng;
 use rand_pcg::Pcg64;
 use rayon::prelude::*;
 
+pub use crate::seed::world_seed;
+
 /// The World's index in its pool and the seed its generator started from.
 #[derive(Resource, Clone, Copy, Debug, PartialEq, Eq)]
 pub struct WorldSeed {
@@ -20,15 +22,6 @@ pub struct WorldSeed {
 /// The World's random number generator (PCG64), seeded by [`world_seed`].
 #[derive(Resource, Clone, Debug)]
 pub struct WorldRng(pub Pcg64);
-
-/// The seed of World `index` of a run seeded with `seed`: SplitMix64 finalisation of
-/// `seed ⊕ golden·(index + 1)`, so neighbouring indices get unrelated streams.
-pub fn world_seed(seed: u64, index: u64) -> u64 {
-    let mut z = seed ^ 0x9E37_79B9_7F4A_7C15u64.wrapping_mul(index.wrapping_add(1));
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
-}
 
 /// Worlds that run side by side.
 #[derive(Default)]

@@ -365,7 +365,7 @@ struct DanceAnswer<'a> {
     fps: f64,
     start_s: f64,
     frames: &'a Frames,
-    figures: crate::scene::DanceFigures,
+    figures: crate::experiments::dance::DanceFigures,
 }
 
 /// One candidate (or liked segment) of `GET /api/candidates` and `POST /api/search`.

@@ -16,8 +16,9 @@ use super::EditorError;
 use super::scene::DanceFile;
 use crate::choreo::edit::Edit;
 use crate::choreo::fill::Fill;
+use crate::experiments::dance::{DanceFigures, figures, perform};
 use crate::humanoid::{Model, ModelClip, humanoid24};
-use crate::scene::{DanceFigures, figures, load_dance, perform, scene_pins, song_timed_bvh};
+use crate::scene::{load_dance, scene_pins, song_timed_bvh};
 
 /// The song the edit dances to.
 #[derive(Debug, Clone)]
@@ -276,13 +277,17 @@ impl Session {
 
     fn dance(&mut self) -> Result<crate::choreo::dance::Dance, EditorError> {
         let segments = self.generate()?.segments.clone();
+        let scene = self.file.scene();
+        // An assembly error is reported as the scene's, as `marionette run` reports it.
         let (d, _) = perform(
-            self.file.scene(),
             self.edit.database(),
             &segments,
             self.edit.bars(),
             &self.song.beats_s,
-        )?;
+            &scene.dance,
+            &scene.feet,
+        )
+        .map_err(|e| EditorError::DanceScene(e.into()))?;
         Ok(d)
     }
 

@@ -6,7 +6,7 @@
 //!
 //! The protocol, one JSON object per line, each message after the header tagged by its one key:
 //! 1. client → worker, once: `{"protocol": "marionette-eval/3", "problem": {…}}` (the problem,
-//!    e.g. a [`FallProblem`](super::fall_fitness::FallProblem));
+//!    any serialisable problem, e.g. the falling paper's `FallProblem`);
 //! 2. per batch, client → worker: `{"genome": {"index": i, "genes": [x, …], "refine": k}}` for
 //!    each genome (`refine` as in [`Evaluator::evaluate`]; absent means 1), then
 //!    `{"evaluate": {"count": n}}`, `n` the number of genomes sent;
@@ -19,14 +19,12 @@
 
 use std::io::{BufRead, BufReader, Read, Write};
 use std::process::{Child, Command, Stdio};
-use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex, mpsc};
 use std::time::{Duration, Instant};
 
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use super::fall_fitness::FallProblem;
 use super::genome::Genome;
 
 /// The protocol's name and version.
@@ -116,97 +114,6 @@ impl<F: Fn(&[Genome], u32) -> Vec<Evaluation>> Evaluator for InProcess<F> {
         refine: u32,
     ) -> Result<Vec<Evaluation>, EvolveError> {
         Ok((self.batch)(genomes, refine))
-    }
-}
-
-/// Evaluates a [`FallProblem`] in this process (its falls in parallel Worlds on the current
-/// rayon pool), overlapping each round of elite checks with the next generation
-/// ([`Evaluator::evaluate_checks`]): a check is a single fall that occupies one thread, so the
-/// next generation's falls run on the others meanwhile and are given up as soon as a check
-/// changes the next generation.
-pub struct InProcessFalls {
-    /// The problem (private: what was evaluated ahead holds for it alone).
-    problem: FallProblem,
-    /// Batches answered from the look-ahead so far (generations whose falls ran alongside
-    /// their parents' elite checks).
-    pub answered_ahead: u64,
-    /// The genomes evaluated ahead and their evaluations, for the next [`Evaluator::evaluate`].
-    ahead: Option<(Vec<Genome>, Vec<Evaluation>)>,
-}
-
-impl InProcessFalls {
-    /// Evaluates `problem`.
-    pub fn new(problem: FallProblem) -> Self {
-        Self {
-            problem,
-            answered_ahead: 0,
-            ahead: None,
-        }
-    }
-
-    /// The problem.
-    pub fn problem(&self) -> &FallProblem {
-        &self.problem
-    }
-}
-
-/// True if `a` and `b` are the same genomes bit for bit.
-fn same_genomes(a: &[Genome], b: &[Genome]) -> bool {
-    a.len() == b.len()
-        && a.iter().zip(b).all(|(x, y)| {
-            x.len() == y.len() && x.iter().zip(y).all(|(u, v)| u.to_bits() == v.to_bits())
-        })
-}
-
-impl Evaluator for InProcessFalls {
-    fn evaluate(
-        &mut self,
-        _: u64,
-        genomes: &[Genome],
-        refine: u32,
-    ) -> Result<Vec<Evaluation>, EvolveError> {
-        if let Some((g, r)) = self.ahead.take()
-            && refine == 1
-            && same_genomes(&g, genomes)
-        {
-            self.answered_ahead += 1;
-            return Ok(r);
-        }
-        Ok(self.problem.evaluate(genomes, refine))
-    }
-
-    fn evaluate_checks(
-        &mut self,
-        _: u64,
-        checks: &[Genome],
-        refine: u32,
-        ahead: &dyn Fn() -> Vec<Genome>,
-        wanted: &(dyn Fn(&[Evaluation]) -> bool + Sync),
-    ) -> Result<Vec<Evaluation>, EvolveError> {
-        self.ahead = None;
-        let p = &self.problem;
-        let ahead = ahead();
-        if ahead.is_empty() {
-            return Ok(p.evaluate(checks, refine));
-        }
-        let stop = AtomicBool::new(false);
-        let ((done, hold), next) = rayon::join(
-            || {
-                let r = p.evaluate(checks, refine);
-                let hold = wanted(&r);
-                if !hold {
-                    stop.store(true, Ordering::Relaxed);
-                }
-                (r, hold)
-            },
-            || p.evaluate_until(&ahead, 1, &stop),
-        );
-        if let Some(next) = next
-            && hold
-        {
-            self.ahead = Some((ahead, next));
-        }
-        Ok(done)
     }
 }
 
@@ -627,16 +534,22 @@ pub const MAX_LINE: usize = 1 << 20;
 /// long).
 pub const MAX_REFINE: u32 = 64;
 
-/// The worker side: reads the header, builds the evaluator of its problem with `make`, then
-/// answers batches until its input ends (a batch mixing refinements is evaluated per
+/// The worker side: reads the header, reads its problem as a `P` and builds the evaluator of
+/// it with `make`, then answers batches until its input ends (a batch mixing refinements is evaluated per
 /// refinement). A line it does not understand (an unknown message or field, a wrong type, a
 /// batch end whose count is not the batch's) ends it with an error naming the line, the column
 /// and the field.
-pub fn serve<R: BufRead, W: Write, E: Fn(&[Genome], u32) -> Vec<Evaluation>>(
+pub fn serve<P, R, W, E>(
     input: R,
     mut output: W,
-    make: impl FnOnce(serde_json::Value) -> Result<E, String>,
-) -> Result<(), EvolveError> {
+    make: impl FnOnce(P) -> Result<E, String>,
+) -> Result<(), EvolveError>
+where
+    P: serde::de::DeserializeOwned,
+    R: BufRead,
+    W: Write,
+    E: Fn(&[Genome], u32) -> Vec<Evaluation>,
+{
     let err = |m: String| EvolveError::Evaluator(m);
     let mut lines = input.lines();
     let first = lines
@@ -650,7 +563,10 @@ pub fn serve<R: BufRead, W: Write, E: Fn(&[Genome], u32) -> Vec<Evaluation>>(
             header.protocol
         )));
     }
-    let eval = make(header.problem).map_err(|e| err(format!("problem: {e}")))?;
+    let eval = serde_json::from_value(header.problem)
+        .map_err(|e| e.to_string())
+        .and_then(make)
+        .map_err(|e| err(format!("problem: {e}")))?;
     let mut batch: Vec<(usize, Genome, u32)> = Vec::new();
     for (k, line) in lines.enumerate() {
         let at = k + 2;
@@ -753,7 +669,7 @@ mod tests {
             input.push('\n');
         }
         let mut out = Vec::new();
-        serve(input.as_bytes(), &mut out, |_| {
+        serve(input.as_bytes(), &mut out, |_: serde_json::Value| {
             Ok(|g: &[Genome], refine: u32| {
                 g.iter()
                     .map(|x| Ok(x.iter().sum::<f64>() * refine as f64))
@@ -852,7 +768,7 @@ mod tests {
     #[test]
     fn a_header_with_an_unknown_field_or_another_protocol_is_refused() {
         let mut out = Vec::new();
-        let make = |_| Ok(|_: &[Genome], _: u32| Vec::new());
+        let make = |_: serde_json::Value| Ok(|_: &[Genome], _: u32| Vec::new());
         let e = serve(
             &b"{\"protocol\":\"marionette-eval/3\",\"problem\":null,\"seed\":1}\n"[..],
             &mut out,
@@ -881,7 +797,7 @@ mod tests {
             )
             .as_bytes(),
             &mut out,
-            |_| Ok(|_: &[Genome], _: u32| vec![Ok(-5.0)]),
+            |_: serde_json::Value| Ok(|_: &[Genome], _: u32| vec![Ok(-5.0)]),
         )
         .unwrap();
         let out = String::from_utf8(out).unwrap();

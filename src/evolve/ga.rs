@@ -1,7 +1,7 @@
 //! The generational genetic algorithm: an initial population uniform in the bounds, then per
 //! generation elitism (the best `elites` pass unchanged), tournament selection, SBX crossover and
 //! polynomial mutation. Every random draw of generation `g` comes from a generator seeded by the
-//! run's seed and `g` ([`crate::ecs::world_seed`]); evaluations draw nothing, so a run is the
+//! run's seed and `g` ([`crate::seed::world_seed`]); evaluations draw nothing, so a run is the
 //! same bits whatever evaluates it and however many threads it uses, and a resumed run continues
 //! exactly. As in the textbook loop (e.g. DEAP's `eaSimple`, which evaluates only the individuals
 //! whose fitness crossover or mutation invalidated), a child that is gene for gene a copy of an
@@ -18,7 +18,7 @@ use super::evaluator::{Evaluation, Evaluator, EvolveError};
 use super::genome::{Bounds, Genome};
 use super::logbook::GenerationRecord;
 use super::operators::{better, polynomial_mutation, sbx, tournament};
-use crate::ecs::world_seed;
+use crate::seed::world_seed;
 
 /// The GA's settings; every operator and rate is a field.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

@@ -43,8 +43,8 @@ pub const PAPER_GAMMA: Gamma = Gamma::Ramp { from: 1.0, to: 0.0 };
 pub const SETTLE_AFTER_LAND_S: f64 = 0.25;
 
 /// Farthest a foot may be from the jump's floor at Land + [`SETTLE_AFTER_LAND_S`] to count as
-/// down (above it, or through it), metres.
-pub const FOOT_DOWN_M: f64 = 0.01;
+/// down (above it, or through it), metres ([`crate::humanoid::FOOT_DOWN_M`]).
+pub const FOOT_DOWN_M: f64 = crate::humanoid::FOOT_DOWN_M;
 
 /// The inputs of the jumping knee kick.
 #[derive(Clone, Debug, PartialEq)]

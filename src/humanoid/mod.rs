@@ -34,6 +34,11 @@ use serde::{Deserialize, Serialize};
 
 use crate::skeleton::{Joint, Skeleton};
 
+/// Farthest a foot's lowest point may be from its floor (above it, or through it) to count as
+/// down, metres: the tolerance of a planted foot in the jumps and in the active character's
+/// feet check.
+pub const FOOT_DOWN_M: f64 = 0.01;
+
 /// How a model joint moves relative to its parent.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub enum JointKind {

@@ -5,6 +5,7 @@
 use glam::DVec3;
 
 use super::RenderError;
+use crate::skeleton::Skeleton;
 pub use crate::skeleton::{Side, side_from_name};
 
 /// A stick figure's topology: one point per joint or end site; `parents[i]` is the point it
@@ -34,6 +35,14 @@ pub struct Track<'a> {
 }
 
 impl Figure {
+    /// The stick figure of `skeleton`: its point names and parents (joints, then End Sites).
+    pub fn of(skeleton: &Skeleton) -> Self {
+        Figure {
+            names: skeleton.point_names(),
+            parents: skeleton.point_parents(),
+        }
+    }
+
     /// The side of every point: [`side_from_name`] of its name, or, when that is
     /// [`Side::Centre`], the side of its parent (so an unnamed end site below `LeftHand` is left).
     /// Points may be listed in any order; on a cyclic figure (which [`Figure::validate`]

@@ -11,7 +11,8 @@
 //!   to a chosen frame rate;
 //!
 //! and from numbers [`plot`]: line plots with title, axis labels, legend and labelled event
-//! markers, as PNG or SVG.
+//! markers, as PNG or SVG; from a song's analysis [`music_png`]: waveform, onsets, beats, bars
+//! and bar intensity in one PNG.
 //!
 //! Conventions of every picture: orthographic views ([`View`]) of the figure turned to face +Z
 //! (its facing found from its left and right points, so "front" is its front); the figure's left limbs blue,
@@ -27,6 +28,7 @@ mod canvas;
 mod facing;
 mod figure;
 mod filmstrip;
+mod music;
 mod plot;
 mod pose;
 mod text;
@@ -37,6 +39,7 @@ pub use animation::{MAX_GIF_FPS, MAX_GIF_FRAMES, animation_gif};
 pub use camera::View;
 pub use figure::{Figure, Side, Track, side_from_name};
 pub use filmstrip::{filmstrip_at_png, filmstrip_png, filmstrip_view_png};
+pub use music::music_png;
 pub use plot::{Plot, Series, plot};
 pub use pose::pose_png;
 pub use text::FONT_TTF;

@@ -15,15 +15,12 @@ use serde_json::json;
 use super::fall::{Controller, write_falls};
 use super::primitives::PrimitiveRender;
 use super::{SceneError, write_output};
-use crate::evolve::ga::ELITE_CHECK;
-use crate::evolve::{
-    Evaluator, FallProblem, GaConfig, InProcessFalls, JsonLines, checkpoint, logbook,
-};
+use crate::evolve::{Evaluator, GaConfig, JsonLines, checkpoint, logbook};
 use crate::experiments::evolve_fall::{
-    Checkpointing, EvolutionRun, EvolveConfig, GroupOutcome, advance, best_falls, halted, outcomes,
-    problem_index, start,
+    self, BestFall, Checkpointing, EvolutionRun, EvolveConfig, EvolveFallError, EvolveOutcome,
+    FallProblem, GroupOutcome, InProcessFalls, halted,
 };
-use crate::experiments::fall::{FallConfig, FallResult, simulate_fall};
+use crate::experiments::fall::{FallConfig, FallResult};
 use crate::humanoid::fall21;
 use crate::humanoid::ranges::AgeGroup;
 use crate::render::{Plot, Series, plot};
@@ -51,7 +48,7 @@ fn default_kp_scale() -> f64 {
     1.0
 }
 fn default_step_margin() -> f64 {
-    crate::evolve::fall_fitness::STEP_MARGIN
+    crate::experiments::evolve_fall::STEP_MARGIN
 }
 fn default_every() -> u64 {
     1
@@ -82,13 +79,13 @@ pub struct EvolveFallScene {
     #[serde(default = "default_kp_scale")]
     pub kp_max_scale: f64,
     /// The GA's time step as a fraction of the stability bound of the strongest genome, in
-    /// (0, 1] (default [`crate::evolve::fall_fitness::STEP_MARGIN`], 0.8): larger is faster
+    /// (0, 1] (default [`crate::experiments::evolve_fall::STEP_MARGIN`], 0.8): larger is faster
     /// and less accurate; the elite check (`ga.elite_check_tolerance`) rejects individuals that
     /// win through the step. Ignored when `fall` is given (it keeps its own `dt_s`).
     #[serde(default = "default_step_margin")]
     pub step_margin: f64,
     /// The fall every genome is tried on, per field (default: the paper's push of the age
-    /// group at the GA's step, [`crate::evolve::fall_fitness::stable_step_for`]; its
+    /// group at the GA's step, [`crate::experiments::evolve_fall::stable_step_for`]; its
     /// key pose and k_p are the genes). A fall given here takes the group's ranges and strength
     /// and keeps its own `dt_s` (0.5 ms unless set).
     #[serde(default)]
@@ -261,40 +258,6 @@ impl Progress {
             eprintln!("{text}");
         }
     }
-}
-
-/// The report of one fall (the figures an evolved fall must not win by an artefact): peak
-/// penetration and its link, worst range excursion and its DOF, each DOF's peak PD torque
-/// against its strength limit, the DOFs whose limit bound (and for how long), the pelvis
-/// impact, and the damage re-simulated at half the step.
-fn honesty(config: &FallConfig, result: &FallResult) -> serde_json::Value {
-    let mut half = config.clone();
-    half.dt_s *= 0.5;
-    half.stop_at_rest = false;
-    let half_damage = simulate_fall(&half).map(|r| r.damage);
-    let argmax = |xs: &[f64]| {
-        xs.iter()
-            .copied()
-            .enumerate()
-            .fold((0, 0.0), |b, (i, x)| if x > b.1 { (i, x) } else { b })
-    };
-    let (worst_dof, worst) = argmax(&result.max_limit_excursion_rad);
-    let (deepest_link, _) = argmax(&result.max_penetration_by_link_m);
-    json!({
-        "dt_s": result.dt_s,
-        "damage": result.damage,
-        "max_penetration_m": result.max_penetration_m,
-        "max_penetration_link": result.link_names.get(deepest_link),
-        "worst_range_excursion_deg": worst.to_degrees(),
-        "worst_range_excursion_dof": result.dof_names.get(worst_dof),
-        "peak_torques": result.peak_torques,
-        "damage_at_half_step": half_damage.as_ref().ok(),
-        "half_step_relative_change": half_damage.as_ref().ok().map(|d| (d - result.damage) / result.damage),
-        "half_step_within_10_percent": half_damage.as_ref().ok().map(|d| ((d - result.damage) / result.damage).abs() <= 0.1),
-        "came_to_rest": result.came_to_rest,
-        "torque_saturation": result.torque_saturation,
-        "pelvis": result.pelvis,
-    })
 }
 
 /// The best controller of a run as a `Fall` scene's `controller` block (degrees, N·m/rad),
@@ -495,8 +458,7 @@ pub fn run_evolve(
         Some(dir) => PathBuf::from(dir),
         None => default_checkpoint_dir(scene, out_dir),
     };
-    let started = Instant::now();
-    let mut runs: Vec<EvolutionRun> = match &scene.resume {
+    let resumed: Option<Vec<EvolutionRun>> = match &scene.resume {
         Some(_) => {
             let mut runs: Vec<EvolutionRun> =
                 checkpoint::load(&ck_dir).map_err(|e| invalid(e.to_string()))?;
@@ -510,9 +472,9 @@ pub fn run_evolve(
             for r in &mut runs {
                 r.state.config.generations = config.ga.generations;
             }
-            runs
+            Some(runs)
         }
-        None => start(&config, &mut evaluators).map_err(|e| invalid(e.to_string()))?,
+        None => None,
     };
     let ck = Checkpointing {
         dir: ck_dir.clone(),
@@ -524,19 +486,26 @@ pub fn run_evolve(
         terminal: std::io::stderr().is_terminal(),
         last_plain: 0,
     };
-    advance(
-        &mut runs,
-        &mut evaluators,
-        |r| problem_index(&config, r),
-        Some(&ck),
-        |r| progress.show(r),
-    )
-    .map_err(|e| invalid(e.to_string()))?;
-    checkpoint::save(&ck_dir, &runs).map_err(|e| invalid(e.to_string()))?;
-    let ga_wall = started.elapsed().as_secs_f64();
+    let outcome = evolve_fall::run(&config, resumed, &mut evaluators, Some(&ck), |r| {
+        progress.show(r)
+    })
+    .map_err(|e| match e {
+        EvolveFallError::Fall(e) => SceneError::from(e),
+        e => invalid(e.to_string()),
+    })?;
+    write_evolution(scene, &outcome, out)?;
+    Ok(report(&config, &outcome, &ck_dir))
+}
 
-    // Logbooks.
-    for r in &runs {
+/// Writes the outcome's files into `out`: the logbooks, the fitness curves (Fig. 2), the best
+/// controller of each group, the best falls (BVH, filmstrip, GIF) and their head height
+/// (Fig. 3).
+fn write_evolution(
+    scene: &EvolveFallScene,
+    outcome: &EvolveOutcome,
+    out: &Path,
+) -> Result<(), SceneError> {
+    for r in &outcome.runs {
         let stem = format!(
             "logbook_{}_seed{}",
             r.problem.age_group.name(),
@@ -551,29 +520,21 @@ pub fn run_evolve(
             logbook::to_json_lines(&r.state.logbook).as_bytes(),
         )?;
     }
-    let groups = outcomes(&runs);
-    // Fig. 2: best damage so far per generation, mean over seeds and the best seed, per group.
-    let mut series = Vec::new();
-    for g in &groups {
-        let rs: Vec<&EvolutionRun> = runs
-            .iter()
-            .filter(|r| r.problem.age_group == g.age_group)
-            .collect();
-        let len = rs.iter().map(|r| r.state.logbook.len()).min().unwrap_or(0);
-        series.push(Series {
-            name: format!("{}: mean of {} seeds", g.age_group.name(), rs.len()),
-            points: (0..len)
-                .map(|k| {
-                    let m = rs
-                        .iter()
-                        .map(|r| r.state.logbook[k].best_so_far)
-                        .sum::<f64>()
-                        / rs.len() as f64;
-                    (k as f64, m)
-                })
-                .collect(),
-        });
-    }
+    let series = outcome
+        .groups
+        .iter()
+        .map(|g| {
+            let (seeds, curve) = outcome.mean_best_so_far(g.age_group);
+            Series {
+                name: format!("{}: mean of {seeds} seeds", g.age_group.name()),
+                points: curve
+                    .into_iter()
+                    .enumerate()
+                    .map(|(k, m)| (k as f64, m))
+                    .collect(),
+            }
+        })
+        .collect();
     plot(
         &Plot {
             title: format!("Best damage so far: {}", scene.name),
@@ -584,49 +545,24 @@ pub fn run_evolve(
         },
         &out.join("fitness.png"),
     )?;
-    // The best run of each group (lowest final damage): its falls before and after.
-    let mut falls: Vec<(String, FallConfig, FallResult)> = Vec::new();
-    for g in &groups {
-        let best = runs
-            .iter()
-            .filter(|r| r.problem.age_group == g.age_group)
-            .min_by(|a, b| {
-                let fa = a.state.best.as_ref().map_or(f64::INFINITY, |b| b.1);
-                let fb = b.state.best.as_ref().map_or(f64::INFINITY, |b| b.1);
-                fa.total_cmp(&fb)
-            })
-            .ok_or_else(|| invalid("no run".into()))?;
-        let (before, after) = best_falls(best)?;
-        let name = g.age_group.name();
-        let cfg = |genes: Option<&Vec<f64>>| {
-            genes.map_or_else(|| best.problem.fall.clone(), |g| best.problem.config(g))
-        };
-        falls.push((
-            format!("{name} before"),
-            cfg(best.state.initial_best.as_ref()),
-            before,
-        ));
-        falls.push((
-            format!("{name} evolved"),
-            cfg(best.state.best.as_ref().map(|b| &b.0)),
-            after,
-        ));
+    for b in &outcome.best {
+        let best = &outcome.runs[b.run];
         if let Some((genes, _)) = &best.state.best {
             write_output(
-                &out.join(format!("best_{name}.controller.ron")),
+                &out.join(format!("best_{}.controller.ron", b.age_group.name())),
                 controller_ron(&best.problem, genes)?.as_bytes(),
             )?;
         }
     }
-    let named: Vec<(String, String, &FallResult)> = falls
-        .iter()
-        .map(|(label, _, r)| {
-            let file = format!("fall_{}", label.replace(' ', "_"));
-            (file, format!("{label} (damage {:.0} N)", r.damage), r)
+    let named: Vec<(String, String, &FallResult)> = outcome
+        .best_falls()
+        .map(|f| {
+            let file = format!("fall_{}", f.label.replace(' ', "_"));
+            let label = format!("{} (damage {:.0} N)", f.label, f.result.damage);
+            (file, label, &f.result)
         })
         .collect();
     write_falls(&named, &scene.render, out)?;
-    // Fig. 3: head height of the best falls before and after.
     plot(
         &Plot {
             title: format!(
@@ -635,11 +571,12 @@ pub fn run_evolve(
             ),
             x_label: "time (s)".into(),
             y_label: "head height (m)".into(),
-            series: falls
-                .iter()
-                .map(|(label, _, r)| Series {
-                    name: label.clone(),
-                    points: r
+            series: outcome
+                .best_falls()
+                .map(|f| Series {
+                    name: f.label.clone(),
+                    points: f
+                        .result
                         .frames
                         .iter()
                         .map(|f| (f.time_s, f.head_height_m))
@@ -650,6 +587,35 @@ pub fn run_evolve(
         },
         &out.join("head_height.png"),
     )?;
+    Ok(())
+}
+
+/// The report of one best fall: the figures an evolved fall must not win by an artefact (peak
+/// penetration and its link, worst range excursion and its DOF, each DOF's peak PD torque
+/// against its strength limit, the DOFs whose limit bound and for how long, the pelvis impact,
+/// and the damage re-simulated at half the step).
+fn honesty_json(f: &BestFall) -> serde_json::Value {
+    let (r, h) = (&f.result, &f.honesty);
+    json!({
+        "dt_s": r.dt_s,
+        "damage": r.damage,
+        "max_penetration_m": r.max_penetration_m,
+        "max_penetration_link": h.max_penetration_link,
+        "worst_range_excursion_deg": h.worst_range_excursion_rad.to_degrees(),
+        "worst_range_excursion_dof": h.worst_range_excursion_dof,
+        "peak_torques": r.peak_torques,
+        "damage_at_half_step": h.damage_at_half_step,
+        "half_step_relative_change": h.half_step_relative_change,
+        "half_step_within_10_percent": h.half_step_within_10_percent,
+        "came_to_rest": r.came_to_rest,
+        "torque_saturation": r.torque_saturation,
+        "pelvis": r.pelvis,
+    })
+}
+
+/// The scene's report of `outcome`: counts, statistics per group, the best falls' honesty
+/// figures and the comparison of two groups.
+fn report(config: &EvolveConfig, outcome: &EvolveOutcome, ck_dir: &Path) -> serde_json::Value {
     let group_json = |g: &GroupOutcome| {
         json!({
             "age_group": g.age_group,
@@ -663,39 +629,37 @@ pub fn run_evolve(
     let mut report = json!({
         "generations": config.ga.generations,
         "population": config.ga.population,
-        "evaluations": runs.iter().map(|r| r.state.evaluations).sum::<u64>(),
-        "inherited_fitness": runs.iter().map(|r| r.state.inherited).sum::<u64>(),
-        "failed_evaluations": runs.iter().flat_map(|r| &r.state.failures).filter(|f| !f.2.starts_with(ELITE_CHECK)).count(),
+        "evaluations": outcome.evaluations(),
+        "inherited_fitness": outcome.inherited_fitness(),
+        "failed_evaluations": outcome.failed_evaluations(),
         "elite_check": {
             "tolerance": config.ga.elite_check_tolerance,
-            "evaluations_at_half_step": runs.iter().map(|r| r.state.check_evaluations).sum::<u64>(),
-            "rejected": runs.iter().flat_map(|r| &r.state.failures).filter(|f| f.2.starts_with(ELITE_CHECK)).count(),
+            "evaluations_at_half_step": outcome.check_evaluations(),
+            "rejected": outcome.rejected_elites(),
         },
-        "groups": groups.iter().map(group_json).collect::<Vec<_>>(),
-        "ga_wall_time_s": ga_wall,
+        "groups": outcome.groups.iter().map(group_json).collect::<Vec<_>>(),
+        "ga_wall_time_s": outcome.ga_wall_time_s,
         "checkpoint": ck_dir.display().to_string(),
-        "best_falls": falls.iter().map(|(label, c, r)| json!({"fall": label, "honesty": honesty(c, r)})).collect::<Vec<_>>(),
+        "best_falls": outcome.best_falls().map(|f| json!({"fall": f.label, "honesty": honesty_json(f)})).collect::<Vec<_>>(),
     });
-    if let [a, b] = groups.as_slice() {
-        let spread = a.final_.std + b.final_.std;
-        let spread0 = a.initial.std + b.initial.std;
+    if let Some(c) = &outcome.comparison {
         report["comparison"] = json!({
-            "groups": [a.age_group, b.age_group],
-            "initial_gap": (a.initial.mean - b.initial.mean),
-            "initial_seed_spread": spread0,
-            "initial_within_seed_spread": (a.initial.mean - b.initial.mean).abs() <= spread0,
-            "final_gap": (a.final_.mean - b.final_.mean),
-            "final_seed_spread": spread,
-            "final_gap_exceeds_seed_spread": (a.final_.mean - b.final_.mean).abs() > spread,
+            "groups": c.groups,
+            "initial_gap": c.initial_gap,
+            "initial_seed_spread": c.initial_seed_spread,
+            "initial_within_seed_spread": c.initial_within_seed_spread,
+            "final_gap": c.final_gap,
+            "final_seed_spread": c.final_seed_spread,
+            "final_gap_exceeds_seed_spread": c.final_gap_exceeds_seed_spread,
         });
     }
-    Ok(report)
+    report
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::evolve::fall_fitness::{STEP_MARGIN, stable_step_for, strength_kp_max};
+    use crate::experiments::evolve_fall::{STEP_MARGIN, stable_step_for, strength_kp_max};
 
     fn scene(step_margin: f64, kp_max_scale: f64) -> EvolveFallScene {
         EvolveFallScene {

@@ -17,7 +17,7 @@ use crate::experiments::fall::{FallConfig, FallResult, Ranges};
 use crate::humanoid::fall21;
 use crate::humanoid::ranges::{AgeGroup, RangeTable};
 use crate::humanoid::strength::torque_limits;
-use crate::render::{Plot, Series, Track, plot};
+use crate::render::{Figure, Plot, Series, Track, plot};
 
 /// Time stepping of a simulation (a field left out keeps the paper's value).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -343,7 +343,7 @@ pub(super) fn write_falls(
             crate::bvh::to_string(&clip.to_bvh()).as_bytes(),
         )?;
     }
-    let figures: Vec<_> = clips.iter().map(|c| c.skeleton.figure()).collect();
+    let figures: Vec<_> = clips.iter().map(|c| Figure::of(&c.skeleton)).collect();
     let frames: Vec<_> = clips.iter().map(|c| c.point_frames()).collect();
     let tracks: Vec<Track> = (0..clips.len())
         .map(|k| Track {

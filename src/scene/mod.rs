@@ -18,8 +18,8 @@ mod summary;
 
 pub use active::{ActiveCharacter, ActiveKneeKickScene, run_active_knee_kick};
 pub use dance::{
-    DanceFigures, DanceInputs, DanceRender, DanceScene, DatabaseSource, Pin, SongSource, figures,
-    load_dance, perform, run_dance, scene_pins, song_timed_bvh, validate_dance,
+    DanceInputs, DanceRender, DanceScene, DatabaseSource, Pin, SongSource, load_dance, run_dance,
+    scene_pins, song_timed_bvh, validate_dance,
 };
 pub use evolve::{EvaluatorChoice, EvolveFallScene, run_evolve};
 pub use fall::{Body, Controller, FallScene, Simulation, fall_report, run_fall};

@@ -22,7 +22,7 @@ use crate::humanoid::{Model, ModelClip};
 use crate::primitive::{
     EventConfig, Gamma, JumpEvents, LearnConfig, Learned, Primitive, Trajectory,
 };
-use crate::render::{Plot, Series, Track, plot};
+use crate::render::{Figure, Plot, Series, Track, plot};
 
 /// Pictures of a primitive scene.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -137,7 +137,7 @@ pub(super) fn draw(
     out: &Path,
 ) -> Result<(), SceneError> {
     let clips: Vec<_> = tracks.iter().map(|(_, m)| m.to_clip()).collect();
-    let figures: Vec<_> = clips.iter().map(|c| c.skeleton.figure()).collect();
+    let figures: Vec<_> = clips.iter().map(|c| Figure::of(&c.skeleton)).collect();
     let frames: Vec<_> = clips.iter().map(|c| c.point_frames()).collect();
     let t: Vec<Track> = tracks
         .iter()

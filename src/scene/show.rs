@@ -12,7 +12,7 @@ use crate::analysis::clip_contacts;
 use crate::ecs::{Clock, Recorder, kinematic_schedule, new_world, spawn_clip_character};
 use crate::humanoid::Model;
 use crate::mapping::effector_errors;
-use crate::render::{Plot, Series, Track, plot, pose_png};
+use crate::render::{Figure, Plot, Series, Track, plot, pose_png};
 use crate::skeleton::Clip;
 
 /// What pictures a scene draws.
@@ -103,7 +103,7 @@ pub fn run_show(
         report["effector_error_m"] = json!(effector_errors(source, mapping, m)?);
     }
     let frames = play_through_ecs(&clip);
-    let figure = clip.skeleton.figure();
+    let figure = Figure::of(&clip.skeleton);
     let label = match &scene.model {
         Some(m) => format!("{} on {m}", scene.name),
         None => scene.name.clone(),

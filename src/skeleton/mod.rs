@@ -114,13 +114,4 @@ impl Skeleton {
         let height = hi - lo;
         (height > 0.0 && self.joints[child].offset.length() > 0.25 * height).then_some(0)
     }
-
-    /// A stick figure for [`crate::render`]: point names and parents (joints, then End Sites).
-    #[cfg(feature = "render")]
-    pub fn figure(&self) -> crate::render::Figure {
-        crate::render::Figure {
-            names: self.point_names(),
-            parents: self.point_parents(),
-        }
-    }
 }

@@ -11,7 +11,7 @@ use std::time::Duration;
 use std::time::Instant;
 
 use marionette::choreo::database::Database;
-use marionette::experiments::dance_fill::generated_database;
+use marionette::choreo::generated::generated_database;
 
 /// A fresh folder holding `dance.db.json` (generated clips: `clips` × `bars_per_clip` bars) and
 /// `dance.ron` (a `Dance` scene: a 120 BPM synthesized song of `song_bars` bars, no pins);

@@ -7,8 +7,8 @@ use std::io::{BufReader, BufWriter};
 
 use anyhow::{Result, bail};
 
-use marionette::evolve::FallProblem;
 use marionette::evolve::evaluator::serve;
+use marionette::experiments::evolve_fall::FallProblem;
 
 // The command's arguments (its help text is on `Command::Eval`).
 #[derive(clap::Args)]
@@ -25,8 +25,7 @@ pub fn eval(args: Args) -> Result<()> {
     }
     let input = BufReader::new(std::io::stdin().lock());
     let output = BufWriter::new(std::io::stdout().lock());
-    serve(input, output, |problem| {
-        let p: FallProblem = serde_json::from_value(problem).map_err(|e| e.to_string())?;
+    serve(input, output, |p: FallProblem| {
         p.bounds().map_err(|e| e.to_string())?;
         Ok(move |genomes: &[Vec<f64>], refine: u32| p.evaluate(genomes, refine))
     })?;

@@ -7,8 +7,8 @@ use anyhow::{Context, Result};
 use serde::Serialize;
 
 use marionette::choreo::music::decode::decode_file;
-use marionette::choreo::music::picture::music_png;
 use marionette::choreo::music::{Bar, MusicParams, analyze};
+use marionette::render::music_png;
 
 // The command's arguments (its help text is on `Command::Music`).
 #[derive(clap::Args)]

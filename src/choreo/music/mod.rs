@@ -14,7 +14,6 @@
 //!   the project's own demo song;
 //! - [`wav`]: a buffer written as a 16-bit PCM WAV file;
 //! - `decode` (feature `audio`): WAV, OGG/Vorbis and MP3 to mono samples with symphonia;
-//! - `picture` (feature `render`): waveform, onsets, beats, bars and bar intensity in one PNG.
 //!
 //! [`analyze`] runs them in order.
 
@@ -25,8 +24,6 @@ pub mod decode;
 pub mod eval;
 pub mod intensity;
 pub mod onsets;
-#[cfg(feature = "render")]
-pub mod picture;
 pub mod synth;
 pub mod tempo;
 pub mod wav;

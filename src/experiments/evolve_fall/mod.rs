@@ -1,16 +1,27 @@
 //! The falling paper's evolution (SPEC §3, paper §5–6) as an experiment: for each age group and
 //! each seed, a GA evolves the key pose θ_d and stiffness k_p of every DOF to minimise the damage
 //! of the pushed fall; the runs advance generation by generation together, checkpointing every K
-//! generations, and report per group the initial and final damage over seeds.
+//! generations, and report per group the initial and final damage over seeds. The problem a
+//! genome is tried on ([`FallProblem`]) and its in-process evaluator ([`InProcessFalls`]) live
+//! here, above the GA kernel ([`crate::evolve`]) that knows no fall.
+
+mod in_process;
+mod outcome;
+mod problem;
+
+pub use in_process::InProcessFalls;
+pub use outcome::{BestFall, Comparison, EvolveFallError, EvolveOutcome, GroupBest, Honesty, run};
+pub use problem::{
+    FallProblem, FallStarts, KP_SATURATION_RAD, ProblemError, STEP_MARGIN, STEP_QUANTA_PER_S,
+    SettleCache, stable_step_for, strength_kp_max,
+};
 
 use std::path::PathBuf;
 
 use serde::{Deserialize, Serialize};
 
 use crate::evolve::ga::{Brood, ELITE_CHECK_REFINE};
-use crate::evolve::{
-    Evaluation, Evaluator, EvolveError, FallProblem, GaConfig, GaState, Genome, checkpoint,
-};
+use crate::evolve::{Evaluation, Evaluator, EvolveError, GaConfig, GaState, Genome, checkpoint};
 use crate::experiments::fall::{FallConfig, FallResult, SimError, simulate_fall};
 use crate::humanoid::ranges::AgeGroup;
 
@@ -153,7 +164,7 @@ pub fn start(
 }
 
 /// Advances every run to its last generation, one generation at a time for all, writing a
-/// checkpoint every `checkpointing.every` generations and at the end, and calling `progress`
+/// checkpoint every `checkpointing.every` generations and once at the end, and calling `progress`
 /// after each generation. `evaluator_of(run)` names the index of the run's evaluator. The
 /// broods of all runs sharing an evaluator are evaluated in one batch (and so are their elite
 /// checks), so the cores stay busy past the end of any one run's generation; every run gets
@@ -184,11 +195,14 @@ pub fn advance(
         halted(runs)
     };
     stop(runs)?;
+    // Whether the checkpoint holds the runs as they stand.
+    let mut saved = false;
     loop {
         let active: Vec<usize> = (0..runs.len()).filter(|&i| !runs[i].state.done()).collect();
         if active.is_empty() {
             break;
         }
+        saved = false;
         let broods: Vec<(usize, Brood)> =
             active.iter().map(|&i| (i, runs[i].state.breed())).collect();
         let generation = broods.iter().map(|b| b.1.generation).max().unwrap_or(0);
@@ -258,7 +272,11 @@ pub fn advance(
             && (g % c.every.max(1) == 0 || all_done)
         {
             checkpoint::save(&c.dir, runs)?;
+            saved = true;
         }
+    }
+    if !saved && let Some(c) = checkpointing {
+        checkpoint::save(&c.dir, runs)?;
     }
     Ok(())
 }
@@ -413,17 +431,6 @@ pub fn outcomes(runs: &[EvolutionRun]) -> Vec<GroupOutcome> {
             }
         })
         .collect()
-}
-
-/// The fall of a run's best genome of generation 0 and of the whole run (the paper's "before"
-/// and "after"), simulated to the end with frames.
-pub fn best_falls(run: &EvolutionRun) -> Result<(FallResult, FallResult), SimError> {
-    let config = |g: Option<&Vec<f64>>| {
-        g.map_or_else(|| run.problem.fall.clone(), |g| run.problem.config(g))
-    };
-    let before = config(run.state.initial_best.as_ref());
-    let after = config(run.state.best.as_ref().map(|b| &b.0));
-    Ok((replay(&before)?, replay(&after)?))
 }
 
 /// A fall simulated to its full duration (not stopped at rest), for pictures.

@@ -13,8 +13,8 @@ use std::sync::atomic::AtomicBool;
 
 use serde::{Deserialize, Serialize};
 
-use super::evaluator::Evaluation;
-use super::genome::{Bounds, Genome};
+use crate::evolve::genome::BoundsError;
+use crate::evolve::{Bounds, Evaluation, Genome};
 use crate::experiments::fall::ecs::{ReactionStart, run_parallel_until};
 use crate::experiments::fall::{FallConfig, Ranges, SettledStart, SimError};
 use crate::humanoid::fall21;
@@ -105,7 +105,7 @@ pub enum ProblemError {
     Fall(#[from] SimError),
     /// The bounds are not a box.
     #[error(transparent)]
-    Bounds(#[from] super::genome::BoundsError),
+    Bounds(#[from] BoundsError),
     /// `kp_max` does not have one value per DOF.
     #[error("kp_max needs {expected} values (one per fall21 DOF), found {found}")]
     KpMax {

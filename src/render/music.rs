@@ -1,4 +1,4 @@
-//! The picture of a song's analysis (feature `render`): three panels over one time axis — the
+//! The picture of a song's analysis ([`crate::choreo::music`]): three panels over one time axis — the
 //! waveform with the bars (numbered) and beats, the onset envelope the beats were placed on with
 //! the beats, and each bar's intensity (RMS in dB) as a step over the bar.
 
@@ -6,8 +6,8 @@ use std::path::Path;
 
 use plotters::prelude::*;
 
-use super::MusicAnalysis;
-use crate::render::RenderError;
+use super::RenderError;
+use crate::choreo::music::MusicAnalysis;
 
 /// Size of the picture (pixels).
 const SIZE: (u32, u32) = (1400, 960);
@@ -58,7 +58,7 @@ pub fn music_png(
     plotters::style::register_font(
         "sans-serif",
         plotters::style::FontStyle::Normal,
-        crate::render::FONT_TTF,
+        super::FONT_TTF,
     )
     .map_err(|_| RenderError::Font("plotters rejected the bundled DejaVu Sans".into()))?;
     let (w, h) = SIZE;
