@@ -43,7 +43,8 @@ fn check(what: &str, r: &serde_json::Value, paper: &serde_json::Value, folder: &
     eprintln!(
         "{what}: below 1 cm {:.4} of frames (deepest {:.4} m), skating {:.3} vs sources {:.3} \
          m/s, beat alignment {:.3} vs sources {:.3}, intensity Spearman {:.3} (paper's fill \
-         {:.3}), seam jerk {seam:.0} vs paper's fill {seam_paper:.0} rad/s³",
+         {:.3}), seam jerk {seam:.0} vs paper's fill {seam_paper:.0} rad/s³, feet in contact \
+         within ±1 cm {:.3} vs sources {:.3}",
         f(&pen["frames_below_1cm_fraction"]),
         f(&pen["deepest_m"]),
         f(&m["foot_skating_m_s"]),
@@ -52,6 +53,8 @@ fn check(what: &str, r: &serde_json::Value, paper: &serde_json::Value, folder: &
         f(&src["beat_alignment_score"]),
         f(&m["intensity_spearman"]),
         f(&paper["metrics"]["intensity_spearman"]),
+        f(&pen["contact_within_1cm_fraction"]),
+        f(&src["contact_within_1cm_fraction"]),
     );
     assert!(
         f(&pen["frames_below_1cm_fraction"]) <= 0.01,

@@ -127,6 +127,9 @@ pub struct FootPenetration {
     pub contact_sole_max_m: f64,
     /// Frames × feet in contact.
     pub contact_foot_frames: usize,
+    /// Fraction of the frames × feet in contact whose sole height is within ±1 cm
+    /// (|[`PENETRATION_M`]|) of the floor (1 without contact).
+    pub contact_within_1cm_fraction: f64,
 }
 
 /// The foot penetration of a clip against the floor y = 0 (module docs); zeros for a clip
@@ -144,7 +147,7 @@ pub fn foot_penetration(clip: &ModelClip) -> FootPenetration {
         deepest_m: f64::INFINITY,
         ..FootPenetration::default()
     };
-    let mut below = 0usize;
+    let (mut below, mut within) = (0usize, 0usize);
     for (f, (left, right)) in feet[0].iter().zip(&feet[1]).enumerate().take(n) {
         let mut lowest = f64::INFINITY;
         for (side, spans) in [&contacts.left, &contacts.right].into_iter().enumerate() {
@@ -162,6 +165,9 @@ pub fn foot_penetration(clip: &ModelClip) -> FootPenetration {
                     .fold(f64::INFINITY, f64::min);
                 out.contact_sole_max_m = out.contact_sole_max_m.max(sole.abs());
                 out.contact_foot_frames += 1;
+                if sole.abs() <= -PENETRATION_M {
+                    within += 1;
+                }
             }
         }
         out.deepest_m = out.deepest_m.min(lowest);
@@ -170,6 +176,11 @@ pub fn foot_penetration(clip: &ModelClip) -> FootPenetration {
         }
     }
     out.frames_below_fraction = below as f64 / n as f64;
+    out.contact_within_1cm_fraction = if out.contact_foot_frames == 0 {
+        1.0
+    } else {
+        within as f64 / out.contact_foot_frames as f64
+    };
     out
 }
 
@@ -207,6 +218,10 @@ pub struct SourceMetrics {
     pub foot_skating_m_s: f64,
     /// Mean over the segments of their beat alignment score against their own counts.
     pub beat_alignment_score: f64,
+    /// Fraction of every segment's frames × feet in contact whose sole is within ±1 cm of the
+    /// floor ([`FootPenetration::contact_within_1cm_fraction`], as assembled, feet not
+    /// planted).
+    pub contact_within_1cm_fraction: f64,
     /// Segments measured.
     pub segments: usize,
 }
@@ -221,6 +236,7 @@ pub fn source_metrics(db: &Database, segments: &[usize], fps: f64) -> SourceMetr
         seam: super::dance::Seam::Spline,
     };
     let (mut skate_sum, mut skate_n, mut bas_sum, mut count) = (0.0, 0.0, 0.0, 0usize);
+    let (mut within, mut contact_frames) = (0.0, 0usize);
     for &s in segments {
         let Some(seg) = db.segments.get(s) else {
             continue;
@@ -239,6 +255,9 @@ pub fn source_metrics(db: &Database, segments: &[usize], fps: f64) -> SourceMetr
         let samples = contact * alone.clip.frame_count() as f64;
         skate_sum += skating * samples;
         skate_n += samples;
+        let pen = foot_penetration(&alone.clip);
+        within += pen.contact_within_1cm_fraction * pen.contact_foot_frames as f64;
+        contact_frames += pen.contact_foot_frames;
         // Its own counts: four to the bar, the first at its start.
         let counts = super::segments::Beat {
             tempo_bpm: 60.0 * BEATS_PER_BAR as f64 / len,
@@ -258,6 +277,11 @@ pub fn source_metrics(db: &Database, segments: &[usize], fps: f64) -> SourceMetr
             bas_sum / count as f64
         } else {
             0.0
+        },
+        contact_within_1cm_fraction: if contact_frames > 0 {
+            within / contact_frames as f64
+        } else {
+            1.0
         },
         segments: count,
     }
@@ -517,6 +541,23 @@ mod tests {
             assert!((glide - 0.2).abs() < 1e-9, "pelvis at {y} m: {glide} m/s");
             assert!((contact - 1.0).abs() < 1e-12, "{contact}");
         }
+    }
+
+    #[test]
+    fn feet_in_contact_count_as_on_the_floor_within_a_centimetre_only() {
+        // The pelvis height at which the soles stand on y = 0.
+        let standing = -foot_penetration(&gliding(0.0, 0.0)).deepest_m;
+        let on = foot_penetration(&gliding(standing, 0.0));
+        assert!(
+            on.contact_foot_frames > 0 && on.deepest_m.abs() < 1e-9,
+            "{on:?}"
+        );
+        assert_eq!(on.contact_within_1cm_fraction, 1.0);
+        // 2 cm up: still in contact (within the analysis's 3 cm), not within 1 cm.
+        let hovering = foot_penetration(&gliding(standing + 0.02, 0.0));
+        assert_eq!(hovering.contact_foot_frames, on.contact_foot_frames);
+        assert_eq!(hovering.contact_within_1cm_fraction, 0.0);
+        assert!((hovering.contact_sole_max_m - 0.02).abs() < 1e-9);
     }
 
     #[test]
