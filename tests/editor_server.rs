@@ -644,6 +644,78 @@ fn candidates_carry_the_clip_name_and_their_fit_to_the_bar() {
     ed.stop();
 }
 
+/// Issue 36: a candidate plays between its bar's current neighbours. The seams name the
+/// neighbours the fill danced, and danced at the fill's own segments they cost, summed over
+/// the song, the fill's total transition cost; the first and last bars have one seam each.
+#[test]
+fn a_candidate_plays_between_its_neighbours_with_both_seams_costed() {
+    let (ed, _) = start("context");
+    let a = ed.addr();
+    post(a, "/api/generate", "{}");
+    let state = get(a, "/api/state");
+    let total = state["fill"]["total_cost"].as_f64().unwrap();
+    let bars = get(a, "/api/bars")["bars"].as_array().unwrap().clone();
+    let n = bars.len();
+    let filled: Vec<u64> = bars.iter().map(|b| b["filled"].as_u64().unwrap()).collect();
+    let mut sum = 0.0;
+    for k in 0..n {
+        let c = get(a, &format!("/api/in-context?bar={k}&segment={}", filled[k]));
+        let (start, end, fps) = (
+            c["start_s"].as_f64().unwrap(),
+            c["end_s"].as_f64().unwrap(),
+            c["fps"].as_f64().unwrap(),
+        );
+        let lo = k.saturating_sub(1);
+        assert!((start - bars[lo]["start_s"].as_f64().unwrap()).abs() < 1e-9);
+        let frames = c["frames"].as_array().unwrap().len() as f64;
+        assert!(
+            (frames - (end - start) * fps).abs() <= 2.0,
+            "bar {k}: {frames} frames for {:.3} s at {fps} fps",
+            end - start
+        );
+        if k == 0 {
+            assert!(c["before"].is_null());
+        } else {
+            assert_eq!(c["before"]["from"].as_u64(), Some(filled[k - 1]));
+            assert_eq!(c["before"]["to"].as_u64(), Some(filled[k]));
+            sum += c["before"]["cost"].as_f64().unwrap();
+        }
+        if k + 1 == n {
+            assert!(c["after"].is_null());
+        } else {
+            assert_eq!(c["after"]["from"].as_u64(), Some(filled[k]));
+            assert_eq!(c["after"]["to"].as_u64(), Some(filled[k + 1]));
+        }
+    }
+    assert!(
+        (sum - total).abs() <= 1e-5 * total,
+        "seams sum to {sum}, the fill costs {total}"
+    );
+    // Another segment: the seams join it to the same neighbours; a pin next door is used.
+    let other = (filled[2] + 1) % state["segments"].as_u64().unwrap();
+    post(
+        a,
+        "/api/set",
+        &format!(r#"{{"bar": 1, "segment": {other}}}"#),
+    );
+    let c = get(a, &format!("/api/in-context?bar=2&segment={other}"));
+    assert_eq!(c["before"]["from"].as_u64(), Some(other));
+    assert_eq!(c["before"]["to"].as_u64(), Some(other));
+    assert_eq!(c["after"]["to"].as_u64(), Some(filled[3]));
+    let s = c["before"]["s"].as_f64().unwrap();
+    let cost = c["before"]["cost"].as_f64().unwrap();
+    assert!(
+        cost > 0.0 && (s <= 0.0 || s * cost <= 1.0 + 1e-9),
+        "S {s}, C {cost}"
+    );
+    assert_eq!(
+        refused(a, "GET", "/api/in-context?bar=2&segment=99999", None).0,
+        400
+    );
+    assert_eq!(refused(a, "GET", "/api/in-context?bar=2", None).0, 400);
+    ed.stop();
+}
+
 /// Issue 36: `marionette edit` stops on SIGINT and on SIGTERM by itself and exits 0, the Save
 /// sent 200 ms before the signal answered and its scene file whole, with the pin. (That the
 /// server waits for an action still running at the signal is by construction,

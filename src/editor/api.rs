@@ -6,6 +6,7 @@
 //! | `GET /api/state` | | pins, undo/redo depth, last fill, tempo, song length, figure links |
 //! | `GET /api/bars` | | every bar (span, dB, normalised intensity, pin, filled segment, whether that fill is stale), beats |
 //! | `GET /api/candidates` | `?bar=K` | bar K's round, τ, segments left, its six candidates' frames and its liked segments' frames |
+//! | `GET /api/in-context` | `?bar=K&segment=S` | S danced in bar K between K's current neighbours (their pins, else their fill) as the dance would be: frames from bar K − 1 to K + 1, and both seams' S and C ([`Session::in_context`]) |
 //! | `GET /api/dance` | | the whole dance of the current pins at the scene's fps (generates first), and its figures |
 //! | `GET /api/audio.wav` | `?bar=K` (optional) | bar K's span of the song (without `bar`, the whole song) as mono 16-bit WAV at most 22.05 kHz ([`crate::editor::session::Song::span`]) |
 //! | `POST /api/search` | `{"bar": K}` | the next relevance-feedback round; as `candidates` |
@@ -137,8 +138,9 @@ pub fn handle(s: &mut Session, method: &str, path: &str, query: &str, b: &[u8]) 
     }
 }
 
-const GETS: [&str; 5] = [
+const GETS: [&str; 6] = [
     "/api/state",
+    "/api/in-context",
     "/api/bars",
     "/api/candidates",
     "/api/dance",
@@ -182,6 +184,11 @@ fn route(s: &mut Session, method: &str, path: &str, query: &str, b: &[u8]) -> Re
         "/api/candidates" => {
             let bar = query_index(query, "bar")?;
             candidates(s, bar)
+        }
+        "/api/in-context" => {
+            let bar = query_index(query, "bar")?;
+            let segment = query_index(query, "segment")?;
+            ok(json!(s.in_context(bar, segment).map_err(fail)?))
         }
         "/api/dance" => {
             let (frames, start_s, figures) = s.dance_with_figures().map_err(fail)?;

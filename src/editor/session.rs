@@ -89,6 +89,44 @@ pub struct Session {
     motion: Vec<f64>,
 }
 
+/// A seam of [`InContext`]: the connection of segment `from` into segment `to`.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct Seam {
+    /// The segment before the seam.
+    pub from: usize,
+    /// The segment after it.
+    pub to: usize,
+    /// The connection score S = S_pose + S_move (eq. 8; higher joins better).
+    pub s: f64,
+    /// The transition cost C = 1/S (eq. 9).
+    pub cost: f64,
+}
+
+/// A candidate danced between its neighbours ([`Session::in_context`]).
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct InContext {
+    /// The bar.
+    pub bar: usize,
+    /// The segment tried in it.
+    pub segment: usize,
+    /// Frames per second of `frames`.
+    pub fps: f64,
+    /// Song time of frame 0 (the neighbour before's bar, or the bar), s.
+    pub start_s: f64,
+    /// Song time at which the bar starts, s.
+    pub bar_start_s: f64,
+    /// Song time at which the bar ends, s.
+    pub bar_end_s: f64,
+    /// Song time at which the last bar shown ends, s.
+    pub end_s: f64,
+    /// The seam from the bar before (none for the song's first bar).
+    pub before: Option<Seam>,
+    /// The seam into the bar after (none for the song's last bar).
+    pub after: Option<Seam>,
+    /// The stick-figure frames of the bars shown.
+    pub frames: Frames,
+}
+
 /// Stick-figure frames: per frame, every drawable point (joints then end sites), metres rounded
 /// to the millimetre (what a stick view draws; the answers stay short: "0.913", not
 /// "0.91283154").
@@ -289,6 +327,75 @@ impl Session {
         )
         .map_err(|e| EditorError::DanceScene(e.into()))?;
         Ok(d)
+    }
+
+    /// Segment `segment` danced in bar `bar` between its current neighbours ([`InContext`]):
+    /// the bars before and after take their pin, or else their segment in the last fill (made
+    /// now if there is none, without keeping it), and the three bars (two at the song's ends)
+    /// are performed as the whole dance is ([`perform`]: warped onto the song's beats, seams,
+    /// feet on the floor), so the seams play as they would be danced.
+    pub fn in_context(&self, bar: usize, segment: usize) -> Result<InContext, EditorError> {
+        let e = &self.edit;
+        e.bar_search(bar)?;
+        let db = e.database();
+        if segment >= db.segments.len() {
+            return Err(crate::choreo::edit::EditError::NoSuchSegment {
+                segment,
+                segments: db.segments.len(),
+            }
+            .into());
+        }
+        let bars = e.bars();
+        let (lo, hi) = (bar.saturating_sub(1), (bar + 1).min(bars.len() - 1));
+        let made;
+        let fill = match &self.fill {
+            Some(f) => f,
+            None => {
+                made = e.generate()?;
+                &made
+            }
+        };
+        let segments: Vec<usize> = (lo..=hi)
+            .map(|k| match k == bar {
+                true => segment,
+                false => e.pins().get(&k).copied().unwrap_or(fill.segments[k]),
+            })
+            .collect();
+        let scene = self.file.scene();
+        let (d, _) = perform(
+            db,
+            &segments,
+            &bars[lo..=hi],
+            &self.song.beats_s,
+            &scene.dance,
+            &scene.feet,
+        )
+        .map_err(|e| EditorError::DanceScene(e.into()))?;
+        let link = |a: usize, b: usize| {
+            let c = crate::choreo::transition::connection(
+                &db.segments[a],
+                &db.segments[b],
+                &e.state().fill.transition,
+            );
+            Seam {
+                from: a,
+                to: b,
+                s: c.s,
+                cost: c.cost,
+            }
+        };
+        Ok(InContext {
+            bar,
+            segment,
+            fps: self.fps(),
+            start_s: d.start_s,
+            bar_start_s: bars[bar].start_s,
+            bar_end_s: bars[bar].end_s,
+            end_s: bars[hi].end_s,
+            before: (lo < bar).then(|| link(segments[0], segment)),
+            after: (hi > bar).then(|| link(segment, segments[segments.len() - 1])),
+            frames: points(&d.clip, DVec3::ZERO),
+        })
     }
 
     /// The whole dance of the current pins as the `motion.bvh` that `marionette run` writes

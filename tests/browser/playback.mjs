@@ -8,7 +8,10 @@
 // Generate; the bars whose segment is danced twice are marked; a drag scrubs; the song arrives
 // bar by bar.
 // MODE "long" (a song of 200 bars, device scale factor 2): the timeline's bar numbers do not
-// overlap; Play from bar 150 sounds within 200 ms of the click.
+// overlap; Play from bar 150 sounds within 200 ms of the click; the wheel zooms (the numbers
+// thin less, a click picks the bar under the pointer) and shift+wheel scrolls.
+// MODE "actions" also plays a candidate in context (between its bar's neighbours, its seams
+// scored).
 // Prints one JSON line of what it measured; exits non-zero on any failed check.
 import { launch } from './launch.mjs';
 import { join } from 'node:path';
@@ -62,9 +65,44 @@ try {
     await page.waitForTimeout(500);
     const t = await songTime();
     if (!(t >= bars[150].start_s && t < bars[152].end_s)) fail(`playing from bar 150 (${bars[150].start_s} s) is at ${t} s`);
+    // Zoom: the wheel over the timeline narrows the span shown around the pointer; the bar
+    // numbers thin less and still do not overlap; a click picks the bar under the pointer;
+    // shift+wheel scrolls later.
+    await page.click('#play'); // pause
+    const cx = box.x + box.w / 2, cy = box.y + box.h / 2;
+    await page.mouse.move(cx, cy);
+    const whole = bars[bars.length - 1].end_s - bars[0].start_s;
+    const shown = async () => { const [a, b] = await page.evaluate(() => window.editor.timeline.visible()); return b - a; };
+    for (let i = 0; i < 20 && (await shown()) > 0.08 * whole; i++) { await page.mouse.wheel(0, -200); await page.waitForTimeout(50); }
+    const [z0, z1] = await page.evaluate(() => window.editor.timeline.visible());
+    if (!(z1 - z0 < 0.2 * whole)) fail(`zoomed in, the timeline still shows ${z0}–${z1} s of ${whole} s`);
+    const zl = await page.evaluate(() => window.editor.timeline.labels);
+    if (zl.length < 2) fail(`zoomed in, ${zl.length} bar numbers`);
+    const zStep = Number(zl[1].text) - Number(zl[0].text);
+    const wholeStep = Number(labels[1].text) - Number(labels[0].text);
+    if (!(zStep < wholeStep)) fail(`zoomed in, bar numbers every ${zStep} bars, as at the whole song (${wholeStep})`);
+    for (let i = 1; i < zl.length; i++) {
+      if (zl[i].x0 < zl[i - 1].x1 + 2) fail(`zoomed, bar numbers ${zl[i - 1].text} and ${zl[i].text} overlap`);
+    }
+    const under = await page.evaluate(([x]) => {
+      const tl = window.editor.timeline, c = tl.canvas;
+      return tl.barAt((x - c.getBoundingClientRect().x) * (c.width / c.clientWidth));
+    }, [cx]);
+    await page.mouse.click(cx, cy);
+    await page.waitForFunction((k) => document.getElementById('bar-title').textContent === `Bar ${k}`, under, { timeout: 20000 })
+      .catch(async () => fail(`zoomed, a click on bar ${under} showed "${await page.textContent('#bar-title')}"`));
+    const ub = bars[under];
+    if (!(ub.end_s > z0 && ub.start_s < z1)) fail(`the bar clicked (${under}) is outside the span shown`);
+    await page.screenshot({ path: join(shots, 'editor_timeline_zoomed.png'), clip: { x: 0, y: 0, width: 1280, height: 240 } });
+    await page.keyboard.down('Shift');
+    await page.mouse.wheel(0, 400);
+    await page.keyboard.up('Shift');
+    await page.waitForTimeout(100);
+    const [s0, s1] = await page.evaluate(() => window.editor.timeline.visible());
+    if (!(s0 > z0 && Math.abs((s1 - s0) - (z1 - z0)) < 1e-6)) fail(`shift+wheel moved the span ${z0}–${z1} s to ${s0}–${s1} s`);
     checkErrors('on the long song');
     const songS = bars[bars.length - 1].end_s;
-    console.log(JSON.stringify({ labels: labels.length, first_label_gap_px: labels[1].x0 - labels[0].x1, first_sound_ms: firstSoundMs, audio_bytes: audio.reduce((a, b) => a + b, 0), song_s: songS }));
+    console.log(JSON.stringify({ labels: labels.length, zoomed_label_step: zStep, whole_label_step: wholeStep, first_label_gap_px: labels[1].x0 - labels[0].x1, first_sound_ms: firstSoundMs, audio_bytes: audio.reduce((a, b) => a + b, 0), song_s: songS }));
     process.exit(0);
   }
 
@@ -168,6 +206,32 @@ try {
   if (!(scrubbed >= bars[6].start_s && scrubbed < bars[6].end_s)) fail(`the scrub ended at ${scrubbed} s, not in bar 6`);
   if (await playing()) fail('a scrub while paused started playback');
   if ((await page.textContent('#bar-title')) !== 'Bar 9') fail('a scrub picked a bar');
+
+  // A candidate of bar 1 in context: it plays from bar 0 through bar 2, both seams scored.
+  await clickBar(1);
+  await page.waitForFunction(() => document.getElementById('bar-title').textContent === 'Bar 1', null, { timeout: 10000 });
+  await page.waitForSelector('#candidates .cand button.context');
+  const still = await candidateShot();
+  await (await page.$$('#candidates .cand button.context'))[0].click();
+  await page.waitForSelector('#candidates .cand[data-context="1"]', { timeout: 20000 }).catch(() => fail('no candidate in context'));
+  const seamText = await page.$eval('#candidates .cand[data-context="1"] .seams', (e) => e.textContent);
+  if (!/^from bar 0 S -?[0-9.]+ · into bar 2 S -?[0-9.]+ · C [0-9.]+$/.test(seamText)) fail(`the seams in context read "${seamText}"`);
+  const c0 = await candidateShot();
+  await page.waitForTimeout(400);
+  const c1 = await candidateShot();
+  if (c0 === c1 || c0 === still) fail('the candidate in context does not move');
+  // Over its loop the card says which bar it is dancing: 0, 1 (this segment), 2.
+  const seen = new Set();
+  const until = Date.now() + 3000 * (bars[2].end_s - bars[0].start_s);
+  while (seen.size < 3 && Date.now() < until) {
+    seen.add(await page.$eval('#candidates .cand[data-context="1"] .where', (e) => e.textContent));
+    await page.waitForTimeout(120);
+  }
+  const wantSeen = ['▶ bar 0 (neighbour)', '▶ bar 1 (this segment)', '▶ bar 2 (neighbour)'];
+  if (!wantSeen.every((w) => seen.has(w))) fail(`in context the card showed ${[...seen]}`);
+  await page.screenshot({ path: join(shots, 'editor_in_context.png'), clip: { x: 0, y: 200, width: 1280, height: 560 } });
+  await (await page.$$('#candidates .cand button.context'))[0].click();
+  await page.waitForFunction(() => !document.querySelector('#candidates .cand[data-context]'), null, { timeout: 5000 }).catch(() => fail('In context did not turn off'));
 
   await clickBar(0);
   await page.waitForFunction(() => document.getElementById('bar-title').textContent === 'Bar 0', null, { timeout: 10000 });

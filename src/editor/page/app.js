@@ -270,6 +270,7 @@ async function selectBar(k) {
   else transport.pos = bars[k].start_s;
   // The bar's sound, ready for Play (88 kB a 2 s bar).
   if (audio.ctx) barBuffer(k);
+  timeline.reveal(bars[k].start_s);
   timeline.draw();
   try {
     let c = await api('GET', `/api/candidates?bar=${k}`);
@@ -311,6 +312,19 @@ function fitWords(c, m) {
     `The bar is louder than ${Math.round(100 * c.loudness_rank)} % of the song's bars; this segment moves more ` +
     `than ${Math.round(100 * m.intensity_rank)} % of the database's segments. Fit (relevance) = 1 − |difference| = ` +
     `${m.relevance.toFixed(2)}: 1 when the segment is as intense among the segments as the bar is loud among the bars.` };
+}
+
+// The seams of a segment in context (`GET /api/in-context`), in words.
+function seamWords(x) {
+  const one = (seam, which) => (seam ? `${which} S ${seam.s.toFixed(2)}` : null);
+  const parts = [one(x.before, `from bar ${x.bar - 1}`), one(x.after, `into bar ${x.bar + 1}`)].filter(Boolean);
+  const cost = [x.before, x.after].filter(Boolean).reduce((a, seam) => a + seam.cost, 0);
+  return {
+    short: parts.length ? `${parts.join(' · ')} · C ${cost.toFixed(2)}` : 'no neighbouring bar',
+    long: 'S: how well two bars join, the posture and movement similarity of the seam (eq. 8; higher joins ' +
+      'better). C = 1/S is the transition cost the fill minimises; C here is the sum over the seams shown. ' +
+      'Compare a candidate\'s C with the others\' to see which one this bar\'s neighbours take best.',
+  };
 }
 
 function showCandidates(c) {
@@ -373,11 +387,39 @@ function fillCards(box, c, list, pin) {
       await refresh();
       status(`bar ${c.bar} pinned to #${m.segment}`);
     });
-    row.append(like, set);
-    card.append(canvas, name, info, row);
+    const seams = document.createElement('div');
+    seams.className = 'info seams';
+    const where = document.createElement('div');
+    where.className = 'info where';
+    const context = document.createElement('button');
+    context.className = 'context';
+    context.textContent = 'In context';
+    context.title = 'Play this segment between the bars before and after it as they are now (their pins, ' +
+      'else the last fill), joined as the dance would join them; the seams\' connection scores are shown';
+    row.append(like, context, set);
+    card.append(canvas, name, info, seams, where, row);
     box.append(card);
     const v = new StickView(canvas, figure, cardCam);
     v.frames = m.frames;
+    v.context = null;
+    v.whereEl = where;
+    context.onclick = () => act(async () => {
+      if (v.context) {
+        v.context = null;
+        context.classList.remove('on');
+        seams.textContent = '';
+        where.textContent = '';
+        delete card.dataset.context;
+        return;
+      }
+      const x = await api('GET', `/api/in-context?bar=${c.bar}&segment=${m.segment}`);
+      v.context = x;
+      context.classList.add('on');
+      card.dataset.context = '1';
+      const words = seamWords(x);
+      seams.textContent = words.short;
+      seams.title = words.long;
+    });
     return v;
   });
 }
@@ -411,6 +453,18 @@ function drawFrame() {
     }
     u = Math.min(1, Math.max(0, u));
     for (const v of views) {
+      if (v.context) {
+        // In context: the bars before, this one and after, looped on the page's clock.
+        const x = v.context, len = x.end_s - x.start_s, n = x.frames.length;
+        const at = (performance.now() / 1000) % len;
+        v.contextTime = x.start_s + at;
+        const t = x.start_s + at;
+        const k = t < x.bar_start_s ? x.bar - 1 : (t < x.bar_end_s ? x.bar : x.bar + 1);
+        const where = k === x.bar ? `▶ bar ${k} (this segment)` : `▶ bar ${k} (neighbour)`;
+        if (v.whereEl && v.whereEl.textContent !== where) v.whereEl.textContent = where;
+        v.draw(x.frames[Math.min(n - 1, Math.floor(at * x.fps))], true);
+        continue;
+      }
       const n = v.frames.length;
       v.draw(v.frames[Math.min(n - 1, Math.floor(u * n))], true);
     }
@@ -429,6 +483,7 @@ function drawFrame() {
   }
   if (bars.length && timeline.playhead !== t) {
     timeline.playhead = t;
+    if (transport.playing) timeline.reveal(t);
     timeline.draw();
   }
 }

@@ -2,6 +2,8 @@
 // its errors number them), beat ticks, pinned bars, fills made for other pins (stale until the
 // next Generate), the loop, the selected bar and the playhead. Drawn at the device's pixel
 // ratio; labels that would overlap are thinned to every k-th bar (k = 1, 2, 5, 10, 20, 50, …).
+// Zoom and scroll as in a sound editor: the wheel zooms around the pointer (down to two bars),
+// shift+wheel or a sideways wheel scrolls; `view` is the song span shown (null: the whole song).
 
 const STEPS = [1, 2, 5, 10, 20, 50, 100, 200, 500, 1000];
 
@@ -17,7 +19,16 @@ export class Timeline {
     this.playhead = null; // song time (s)
     this.labels = []; // the bar numbers drawn: { text, x0, x1 } in CSS pixels (for tests)
     this.repeated = []; // the bars whose segment is danced in another bar too
+    this.view = null; // [a, b]: the song span shown (s); null: all of it
     const px = (e) => e.offsetX * (canvas.width / canvas.clientWidth);
+    canvas.addEventListener('wheel', (e) => {
+      if (!this.bars.length) return;
+      e.preventDefault();
+      // Shift turns a wheel sideways (some browsers swap the deltas themselves).
+      const d = Math.abs(e.deltaX) > Math.abs(e.deltaY) ? e.deltaX : e.deltaY;
+      if (e.shiftKey || Math.abs(e.deltaX) > Math.abs(e.deltaY)) this.scroll(d / (canvas.clientWidth || 1));
+      else this.zoom(Math.exp(e.deltaY * 0.002), this.timeAt(px(e)));
+    }, { passive: false });
     let drag = null;
     canvas.addEventListener('pointerdown', (e) => {
       drag = { x: e.offsetX, moved: false };
@@ -42,9 +53,9 @@ export class Timeline {
     });
   }
 
-  // The song time at canvas pixel `px`, within the bars.
+  // The song time at canvas pixel `px`, within the span shown.
   timeAt(px) {
-    const [a, b] = this.span();
+    const [a, b] = this.visible();
     const m = 8 * this.dpr();
     const u = Math.min(1, Math.max(0, (px - m) / (this.canvas.width - 2 * m)));
     return Math.min(a + u * (b - a), b - 1e-6);
@@ -57,8 +68,44 @@ export class Timeline {
     return n ? [this.bars[0].start_s, this.bars[n - 1].end_s] : [0, 1];
   }
 
+  // The song span shown, [a, b] in s.
+  visible() {
+    return this.view ?? this.span();
+  }
+
+  // Shows `[a, b]` (s), kept within the song and at least two bars long; the whole song is
+  // shown as null.
+  show(a, b) {
+    const [s0, s1] = this.span();
+    const n = this.bars.length;
+    const least = Math.min(s1 - s0, n ? 2 * (s1 - s0) / n : s1 - s0);
+    let w = Math.max(least, Math.min(s1 - s0, b - a));
+    a = Math.min(Math.max(s0, a), s1 - w);
+    this.view = w >= (s1 - s0) - 1e-9 ? null : [a, a + w];
+    this.draw();
+  }
+
+  // Zooms by `factor` (< 1: in) around song time `at`, which stays under the pointer.
+  zoom(factor, at) {
+    const [a, b] = this.visible();
+    this.show(at - (at - a) * factor, at + (b - at) * factor);
+  }
+
+  // Scrolls by `fraction` of the span shown (positive: later).
+  scroll(fraction) {
+    const [a, b] = this.visible();
+    const d = fraction * (b - a);
+    this.show(a + d, b + d);
+  }
+
+  // Scrolls so that song time `t` is shown (a quarter in from the left when it was off).
+  reveal(t) {
+    const [a, b] = this.visible();
+    if (this.view && (t < a || t > b)) this.show(t - (b - a) / 4, t + 3 * (b - a) / 4);
+  }
+
   x(t) {
-    const [a, b] = this.span();
+    const [a, b] = this.visible();
     const m = 8 * this.dpr();
     return m + (this.canvas.width - 2 * m) * (t - a) / (b - a);
   }
@@ -85,7 +132,10 @@ export class Timeline {
     g.clearRect(0, 0, w, h);
     const top = 20 * r, bottom = h - 22 * r, n = this.bars.length;
     if (!n) return;
-    const perBar = (w - 16 * r) / n;
+    // The span shown, and a bar's mean width in pixels at this zoom.
+    const [va, vb] = this.visible();
+    const [s0, s1] = this.span();
+    const perBar = (w - 16 * r) / (vb - va) * ((s1 - s0) / n);
     g.font = `${12 * r}px system-ui, sans-serif`;
     g.textAlign = 'center';
     const numW = g.measureText(String(n - 1)).width;
@@ -110,6 +160,7 @@ export class Timeline {
       g.fillRect(x0, 0, x1 - x0, 3 * r);
     }
     this.bars.forEach((b, k) => {
+      if (b.end_s <= va || b.start_s >= vb) return;
       const x0 = this.x(b.start_s), x1 = this.x(b.end_s), mid = (x0 + x1) / 2;
       const gap = Math.min(1 * r, (x1 - x0) / 8);
       const v = 0.15 + 0.85 * b.intensity;
