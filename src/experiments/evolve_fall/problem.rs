@@ -132,26 +132,12 @@ pub fn strength_kp_max(group: AgeGroup, scale: f64) -> Vec<f64> {
 /// the margin of the stability bound ([`stable_step_for`]).
 pub const STEP_QUANTA_PER_S: f64 = 20_000.0;
 /// The fraction of the stability bound the GA's step may take: 0.8 (0.70 ms on the paper's
-/// falls, bound 0.92 ms), an accuracy margin, not only a stability one. Near its bound
-/// (ω h → 2) semi-implicit Euler is stable but distorts the stiffest mode (its frequency by
-/// `asin(ωh/2)/(ωh/2)`: +40 % at 0.98 of the bound, +14 % at 0.8, +9 % at 0.65), and the GA
-/// selects falls that win through it: an adult controller evolved for 15 generations at 0.98
-/// (0.9 ms), before the elite check existed, had 27 % more damage at half the step (4,593 N →
-/// 5,848 N; 5,876 N at a quarter). With the elite check (`GaConfig::elite_check_tolerance`:
-/// an elite whose damage moves by more than 10 % at half the step is rejected), 40-generation
-/// runs of both groups over seeds 1–5 rejected 9 of 460 checked elites at 0.65 (0.55 ms),
-/// 5 of 461 at 0.8 (0.70 ms) and 21 of 456 at 0.9 (0.80 ms), GA wall time 96.1 s, 70.7 s and
-/// 74.7 s (at 0.9 the rejections cost more than the fewer steps save); every reported best
-/// fall held within 1 % at half the step at 0.8 except the adult's generation 0 (+6.1 %). Of
-/// the margins tried, 0.8 is the largest at which winning through the step stays as rare as at
-/// 0.65. The scene field `step_margin` sets another. Taking the floor's damping implicitly
-/// ([`ContactParams::implicit_damping`]) lifts the bound to 1.85 ms (the heel pad's damper no
-/// longer narrows it), but evolved falls then win through the step: in 20-generation runs at
-/// 0.9 ms (0.49 of that bound) the best evolved adult of seed 3 had +15.7 % damage at half the
-/// step and that of seed 4 +87.8 % (seeds 1 and 2: within 7.1 %), so the GA keeps the damping
-/// explicit.
-///
-/// [`ContactParams::implicit_damping`]: crate::dynamics::forces::contact::ContactParams::implicit_damping
+/// falls, bound 0.92 ms). An accuracy margin, not only a stability one: near its bound (ω h → 2)
+/// semi-implicit Euler distorts the stiffest mode's frequency by `asin(ωh/2)/(ωh/2)` (+14 % at
+/// 0.8, +40 % at 0.98), and the GA would select falls that win through that error. The largest
+/// margin at which the elite check rejects such falls as rarely as at 0.65; the measurements
+/// that chose it are in `docs/falls.md` ("The step margin"). The scene field `step_margin`
+/// sets another.
 pub const STEP_MARGIN: f64 = 0.8;
 
 /// The GA's step for every genome of the box `kp ≤ kp_max` on `fall` (s): the
