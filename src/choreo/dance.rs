@@ -254,6 +254,136 @@ pub fn assemble(
 ) -> Result<Dance, DanceError> {
     let model = humanoid24();
     let dofs = model.dofs.len();
+    check_inputs(db, segments, bars, p, dofs)?;
+    let start_s = bars[0].start_s;
+    let (frames, dt) = frame_count(bars, p.fps)?;
+    let bar_frames = bar_frames(bars, p, frames, dt)?;
+    let w = p.seam_frames;
+
+    let mut clip = ModelClip {
+        model: model.clone(),
+        frame_time: dt,
+        root_translation: Vec::with_capacity(frames),
+        root_rotation: Vec::with_capacity(frames),
+        angles: Vec::with_capacity(frames * dofs),
+    };
+    // The carry-on of the previous bar: its rotation about Y and horizontal offset, and where
+    // its segment ends (extrapolated to phase 1) in the dance.
+    let mut end: Option<(DVec3, f64)> = None;
+    // Each segment's beats (phases of counts 2, 3, 4), found once per segment.
+    let mut beats_of: std::collections::BTreeMap<usize, Vec<Option<f64>>> = Default::default();
+    let mut warped_beats = Vec::with_capacity(bars.len());
+    for (k, (&s, bar)) in segments.iter().zip(bars).enumerate() {
+        let seg = &db.segments[s];
+        let m = seg.frame_count();
+        let (first, stop) = bar_frames[k];
+        let length = bar.end_s - bar.start_s;
+        let warp = if p.beat_warp {
+            let own = beats_of
+                .entry(s)
+                .or_insert_with(|| segment_beats(seg, &model));
+            bar_warp(bar, beats_s, own)
+        } else {
+            Warp::identity()
+        };
+        warped_beats.push(warp.knots().len() - 2);
+        let part = sample(
+            seg,
+            dofs,
+            (first..stop)
+                .map(|f| warp.at((f as f64 * dt - (bar.start_s - start_s)) / length) * m as f64),
+        );
+        let (turn, offset) = carry_on(seg, end);
+        for (t, q) in part.root_translation.iter().zip(&part.root_rotation) {
+            clip.root_translation.push(turn * *t + offset);
+            clip.root_rotation.push((turn * *q).normalize());
+        }
+        // Angles, each DOF unwrapped against the previous bar's last frame.
+        let base = clip.angles.len();
+        clip.angles.extend_from_slice(&part.angles);
+        if k > 0 {
+            unwrap_against_previous(&mut clip.angles[base - dofs..], dofs);
+        }
+        end = Some(phase_one_end(seg, turn, offset));
+    }
+
+    rewrite_seams(&mut clip, &bar_frames, w, p.seam);
+    Ok(Dance {
+        clip,
+        start_s,
+        seams_s: bar_frames.iter().skip(1).map(|b| b.0 as f64 * dt).collect(),
+        bar_frames,
+        segments: segments.to_vec(),
+        seam_frames: w,
+        warped_beats,
+    })
+}
+
+/// The rigid carry-on of `seg` after a bar that ended at `end` (its root's place and heading
+/// at phase 1, [`phase_one_end`]): the yaw ψ and horizontal offset o that put the segment's
+/// first root frame there, world = R_ψ p + o; none for the first bar.
+fn carry_on(seg: &Segment, end: Option<(DVec3, f64)>) -> (DQuat, DVec3) {
+    match end {
+        None => (DQuat::IDENTITY, DVec3::ZERO),
+        Some((e, yaw)) => {
+            let turn = DQuat::from_rotation_y(yaw - heading(seg.root_rotation[0]));
+            let p0 = turn * seg.root_translation[0];
+            (turn, DVec3::new(e.x - p0.x, 0.0, e.z - p0.z))
+        }
+    }
+}
+
+/// Where `seg`, carried on by `turn` and `offset`, ends at phase 1 (one of its frames past its
+/// last, extrapolated): its root's place and heading (rad).
+fn phase_one_end(seg: &Segment, turn: DQuat, offset: DVec3) -> (DVec3, f64) {
+    let m = seg.frame_count();
+    let (pl, pm) = (seg.root_translation[m - 1], seg.root_translation[m - 2]);
+    let (ql, qm) = (seg.root_rotation[m - 1], seg.root_rotation[m - 2]);
+    let e = turn * (pl + (pl - pm)) + offset;
+    let qe = turn * (ql * (qm.inverse() * ql));
+    (e, heading(qe))
+}
+
+/// Every seam of `clip` (at the first frame of each bar of `bar_frames` after the first)
+/// rewritten over `w` frames on each side as `seam` says; nothing when `w` is 0.
+fn rewrite_seams(clip: &mut ModelClip, bar_frames: &[(usize, usize)], w: usize, seam: Seam) {
+    if w == 0 {
+        return;
+    }
+    let original = clip.clone();
+    for &(s, _) in bar_frames.iter().skip(1) {
+        match seam {
+            Seam::Spline => rewrite_seam(&original, clip, s, w),
+            Seam::Offset => offset_seam(&original, clip, s, w),
+        }
+    }
+}
+
+/// The dance's frame count over `bars` at `fps` (at least 1, at most [`MAX_FRAMES`]) and its
+/// frame time (s), which fits the bars' span exactly.
+fn frame_count(bars: &[Bar], fps: f64) -> Result<(usize, f64), DanceError> {
+    let span = bars[bars.len() - 1].end_s - bars[0].start_s;
+    let frames_f = (span * fps).round();
+    if frames_f > MAX_FRAMES as f64 {
+        return Err(DanceError::TooLong {
+            frames: frames_f as usize,
+        });
+    }
+    let frames = (frames_f as usize).max(1);
+    Ok((frames, span / frames as f64))
+}
+
+/// Refuses what [`assemble`] cannot dance: an empty database, no bars, a segment count that is
+/// not the bar count, a frame rate outside [`MIN_FPS`, `MAX_FPS`], a segment index out of range
+/// or a segment of the wrong size (`dofs` angles a frame), a bar that is not a finite, positive
+/// span, or bars that do not meet.
+fn check_inputs(
+    db: &Database,
+    segments: &[usize],
+    bars: &[Bar],
+    p: &DanceParams,
+    dofs: usize,
+) -> Result<(), DanceError> {
     if db.segments.is_empty() {
         return Err(DanceError::EmptyDatabase);
     }
@@ -304,16 +434,20 @@ pub fn assemble(
             }
         }
     }
+    Ok(())
+}
+
+/// The dance's frames `[first, end)` of every bar: `frames` frames of `dt` s from the first
+/// bar's start, each bar from the frame nearest its start (the first from 0, the last to the
+/// end); refused when a bar has fewer frames than its two seams need ([`SEAM_KNOTS`] knots
+/// and `p.seam_frames` frames on each side).
+fn bar_frames(
+    bars: &[Bar],
+    p: &DanceParams,
+    frames: usize,
+    dt: f64,
+) -> Result<Vec<(usize, usize)>, DanceError> {
     let start_s = bars[0].start_s;
-    let span = bars[bars.len() - 1].end_s - start_s;
-    let frames_f = (span * p.fps).round();
-    if frames_f > MAX_FRAMES as f64 {
-        return Err(DanceError::TooLong {
-            frames: frames_f as usize,
-        });
-    }
-    let frames = (frames_f as usize).max(1);
-    let dt = span / frames as f64;
     let at = |t: f64| (((t - start_s) / dt).round().max(0.0) as usize).min(frames);
     let bar_frames: Vec<(usize, usize)> = bars
         .iter()
@@ -345,94 +479,25 @@ pub fn assemble(
         }
     }
 
-    let mut clip = ModelClip {
-        model: model.clone(),
-        frame_time: dt,
-        root_translation: Vec::with_capacity(frames),
-        root_rotation: Vec::with_capacity(frames),
-        angles: Vec::with_capacity(frames * dofs),
-    };
-    // The carry-on of the previous bar: its rotation about Y and horizontal offset, and where
-    // its segment ends (extrapolated to phase 1) in the dance.
-    let mut end: Option<(DVec3, f64)> = None;
-    // Each segment's beats (phases of counts 2, 3, 4), found once per segment.
-    let mut beats_of: std::collections::BTreeMap<usize, Vec<Option<f64>>> = Default::default();
-    let mut warped_beats = Vec::with_capacity(bars.len());
-    for (k, (&s, bar)) in segments.iter().zip(bars).enumerate() {
-        let seg = &db.segments[s];
-        let m = seg.frame_count();
-        let (first, stop) = bar_frames[k];
-        let length = bar.end_s - bar.start_s;
-        let warp = if p.beat_warp {
-            let own = beats_of
-                .entry(s)
-                .or_insert_with(|| segment_beats(seg, &model));
-            bar_warp(bar, beats_s, own)
-        } else {
-            Warp::identity()
-        };
-        warped_beats.push(warp.knots().len() - 2);
-        let part = sample(
-            seg,
-            dofs,
-            (first..stop)
-                .map(|f| warp.at((f as f64 * dt - (bar.start_s - start_s)) / length) * m as f64),
-        );
-        // The rigid carry-on: yaw ψ and horizontal offset o, world = R_ψ p + o.
-        let (turn, offset) = match end {
-            None => (DQuat::IDENTITY, DVec3::ZERO),
-            Some((e, yaw)) => {
-                let turn = DQuat::from_rotation_y(yaw - heading(seg.root_rotation[0]));
-                let p0 = turn * seg.root_translation[0];
-                (turn, DVec3::new(e.x - p0.x, 0.0, e.z - p0.z))
-            }
-        };
-        for (t, q) in part.root_translation.iter().zip(&part.root_rotation) {
-            clip.root_translation.push(turn * *t + offset);
-            clip.root_rotation.push((turn * *q).normalize());
-        }
-        // Angles, each DOF unwrapped against the previous bar's last frame.
-        let base = clip.angles.len();
-        clip.angles.extend_from_slice(&part.angles);
-        if k > 0 {
-            for d in 0..dofs {
-                let prev = clip.angles[base - dofs + d];
-                let diff = clip.angles[base + d] - prev;
-                let turns = (diff / std::f64::consts::TAU).round();
-                if diff.abs() > std::f64::consts::PI && turns != 0.0 {
-                    let shift = turns * std::f64::consts::TAU;
-                    for f in 0..stop - first {
-                        clip.angles[base + f * dofs + d] -= shift;
-                    }
-                }
-            }
-        }
-        // Where this segment ends at phase 1: one of its frames past its last.
-        let (pl, pm) = (seg.root_translation[m - 1], seg.root_translation[m - 2]);
-        let (ql, qm) = (seg.root_rotation[m - 1], seg.root_rotation[m - 2]);
-        let e = turn * (pl + (pl - pm)) + offset;
-        let qe = turn * (ql * (qm.inverse() * ql));
-        end = Some((e, heading(qe)));
-    }
+    Ok(bar_frames)
+}
 
-    if w > 0 {
-        let original = clip.clone();
-        for &(s, _) in bar_frames.iter().skip(1) {
-            match p.seam {
-                Seam::Spline => rewrite_seam(&original, &mut clip, s, w),
-                Seam::Offset => offset_seam(&original, &mut clip, s, w),
+/// Unwraps each of the `dofs` angles of the frame after `angles`' first (one frame of `dofs`
+/// angles, then the new bar's frames) against that first frame, shifting the whole new bar by
+/// whole turns where its first value is more than π away: a DOF's angle stays continuous
+/// across the seam.
+fn unwrap_against_previous(angles: &mut [f64], dofs: usize) {
+    let count = angles.len() / dofs - 1;
+    for d in 0..dofs {
+        let diff = angles[dofs + d] - angles[d];
+        let turns = (diff / std::f64::consts::TAU).round();
+        if diff.abs() > std::f64::consts::PI && turns != 0.0 {
+            let shift = turns * std::f64::consts::TAU;
+            for f in 1..=count {
+                angles[f * dofs + d] -= shift;
             }
         }
     }
-    Ok(Dance {
-        clip,
-        start_s,
-        seams_s: bar_frames.iter().skip(1).map(|b| b.0 as f64 * dt).collect(),
-        bar_frames,
-        segments: segments.to_vec(),
-        seam_frames: w,
-        warped_beats,
-    })
 }
 
 /// Speed-curve samples per segment frame that [`segment_beats`] looks for minima in.
