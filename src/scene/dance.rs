@@ -496,7 +496,7 @@ fn write_dance(
         std::slice::from_ref(&track),
         &mid,
         &labels,
-        View::Front,
+        View::ThreeQuarter,
         &out.join("filmstrip.png"),
     )?;
     if scene.render.gif {
