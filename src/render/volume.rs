@@ -14,7 +14,8 @@
 //! - **Any other skeleton**: a capsule (a cylinder with hemispherical ends) along each bone, of
 //!   radius r by this proportion rule of the figure's height H (the largest vertical extent of
 //!   its points over the motion) and the bone's length ℓ:
-//!   - the head (a bone from a point named like `head`): 0.055 H;
+//!   - the head (a bone from a point named like `head`, to its end site or to the eyes): 0.055 H,
+//!     coloured as the mid-line;
 //!   - the neck (a bone to a point named like `neck` or `head`): 0.03 H;
 //!   - the trunk (a bone between two mid-line points): 0.055 H;
 //!   - a limb's girdle (the first bone of a limb longer than 0.02 H: hip, clavicle): 0.045 H;
@@ -23,7 +24,8 @@
 //!
 //!   A root that only stands in for the ground (see [`super::canvas::ground_proxy`]) gets none.
 //!
-//! Every volume carries the side of its point ([`super::Figure::sides`]) for its colour.
+//! Every volume carries the side of its point ([`super::Figure::sides`]) for its colour (but the
+//! head's).
 
 use glam::{DMat3, DQuat, DVec3};
 
@@ -231,9 +233,16 @@ impl Body {
                 if Some(p) == proxy {
                     return None;
                 }
-                let radius = if named(p, "head") {
-                    0.055 * h
-                } else if named(i, "neck") || named(i, "head") {
+                // The head is the mid-line's whatever its bones point at (eyes, say).
+                if named(p, "head") {
+                    let shape = Shape::Capsule {
+                        from: p,
+                        to: i,
+                        radius: 0.055 * h,
+                    };
+                    return Some((shape, Side::Centre));
+                }
+                let radius = if named(i, "neck") || named(i, "head") {
                     0.03 * h
                 } else if sides[i] == Side::Centre && sides[p] == Side::Centre {
                     0.055 * h
