@@ -374,7 +374,7 @@ mod tests {
     use super::*;
 
     fn model_track(model: &humanoid::Model, pts: &[Vec<DVec3>]) -> Body {
-        let fig = model.skeleton().figure();
+        let fig = Figure::of(&model.skeleton());
         let t = Track {
             figure: &fig,
             frames: pts,
