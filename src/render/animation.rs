@@ -160,7 +160,8 @@ pub fn animation_gif(tracks: &[Track], fps: f64, path: &Path) -> Result<(), Rend
     let height = MARGIN + header + label_row + PANEL_HEIGHT + footer;
     sheet_size(row + 2 * MARGIN as u64, height as u64)?;
     let row_w = row as u32;
-    let key_w = key_width(font, mpp, row_w as f64 * 0.6, style) as u32;
+    let caption = cam.eye.caption();
+    let key_w = key_width(font, mpp, row_w as f64 * 0.6, style, Some(&caption)) as u32;
     let width = 2 * MARGIN + row_w.max(key_w);
     let (Ok(w16), Ok(h16)) = (u16::try_from(width), u16::try_from(height)) else {
         return Err(RenderError::InvalidArgument(format!(
@@ -173,7 +174,7 @@ pub fn animation_gif(tracks: &[Track], fps: f64, path: &Path) -> Result<(), Rend
     let panel_y = MARGIN + header + label_row;
     let label_base = (MARGIN + header) as f32 + ascent(font, style.text);
     let mut origins = Vec::new();
-    let background = panel_background(&cam, font, style, true)?;
+    let background = panel_background(&cam, font, style, false)?;
     for (i, track) in tracks.iter().enumerate() {
         let x = MARGIN + i as u32 * (block_w + TRACK_GAP);
         let lx = x as f32;
@@ -200,6 +201,7 @@ pub fn animation_gif(tracks: &[Track], fps: f64, path: &Path) -> Result<(), Rend
         mpp,
         row_w as f64 * 0.6,
         style,
+        Some(&caption),
     );
 
     let duration = tracks.iter().map(Track::duration).fold(0.0, f64::max);

@@ -634,7 +634,9 @@ fn scale_label(len: f64) -> String {
 }
 
 /// Draws the footer key at (`x`, `y` = baseline): a scale bar of [`scale_length`] with its
-/// length written beside it, then the left/right colour key. Returns the width used.
+/// length written beside it, then the left/right colour key and, if given, `view` (the
+/// caption of the one view every panel shares) in grey. Returns the width used.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn draw_key(
     p: &mut Pixmap,
     font: &FontRef,
@@ -643,6 +645,7 @@ pub(crate) fn draw_key(
     mpp: f64,
     max_bar_px: f64,
     style: Style,
+    view: Option<&str>,
 ) -> f32 {
     let s = style.small;
     let len = scale_length(mpp, max_bar_px);
@@ -681,17 +684,41 @@ pub(crate) fn draw_key(
         );
         cx += text_width(font, name, s) + 18.0;
     }
+    if let Some(view) = view {
+        cx += 12.0;
+        draw_text(
+            p,
+            font,
+            view,
+            (cx, y),
+            Pen {
+                size: s,
+                rgb: FLOOR,
+                align: Align::Left,
+            },
+        );
+        cx += text_width(font, view, s);
+    }
     cx - x
 }
 
 /// Width in pixels that [`draw_key`] uses with the same arguments.
-pub(crate) fn key_width(font: &FontRef, mpp: f64, max_bar_px: f64, style: Style) -> f32 {
+pub(crate) fn key_width(
+    font: &FontRef,
+    mpp: f64,
+    max_bar_px: f64,
+    style: Style,
+    view: Option<&str>,
+) -> f32 {
     let s = style.small;
     let len = scale_length(mpp, max_bar_px);
     let label = scale_label(len);
     let mut w = (len / mpp) as f32 + 8.0 + text_width(font, &label, s) + 24.0;
     for name in ["left", "right"] {
         w += 30.0 + text_width(font, name, s) + 18.0;
+    }
+    if let Some(view) = view {
+        w += 12.0 + text_width(font, view, s);
     }
     w
 }
@@ -764,6 +791,41 @@ mod tests {
         } else {
             Side::Centre
         }
+    }
+
+    #[test]
+    fn the_view_is_named_in_the_key_after_the_colours() {
+        let font = crate::render::text::font().unwrap();
+        let style = Style::for_height(400);
+        let (mpp, bar) = (0.005, 300.0);
+        let caption = "three-quarter, 60° left";
+        let plain = key_width(font, mpp, bar, style, None);
+        let with = key_width(font, mpp, bar, style, Some(caption));
+        assert!(with > plain + 12.0 + 50.0, "{plain} → {with}");
+        let inked = |view: Option<&str>| {
+            let mut p = new_pixmap(with as u32 + 40, 40, WHITE).unwrap();
+            let used = draw_key(&mut p, font, 10.0, 30.0, mpp, bar, style, view);
+            let xs: Vec<u32> = (0..p.width())
+                .filter(|&x| (0..p.height()).any(|y| p.pixel(x, y).unwrap().red() < 200))
+                .collect();
+            (used, *xs.last().unwrap())
+        };
+        let (used_plain, last_plain) = inked(None);
+        let (used_with, last_with) = inked(Some(caption));
+        assert!((used_plain - plain).abs() < 0.5 && (used_with - with).abs() < 0.5);
+        // Without a view nothing is inked past the colour key; with one, its text is.
+        assert!(
+            last_plain as f32 <= 10.0 + plain + 1.0,
+            "{last_plain} vs {plain}"
+        );
+        assert!(
+            last_with as f32 > 10.0 + plain + 12.0,
+            "{last_with} vs {plain}"
+        );
+        assert!(
+            last_with as f32 <= 10.0 + with + 1.0,
+            "{last_with} vs {with}"
+        );
     }
 
     #[test]

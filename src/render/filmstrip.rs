@@ -349,7 +349,8 @@ fn draw_columns(
         rows + (MARGIN + time_row + footer) as u64,
     )?;
     let row_w = row as u32;
-    let key_w = key_width(font, mpp, row_w as f64 * 0.6, style) as u32;
+    let caption = cam.eye.caption();
+    let key_w = key_width(font, mpp, row_w as f64 * 0.6, style, Some(&caption)) as u32;
     let width = 2 * MARGIN + row_w.max(key_w);
     let height = MARGIN + time_row + rows as u32 + footer;
     let mut sheet = new_pixmap(width, height, WHITE)?;
@@ -372,9 +373,8 @@ fn draw_columns(
         );
     }
     y += time_row;
-    // The view's name only in each row's first cell.
-    let first = panel_background(cam, font, style, true)?;
-    let rest = panel_background(cam, font, style, false)?;
+    // The view's name is in the key, where no figure can cover it.
+    let background = panel_background(cam, font, style, false)?;
     for track in tracks {
         let base = y as f32 + ascent(font, style.text);
         draw_text(
@@ -391,7 +391,7 @@ fn draw_columns(
         y += label_row;
         let body = Body::of(track);
         for (j, &t) in times.iter().enumerate() {
-            let mut cell = if j == 0 { first.clone() } else { rest.clone() };
+            let mut cell = background.clone();
             draw_body(&mut cell, cam, track, &body, track.frame_at(t), style);
             blit(&mut sheet, &cell, x0 + j as u32 * (cam.width + GAP), y);
         }
@@ -406,6 +406,7 @@ fn draw_columns(
         mpp,
         row_w as f64 * 0.6,
         style,
+        Some(&caption),
     );
     write(path, &encode_png(&sheet)?)
 }

@@ -61,7 +61,7 @@ pub fn pose_png(track: &Track, frame: usize, path: &Path) -> Result<(), RenderEr
     let footer = (style.small * 2.6) as u32;
     // Panels are at most MAX_PANEL wide, so these sums stay far below u32::MAX.
     let panels_w = cams.iter().map(|c| c.width).sum::<u32>() + 2 * GAP;
-    let key_w = key_width(font, mpp, panels_w as f64 * 0.6, style) as u32;
+    let key_w = key_width(font, mpp, panels_w as f64 * 0.6, style, None) as u32;
     let width = 2 * MARGIN + panels_w.max(key_w);
     let height = MARGIN + header + PANEL_HEIGHT + footer + MARGIN / 2;
     sheet_size(width as u64, height as u64)?;
@@ -114,6 +114,7 @@ pub fn pose_png(track: &Track, frame: usize, path: &Path) -> Result<(), RenderEr
         mpp,
         panels_w as f64 * 0.6,
         style,
+        None,
     );
     write(path, &encode_png(&sheet)?)
 }
