@@ -23,8 +23,9 @@
 //! (decided from point names by [`side_from_name`]); the floor y = 0 as a line over a light
 //! ground seen edge-on, as a patch with a 0.5 m grid seen from above; one scale (metres per pixel)
 //! for every view of a picture, framed on the whole motion (all frames, all tracks) so figures
-//! do not jump; a 1 m scale bar. Text uses the bundled DejaVu Sans, so nothing depends on system
-//! fonts. Every file is rendered in memory and written atomically ([`crate::io::write_atomic`]).
+//! do not jump; a 1 m scale bar, and in filmstrips and GIFs the view's name beside it. Text
+//! uses the bundled DejaVu Sans, so nothing depends on system fonts. Every file is rendered in
+//! memory and written atomically ([`crate::io::write_atomic`]).
 
 mod animation;
 mod camera;
