@@ -509,10 +509,7 @@ fn floor_patch(p: &mut Pixmap, cam: &Camera, centre: DVec2) {
     ];
     polygon(p, &quad, GROUND);
     // 0.5 m squares, doubled until at most 100 lines cross the patch each way.
-    let mut step = 0.5;
-    while ((hi - lo) / step).max_element() > 100.0 {
-        step *= 2.0;
-    }
+    let step = grid_step((hi - lo).max_element());
     for axis in 0..2 {
         let first = (lo[axis] / step).ceil() as i64;
         let last = (hi[axis] / step).floor() as i64;
@@ -560,10 +557,22 @@ pub(crate) fn ground_proxy(fig: &super::figure::Figure, pts: &[DVec3]) -> Option
         .then_some(root)
 }
 
+/// The floor's grid spacing over `span` metres: 0.5 m, doubled until at most 100 lines cross
+/// it (so a panel framed on a far-flung point draws a hundred lines, not billions).
+fn grid_step(span: f64) -> f64 {
+    let mut step = 0.5;
+    while span / step > 100.0 && step.is_finite() {
+        step *= 2.0;
+    }
+    step
+}
+
+/// Seen edge-on, ticks on the floor line every 0.5 m (coarser when the panel spans more than
+/// 50 m).
 fn floor_ticks(p: &mut Pixmap, cam: &Camera, centre: glam::DVec2) {
     let (_, y0) = cam.pixel(centre, glam::DVec2::ZERO);
     let half = cam.width as f64 * 0.5 * cam.mpp;
-    let step = 0.5;
+    let step = grid_step(2.0 * half);
     let first = ((centre.x - half) / step).floor() as i64;
     let last = ((centre.x + half) / step).ceil() as i64;
     for m in first..=last {
@@ -573,9 +582,9 @@ fn floor_ticks(p: &mut Pixmap, cam: &Camera, centre: glam::DVec2) {
 }
 
 /// Seen from above, the floor as a light grid of 0.5 m squares (it moves when the camera
-/// follows the root).
+/// follows the root; coarser when the panel spans more than 50 m).
 fn floor_grid(p: &mut Pixmap, cam: &Camera, centre: glam::DVec2) {
-    let step = 0.5;
+    let step = grid_step([cam.width, cam.height].into_iter().max().unwrap_or(0) as f64 * cam.mpp);
     let (w, h) = (cam.width as f32, cam.height as f32);
     for axis in 0..2 {
         let half = [cam.width, cam.height][axis] as f64 * 0.5 * cam.mpp;
@@ -791,6 +800,16 @@ mod tests {
         } else {
             Side::Centre
         }
+    }
+
+    #[test]
+    fn the_floor_grid_is_half_a_metre_until_a_hundred_lines_would_cross_it() {
+        assert_eq!(grid_step(3.0), 0.5);
+        assert_eq!(grid_step(50.0), 0.5);
+        assert_eq!(grid_step(50.1), 1.0);
+        // A panel framed on a point a billion kilometres away: about a hundred lines.
+        let step = grid_step(4e12);
+        assert!(4e12 / step <= 100.0 && 4e12 / step > 50.0, "{step}");
     }
 
     #[test]
