@@ -1,8 +1,11 @@
-//! A looping GIF of one or more motions side by side (front and side view of each), subsampled
-//! to a chosen frame rate and quantised to a small fixed palette.
+//! A looping GIF of one or more motions side by side (each in the three-quarter view chosen
+//! from the motions, its body as shaded volumes), subsampled to a chosen frame rate and
+//! quantised to a small fixed palette.
 //!
-//! The drawing uses few colours ([`super::canvas::INKS`]) on white, and anti-aliasing mixes each
-//! of them with white, so the palette is the 16-step ramp from white to every ink. A 32×32×32
+//! The drawing uses few colours ([`super::canvas::INKS`]) on white, anti-aliasing mixes each
+//! of them with white and shading darkens the limbs' colours, so the palette is the 16-step
+//! ramp from white to every ink and an 8-step ramp from each limb colour down to
+//! [`super::canvas::AMBIENT`] of it. A 32×32×32
 //! lookup table maps 5-bit-per-channel RGB to the nearest palette entry once; each pixel then
 //! costs one table look-up. Frames are drawn and quantised in parallel (rayon), in chunks; each
 //! frame after the first stores only the rectangle that changed, unchanged pixels in it
@@ -16,23 +19,25 @@ use std::sync::OnceLock;
 use rayon::prelude::*;
 use tiny_skia::Pixmap;
 
-use super::camera::{Camera, PanelLimits, View, scale_for};
+use super::camera::{Camera, Eye, PanelLimits, View, scale_for};
 use super::canvas::{
-    INK, INKS, Style, WHITE, blit, draw_figure, draw_key, key_width, new_pixmap, panel_background,
-    sheet_size,
+    AMBIENT, INK, INKS, LEFT, RIGHT, Style, WHITE, blit, draw_body, draw_key, key_width,
+    new_pixmap, panel_background, shade, sheet_size,
 };
 use super::figure::{Track, validate_tracks};
 use super::text::{Align, Pen, ascent, draw_text, font};
+use super::volume::Body;
 use super::{RenderError, require_extension, write};
 
 /// Height of each view (pixels).
 const PANEL_HEIGHT: u32 = 320;
 const MARGIN: u32 = 12;
-/// Gap between the two views of a track, and between tracks (pixels).
-const GAP: u32 = 8;
+/// Gap between tracks (pixels).
 const TRACK_GAP: u32 = 24;
 /// Steps of each white-to-ink ramp in the palette.
 const LEVELS: usize = 16;
+/// Steps of each shaded limb colour's ramp in the palette.
+const DARK_LEVELS: usize = 8;
 /// Most frames in one GIF (an hour at 25 frames per second).
 pub const MAX_GIF_FRAMES: usize = 90_000;
 /// Frames drawn and compressed per parallel batch (bounds memory).
@@ -42,17 +47,29 @@ const CHUNK: usize = 48;
 pub const MAX_GIF_FPS: f64 = 50.0;
 
 /// The fixed palette as RGB triples: for each ink c and level l = 0 … 15 the mix
-/// white + (c − white) · l/15.
+/// white + (c − white) · l/15; then for each limb colour c and level l = 1 … 8 the shade
+/// c · (1 − (1 − AMBIENT) · l/8).
 fn palette() -> Vec<[u8; 3]> {
-    let mut p = Vec::with_capacity(INKS.len() * LEVELS);
+    let mut p = Vec::with_capacity(PALETTE_SIZE);
     for c in INKS {
         for l in 0..LEVELS {
             let a = l as f32 / (LEVELS - 1) as f32;
             p.push(c.map(|ch| (255.0 + (ch as f32 - 255.0) * a).round() as u8));
         }
     }
+    for c in [LEFT, RIGHT] {
+        for l in 1..=DARK_LEVELS {
+            p.push(shade(
+                c,
+                1.0 - (1.0 - AMBIENT) * l as f64 / DARK_LEVELS as f64,
+            ));
+        }
+    }
     p
 }
+
+/// Colours in [`palette`].
+const PALETTE_SIZE: usize = INKS.len() * LEVELS + 2 * DARK_LEVELS;
 
 /// Nearest palette entry (squared RGB distance) for every 5-bit-per-channel colour, indexed by
 /// (r >> 3) << 10 | (g >> 3) << 5 | (b >> 3).
@@ -104,8 +121,10 @@ fn delay(k: usize, fps: f64) -> u16 {
     (at(k + 1) - at(k)).clamp(1.0, u16::MAX as f64) as u16
 }
 
-/// Writes a looping GIF of `tracks` at `path`: each track's front and side view side by side,
-/// its label above, all tracks in one row at one scale and one framing of the whole motion.
+/// Writes a looping GIF of `tracks` at `path`: each track in the three-quarter view chosen from
+/// all the tracks' motion ([`super::camera::three_quarter`], after each is turned to face +Z),
+/// drawn as volumes over its shadow ([`super::volume`]), its label above, all tracks in one
+/// row at one scale and one framing of the whole motion.
 /// GIF frame k shows time t = k/fps (header "t = … s"), each track at its nearest frame (held
 /// after its end), for k = 0 … ⌊T·fps⌋ with T the longest duration. `fps` must be in
 /// (0, [`MAX_GIF_FPS`]]; 25 is a good choice.
@@ -121,26 +140,28 @@ pub fn animation_gif(tracks: &[Track], fps: f64, path: &Path) -> Result<(), Rend
     let turned_tracks = super::facing::with_frames(tracks, &turned);
     let tracks = &turned_tracks[..];
     let font = font()?;
-    let (mpp, pad) = scale_for(tracks, PANEL_HEIGHT);
+    let eye = Eye::for_view(View::ThreeQuarter, tracks);
+    let (mpp, pad) = scale_for(tracks, &eye, PANEL_HEIGHT);
     let limits = PanelLimits {
         height: PANEL_HEIGHT,
-        min_width: PANEL_HEIGHT / 2,
+        min_width: PANEL_HEIGHT * 3 / 5,
         max_width: PANEL_HEIGHT * 8 / 5,
     };
-    let cams = [View::Front, View::Side].map(|v| Camera::fit(tracks, v, mpp, pad, limits));
+    let cam = Camera::fit(tracks, eye, mpp, pad, limits);
     let style = Style::for_height(PANEL_HEIGHT);
 
-    // Layout: header (time), then per track a label row and its two panels, then the key.
+    // Layout: header (time), then per track a label row and its panel, then the key.
     let header = (style.text * 1.8) as u32;
     let label_row = (style.text * 1.6) as u32;
     let footer = (style.small * 2.4) as u32;
-    let block_w = cams[0].width + GAP + cams[1].width;
+    let block_w = cam.width;
     let n = tracks.len() as u64;
     let row = n * block_w as u64 + (n - 1) * TRACK_GAP as u64;
     let height = MARGIN + header + label_row + PANEL_HEIGHT + footer;
     sheet_size(row + 2 * MARGIN as u64, height as u64)?;
     let row_w = row as u32;
-    let key_w = key_width(font, mpp, row_w as f64 * 0.6, style) as u32;
+    let caption = cam.eye.caption();
+    let key_w = key_width(font, mpp, row_w as f64 * 0.6, style, Some(&caption)) as u32;
     let width = 2 * MARGIN + row_w.max(key_w);
     let (Ok(w16), Ok(h16)) = (u16::try_from(width), u16::try_from(height)) else {
         return Err(RenderError::InvalidArgument(format!(
@@ -153,10 +174,7 @@ pub fn animation_gif(tracks: &[Track], fps: f64, path: &Path) -> Result<(), Rend
     let panel_y = MARGIN + header + label_row;
     let label_base = (MARGIN + header) as f32 + ascent(font, style.text);
     let mut origins = Vec::new();
-    let backgrounds = [
-        panel_background(&cams[0], font, style, true)?,
-        panel_background(&cams[1], font, style, true)?,
-    ];
+    let background = panel_background(&cam, font, style, false)?;
     for (i, track) in tracks.iter().enumerate() {
         let x = MARGIN + i as u32 * (block_w + TRACK_GAP);
         let lx = x as f32;
@@ -171,14 +189,8 @@ pub fn animation_gif(tracks: &[Track], fps: f64, path: &Path) -> Result<(), Rend
                 align: Align::Left,
             },
         );
-        blit(&mut sheet, &backgrounds[0], x, panel_y);
-        blit(
-            &mut sheet,
-            &backgrounds[1],
-            x + cams[0].width + GAP,
-            panel_y,
-        );
-        origins.push([x, x + cams[0].width + GAP]);
+        blit(&mut sheet, &background, x, panel_y);
+        origins.push(x);
     }
     let key_base = (panel_y + PANEL_HEIGHT) as f32 + style.small * 1.7;
     draw_key(
@@ -189,6 +201,7 @@ pub fn animation_gif(tracks: &[Track], fps: f64, path: &Path) -> Result<(), Rend
         mpp,
         row_w as f64 * 0.6,
         style,
+        Some(&caption),
     );
 
     let duration = tracks.iter().map(Track::duration).fold(0.0, f64::max);
@@ -199,7 +212,7 @@ pub fn animation_gif(tracks: &[Track], fps: f64, path: &Path) -> Result<(), Rend
         )));
     }
     let frames = steps as usize + 1;
-    let sides: Vec<_> = tracks.iter().map(|t| t.figure.sides()).collect();
+    let bodies: Vec<Body> = tracks.iter().map(Body::of).collect();
     let lut = lookup();
     let time_base = MARGIN as f32 + ascent(font, style.text);
     let mut still = vec![0u8; (width * height) as usize];
@@ -222,13 +235,10 @@ pub fn animation_gif(tracks: &[Track], fps: f64, path: &Path) -> Result<(), Rend
         };
         draw_text(&mut strip, font, &label, (MARGIN as f32, time_base), pen);
         quantise_into(&mut img, width as usize, &strip, 0, 0, lut);
-        for ((track, origin), sides) in tracks.iter().zip(&origins).zip(&sides) {
-            let f = track.frame_at(t);
-            for (v, cam) in cams.iter().enumerate() {
-                let mut panel = backgrounds[v].clone();
-                draw_figure(&mut panel, cam, track, sides, f, style);
-                quantise_into(&mut img, width as usize, &panel, origin[v], panel_y, lut);
-            }
+        for ((track, &origin), body) in tracks.iter().zip(&origins).zip(&bodies) {
+            let mut panel = background.clone();
+            draw_body(&mut panel, &cam, track, body, track.frame_at(t), style);
+            quantise_into(&mut img, width as usize, &panel, origin, panel_y, lut);
         }
         img
     };
@@ -290,7 +300,7 @@ pub fn animation_gif(tracks: &[Track], fps: f64, path: &Path) -> Result<(), Rend
 }
 
 /// Palette index that marks a pixel as unchanged from the previous frame.
-const TRANSPARENT: u8 = (INKS.len() * LEVELS) as u8;
+const TRANSPARENT: u8 = PALETTE_SIZE as u8;
 
 /// The part of `next` (w×h palette indices) that differs from `prev`, as a frame over the
 /// bounding rectangle of the changed pixels, unchanged pixels inside it set to [`TRANSPARENT`]

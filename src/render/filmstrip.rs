@@ -4,13 +4,14 @@
 
 use std::path::Path;
 
-use super::camera::{Camera, PanelLimits, View, scale_for};
+use super::camera::{Camera, Eye, PanelLimits, View, scale_for};
 use super::canvas::{
-    INK, Style, WHITE, blit, draw_figure, draw_key, encode_png, key_width, new_pixmap,
+    INK, Style, WHITE, blit, draw_body, draw_key, encode_png, key_width, new_pixmap,
     panel_background, sheet_size,
 };
 use super::figure::{Side, Track, validate_tracks};
 use super::text::{Align, Pen, ascent, draw_text, font};
+use super::volume::Body;
 use super::{RenderError, require_extension, write};
 use crate::analysis::{ContactConfig, ground_contacts};
 use glam::DVec3;
@@ -22,9 +23,11 @@ const MARGIN: u32 = 16;
 const GAP: u32 = 6;
 const ROW_GAP: u32 = 10;
 
-/// [`filmstrip_view_png`] in the left side view, where falls, steps and jumps read best.
+/// [`filmstrip_view_png`] in the three-quarter view chosen from the motion
+/// ([`super::camera::three_quarter`]: from in front and to the side, so that the travel crosses
+/// the picture and the near and far limbs stand apart).
 pub fn filmstrip_png(tracks: &[Track], n: usize, path: &Path) -> Result<(), RenderError> {
-    filmstrip_view_png(tracks, n, View::Side, path)
+    filmstrip_view_png(tracks, n, View::ThreeQuarter, path)
 }
 
 /// Share of the column spacing given to elapsed time; the rest follows the motion.
@@ -241,7 +244,7 @@ const APEX_RISE: f64 = 0.08;
 
 /// Draws `n` instants of every track as a PNG at `path`, one row per track (its label above
 /// it), in `view`, each frame's figure turned to face +Z by its own facing (see
-/// [`super::facing`]). Columns share one time t_j chosen by motion ([`column_times`]: a column at
+/// [`super::facing`]) and drawn as volumes over its shadow ([`super::volume`]). Columns share one time t_j chosen by motion ([`column_times`]: a column at
 /// every flight's apex of the first track, the rest spread by distance travelled; more than `n`
 /// when the flights need them), written above each column; a shorter track holds its last frame. All cells
 /// share one scale and one framing of the whole motion, so positions compare across the page;
@@ -260,11 +263,20 @@ pub fn filmstrip_view_png(
             "a filmstrip needs at least one column".into(),
         ));
     }
-    draw_facing(tracks, view, path, |tracks| {
-        let times = column_times(tracks, n);
-        let labels = times.iter().map(|t| format!("t = {t:.2} s")).collect();
-        (times, labels)
-    })
+    draw_facing(tracks, view, path, |tracks| labelled_columns(tracks, n))
+}
+
+/// The columns of a filmstrip of `n`: [`column_times`], each moved onto the first track's frame
+/// shown there (so the instant is one the track has), labelled with that frame's time,
+/// "t = 1.23 s".
+pub(crate) fn labelled_columns(tracks: &[Track], n: usize) -> (Vec<f64>, Vec<String>) {
+    let first = &tracks[0];
+    let times: Vec<f64> = column_times(tracks, n)
+        .into_iter()
+        .map(|t| first.frame_at(t) as f64 * first.frame_time)
+        .collect();
+    let labels = times.iter().map(|t| format!("t = {t:.2} s")).collect();
+    (times, labels)
 }
 
 /// Draws `tracks` at the given instants (seconds), each column headed by its label, in `view`,
@@ -301,13 +313,14 @@ fn draw_facing(
     let turned = super::facing::turned_frames_each(tracks);
     let turned_tracks = super::facing::with_frames(tracks, &turned);
     let tracks = &turned_tracks[..];
-    let (mpp, pad) = scale_for(tracks, CELL_HEIGHT);
+    let eye = Eye::for_view(view, tracks);
+    let (mpp, pad) = scale_for(tracks, &eye, CELL_HEIGHT);
     let limits = PanelLimits {
         height: CELL_HEIGHT,
         min_width: CELL_HEIGHT * 9 / 20,
         max_width: CELL_HEIGHT * 9 / 10,
     };
-    let cam = Camera::fit(tracks, view, mpp, pad, limits);
+    let cam = Camera::fit(tracks, eye, mpp, pad, limits);
     let style = Style::for_height(CELL_HEIGHT.max(cam.height));
     let (times, labels) = columns(tracks);
     draw_columns(tracks, &times, &labels, &cam, style, mpp, path)
@@ -336,7 +349,8 @@ fn draw_columns(
         rows + (MARGIN + time_row + footer) as u64,
     )?;
     let row_w = row as u32;
-    let key_w = key_width(font, mpp, row_w as f64 * 0.6, style) as u32;
+    let caption = cam.eye.caption();
+    let key_w = key_width(font, mpp, row_w as f64 * 0.6, style, Some(&caption)) as u32;
     let width = 2 * MARGIN + row_w.max(key_w);
     let height = MARGIN + time_row + rows as u32 + footer;
     let mut sheet = new_pixmap(width, height, WHITE)?;
@@ -359,9 +373,8 @@ fn draw_columns(
         );
     }
     y += time_row;
-    // The view's name only in each row's first cell.
-    let first = panel_background(cam, font, style, true)?;
-    let rest = panel_background(cam, font, style, false)?;
+    // The view's name is in the key, where no figure can cover it.
+    let background = panel_background(cam, font, style, false)?;
     for track in tracks {
         let base = y as f32 + ascent(font, style.text);
         draw_text(
@@ -376,10 +389,10 @@ fn draw_columns(
             },
         );
         y += label_row;
-        let sides = track.figure.sides();
+        let body = Body::of(track);
         for (j, &t) in times.iter().enumerate() {
-            let mut cell = if j == 0 { first.clone() } else { rest.clone() };
-            draw_figure(&mut cell, cam, track, &sides, track.frame_at(t), style);
+            let mut cell = background.clone();
+            draw_body(&mut cell, cam, track, &body, track.frame_at(t), style);
             blit(&mut sheet, &cell, x0 + j as u32 * (cam.width + GAP), y);
         }
         y += cam.height + ROW_GAP;
@@ -393,6 +406,7 @@ fn draw_columns(
         mpp,
         row_w as f64 * 0.6,
         style,
+        Some(&caption),
     );
     write(path, &encode_png(&sheet)?)
 }
@@ -480,6 +494,41 @@ mod tests {
             ..tr
         };
         assert_eq!(flight_apexes(&tr).unwrap(), vec![]);
+    }
+
+    #[test]
+    fn each_column_is_labelled_with_the_time_of_the_frame_it_shows() {
+        let fig = Figure {
+            names: vec!["a".into()],
+            parents: vec![None],
+        };
+        // A coarse first track (10 frames/s) beside a fine one (1/30 s): the columns are
+        // spread on the fine clock but show the coarse track's frames.
+        let fall: Vec<Vec<DVec3>> = (0..21)
+            .map(|k| vec![DVec3::new(0.0, (1.0 - k as f64 * 0.07).max(0.0), 0.0)])
+            .collect();
+        let fine: Vec<Vec<DVec3>> = (0..61).map(|k| vec![DVec3::X * k as f64 * 0.01]).collect();
+        let coarse = track(&fig, &fall);
+        let other = Track {
+            frames: &fine,
+            frame_time: 1.0 / 30.0,
+            ..coarse.clone()
+        };
+        let tracks = [coarse, other];
+        let (times, labels) = labelled_columns(&tracks, 7);
+        assert_eq!(times.len(), 7);
+        for (t, label) in times.iter().zip(&labels) {
+            let shown = tracks[0].frame_at(*t) as f64 * tracks[0].frame_time;
+            let written: f64 = label
+                .trim_start_matches("t = ")
+                .trim_end_matches(" s")
+                .parse()
+                .unwrap();
+            assert!(
+                (written - shown).abs() < 0.005 + 1e-12,
+                "{label} shows {shown} s"
+            );
+        }
     }
 
     #[test]

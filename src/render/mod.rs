@@ -4,10 +4,11 @@
 //! position of every point in every frame (metres, Y up, the figure faces +Z, its left is +X).
 //! From tracks this module draws
 //!
-//! - [`pose_png`]: one frame, front and side views side by side;
+//! - [`pose_png`]: one frame, front, side and three-quarter views side by side;
 //! - [`filmstrip_png`] / [`filmstrip_view_png`]: N instants chosen by motion in one PNG, one row
-//!   per track, time labels above the columns (like the figures in the papers);
-//! - [`animation_gif`]: all tracks side by side (front and side view each), looping, subsampled
+//!   per track, time labels above the columns (like the figures in the papers), in the
+//!   three-quarter view chosen from the motion ([`three_quarter`]) or a named one;
+//! - [`animation_gif`]: all tracks side by side in the three-quarter view, looping, subsampled
 //!   to a chosen frame rate;
 //!
 //! and from numbers [`plot`]: line plots with title, axis labels, legend and labelled event
@@ -15,12 +16,16 @@
 //! and bar intensity in one PNG.
 //!
 //! Conventions of every picture: orthographic views ([`View`]) of the figure turned to face +Z
-//! (its facing found from its left and right points, so "front" is its front); the figure's left limbs blue,
-//! its right limbs vermillion, mid-line grey (decided from point names by [`side_from_name`]);
-//! joints as dots; the floor y = 0 as a line over a light ground; one scale (metres per pixel)
+//! (its facing found from its left and right points, so "front" is its front); the body drawn
+//! as volumes ([`Body`]: the contact boxes of the project's models, capsules along the bones
+//! of any other skeleton), shaded against one light and sorted back to front, over its shadow
+//! on the floor; the figure's left limbs blue, its right limbs vermillion, mid-line grey
+//! (decided from point names by [`side_from_name`]); the floor y = 0 as a line over a light
+//! ground seen edge-on, as a patch with a 0.5 m grid seen from above; one scale (metres per pixel)
 //! for every view of a picture, framed on the whole motion (all frames, all tracks) so figures
-//! do not jump; a 1 m scale bar. Text uses the bundled DejaVu Sans, so nothing depends on system
-//! fonts. Every file is rendered in memory and written atomically ([`crate::io::write_atomic`]).
+//! do not jump; a 1 m scale bar, and in filmstrips and GIFs the view's name beside it. Text
+//! uses the bundled DejaVu Sans, so nothing depends on system fonts. Every file is rendered in
+//! memory and written atomically ([`crate::io::write_atomic`]).
 
 mod animation;
 mod camera;
@@ -32,17 +37,19 @@ mod music;
 mod plot;
 mod pose;
 mod text;
+mod volume;
 
 use std::path::{Path, PathBuf};
 
 pub use animation::{MAX_GIF_FPS, MAX_GIF_FRAMES, animation_gif};
-pub use camera::View;
+pub use camera::{ELEVATION, Eye, View, three_quarter};
 pub use figure::{Figure, Side, Track, side_from_name};
 pub use filmstrip::{filmstrip_at_png, filmstrip_png, filmstrip_view_png};
 pub use music::music_png;
 pub use plot::{Plot, Series, plot};
 pub use pose::pose_png;
 pub use text::FONT_TTF;
+pub use volume::{Body, Shape, Solid};
 
 /// Why a picture or plot could not be made.
 #[derive(Debug, thiserror::Error)]

@@ -1,14 +1,16 @@
-//! One pose: the front and the side view of a frame, side by side, in one PNG.
+//! One pose: the front, the side and the three-quarter view of a frame, side by side, in one
+//! PNG, the body drawn as volumes.
 
 use std::path::Path;
 
-use super::camera::{Camera, PanelLimits, View, scale_for};
+use super::camera::{Camera, Eye, PanelLimits, View, scale_for};
 use super::canvas::{
-    INK, Style, WHITE, blit, draw_figure, draw_key, encode_png, key_width, new_pixmap,
+    INK, Style, WHITE, blit, draw_body, draw_key, encode_png, key_width, new_pixmap,
     panel_background, sheet_size,
 };
 use super::figure::Track;
 use super::text::{Align, Pen, ascent, draw_text, font};
+use super::volume::Body;
 use super::{RenderError, require_extension, write};
 
 /// Height of each view (pixels).
@@ -18,7 +20,8 @@ const MARGIN: u32 = 16;
 const GAP: u32 = 12;
 
 /// Draws frame `frame` of `track` as a PNG at `path`: the front view (the figure's left on the
-/// viewer's right) and its left side view, side by side at the same scale, framed on the whole
+/// viewer's right), its left side view and the three-quarter view chosen from the motion
+/// ([`super::camera::three_quarter`]), side by side at the same scale, framed on the whole
 /// track so pictures of different frames line up; header with the track label, frame index and
 /// time t = frame · frame_time (s); footer with a 1 m scale bar and the left/right colour key.
 pub fn pose_png(track: &Track, frame: usize, path: &Path) -> Result<(), RenderError> {
@@ -36,20 +39,29 @@ pub fn pose_png(track: &Track, frame: usize, path: &Path) -> Result<(), RenderEr
     let track = &turned_tracks[0];
     let font = font()?;
     let tracks = std::slice::from_ref(track);
-    let (mpp, pad) = scale_for(tracks, PANEL_HEIGHT);
+    let eyes = [
+        Eye::fixed(View::Front),
+        Eye::fixed(View::Side),
+        Eye::for_view(View::ThreeQuarter, tracks),
+    ];
+    // One scale for the three: the one that fits the tallest.
+    let (mpp, pad) = eyes
+        .iter()
+        .map(|e| scale_for(tracks, e, PANEL_HEIGHT))
+        .fold((0.0, 0.0), |a, b| if b.0 > a.0 { b } else { a });
     let limits = PanelLimits {
         height: PANEL_HEIGHT,
         min_width: PANEL_HEIGHT * 11 / 20,
         max_width: PANEL_HEIGHT * 2,
     };
-    let cams = [View::Front, View::Side].map(|v| Camera::fit(tracks, v, mpp, pad, limits));
+    let cams = eyes.map(|e| Camera::fit(tracks, e, mpp, pad, limits));
     let style = Style::for_height(PANEL_HEIGHT);
 
     let header = (style.text * 2.0) as u32;
     let footer = (style.small * 2.6) as u32;
     // Panels are at most MAX_PANEL wide, so these sums stay far below u32::MAX.
-    let panels_w = cams[0].width + GAP + cams[1].width;
-    let key_w = key_width(font, mpp, panels_w as f64 * 0.6, style) as u32;
+    let panels_w = cams.iter().map(|c| c.width).sum::<u32>() + 2 * GAP;
+    let key_w = key_width(font, mpp, panels_w as f64 * 0.6, style, None) as u32;
     let width = 2 * MARGIN + panels_w.max(key_w);
     let height = MARGIN + header + PANEL_HEIGHT + footer + MARGIN / 2;
     sheet_size(width as u64, height as u64)?;
@@ -84,12 +96,12 @@ pub fn pose_png(track: &Track, frame: usize, path: &Path) -> Result<(), RenderEr
         },
     );
 
-    let sides = track.figure.sides();
+    let body = Body::of(track);
     let mut x = MARGIN + (width - 2 * MARGIN - panels_w) / 2;
     let y = MARGIN + header;
     for cam in &cams {
         let mut panel = panel_background(cam, font, style, true)?;
-        draw_figure(&mut panel, cam, track, &sides, frame, style);
+        draw_body(&mut panel, cam, track, &body, frame, style);
         blit(&mut sheet, &panel, x, y);
         x += cam.width + GAP;
     }
@@ -102,6 +114,7 @@ pub fn pose_png(track: &Track, frame: usize, path: &Path) -> Result<(), RenderEr
         mpp,
         panels_w as f64 * 0.6,
         style,
+        None,
     );
     write(path, &encode_png(&sheet)?)
 }

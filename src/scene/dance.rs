@@ -483,20 +483,21 @@ fn write_dance(
         .iter()
         .map(|&(a, b)| 0.5 * (a + b) as f64 * dclip.frame_time)
         .collect();
-    let labels: Vec<String> = (0..bars_n)
-        .map(|b| {
-            if pins.contains_key(&b) {
-                format!("bar {b} (pinned)")
-            } else {
-                format!("bar {b}")
-            }
+    // Each column names its bar and the time of the frame it shows.
+    let labels: Vec<String> = mid
+        .iter()
+        .enumerate()
+        .map(|(b, &t)| {
+            let shown = track.frame_at(t) as f64 * track.frame_time;
+            let pinned = if pins.contains_key(&b) { " pinned" } else { "" };
+            format!("bar {b}{pinned} · {shown:.2} s")
         })
         .collect();
     filmstrip_at_png(
         std::slice::from_ref(&track),
         &mid,
         &labels,
-        View::Front,
+        View::ThreeQuarter,
         &out.join("filmstrip.png"),
     )?;
     if scene.render.gif {
