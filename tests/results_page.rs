@@ -1,5 +1,5 @@
 //! The results page (`index.html` in every scene's output folder, and `marionette view`'s page)
-//! in a real browser: `marionette run` of the fall, a short evolution, the high jump and the
+//! in a real browser: `marionette run` of the fall, a short evolution (`scenes/evolve_fall_quick.ron`), the high jump and the
 //! dance, each page opened from its `file://` URL in headless Chromium by
 //! `tests/browser/results.mjs` — no console error and nothing fetched, every motion of the
 //! scene listed, play advancing the frame, the plots' cursor on the playhead, a frame step,
@@ -180,13 +180,8 @@ fn every_scene_writes_a_page_that_plays_in_chromium() {
     let cases: [(&str, &[&str], &[&str], usize); 4] = [
         ("fall", &[], &["(elderly)", "(adult)"], 5_000_000),
         (
-            "evolve_fall",
-            &[
-                "seeds=[1]",
-                "ga.population=6",
-                "ga.generations=2",
-                "render.gif=false",
-            ],
+            "evolve_fall_quick",
+            &["render.gif=false"],
             &[
                 "elderly before",
                 "elderly evolved",

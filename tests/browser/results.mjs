@@ -49,7 +49,11 @@ try {
   const lit = await page.$eval('#stage canvas', (cv) => {
     const d = cv.getContext('2d').getImageData(0, 0, cv.width, cv.height).data;
     let n = 0;
-    for (let i = 0; i < d.length; i += 4) if (Math.abs(d[i] - d[i + 1]) > 30 || Math.abs(d[i + 1] - d[i + 2]) > 30) n++;
+    // A body pixel: coloured (a left or right limb, a touching box, a ring) or the cool grey of
+    // the mid-line; the floor, its grid and the shadows are warm greys (blue below red).
+    for (let i = 0; i < d.length; i += 4) {
+      if (Math.abs(d[i] - d[i + 1]) > 30 || Math.abs(d[i + 1] - d[i + 2]) > 30 || d[i + 2] - d[i] >= 4) n++;
+    }
     return n / (cv.width * cv.height);
   });
   await page.screenshot({ path: shot, fullPage: true });

@@ -444,9 +444,14 @@ function seek(t) {
   draw();
 }
 
+// One frame back or on: to the neighbouring frame of the finest motion (the shortest frame
+// time), from the frame shown now; outside that motion's span, by its frame time.
 function stepFrame(dir) {
   pause();
-  seek(state.t + dir * STEP);
+  const m = motions.reduce((a, b) => (b.frame_time < a.frame_time ? b : a));
+  const local = (state.t - m.start_s) / m.frame_time;
+  if (local < 0 || local > m.frames - 1) { seek(state.t + dir * STEP); return; }
+  seek(m.start_s + (frameOf(m, state.t) + dir) * m.frame_time);
 }
 
 function play() {
