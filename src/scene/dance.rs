@@ -28,8 +28,8 @@ use crate::choreo::search::SearchParams;
 use crate::choreo::segments::{Beat, TempoSource};
 use crate::experiments::dance::{self as generated, DanceFigures, GenerateError, Generated};
 use crate::render::{
-    Figure, Page, PageMotion, PageSong, Plot, Series, Track, View, animation_gif,
-    filmstrip_at_png, plot,
+    Figure, Page, PageMotion, PageSong, Plot, Series, Track, View, animation_gif, filmstrip_at_png,
+    plot,
 };
 
 /// Where the song comes from.
