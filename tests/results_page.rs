@@ -1,10 +1,11 @@
 //! The results page (`index.html` in every scene's output folder, and `marionette view`'s page)
-//! in a real browser: `marionette run` of the fall, a short evolution (`scenes/evolve_fall_quick.ron`), the high jump and the
-//! dance, each page opened from its `file://` URL in headless Chromium by
-//! `tests/browser/results.mjs` — no console error and nothing fetched, every motion of the
-//! scene listed, play advancing the frame, the plots' cursor on the playhead, a frame step,
-//! and each figure standing on the floor in the first frame (its lowest drawn body point at the
-//! floor, its highest a person's height above it). Then `marionette view` on a real BVH of the
+//! in a real browser: `marionette run` of the fall, a short evolution
+//! (`scenes/evolve_fall_quick.ron`), the high jump and the dance, each page opened from its
+//! `file://` URL in headless Chromium by `tests/browser/results.mjs` — no console error and
+//! nothing fetched, every motion of the scene listed, play advancing the frame, the plots'
+//! cursor on the playhead, a frame step, and each figure standing on the floor in the first
+//! frame (its lowest drawn body point at the floor, its highest a person's height above it, its
+//! contact with the floor marked). Then `marionette view` on a real BVH of the
 //! shared data and on a skeleton made up here (Z up, centimetres, names of no known rig, half a
 //! metre below its floor). Screenshots go to `target/results-page/`. Needs Chromium, Node and
 //! `tests/browser/node_modules`: ignored with that reason when absent (`cfg(tool_browser)`).
@@ -77,7 +78,7 @@ fn frames_of(v: &serde_json::Value) -> Vec<u64> {
 
 /// What every page must show: no error, the motions listed as `expected` (each label holding
 /// its text), play advancing the frame, the cursors on the playhead, a frame step, and every
-/// figure standing on the floor at the first frame.
+/// figure standing on the floor at the first frame, something of it marked touching the floor.
 fn check_page(what: &str, v: &serde_json::Value, expected: &[&str]) {
     assert_eq!(v["errors"], serde_json::json!([]), "{what}: {v}");
     let listed: Vec<&str> = v["listed"]
@@ -158,6 +159,18 @@ fn check_page(what: &str, v: &serde_json::Value, expected: &[&str]) {
             "{what}: {} is {:.2} m tall, not standing",
             s["motion"],
             hi - lo
+        );
+        // Standing, it touches the floor (its feet): some box or end segment is marked red.
+        let touching: Vec<&str> = s["touching"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|t| t.as_str().unwrap())
+            .collect();
+        assert!(
+            !touching.is_empty(),
+            "{what}: {} stands but nothing is marked touching the floor",
+            s["motion"]
         );
     }
     assert!(

@@ -10,6 +10,12 @@ const SIDE_RGB = { l: [70, 150, 230], r: [230, 110, 40], c: [175, 178, 184] };
 const PALETTE = [[70, 150, 230], [230, 110, 40], [60, 170, 100], [190, 80, 170], [200, 170, 40], [120, 120, 220]];
 const CONTACT_RGB = [220, 30, 30];
 const CONTACT_M = 0.005; // a box whose lowest corner is this close to the floor, or below, touches it
+// An end segment (foot, hand) touches the floor while its capsule is within END_CONTACT_M of
+// its own lowest height over the motion, when that comes within END_NEAR_M of the floor (joint
+// centres of a capture stand above the floor by the foot's thickness; a hand that never comes
+// near the floor never touches it).
+const END_CONTACT_M = 0.03;
+const END_NEAR_M = 0.15;
 const $ = (id) => document.getElementById(id);
 const el = (tag, attrs = {}, text) => {
   const e = document.createElement(tag);
@@ -60,8 +66,15 @@ const motions = DATA.motions.map((m, idx) => {
     const dx = pts[3 * i] - pts[3 * p], dy = pts[3 * i + 1] - pts[3 * p + 1], dz = pts[3 * i + 2] - pts[3 * p + 2];
     const leaf = !m.parents.includes(i);
     const head = /head/i.test(m.names[p]) || (leaf && /head/i.test(m.names[i]));
-    bones.push({ a: p, b: i, r: radius(Math.hypot(dx, dy, dz), head), side: m.sides[i] });
+    bones.push({ a: p, b: i, r: radius(Math.hypot(dx, dy, dz), head), side: m.sides[i], end: leaf && !head });
   });
+  for (const bone of bones.filter((x) => x.end)) {
+    let rest = Infinity;
+    for (let k = 0; k < m.frames; k++) {
+      rest = Math.min(rest, pts[3 * (k * n + bone.a) + 1], pts[3 * (k * n + bone.b) + 1]);
+    }
+    bone.rest = rest - bone.r;
+  }
   return { ...m, idx, pts, boxes, n, nb, bones, colour: PALETTE[idx % PALETTE.length],
     end: m.start_s + (m.frames - 1) * m.frame_time, shown: true };
 });
@@ -142,7 +155,7 @@ function build() {
   document.body.append(el('section', { id: 'stage' }));
   document.body.append(el('p', { class: 'hint' },
     'drag: orbit · wheel: zoom · space: play/pause · ←/→: frame · ' +
-    (motions.some((m) => m.boxes) ? 'links drawn as their contact boxes; red: touching the floor (a corner within 5 mm of it or below) · ' : 'bones drawn as capsules sized from their lengths · ') +
+    (motions.some((m) => m.boxes) ? 'links drawn as their contact boxes; red: touching the floor (a corner within 5 mm of it or below) · ' : 'bones drawn as capsules sized from their lengths; red: an end segment (foot, hand) on the floor, within 3 cm of its lowest height · ') +
     'blue: left, orange: right · rings: events of the list'));
   const plots = el('section', { id: 'plots' });
   DATA.plots.forEach((p, i) => {
@@ -210,7 +223,7 @@ function setView(name) {
 
 // The volumes of motion m at frame k as drawable pieces: capsules or box faces.
 function pieces(m, k, tint) {
-  const out = [];
+  const out = [], touching = [];
   let lowest = Infinity, highest = -Infinity;
   if (m.boxes) {
     for (let b = 0; b < m.nb; b++) {
@@ -224,7 +237,10 @@ function pieces(m, k, tint) {
       highest = Math.max(highest, c[1] + Math.abs(ax[0][1]) + Math.abs(ax[1][1]) + Math.abs(ax[2][1]));
       const side = sideOf(m.box_names[b]);
       let col = tint ? tint : SIDE_RGB[side];
-      if (low <= CONTACT_M) col = mix(col, CONTACT_RGB, Math.min(1, 0.55 + (CONTACT_M - low) / 0.03));
+      if (low <= CONTACT_M) {
+        col = mix(col, CONTACT_RGB, Math.min(1, 0.55 + (CONTACT_M - low) / 0.03));
+        touching.push(m.box_names[b]);
+      }
       for (let a = 0; a < 3; a++) {
         for (const sg of [-1, 1]) {
           const [u, w] = [0, 1, 2].filter((x) => x !== a);
@@ -242,12 +258,18 @@ function pieces(m, k, tint) {
   } else {
     for (const bone of m.bones) {
       const a = point(m, k, bone.a), b = point(m, k, bone.b);
-      lowest = Math.min(lowest, a[1] - bone.r, b[1] - bone.r);
+      const low = Math.min(a[1], b[1]) - bone.r;
+      lowest = Math.min(lowest, low);
       highest = Math.max(highest, a[1] + bone.r, b[1] + bone.r);
-      out.push({ kind: 'capsule', a, b, r: bone.r, col: tint ? mix(tint, SIDE_RGB[bone.side], 0.25) : SIDE_RGB[bone.side] });
+      let col = tint ? mix(tint, SIDE_RGB[bone.side], 0.25) : SIDE_RGB[bone.side];
+      if (bone.end && bone.rest <= END_NEAR_M && low <= Math.max(bone.rest, 0) + END_CONTACT_M) {
+        col = mix(col, CONTACT_RGB, 0.75);
+        touching.push(m.names[bone.b]);
+      }
+      out.push({ kind: 'capsule', a, b, r: bone.r, col });
     }
   }
-  return { out, lowest, highest };
+  return { out, lowest, highest, touching };
 }
 
 function sideOf(name) {
@@ -275,8 +297,8 @@ function drawView(v, t) {
   const all = [];
   v.stats = [];
   v.motions.forEach((m, i) => {
-    const { out, lowest, highest } = pieces(m, frames[i], overlay ? m.colour : null);
-    v.stats.push({ motion: m.label, frame: frames[i], lowest, highest });
+    const { out, lowest, highest, touching } = pieces(m, frames[i], overlay ? m.colour : null);
+    v.stats.push({ motion: m.label, frame: frames[i], lowest, highest, touching });
     all.push(...out);
     // Shadow: the bones flattened onto the floor.
     g.strokeStyle = 'rgba(60,60,50,0.18)';
@@ -493,8 +515,8 @@ function tick(now) {
   requestAnimationFrame(tick);
 }
 
-// For tests and for anyone scripting the page: the playhead, each motion's frame and the
-// lowest point of each drawn body (m above the floor).
+// For tests and for anyone scripting the page: the playhead, each motion's frame, and of each
+// drawn body its lowest and highest point (m above the floor) and the parts marked touching it.
 window.resultsPage = {
   motions: () => motions.map((m) => m.label),
   time: () => state.t,
