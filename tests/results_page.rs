@@ -391,3 +391,76 @@ fn view_stands_any_bvh_upright_on_its_floor() {
     }
     std::fs::remove_dir_all(&d).unwrap();
 }
+
+/// Runs the command expecting it to fail; its error output.
+fn marionette_fails(args: &[&str]) -> String {
+    let out = Command::new(env!("CARGO_BIN_EXE_marionette"))
+        .args(args)
+        .current_dir(root())
+        .output()
+        .unwrap();
+    assert_eq!(
+        out.status.code(),
+        Some(1),
+        "marionette {args:?} should fail"
+    );
+    assert!(out.stdout.is_empty(), "marionette {args:?} printed a page");
+    String::from_utf8(out.stderr).unwrap()
+}
+
+#[test]
+fn view_refuses_bad_input_naming_the_file_and_what_was_expected() {
+    let d = scratch("bad");
+    let missing = d.join("absent.bvh");
+    let err = marionette_fails(&["view", &missing.display().to_string()]);
+    assert!(err.contains("absent.bvh"), "{err}");
+    let garbage = d.join("garbage.bvh");
+    std::fs::write(&garbage, "not a motion\n").unwrap();
+    let err = marionette_fails(&["view", &garbage.display().to_string()]);
+    assert!(
+        err.contains("garbage.bvh") && err.contains("line 1") && err.contains("HIERARCHY"),
+        "{err}"
+    );
+    let empty = d.join("empty");
+    std::fs::create_dir_all(&empty).unwrap();
+    let err = marionette_fails(&["view", &empty.display().to_string()]);
+    assert!(
+        err.contains("empty") && err.contains("no .bvh file"),
+        "{err}"
+    );
+    let bvh = d.join("inconnu.bvh");
+    std::fs::write(&bvh, made_up_bvh()).unwrap();
+    let err = marionette_fails(&[
+        "view",
+        &bvh.display().to_string(),
+        "--unit-scale",
+        "0.01",
+        "--model",
+        "humanoid99",
+    ]);
+    assert!(
+        err.contains("humanoid99") && err.contains("humanoid24"),
+        "{err}"
+    );
+    // Without a browser: the page is written, names the motion and says how it stood it up.
+    let page = d.join("inconnu.html");
+    let printed = marionette(&[
+        "view",
+        &bvh.display().to_string(),
+        "--unit-scale",
+        "0.01",
+        "--out",
+        &page.display().to_string(),
+    ]);
+    assert_eq!(printed.trim(), page.display().to_string());
+    let html = std::fs::read_to_string(&page).unwrap();
+    assert!(
+        html.contains("\"label\":\"inconnu\""),
+        "the motion is not in the page"
+    );
+    assert!(
+        html.contains("up axis (+Z) is up"),
+        "no word on standing it up"
+    );
+    std::fs::remove_dir_all(&d).unwrap();
+}
