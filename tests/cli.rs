@@ -531,6 +531,27 @@ fn run_sums_up_each_scene_in_a_few_lines_from_its_report() {
     );
     assert!(text.lines().count() <= 40, "{text}");
     assert_eq!(text.matches("done in").count(), 3, "{text}");
+    // Each scene's block names its results page; the last line is the run's page linking them.
+    let index = tour.join("index.html");
+    assert_eq!(
+        text.trim_end().lines().last().unwrap(),
+        format!("page: {}", index.display()),
+        "{text}"
+    );
+    let linked = std::fs::read_to_string(&index).unwrap();
+    for name in ["jumping_knee_kick", "dance", "evolve_fall_quick"] {
+        let page = tour.join(name).join("index.html");
+        assert!(
+            text.contains(&format!("  page: {}\n", page.display())),
+            "{name}: its page not named\n{text}"
+        );
+        assert!(page.is_file(), "{}", page.display());
+        assert!(
+            linked.contains(&format!("href=\"{name}/index.html\"")),
+            "{name}: not linked from {}",
+            index.display()
+        );
+    }
     // The other scene kinds, and --set refused with several scenes.
     let rest = temp("rest");
     let (code, _, err) = run_cli(&[

@@ -15,7 +15,6 @@
 mod common;
 mod editor_fixture;
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command};
 
@@ -24,43 +23,6 @@ use marionette::choreo::augment::augment;
 use marionette::choreo::database::{BuildParams, Database, Manifest, OnRefusal};
 use marionette::choreo::generated::generated_database;
 use marionette::editor::session::Session;
-
-/// Chromium and the Node modules of `tests/browser`, or `None` after saying what is missing.
-fn browser() -> Option<PathBuf> {
-    let chromium = std::env::var_os("CHROMIUM")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from("/usr/bin/chromium"));
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/browser");
-    let node = Command::new("node")
-        .arg("--version")
-        .output()
-        .is_ok_and(|o| o.status.success());
-    let missing: Vec<String> = [
-        (!chromium.exists()).then(|| format!("{} (apt-get install chromium)", chromium.display())),
-        (!node).then(|| "node".to_string()),
-        (!dir.join("node_modules/playwright-core").exists())
-            .then(|| "tests/browser/node_modules (npm ci in tests/browser)".to_string()),
-    ]
-    .into_iter()
-    .flatten()
-    .collect();
-    if missing.is_empty() {
-        return Some(chromium);
-    }
-    let test = std::thread::current()
-        .name()
-        .unwrap_or("this test")
-        .to_string();
-    if common::in_ci() {
-        panic!("{test}: missing {missing:?}; .ci/run installs them");
-    }
-    let _ = writeln!(
-        std::io::stderr(),
-        "SKIPPED: {test}: needs {} (run .ci/run)",
-        missing.join(", ")
-    );
-    None
-}
 
 /// The folder of the browser tests' screenshots and numbers.
 fn shots() -> PathBuf {
@@ -94,7 +56,9 @@ fn node(script: &str, args: &[&Path], chromium: &Path, child: &mut Child) -> ser
     ignore = "needs Chromium, Node and tests/browser/node_modules (installed by .ci/run)"
 )]
 fn the_page_searches_sets_generates_plays_saves_and_exports_in_chromium() {
-    let Some(chromium) = browser() else { return };
+    let Some(chromium) = common::browser() else {
+        return;
+    };
     // A copy of the project's own dance scene (Save writes it back).
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let dir = std::env::temp_dir().join(format!("marionette-editor-page-{}", std::process::id()));
@@ -198,7 +162,9 @@ fn the_page_searches_sets_generates_plays_saves_and_exports_in_chromium() {
     ignore = "needs Chromium, Node and tests/browser/node_modules (installed by .ci/run)"
 )]
 fn latency_of_search_generate_and_first_load_on_2000_segments() {
-    let Some(chromium) = browser() else { return };
+    let Some(chromium) = common::browser() else {
+        return;
+    };
     // The 2,000-segment database of benches/choreo_fill.rs: the shared dance clips (or, without
     // them, the project's generated clips) grown by mirror images and time offsets.
     let dir = marionette::io::data_dir().join("dance");
@@ -295,7 +261,9 @@ fn dance_scene_copy(name: &str) -> PathBuf {
     ignore = "needs Chromium, Node and tests/browser/node_modules (installed by .ci/run)"
 )]
 fn playback_survives_every_action_seeks_loops_and_pauses_with_live_previews() {
-    let Some(chromium) = browser() else { return };
+    let Some(chromium) = common::browser() else {
+        return;
+    };
     let path = dance_scene_copy("playback");
     let (mut child, url, addr, _) = start_editor(&path);
     let shots = shots();
@@ -329,7 +297,9 @@ fn playback_survives_every_action_seeks_loops_and_pauses_with_live_previews() {
     ignore = "needs Chromium, Node and tests/browser/node_modules (installed by .ci/run)"
 )]
 fn a_200_bar_timeline_reads_at_scale_2_and_sounds_within_200_ms() {
-    let Some(chromium) = browser() else { return };
+    let Some(chromium) = common::browser() else {
+        return;
+    };
     let path = editor_fixture::scene("long", 6, 10, 200);
     let (mut child, url, _, _) = start_editor(&path);
     let shots = shots();

@@ -59,7 +59,12 @@ const ASSETS: [(&str, &str, &[u8]); 5] = [
     (
         "/figure.js",
         "text/javascript; charset=utf-8",
-        include_bytes!("page/figure.js"),
+        // The shared orbit camera first: the editor's stick figure extends it.
+        concat!(
+            include_str!("../render/page/orbit.js"),
+            include_str!("page/figure.js")
+        )
+        .as_bytes(),
     ),
     (
         "/timeline.js",

@@ -11,6 +11,9 @@
 //! - [`animation_gif`]: all tracks side by side in the three-quarter view, looping, subsampled
 //!   to a chosen frame rate;
 //!
+//! - [`write_page`]: the results page, one self-contained `index.html` with every motion in 3-D,
+//!   a shared timeline, the plots and the headline figures;
+//!
 //! and from numbers [`plot`]: line plots with title, axis labels, legend and labelled event
 //! markers, as PNG or SVG; from a song's analysis [`music_png`]: waveform, onsets, beats, bars
 //! and bar intensity in one PNG.
@@ -34,6 +37,7 @@ mod facing;
 mod figure;
 mod filmstrip;
 mod music;
+mod page;
 mod plot;
 mod pose;
 mod text;
@@ -46,6 +50,10 @@ pub use camera::{ELEVATION, Eye, View, three_quarter};
 pub use figure::{Figure, Side, Track, side_from_name};
 pub use filmstrip::{filmstrip_at_png, filmstrip_png, filmstrip_view_png};
 pub use music::music_png;
+pub use page::{
+    MAX_PAGE_VALUES, ORBIT_JS, Page, PageBox, PageEvent, PageMotion, PagePlot, PageSong, SONG_RATE,
+    page_html, stand_upright, write_page,
+};
 pub use plot::{Plot, Series, plot};
 pub use pose::pose_png;
 pub use text::FONT_TTF;

@@ -15,13 +15,13 @@ use serde::{Deserialize, Serialize};
 use serde_json::json;
 
 use super::primitives::{JumpingKneeKickScene, PrimitiveRender, draw, knee_kick_config, write_bvh};
-use super::{SceneError, write_output};
+use super::{SceneError, page, write_output};
 use crate::dynamics::forces::external::Push;
 use crate::ecs::character::PhysicalSettings;
 use crate::experiments::active::{ActiveConfig, ActiveOutcome, run_active};
 use crate::experiments::knee_kick;
 use crate::humanoid::ranges::AgeGroup;
-use crate::render::{Plot, Series, plot};
+use crate::render::{Page, Plot, Series, plot};
 
 fn default_push() -> Push {
     Push {
@@ -149,7 +149,7 @@ pub fn run_active_knee_kick(
     };
     let o = run_active(&config, &kk.sequence()).map_err(|e| SceneError::Invalid(e.to_string()))?;
     write_bvh(&out.join("active_knee_kick.bvh"), &o.motion)?;
-    draw(
+    let motions = draw(
         &[
             ("animated (kinematic)", &kk.result_clip),
             (
@@ -160,11 +160,42 @@ pub fn run_active_knee_kick(
         &scene.render,
         out,
     )?;
-    pelvis_plot(&o, out)?;
-    Ok(report(scene, &kk.events, &o))
+    let pelvis = pelvis_plot(&o, out)?;
+    let report = report(scene, &kk.events, &o);
+    let at = |t: Option<f64>| t.map_or("never".to_string(), |t| format!("at {t:.2} s"));
+    page::write(
+        &Page {
+            title: format!("{}: active jumping knee kick", scene.name),
+            headline: vec![
+                format!(
+                    "Before the push the physical character tracks the animation to {:.1}° RMS \
+                     over the joints.",
+                    o.tracking_rms_deg
+                ),
+                format!(
+                    "Pushed at the {} with {:.0} N {}; released {}; fallen {}.",
+                    scene.push.link,
+                    scene.push.force_n,
+                    at(o.push_s),
+                    at(o.release_s),
+                    at(o.fall_s)
+                ),
+                format!(
+                    "Pelvis height {:.2} m at the start, {:.2} m at the end; damage after the \
+                     push {:.0} N.",
+                    o.pelvis_height_m.0, o.pelvis_height_m.1, o.damage
+                ),
+            ],
+            motions,
+            plots: vec![page::timed(pelvis)],
+            ..Page::default()
+        },
+        out,
+    )?;
+    Ok(report)
 }
 
-fn pelvis_plot(o: &ActiveOutcome, out: &Path) -> Result<(), SceneError> {
+fn pelvis_plot(o: &ActiveOutcome, out: &Path) -> Result<Plot, SceneError> {
     let series = |label: &str, k: usize| Series {
         name: label.into(),
         points: o
@@ -183,16 +214,14 @@ fn pelvis_plot(o: &ActiveOutcome, out: &Path) -> Result<(), SceneError> {
             markers.push((t, l.to_string()));
         }
     }
-    plot(
-        &Plot {
-            title: "pelvis height: animated vs physical".into(),
-            x_label: "time (s)".into(),
-            y_label: "pelvis height (m)".into(),
-            series: vec![series("animated", 2), series("physical", 1)],
-            markers,
-        },
-        &out.join("pelvis_height.png"),
-    )?;
+    let pelvis = Plot {
+        title: "pelvis height: animated vs physical".into(),
+        x_label: "time (s)".into(),
+        y_label: "pelvis height (m)".into(),
+        series: vec![series("animated", 2), series("physical", 1)],
+        markers,
+    };
+    plot(&pelvis, &out.join("pelvis_height.png"))?;
     write_output(
         &out.join("pelvis_height.csv"),
         {
@@ -203,7 +232,8 @@ fn pelvis_plot(o: &ActiveOutcome, out: &Path) -> Result<(), SceneError> {
             s
         }
         .as_bytes(),
-    )
+    )?;
+    Ok(pelvis)
 }
 
 fn report(

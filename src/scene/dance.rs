@@ -16,7 +16,7 @@ use serde::{Deserialize, Serialize};
 use serde_json::json;
 
 use super::source::resolve_path;
-use super::{SceneError, write_output};
+use super::{SceneError, page, write_output};
 use crate::choreo::authored::{AuthoredDance, generate};
 use crate::choreo::dance::{self, DanceParams};
 use crate::choreo::database::{BuildParams, ClipOutcome, Database, Manifest, OnRefusal};
@@ -27,7 +27,10 @@ use crate::choreo::music::{Bar, MusicAnalysis, MusicParams, analyze};
 use crate::choreo::search::SearchParams;
 use crate::choreo::segments::{Beat, TempoSource};
 use crate::experiments::dance::{self as generated, DanceFigures, GenerateError, Generated};
-use crate::render::{Figure, Plot, Series, Track, View, animation_gif, filmstrip_at_png, plot};
+use crate::render::{
+    Figure, Page, PageMotion, PageSong, Plot, Series, Track, View, animation_gif, filmstrip_at_png,
+    plot,
+};
 
 /// Where the song comes from.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -433,8 +436,9 @@ pub fn run_dance(
 }
 
 /// Writes the dance `g` of `inputs` into `out`: `motion.bvh` at the song's timing, the song as
-/// WAV when it is synthesized, the filmstrip, the GIF and the intensity plot. Returns the frames
-/// the BVH holds the first frame for before the first bar.
+/// WAV when it is synthesized, the filmstrip, the GIF, the intensity plot and the results page
+/// (the dance with the song in sync). Returns the frames the BVH holds the first frame for
+/// before the first bar.
 fn write_dance(
     scene: &DanceScene,
     inputs: &DanceInputs,
@@ -507,37 +511,102 @@ fn write_dance(
             &out.join("motion.gif"),
         )?;
     }
-    plot(
-        &Plot {
-            title: format!("{}: music and motion intensity per bar", scene.name),
-            x_label: "bar".into(),
-            y_label: "percentile rank (RMS in song, W in database)".into(),
-            series: vec![
-                Series {
-                    name: "music (bar RMS)".into(),
-                    points: music_rank
-                        .iter()
-                        .enumerate()
-                        .map(|(b, v)| (b as f64, *v))
-                        .collect(),
-                },
-                Series {
-                    name: "motion (chosen segment's W)".into(),
-                    points: motion_rank
-                        .iter()
-                        .enumerate()
-                        .map(|(b, v)| (b as f64, *v))
-                        .collect(),
-                },
-            ],
-            markers: pins
-                .keys()
-                .map(|&b| (b as f64, "pin".to_string()))
-                .collect(),
+    let intensity = Plot {
+        title: format!("{}: music and motion intensity per bar", scene.name),
+        x_label: "bar".into(),
+        y_label: "percentile rank (RMS in song, W in database)".into(),
+        series: vec![
+            Series {
+                name: "music (bar RMS)".into(),
+                points: music_rank
+                    .iter()
+                    .enumerate()
+                    .map(|(b, v)| (b as f64, *v))
+                    .collect(),
+            },
+            Series {
+                name: "motion (chosen segment's W)".into(),
+                points: motion_rank
+                    .iter()
+                    .enumerate()
+                    .map(|(b, v)| (b as f64, *v))
+                    .collect(),
+            },
+        ],
+        markers: pins
+            .keys()
+            .map(|&b| (b as f64, "pin".to_string()))
+            .collect(),
+    };
+    plot(&intensity, &out.join("intensity.png"))?;
+    // On the page the same ranks stand at each bar's time in the song, under the playhead; the
+    // dance's frame 0 is the first bar's time in the song.
+    let mut motion = PageMotion::from_track(&track);
+    motion.start_s = d.start_s;
+    let at_bar_times = |x: f64| bars[(x as usize).min(bars_n - 1)].start_s;
+    let mut timed = intensity;
+    timed.x_label = "time in the song at the bar's start (s)".into();
+    for s in &mut timed.series {
+        for p in &mut s.points {
+            p.0 = at_bar_times(p.0);
+        }
+    }
+    for m in &mut timed.markers {
+        m.0 = at_bar_times(m.0);
+    }
+    page::write(
+        &Page {
+            title: format!("{}: dance", scene.name),
+            headline: page_headline(inputs, g),
+            motions: vec![motion],
+            plots: vec![page::timed(timed)],
+            song: Some(PageSong {
+                samples: samples.clone(),
+                sample_rate: *sample_rate,
+                start_s: 0.0,
+            }),
+            notes: vec![],
         },
-        &out.join("intensity.png"),
+        out,
     )?;
     Ok(lead)
+}
+
+/// The dance's headline figures in words, for the results page.
+fn page_headline(inputs: &DanceInputs, g: &Generated) -> Vec<String> {
+    let DanceInputs {
+        song_origin,
+        analysis,
+        bars,
+        db,
+        pins,
+        ..
+    } = inputs;
+    let (d, m) = (&g.dance, &g.figures.metrics);
+    vec![
+        format!(
+            "{} bars of the song ({song_origin}), its tempo found at {:.1} beats/min: {:.1} s of \
+             dance from {:.2} s into the song, {} bars pinned, the rest filled from {} segments.",
+            bars.len(),
+            analysis.tempo_bpm,
+            d.clip.frame_count() as f64 * d.clip.frame_time,
+            d.start_s,
+            pins.len(),
+            db.segments.len()
+        ),
+        format!(
+            "Beat alignment {:.3}; seam jerk peak {:.0} rad/s³ (inside the segments {:.0}); foot \
+             skating {:.3} m/s.",
+            m.beat_alignment_score,
+            m.seam_jerk.peak_rad_s3,
+            m.inside_jerk.peak_rad_s3,
+            m.foot_skating_m_s
+        ),
+        format!(
+            "Music and motion intensity per bar agree with a Spearman correlation of {:.2}.",
+            g.figures.intensity_spearman
+        ),
+    ]
 }
 
 /// The report of the dance `g` of `inputs` (`lead`: frames the BVH holds before the first bar).

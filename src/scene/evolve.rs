@@ -12,9 +12,9 @@ use std::time::Instant;
 use serde::{Deserialize, Serialize};
 use serde_json::json;
 
-use super::fall::{Controller, write_falls};
+use super::fall::{self, Controller, write_falls};
 use super::primitives::PrimitiveRender;
-use super::{SceneError, write_output};
+use super::{SceneError, page, write_output};
 use crate::evolve::{Evaluator, GaConfig, JsonLines, checkpoint, logbook};
 use crate::experiments::evolve_fall::{
     self, BestFall, Checkpointing, EvolutionRun, EvolveConfig, EvolveFallError, EvolveOutcome,
@@ -23,7 +23,7 @@ use crate::experiments::evolve_fall::{
 use crate::experiments::fall::{FallConfig, FallResult};
 use crate::humanoid::fall21;
 use crate::humanoid::ranges::AgeGroup;
-use crate::render::{Plot, Series, plot};
+use crate::render::{Page, Plot, Series, plot};
 
 /// Who evaluates the generations.
 #[derive(Clone, Debug, PartialEq, Default, Serialize, Deserialize)]
@@ -493,18 +493,51 @@ pub fn run_evolve(
         EvolveFallError::Fall(e) => SceneError::from(e),
         e => invalid(e.to_string()),
     })?;
-    write_evolution(scene, &outcome, out)?;
+    let mut page = write_evolution(scene, &outcome, out)?;
+    page.headline = headline(&config, &outcome);
+    page::write(&page, out)?;
     Ok(report(&config, &outcome, &ck_dir))
+}
+
+/// The evolution's headline figures in words, for the results page.
+fn headline(config: &EvolveConfig, outcome: &EvolveOutcome) -> Vec<String> {
+    let mut lines = vec![format!(
+        "{} generations of {} controllers: {} evaluations in {:.0} s.",
+        config.ga.generations,
+        config.ga.population,
+        outcome.evaluations(),
+        outcome.ga_wall_time_s
+    )];
+    for g in &outcome.groups {
+        lines.push(format!(
+            "{}: best damage {:.0} ± {:.0} N at generation 0, {:.0} ± {:.0} N after evolution \
+             (mean ± sd over {} seed{}).",
+            g.age_group.name(),
+            g.initial.mean,
+            g.initial.std,
+            g.final_.mean,
+            g.final_.std,
+            g.seeds.len(),
+            if g.seeds.len() == 1 { "" } else { "s" }
+        ));
+    }
+    for f in outcome.best_falls() {
+        lines.push(fall::fall_headline(
+            &format!("best fall, {}", f.label),
+            &fall::fall_report(&f.result, 0.0),
+        ));
+    }
+    lines
 }
 
 /// Writes the outcome's files into `out`: the logbooks, the fitness curves (Fig. 2), the best
 /// controller of each group, the best falls (BVH, filmstrip, GIF) and their head height
-/// (Fig. 3).
+/// (Fig. 3); returns the results page of them (without its headline).
 fn write_evolution(
     scene: &EvolveFallScene,
     outcome: &EvolveOutcome,
     out: &Path,
-) -> Result<(), SceneError> {
+) -> Result<Page, SceneError> {
     for r in &outcome.runs {
         let stem = format!(
             "logbook_{}_seed{}",
@@ -535,16 +568,14 @@ fn write_evolution(
             }
         })
         .collect();
-    plot(
-        &Plot {
-            title: format!("Best damage so far: {}", scene.name),
-            x_label: "generation".into(),
-            y_label: "damage D (N)".into(),
-            series,
-            markers: vec![],
-        },
-        &out.join("fitness.png"),
-    )?;
+    let fitness = Plot {
+        title: format!("Best damage so far: {}", scene.name),
+        x_label: "generation".into(),
+        y_label: "damage D (N)".into(),
+        series,
+        markers: vec![],
+    };
+    plot(&fitness, &out.join("fitness.png"))?;
     for b in &outcome.best {
         let best = &outcome.runs[b.run];
         if let Some((genes, _)) = &best.state.best {
@@ -562,32 +593,27 @@ fn write_evolution(
             (file, label, &f.result)
         })
         .collect();
-    write_falls(&named, &scene.render, out)?;
-    plot(
-        &Plot {
-            title: format!(
-                "Head height, best fall before and after evolution: {}",
-                scene.name
-            ),
-            x_label: "time (s)".into(),
-            y_label: "head height (m)".into(),
-            series: outcome
-                .best_falls()
-                .map(|f| Series {
-                    name: f.label.clone(),
-                    points: f
-                        .result
-                        .frames
-                        .iter()
-                        .map(|f| (f.time_s, f.head_height_m))
-                        .collect(),
-                })
-                .collect(),
-            markers: vec![],
-        },
-        &out.join("head_height.png"),
-    )?;
-    Ok(())
+    let motions = write_falls(&named, &scene.render, out)?;
+    let head = Plot {
+        title: format!(
+            "Head height, best fall before and after evolution: {}",
+            scene.name
+        ),
+        x_label: "time (s)".into(),
+        y_label: "head height (m)".into(),
+        series: outcome
+            .best_falls()
+            .map(|f| fall::head_height_series(f.label.clone(), &f.result))
+            .collect(),
+        markers: vec![],
+    };
+    plot(&head, &out.join("head_height.png"))?;
+    Ok(Page {
+        title: format!("{}: evolved falls", scene.name),
+        motions,
+        plots: vec![page::timed(head), page::untimed(fitness)],
+        ..Page::default()
+    })
 }
 
 /// The report of one best fall: the figures an evolved fall must not win by an artefact (peak

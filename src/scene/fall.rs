@@ -8,7 +8,7 @@ use serde_json::json;
 
 use super::primitives::PrimitiveRender;
 use super::source::resolve_path;
-use super::{SceneError, draw_tracks, write_output};
+use super::{SceneError, draw_tracks, page, write_output};
 use crate::dynamics::forces::contact::ContactParams;
 use crate::dynamics::forces::external::Push;
 use crate::dynamics::integrator::Integrator;
@@ -17,7 +17,7 @@ use crate::experiments::fall::{FallConfig, FallResult, Ranges};
 use crate::humanoid::fall21;
 use crate::humanoid::ranges::{AgeGroup, RangeTable};
 use crate::humanoid::strength::torque_limits;
-use crate::render::{Figure, Plot, Series, Track, plot};
+use crate::render::{Figure, Page, PageMotion, Plot, Series, Track, plot};
 
 /// Time stepping of a simulation (a field left out keeps the paper's value).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -327,12 +327,13 @@ pub fn fall_report(r: &FallResult, sim_wall_s: f64) -> serde_json::Value {
 }
 
 /// Writes each fall as `<file>.bvh` (fall21 skeleton) and draws them together as
-/// `filmstrip.png` (and `motion.gif`), one track per fall with its label.
+/// `filmstrip.png` (and `motion.gif`), one track per fall with its label; returns the falls as
+/// motions of the results page.
 pub(super) fn write_falls(
     falls: &[(String, String, &FallResult)],
     render: &PrimitiveRender,
     out: &Path,
-) -> Result<(), SceneError> {
+) -> Result<Vec<PageMotion>, SceneError> {
     let clips: Vec<_> = falls
         .iter()
         .map(|(_, _, r)| r.to_model_clip().to_clip())
@@ -358,6 +359,38 @@ pub(super) fn write_falls(
         render.filmstrip_frames,
         render.gif.then_some(render.gif_fps),
         out,
+    )?;
+    falls
+        .iter()
+        .map(|(_, label, r)| page::fall_motion(label, r))
+        .collect()
+}
+
+/// A fall's head height (m) over time (s) as a plot series.
+pub(super) fn head_height_series(name: String, r: &FallResult) -> Series {
+    Series {
+        name,
+        points: r
+            .frames
+            .iter()
+            .map(|f| (f.time_s, f.head_height_m))
+            .collect(),
+    }
+}
+
+/// One fall's headline figures in words, from its report ([`fall_report`]).
+pub(super) fn fall_headline(who: &str, report: &serde_json::Value) -> String {
+    let num = |v: &serde_json::Value| v.as_f64().unwrap_or(f64::NAN);
+    format!(
+        "{who}: damage {:.0} N; the head ends {:.2} m above the floor; the pelvis meets the \
+         floor at {:.2} m/s{}.",
+        num(&report["damage"]),
+        num(&report["final_head_height_m"]),
+        num(&report["pelvis"]["impact_velocity_m_s"]),
+        match report["rest_time_s"].as_f64() {
+            Some(t) if report["came_to_rest"] == true => format!(" and is at rest from {t:.2} s"),
+            _ => " and has not come to rest by the end".to_string(),
+        }
     )
 }
 
@@ -401,32 +434,23 @@ pub fn run_fall(
             (file, format!("{} ({})", scene.name, g.name()), r)
         })
         .collect();
-    write_falls(&named, &scene.render, out)?;
+    let motions = write_falls(&named, &scene.render, out)?;
     let push_end = scene.push.start_s + scene.push.duration_s;
-    plot(
-        &Plot {
-            title: format!("Head height: {}", scene.name),
-            x_label: "time (s)".into(),
-            y_label: "head height (m)".into(),
-            series: results
-                .iter()
-                .zip(&groups)
-                .map(|(r, (g, _))| Series {
-                    name: g.name().into(),
-                    points: r
-                        .frames
-                        .iter()
-                        .map(|f| (f.time_s, f.head_height_m))
-                        .collect(),
-                })
-                .collect(),
-            markers: vec![
-                (scene.push.start_s, "push".into()),
-                (push_end, "push ends".into()),
-            ],
-        },
-        &out.join("head_height.png"),
-    )?;
+    let head = Plot {
+        title: format!("Head height: {}", scene.name),
+        x_label: "time (s)".into(),
+        y_label: "head height (m)".into(),
+        series: results
+            .iter()
+            .zip(&groups)
+            .map(|(r, (g, _))| head_height_series(g.name().into(), r))
+            .collect(),
+        markers: vec![
+            (scene.push.start_s, "push".into()),
+            (push_end, "push ends".into()),
+        ],
+    };
+    plot(&head, &out.join("head_height.png"))?;
     if let Some(e) = evolved_for
         && groups.iter().all(|(g, _)| *g != e)
     {
@@ -444,10 +468,32 @@ pub fn run_fall(
         report["controller_evolved_for"] = json!(e);
     }
     report["damage_weights"] = json!(config.damage_weights);
+    let mut headline = vec![fall_headline(&named[0].1, &report)];
     if let (Some(r), Some((g, _))) = (results.get(1), groups.get(1)) {
         let mut other = fall_report(r, sim_wall);
         other["age_group"] = json!(g);
+        headline.push(fall_headline(&named[1].1, &other));
         report["compared"] = other;
     }
+    headline.push(format!(
+        "Pushed at the {} with {:.0} N from {:.2} s for {:.2} s; {:.1} s simulated at a step of \
+         {} s.",
+        scene.push.link,
+        scene.push.force_n,
+        scene.push.start_s,
+        scene.push.duration_s,
+        config.duration_s,
+        config.dt_s
+    ));
+    page::write(
+        &Page {
+            title: format!("{}: pushed fall", scene.name),
+            headline,
+            motions,
+            plots: vec![page::timed(head)],
+            ..Page::default()
+        },
+        out,
+    )?;
     Ok(report)
 }

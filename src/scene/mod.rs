@@ -11,6 +11,7 @@ mod dance;
 mod evolve;
 mod fall;
 mod output;
+mod page;
 mod primitives;
 mod show;
 mod source;
@@ -23,6 +24,7 @@ pub use dance::{
 };
 pub use evolve::{EvaluatorChoice, EvolveFallScene, run_evolve};
 pub use fall::{Body, Controller, FallScene, Simulation, fall_report, run_fall};
+pub use page::{PAGE_FILE, RunPage, write_run_index};
 pub use primitives::{
     HighJumpScene, JumpingKneeKickScene, PrimitiveRender, knee_kick_config, run_high_jump,
     run_jumping_knee_kick,

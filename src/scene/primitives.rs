@@ -12,7 +12,7 @@ use serde::{Deserialize, Serialize};
 use serde_json::json;
 
 use super::source::{ClipSource, load_motion};
-use super::{SceneError, draw_tracks, write_output};
+use super::{SceneError, draw_tracks, page, write_output};
 use crate::ecs::{
     Clock, Recorder, kinematic_schedule, new_world, run_ticks, spawn_primitive_character,
 };
@@ -22,7 +22,7 @@ use crate::humanoid::{Model, ModelClip};
 use crate::primitive::{
     EventConfig, Gamma, JumpEvents, LearnConfig, Learned, Primitive, Trajectory,
 };
-use crate::render::{Figure, Plot, Series, Track, plot};
+use crate::render::{Figure, Page, PageMotion, Plot, Series, Track, plot};
 
 /// Pictures of a primitive scene.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -130,12 +130,12 @@ fn fit_json(l: &Learned) -> serde_json::Value {
     json!({ "median": l.fit.median_angle_rmse_deg(), "max": l.fit.max_angle_rmse_deg() })
 }
 
-/// Draws tracks of model clips: filmstrip, GIF.
+/// Draws tracks of model clips: filmstrip, GIF; returns them as motions of the results page.
 pub(super) fn draw(
     tracks: &[(&str, &ModelClip)],
     render: &PrimitiveRender,
     out: &Path,
-) -> Result<(), SceneError> {
+) -> Result<Vec<PageMotion>, SceneError> {
     let clips: Vec<_> = tracks.iter().map(|(_, m)| m.to_clip()).collect();
     let figures: Vec<_> = clips.iter().map(|c| Figure::of(&c.skeleton)).collect();
     let frames: Vec<_> = clips.iter().map(|c| c.point_frames()).collect();
@@ -155,7 +155,7 @@ pub(super) fn draw(
         render.gif.then_some(render.gif_fps),
         out,
     )?;
-    Ok(())
+    Ok(t.iter().map(PageMotion::from_track).collect())
 }
 
 /// One DOF of a trajectory as a plot series in degrees, its time shifted by `offset` seconds.
@@ -220,7 +220,7 @@ pub fn run_high_jump(
     }
     save_primitives([&learned.low, &learned.normal, &learned.high], out)?;
     let label = scene.gamma.label();
-    draw(
+    let motions = draw(
         &[
             ("low", &clips.low),
             ("normal", &clips.normal),
@@ -229,26 +229,53 @@ pub fn run_high_jump(
         &scene.render,
         out,
     )?;
-    plot(
-        &Plot {
-            title: format!("Left knee flexion: low, normal and blended high jump ({label})"),
-            x_label: "time (s)".into(),
-            y_label: "left knee flexion (deg)".into(),
-            series: vec![
-                dof_series("low (time-scaled)", &rollouts.low, "left_knee", 0.0)?,
-                dof_series("normal", &rollouts.normal, "left_knee", 0.0)?,
-                dof_series("high", &rollouts.high, "left_knee", 0.0)?,
-            ],
-            markers: vec![],
-        },
-        &out.join("left_knee.png"),
-    )?;
+    let knee = Plot {
+        title: format!("Left knee flexion: low, normal and blended high jump ({label})"),
+        x_label: "time (s)".into(),
+        y_label: "left knee flexion (deg)".into(),
+        series: vec![
+            dof_series("low (time-scaled)", &rollouts.low, "left_knee", 0.0)?,
+            dof_series("normal", &rollouts.normal, "left_knee", 0.0)?,
+            dof_series("high", &rollouts.high, "left_knee", 0.0)?,
+        ],
+        markers: vec![],
+    };
+    plot(&knee, &out.join("left_knee.png"))?;
     let (p, whole) = (&hj.crouch_knee_flexion_deg, &hj.whole_clip_knee_flexion_deg);
     let (fig, pred, plan) = (
         &hj.figures,
         &hj.primitives.prediction,
         &hj.primitives.flight,
     );
+    let mut headline: Vec<String> = [
+        ("low", &fig.low, p.low),
+        ("normal", &fig.normal, p.normal),
+        (&format!("high ({label})"), &fig.high, p.high),
+    ]
+    .iter()
+    .map(|(name, f, knee)| {
+        format!(
+            "{name} jump: the root rises {:.3} m above standing at {:.2} s, {:.3} s in flight; \
+             the left knee bends {knee:.1}° in the crouch.",
+            f.apex_above_standing_m, f.apex_time_s, f.flight_s
+        )
+    })
+    .collect();
+    headline.push(format!(
+        "Extrapolating the two jumps predicts {:.3} m above standing and {:.3} s in flight for \
+         the high jump.",
+        pred.apex_above_standing_m, pred.flight_s
+    ));
+    page::write(
+        &Page {
+            title: format!("{}: high jump", scene.name),
+            headline,
+            motions,
+            plots: vec![page::timed(knee)],
+            ..Page::default()
+        },
+        out,
+    )?;
     Ok(json!({
         "gamma": label,
         "jumps": { "low": fig.low, "normal": fig.normal, "high": fig.high },
@@ -360,7 +387,7 @@ pub fn run_jumping_knee_kick(
 
     write_bvh(&out.join("jumping_knee_kick.bvh"), &kk.result_clip)?;
     save_primitives(&kk.parts, out)?;
-    draw(
+    let motions = draw(
         &[
             (
                 &format!("high jump (A, {})", scene.jump.gamma.label()),
@@ -381,27 +408,47 @@ pub fn run_jumping_knee_kick(
         (ev.leap, "Leap".into()),
         (ev.land, "Land".into()),
     ];
+    let mut plots = vec![];
     for dof in ["left_knee", "right_knee"] {
         let series =
             |label: &str, traj: &Trajectory, offset: f64| dof_series(label, traj, dof, offset);
-        plot(
-            &Plot {
-                title: format!(
-                    "{dof}: high jump, knee kick (placed Bend→Leap) and jumping knee kick"
-                ),
-                x_label: "time (s)".into(),
-                y_label: format!("{dof} flexion (deg)"),
-                series: vec![
-                    series("high jump", &kk.jump_rollout, 0.0)?,
-                    series("knee kick (time-scaled)", &kk.kick_placed_rollout, ev.bend)?,
-                    series("jumping knee kick", &kk.connected.trajectory, 0.0)?,
-                ],
-                markers: markers.clone(),
-            },
-            &out.join(format!("{dof}.png")),
-        )?;
+        let knee = Plot {
+            title: format!("{dof}: high jump, knee kick (placed Bend→Leap) and jumping knee kick"),
+            x_label: "time (s)".into(),
+            y_label: format!("{dof} flexion (deg)"),
+            series: vec![
+                series("high jump", &kk.jump_rollout, 0.0)?,
+                series("knee kick (time-scaled)", &kk.kick_placed_rollout, ev.bend)?,
+                series("jumping knee kick", &kk.connected.trajectory, 0.0)?,
+            ],
+            markers: markers.clone(),
+        };
+        plot(&knee, &out.join(format!("{dof}.png")))?;
+        plots.push(page::timed(knee));
     }
     let (j, gap, parts) = (&kk.junction, &kk.posture_gap_deg, &kk.parts);
+    page::write(
+        &Page {
+            title: format!("{}: jumping knee kick", scene.name),
+            headline: vec![
+                format!(
+                    "Events: start {:.2} s, bend {:.2} s, leap {:.2} s, land {:.2} s.",
+                    ev.start, ev.bend, ev.leap, ev.land
+                ),
+                format!(
+                    "Peak knee flexion of the jumping knee kick: right {:.1}°, left {:.1}°; it \
+                     lands with both feet: {}.",
+                    kk.peak_knee_flexion_deg.right_knee,
+                    kk.peak_knee_flexion_deg.left_knee,
+                    if kk.lands_with_both_feet { "yes" } else { "no" }
+                ),
+            ],
+            motions,
+            plots,
+            ..Page::default()
+        },
+        out,
+    )?;
     Ok(json!({
         "gamma": scene.gamma.label(),
         "jump_gamma": scene.jump.gamma.label(),

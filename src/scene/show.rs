@@ -7,12 +7,12 @@ use serde::{Deserialize, Serialize};
 use serde_json::json;
 
 use super::source::{ClipSource, LoadedMotion, load_motion};
-use super::{SceneError, draw_tracks, write_output};
+use super::{SceneError, draw_tracks, page, write_output};
 use crate::analysis::clip_contacts;
 use crate::ecs::{Clock, Recorder, kinematic_schedule, new_world, spawn_clip_character};
 use crate::humanoid::Model;
 use crate::mapping::effector_errors;
-use crate::render::{Figure, Plot, Series, Track, plot, pose_png};
+use crate::render::{Figure, Page, PageMotion, Plot, Series, Track, plot, pose_png};
 use crate::skeleton::Clip;
 
 /// What pictures a scene draws.
@@ -125,6 +125,11 @@ pub fn run_show(
         scene.render.gif.then_some(scene.render.gif_fps),
         out,
     )?;
+    let mut page = Page {
+        title: format!("{}: motion", scene.name),
+        motions: vec![PageMotion::from_track(&track)],
+        ..Page::default()
+    };
     report["frames"] = json!(clip.frame_count());
     report["fps"] = json!(1.0 / clip.frame_time);
     report["duration_s"] = json!(clip.duration());
@@ -158,19 +163,34 @@ pub fn run_show(
             });
         }
         if !series.is_empty() {
-            plot(
-                &Plot {
-                    title: format!("{}: joint angles on {}", scene.name, m.model.name),
-                    x_label: "time (s)".into(),
-                    y_label: "angle (deg)".into(),
-                    series,
-                    markers: vec![],
-                },
-                &out.join("angles.png"),
-            )?;
+            let angles = Plot {
+                title: format!("{}: joint angles on {}", scene.name, m.model.name),
+                x_label: "time (s)".into(),
+                y_label: "angle (deg)".into(),
+                series,
+                markers: vec![],
+            };
+            plot(&angles, &out.join("angles.png"))?;
+            page.plots.push(page::timed(angles));
         }
         report["model"] = json!(m.model.name);
         report["dof_range_deg"] = serde_json::Value::Object(peaks);
     }
+    page.headline.push(format!(
+        "{} frames at {:.0} frames/s, {:.2} s, from {}{}.",
+        clip.frame_count(),
+        1.0 / clip.frame_time,
+        clip.duration(),
+        scene.clip.file,
+        match &scene.model {
+            Some(m) => format!(", mapped onto {m}"),
+            None => String::new(),
+        }
+    ));
+    if let Some(f) = report["flights"].as_array() {
+        page.headline
+            .push(format!("{} flights (both feet off the floor).", f.len()));
+    }
+    page::write(&page, out)?;
     Ok(report)
 }

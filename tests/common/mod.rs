@@ -85,3 +85,40 @@ pub fn python_with(modules: &[&str]) -> Option<PathBuf> {
     );
     None
 }
+
+/// Chromium and the Node modules of `tests/browser`, or `None` after saying what is missing.
+pub fn browser() -> Option<PathBuf> {
+    let chromium = std::env::var_os("CHROMIUM")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from("/usr/bin/chromium"));
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/browser");
+    let node = std::process::Command::new("node")
+        .arg("--version")
+        .output()
+        .is_ok_and(|o| o.status.success());
+    let missing: Vec<String> = [
+        (!chromium.exists()).then(|| format!("{} (apt-get install chromium)", chromium.display())),
+        (!node).then(|| "node".to_string()),
+        (!dir.join("node_modules/playwright-core").exists())
+            .then(|| "tests/browser/node_modules (npm ci in tests/browser)".to_string()),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
+    if missing.is_empty() {
+        return Some(chromium);
+    }
+    let test = std::thread::current()
+        .name()
+        .unwrap_or("this test")
+        .to_string();
+    if in_ci() {
+        panic!("{test}: missing {missing:?}; .ci/run installs them");
+    }
+    let _ = writeln!(
+        std::io::stderr(),
+        "SKIPPED: {test}: needs {} (run .ci/run)",
+        missing.join(", ")
+    );
+    None
+}

@@ -25,6 +25,7 @@ mod mapping;
 mod music;
 mod render;
 mod run;
+mod view;
 
 use std::process::ExitCode;
 
@@ -61,6 +62,9 @@ enum Command {
     /// Run scene files one after the other; each writes one folder (default out/<scene name>/)
     /// with report.json, and prints its headline figures and where its pictures are.
     Run(run::Args),
+    /// Write the results page (one self-contained HTML file: the motions in 3-D on a shared
+    /// timeline) for a BVH file or a scene's output folder, and print its path.
+    View(view::Args),
     /// Evaluate fall genomes for a GA over the JSON-lines protocol (`--stdin`): the worker a
     /// cluster runs.
     Eval(eval::Args),
@@ -90,6 +94,7 @@ fn main() -> ExitCode {
         Command::Dance(a) => dance::dance(a),
         Command::Edit(a) => edit::edit(a),
         Command::Run(a) => run::run(a),
+        Command::View(a) => view::view(a),
         Command::Eval(a) => eval::eval(a),
         Command::Body(a) => body::body(a),
     };

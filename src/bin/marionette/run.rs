@@ -38,20 +38,38 @@ pub fn run(args: Args) -> Result<()> {
         );
     }
     let many = scenes.len() > 1;
+    let mut pages = Vec::new();
     for path in &scenes {
-        run_one(path, out.as_deref(), many, set.clone(), resume.clone())?;
+        pages.push(run_one(
+            path,
+            out.as_deref(),
+            many,
+            set.clone(),
+            resume.clone(),
+        )?);
     }
+    // The last line: the results page of the one scene, or with several a page linking each
+    // scene's page, in the folder holding their folders.
+    let page = match pages.as_slice() {
+        [one] => one.page.clone(),
+        _ => {
+            let dir = out.unwrap_or_else(|| PathBuf::from("out"));
+            scene::write_run_index(&pages, &dir)?
+        }
+    };
+    println!("page: {}", page.display());
     Ok(())
 }
 
-/// One scene: loaded, overridden, run, and summed up in a few lines.
+/// One scene: loaded, overridden, run, and summed up in a few lines (with several scenes, the
+/// last names its results page). Returns what the run's index page says of it.
 fn run_one(
     path: &Path,
     out: Option<&Path>,
     many: bool,
     mut set: Vec<String>,
     resume: Option<PathBuf>,
-) -> Result<()> {
+) -> Result<scene::RunPage> {
     let scene = Scene::load(path)?;
     if let Some(dir) = resume {
         if !matches!(scene, Scene::EvolveFall(_)) {
@@ -77,12 +95,21 @@ fn run_one(
         wall.unwrap_or(f64::NAN),
         out.display()
     );
-    for line in scene::headline(&scene, &report) {
+    let headline = scene::headline(&scene, &report);
+    for line in &headline {
         println!("  {line}");
     }
     println!("  pictures: {}", pictures(&out)?.join(" "));
     println!("  report: {}", out.join("report.json").display());
-    Ok(())
+    let page = out.join(scene::PAGE_FILE);
+    if many {
+        println!("  page: {}", page.display());
+    }
+    Ok(scene::RunPage {
+        name: scene.name().to_string(),
+        page,
+        headline,
+    })
 }
 
 /// The PNG and GIF files of an output folder, sorted by name.
