@@ -73,6 +73,9 @@ fn the_processor_specific_step_gives_the_portable_steps_bits() {
     let name = "the_processor_specific_step_gives_the_portable_steps_bits";
     let here = fall_steps();
     if std::env::var_os(CHILD).is_some() {
+        // A line of its own first: the test harness's "test NAME ... " is not ended by a
+        // newline before the test's own output.
+        println!();
         for l in &here {
             println!("step {l}");
         }

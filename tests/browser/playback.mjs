@@ -5,8 +5,8 @@
 // Generate while playing, without a page error and with the song time still running; a click on
 // a bar while playing seeks there; a loop keeps the song time inside its bar; after Pause the
 // playhead stands still and the candidates still move; a Set marks the other fills stale until
-// Generate; the bars whose segment is danced twice are marked; a drag scrubs; the song arrives
-// bar by bar.
+// Generate; the bars whose segment is danced twice are marked; a drag scrubs; a candidate plays
+// in context; Save and Export through the buttons; the song arrives bar by bar.
 // MODE "long" (a song of 200 bars, device scale factor 2): the timeline's bar numbers do not
 // overlap; Play from bar 150 sounds within 200 ms of the click; the wheel zooms (the numbers
 // thin less, a click picks the bar under the pointer) and shift+wheel scrolls.
@@ -235,10 +235,18 @@ try {
 
   await clickBar(0);
   await page.waitForFunction(() => document.getElementById('bar-title').textContent === 'Bar 0', null, { timeout: 10000 });
+
+  // Save and Export through the page's buttons: the whole edit, from loading to Export.
+  await page.click('#save');
+  await waitStatus('saved');
+  const download = page.waitForEvent('download', { timeout: 30000 });
+  await page.click('#export');
+  const bvh = join(shots, 'playback_dance.bvh');
+  await (await download).saveAs(bvh);
   checkErrors('at the end');
   await page.waitForTimeout(300); // the last pieces asked for arrive
   const bytes = audio.reduce((x, y) => x + y, 0);
-  console.log(JSON.stringify({ repeated: marked, first_sound_ms: firstSoundMs, audio_pieces: audio.length, audio_bytes: bytes, loop_samples: samples.length, loop_wraps: wraps, status_while_playing: danceShown }));
+  console.log(JSON.stringify({ repeated: marked, first_sound_ms: firstSoundMs, audio_pieces: audio.length, audio_bytes: bytes, loop_samples: samples.length, loop_wraps: wraps, status_while_playing: danceShown, bvh }));
 } finally {
   await browser.close();
 }
