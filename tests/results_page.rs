@@ -336,6 +336,21 @@ fn made_up_bvh() -> String {
     s
 }
 
+/// `marionette view BVH --unit-scale 0.01 --out PAGE` on the made-up centimetre skeleton: it
+/// prints the page's path and nothing else; the page's text.
+fn view_made_up(bvh: &Path, page: &Path) -> String {
+    let printed = marionette(&[
+        "view",
+        &bvh.display().to_string(),
+        "--unit-scale",
+        "0.01",
+        "--out",
+        &page.display().to_string(),
+    ]);
+    assert_eq!(printed.trim(), page.display().to_string());
+    std::fs::read_to_string(page).unwrap()
+}
+
 #[test]
 #[cfg_attr(
     not(tool_browser),
@@ -350,16 +365,7 @@ fn view_stands_any_bvh_upright_on_its_floor() {
     let bvh = d.join("inconnu.bvh");
     std::fs::write(&bvh, made_up_bvh()).unwrap();
     let page = d.join("inconnu.html");
-    let printed = marionette(&[
-        "view",
-        &bvh.display().to_string(),
-        "--unit-scale",
-        "0.01",
-        "--out",
-        &page.display().to_string(),
-    ]);
-    assert_eq!(printed.trim(), page.display().to_string());
-    let html = std::fs::read_to_string(&page).unwrap();
+    let html = view_made_up(&bvh, &page);
     assert!(
         html.contains("up axis (+Z) is up") && html.contains("moved up"),
         "the page does not say how it stood the figure up"
@@ -444,16 +450,7 @@ fn view_refuses_bad_input_naming_the_file_and_what_was_expected() {
     );
     // Without a browser: the page is written, names the motion and says how it stood it up.
     let page = d.join("inconnu.html");
-    let printed = marionette(&[
-        "view",
-        &bvh.display().to_string(),
-        "--unit-scale",
-        "0.01",
-        "--out",
-        &page.display().to_string(),
-    ]);
-    assert_eq!(printed.trim(), page.display().to_string());
-    let html = std::fs::read_to_string(&page).unwrap();
+    let html = view_made_up(&bvh, &page);
     assert!(
         html.contains("\"label\":\"inconnu\""),
         "the motion is not in the page"

@@ -91,7 +91,7 @@ pub struct Session {
 
 /// A seam of [`InContext`]: the connection of segment `from` into segment `to`.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
-pub struct Seam {
+pub struct SeamScore {
     /// The segment before the seam.
     pub from: usize,
     /// The segment after it.
@@ -120,9 +120,9 @@ pub struct InContext {
     /// Song time at which the last bar shown ends, s.
     pub end_s: f64,
     /// The seam from the bar before (none for the song's first bar).
-    pub before: Option<Seam>,
+    pub before: Option<SeamScore>,
     /// The seam into the bar after (none for the song's last bar).
-    pub after: Option<Seam>,
+    pub after: Option<SeamScore>,
     /// The stick-figure frames of the bars shown.
     pub frames: Frames,
 }
@@ -377,7 +377,7 @@ impl Session {
                 &db.segments[b],
                 &e.state().fill.transition,
             );
-            Seam {
+            SeamScore {
                 from: a,
                 to: b,
                 s: c.s,

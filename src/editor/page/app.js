@@ -457,7 +457,6 @@ function drawFrame() {
         // In context: the bars before, this one and after, looped on the page's clock.
         const x = v.context, len = x.end_s - x.start_s, n = x.frames.length;
         const at = (performance.now() / 1000) % len;
-        v.contextTime = x.start_s + at;
         const t = x.start_s + at;
         const k = t < x.bar_start_s ? x.bar - 1 : (t < x.bar_end_s ? x.bar : x.bar + 1);
         const where = k === x.bar ? `▶ bar ${k} (this segment)` : `▶ bar ${k} (neighbour)`;
