@@ -2,8 +2,10 @@
 //! inserts a shorter bar.
 //!
 //! Each beat i gets a downbeat evidence e_i: the rank among the beats of its onset strength in
-//! the low band (bass and kick drum come in on the downbeat) plus half that of its full-band
-//! onset strength; z_i is e_i standardised over the song. The downbeats are the bar positions (0 .. B − 1, B = beats per
+//! the low band (bass and kick drum come in on the downbeat), plus half that of its full-band
+//! onset strength, plus that of the harmonic change at the beat (chords change most often on
+//! the bar's first beat; [`super::chroma::harmonic_change`] over two beats each side); z_i is
+//! e_i standardised over the song. The downbeats are the bar positions (0 .. B − 1, B = beats per
 //! bar) that maximise Σ_{i: position 0} z_i by dynamic programming (Viterbi) over the beats:
 //! the position advances by one each beat and wraps from B − 1 to 0, and a bar may end early
 //! (a bar of fewer beats, as when a song inserts a 2/4 bar) at a cost of `rephase_sd` (in
@@ -40,14 +42,20 @@ pub(super) fn at(x: &[f64], f: f64) -> f64 {
     x[lo.min(hi)..hi].iter().fold(0.0, |m, &v| m.max(v))
 }
 
-/// The standardised downbeat evidence z_i of each beat (module docs): each feature enters as
-/// its rank among the beats (0 to 1), so that one outlier, as the first onset of a song, does
-/// not outweigh the rest.
-pub fn downbeat_evidence(env: &OnsetEnvelope, beat_frames: &[f64]) -> Vec<f64> {
+/// The standardised downbeat evidence z_i of each beat (module docs) from the onsets at each
+/// beat and the harmonic change at each beat (`harmony`, one per beat, or empty to leave it
+/// out): each feature enters as its rank among the beats (0 to 1), so that one outlier, as the
+/// first onset of a song, does not outweigh the rest.
+pub fn downbeat_evidence(env: &OnsetEnvelope, beat_frames: &[f64], harmony: &[f64]) -> Vec<f64> {
     let n = beat_frames.len();
     let mut e = vec![0.0; n];
-    for (x, weight) in [(&env.low, 1.0), (&env.values, 0.5)] {
-        let s: Vec<f64> = beat_frames.iter().map(|&f| at(x, f)).collect();
+    let low: Vec<f64> = beat_frames.iter().map(|&f| at(&env.low, f)).collect();
+    let full: Vec<f64> = beat_frames.iter().map(|&f| at(&env.values, f)).collect();
+    let mut features = vec![(low, 1.0), (full, 0.5)];
+    if harmony.len() == n {
+        features.push((harmony.to_vec(), 1.0));
+    }
+    for (s, weight) in features {
         let mut order: Vec<usize> = (0..n).collect();
         order.sort_by(|&a, &b| s[a].total_cmp(&s[b]).then(a.cmp(&b)));
         for (rank, &i) in order.iter().enumerate() {
@@ -170,7 +178,7 @@ mod tests {
             values,
             low,
         };
-        let z = downbeat_evidence(&env, &frames);
+        let z = downbeat_evidence(&env, &frames, &[]);
         assert_eq!(track_downbeats(&z, 4, f64::INFINITY)[0], 3);
     }
 

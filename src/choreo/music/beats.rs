@@ -26,6 +26,11 @@ pub struct BeatParams {
     /// average at least this strong relative to the onsets on them ([`midpoint_ratio`]): such
     /// a level groups two beats, as kick on 1 and 3 with the snare's backbeat on 2 and 4 does.
     pub midpoint_ratio: f64,
+    /// The beats are also tracked again twice as fast when the harmony changes more halfway
+    /// between them than on them, by at least this factor
+    /// ([`super::chroma::midpoint_harmony_ratio`]): chords change on beats, so such beats are
+    /// every second beat of the song, or off the beat.
+    pub midpoint_harmony: f64,
 }
 
 impl Default for BeatParams {
@@ -34,6 +39,7 @@ impl Default for BeatParams {
             tightness: 100.0,
             trim: 0.5,
             midpoint_ratio: 0.8,
+            midpoint_harmony: 1.0,
         }
     }
 }
@@ -60,12 +66,17 @@ pub fn track_beats(
             expected: "a non-negative number",
         });
     }
-    if params.midpoint_ratio.is_nan() || params.midpoint_ratio < 0.0 {
-        return Err(MusicError::Parameter {
-            name: "midpoint_ratio",
-            value: params.midpoint_ratio,
-            expected: "a non-negative number (inf: never)",
-        });
+    for (name, value) in [
+        ("midpoint_ratio", params.midpoint_ratio),
+        ("midpoint_harmony", params.midpoint_harmony),
+    ] {
+        if value.is_nan() || value < 0.0 {
+            return Err(MusicError::Parameter {
+                name,
+                value,
+                expected: "a non-negative number (inf: never)",
+            });
+        }
     }
     if !(0.0..=1.0).contains(&params.trim) {
         return Err(MusicError::Parameter {

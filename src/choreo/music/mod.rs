@@ -6,8 +6,9 @@
 //! - [`onsets`]: the onset-strength envelope (spectral flux on a log-magnitude spectrogram);
 //! - [`tempo`]: the tempo (autocorrelation of the envelope weighted by a log-normal tempo prior);
 //! - [`beats`]: beat placement by dynamic programming on the envelope (Ellis 2007);
-//! - [`bars`]: bars of 4 beats from downbeats tracked on the bass and the onsets (a shorter bar
-//!   where the song inserts one), or from a given first downbeat;
+//! - [`chroma`]: the harmony between beats (pitch-class profiles) and where it changes;
+//! - [`bars`]: bars of 4 beats from downbeats tracked on the bass, the onsets and the chord
+//!   changes (a shorter bar where the song inserts one), or from a given first downbeat;
 //! - [`eval`]: the standard beat, continuity, tempo and downbeat scores against annotations;
 //! - [`intensity`]: each bar's RMS and its level in dB;
 //! - [`synth`]: a drum track with exact ground truth (tempo, beats, bar loudness) for tests and
@@ -19,6 +20,7 @@
 
 pub mod bars;
 pub mod beats;
+pub mod chroma;
 #[cfg(feature = "audio")]
 pub mod decode;
 pub mod eval;
@@ -34,6 +36,7 @@ use serde::{Deserialize, Serialize};
 
 pub use bars::{Bar, bars_from_downbeats, downbeat_evidence, track_downbeats};
 pub use beats::{BeatParams, track_beats};
+pub use chroma::{Chroma, ChromaParams, harmonic_change, interval_chroma};
 pub use intensity::{bar_intensity, rms_db};
 pub use onsets::{OnsetEnvelope, OnsetParams, onset_envelope};
 pub use tempo::{TempoEstimate, TempoPrior, estimate_tempo};
@@ -141,6 +144,8 @@ pub struct MusicParams {
     pub prior: TempoPrior,
     /// The beat tracker.
     pub beats: BeatParams,
+    /// The chroma of the harmony between beats (the beat level's check and the downbeats).
+    pub chroma: ChromaParams,
     /// Beats per bar (4 for 4/4).
     pub beats_per_bar: usize,
     /// Index of the first downbeat among the beats (0 .. beats_per_bar); every bar then has
@@ -162,6 +167,7 @@ impl Default for MusicParams {
             onsets: OnsetParams::default(),
             prior: TempoPrior::default(),
             beats: BeatParams::default(),
+            chroma: ChromaParams::default(),
             beats_per_bar: 4,
             downbeat: None,
             rephase_sd: 8.0,
@@ -333,14 +339,23 @@ pub fn analyze(
         });
     }
     let mut beat_frames = track_beats(&env, tempo.period_frames, &params.beats)?;
-    // A level whose midpoints are as strong as its beats groups two beats (a backbeat).
+    // A level whose midpoints are as strong as its beats groups two beats (a backbeat); one
+    // whose chords change between its beats is every second beat, or off the beat.
     let fastest = 60.0 * env.frame_rate() / params.prior.max_bpm;
+    let mut halves = None;
     if tempo.period_frames / 2.0 >= fastest
-        && beats::midpoint_ratio(&env, &beat_frames) >= params.beats.midpoint_ratio
+        && (beats::midpoint_ratio(&env, &beat_frames) >= params.beats.midpoint_ratio
+            || chroma::midpoint_harmony_ratio(halves.insert(tonal_halves(
+                samples,
+                sample_rate,
+                &times_of(&env, &beat_frames),
+                &params.chroma,
+            ))) >= params.beats.midpoint_harmony)
     {
         beat_frames = track_beats(&env, tempo.period_frames / 2.0, &params.beats)?;
+        halves = None;
     }
-    let beats_s: Vec<f64> = beat_frames.iter().map(|&f| env.time_of(f)).collect();
+    let beats_s = times_of(&env, &beat_frames);
     if beats_s.len() < 2 {
         return Err(MusicError::TooFewBeats {
             beats: beats_s.len(),
@@ -351,7 +366,10 @@ pub fn analyze(
     let (downbeats, downbeat_given) = match params.downbeat {
         Some(d) => (bars::regular_downbeats(d, bpb, beats_s.len()), true),
         None => {
-            let z = downbeat_evidence(&env, &beat_frames);
+            let halves = halves
+                .unwrap_or_else(|| tonal_halves(samples, sample_rate, &beats_s, &params.chroma));
+            let harmony = harmonic_change(&chroma::beat_chroma(&halves), 2);
+            let z = downbeat_evidence(&env, &beat_frames, &harmony);
             (track_downbeats(&z, bpb, params.rephase_sd), false)
         }
     };
@@ -371,4 +389,24 @@ pub fn analyze(
         bars,
         onsets: env,
     })
+}
+
+/// Times (s) of envelope frames.
+fn times_of(env: &OnsetEnvelope, frames: &[f64]) -> Vec<f64> {
+    frames.iter().map(|&f| env.time_of(f)).collect()
+}
+
+/// The chroma of each half beat of `beats_s` ([`chroma::half_beat_chroma`]); empty for a song
+/// less tonal than `p.min_tonality` (drums, noise), whose harmony is not used.
+fn tonal_halves(
+    samples: &[f32],
+    sample_rate: u32,
+    beats_s: &[f64],
+    p: &ChromaParams,
+) -> Vec<Chroma> {
+    let halves = chroma::half_beat_chroma(samples, sample_rate, beats_s, p);
+    if chroma::tonality(&halves) < p.min_tonality {
+        return vec![];
+    }
+    halves
 }
