@@ -96,8 +96,8 @@ pub enum KeyframeError {
     Content { path: String, message: String },
 }
 
-/// Key `i`'s root values within their bounds and its DOFs those of `model` (named `model_name`), at finite angles
-/// within ±[`MAX_KEY_ANGLE_DEG`]; otherwise what is wrong.
+/// Key `i`'s root values within their bounds and its DOFs those of `model` (named
+/// `model_name`), at finite angles within ±[`MAX_KEY_ANGLE_DEG`]; otherwise what is wrong.
 fn check_key(i: usize, k: &Key, model: &Model, model_name: &str) -> Result<(), String> {
     let root = [
         ("forward", k.forward, MAX_KEY_POSITION_M, "m"),
