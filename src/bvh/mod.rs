@@ -163,6 +163,39 @@ impl Bvh {
                 self.joints.len()
             ));
         }
+        let next_channel = self.check_joints()?;
+        if self.channel_count != next_channel {
+            return invalid(format!(
+                "channel_count is {}, but the joints have {next_channel} channels",
+                self.channel_count
+            ));
+        }
+        let frames_ok = if self.channel_count == 0 {
+            self.motion.is_empty()
+        } else {
+            self.motion.len().is_multiple_of(self.channel_count)
+        };
+        if !frames_ok {
+            return invalid(format!(
+                "motion has {} values, not a whole number of frames of {} channels",
+                self.motion.len(),
+                self.channel_count
+            ));
+        }
+        if !(self.frame_time.is_finite() && self.frame_time > 0.0) {
+            return invalid(format!("frame_time is {}, expected > 0", self.frame_time));
+        }
+        if let Some(k) = self.motion.iter().position(|v| !v.is_finite()) {
+            return invalid(format!("motion value {k} is {}", self.motion[k]));
+        }
+        Ok(())
+    }
+
+    /// [`Bvh::validate`]'s checks of each joint: its name, its parent on the depth-first path,
+    /// its depth, its channels following the ones before, its finite offsets. Returns the
+    /// joints' channel count.
+    fn check_joints(&self) -> Result<usize, BvhError> {
+        let invalid = |message: String| Err(BvhError::Invalid { message });
         let mut seen = std::collections::HashMap::new();
         let mut path: Vec<usize> = Vec::new();
         let mut next_channel = 0usize;
@@ -212,30 +245,6 @@ impl Bvh {
                 return invalid(format!("joint {i} `{n}` has a non-finite offset"));
             }
         }
-        if self.channel_count != next_channel {
-            return invalid(format!(
-                "channel_count is {}, but the joints have {next_channel} channels",
-                self.channel_count
-            ));
-        }
-        let frames_ok = if self.channel_count == 0 {
-            self.motion.is_empty()
-        } else {
-            self.motion.len().is_multiple_of(self.channel_count)
-        };
-        if !frames_ok {
-            return invalid(format!(
-                "motion has {} values, not a whole number of frames of {} channels",
-                self.motion.len(),
-                self.channel_count
-            ));
-        }
-        if !(self.frame_time.is_finite() && self.frame_time > 0.0) {
-            return invalid(format!("frame_time is {}, expected > 0", self.frame_time));
-        }
-        if let Some(k) = self.motion.iter().position(|v| !v.is_finite()) {
-            return invalid(format!("motion value {k} is {}", self.motion[k]));
-        }
-        Ok(())
+        Ok(next_channel)
     }
 }

@@ -309,89 +309,118 @@ impl<'a> Reader<'a> {
         let mut stack: Vec<Open> = Vec::new();
         loop {
             let Some(tok) = self.lex.next() else {
-                let line = self.lex.line;
-                return Err(match stack.last() {
-                    Some(open) => BvhError::Unclosed {
-                        line,
-                        joint: self.joints[open.joint].name.clone(),
-                        opened: open.opened,
-                        found: "the end of the file".into(),
-                    },
-                    None if self.joints.is_empty() => BvhError::UnexpectedEnd {
-                        line,
-                        expected: "ROOT".into(),
-                    },
-                    None => BvhError::MissingMotion { line },
-                });
+                return Err(self.end_in_hierarchy(stack.last()));
             };
-            let t = tok.text;
-            let Some(&open) = stack.last() else {
-                if kw(t, "ROOT") {
-                    stack.push(self.begin_joint(None)?);
-                } else if kw(t, "MOTION") && !self.joints.is_empty() {
-                    return Ok(());
-                } else if t == "}" {
-                    return Err(BvhError::UnmatchedClose {
-                        line: tok.line,
-                        column: tok.column,
-                    });
-                } else if self.joints.is_empty() {
-                    return Err(expected(tok, "ROOT"));
-                } else {
-                    return Err(expected(tok, "ROOT or MOTION"));
+            match stack.last() {
+                None => {
+                    if self.outside_joints(tok, &mut stack)? {
+                        return Ok(());
+                    }
                 }
-                continue;
-            };
-            let j = open.joint;
-            if kw(t, "OFFSET") {
-                if open.has_offset {
-                    return Err(self.joint_item(j, tok, "has a second OFFSET"));
-                }
-                let what = format!("OFFSET of joint `{}`", self.joints[j].name);
-                self.joints[j].offset = self.vec3(&what)?;
-                if let Some(o) = stack.last_mut() {
-                    o.has_offset = true;
-                }
-            } else if kw(t, "CHANNELS") {
-                if open.has_channels {
-                    return Err(self.joint_item(j, tok, "has a second CHANNELS line"));
-                }
-                let channels = self.channels(tok, j)?;
-                self.joints[j].first_channel = self.channel_count;
-                self.channel_count += channels.len();
-                self.joints[j].channels = channels;
-                if let Some(o) = stack.last_mut() {
-                    o.has_channels = true;
-                }
-            } else if kw(t, "JOINT") {
-                self.require_items(open, tok)?;
-                if stack.len() >= MAX_DEPTH {
-                    return Err(BvhError::TooLarge {
-                        line: tok.line,
-                        what: format!(
-                            "the hierarchy is nested deeper than {MAX_DEPTH} joints (a human \
-                             skeleton is about 10 deep)"
-                        ),
-                    });
-                }
-                stack.push(self.begin_joint(Some(j))?);
-            } else if kw(t, "End") {
-                self.require_items(open, tok)?;
-                self.end_site(tok, j)?;
-            } else if t == "}" {
-                self.require_items(open, tok)?;
-                stack.pop();
-            } else if kw(t, "MOTION") || kw(t, "ROOT") {
-                return Err(BvhError::Unclosed {
-                    line: tok.line,
-                    joint: self.joints[j].name.clone(),
-                    opened: open.opened,
-                    found: quote(t),
-                });
-            } else {
-                return Err(expected(tok, "OFFSET, CHANNELS, JOINT, End Site or `}`"));
+                Some(&open) => self.joint_item_of(open, tok, &mut stack)?,
             }
         }
+    }
+
+    /// The error for a file that ends in the hierarchy: inside joint `open`, before any ROOT, or
+    /// before MOTION.
+    fn end_in_hierarchy(&self, open: Option<&Open>) -> BvhError {
+        let line = self.lex.line;
+        match open {
+            Some(open) => BvhError::Unclosed {
+                line,
+                joint: self.joints[open.joint].name.clone(),
+                opened: open.opened,
+                found: "the end of the file".into(),
+            },
+            None if self.joints.is_empty() => BvhError::UnexpectedEnd {
+                line,
+                expected: "ROOT".into(),
+            },
+            None => BvhError::MissingMotion { line },
+        }
+    }
+
+    /// A token outside every joint: ROOT opens one on `stack`, MOTION after a ROOT ends the
+    /// hierarchy (true); anything else is an error.
+    fn outside_joints(&mut self, tok: Token<'_>, stack: &mut Vec<Open>) -> Result<bool, BvhError> {
+        let t = tok.text;
+        if kw(t, "ROOT") {
+            stack.push(self.begin_joint(None)?);
+            Ok(false)
+        } else if kw(t, "MOTION") && !self.joints.is_empty() {
+            Ok(true)
+        } else if t == "}" {
+            Err(BvhError::UnmatchedClose {
+                line: tok.line,
+                column: tok.column,
+            })
+        } else if self.joints.is_empty() {
+            Err(expected(tok, "ROOT"))
+        } else {
+            Err(expected(tok, "ROOT or MOTION"))
+        }
+    }
+
+    /// A token inside joint `open` (the top of `stack`): its OFFSET or CHANNELS, a child JOINT
+    /// or End Site, or the `}` that closes it.
+    fn joint_item_of(
+        &mut self,
+        open: Open,
+        tok: Token<'_>,
+        stack: &mut Vec<Open>,
+    ) -> Result<(), BvhError> {
+        let t = tok.text;
+        let j = open.joint;
+        if kw(t, "OFFSET") {
+            if open.has_offset {
+                return Err(self.joint_item(j, tok, "has a second OFFSET"));
+            }
+            let what = format!("OFFSET of joint `{}`", self.joints[j].name);
+            self.joints[j].offset = self.vec3(&what)?;
+            if let Some(o) = stack.last_mut() {
+                o.has_offset = true;
+            }
+        } else if kw(t, "CHANNELS") {
+            if open.has_channels {
+                return Err(self.joint_item(j, tok, "has a second CHANNELS line"));
+            }
+            let channels = self.channels(tok, j)?;
+            self.joints[j].first_channel = self.channel_count;
+            self.channel_count += channels.len();
+            self.joints[j].channels = channels;
+            if let Some(o) = stack.last_mut() {
+                o.has_channels = true;
+            }
+        } else if kw(t, "JOINT") {
+            self.require_items(open, tok)?;
+            if stack.len() >= MAX_DEPTH {
+                return Err(BvhError::TooLarge {
+                    line: tok.line,
+                    what: format!(
+                        "the hierarchy is nested deeper than {MAX_DEPTH} joints (a human \
+                         skeleton is about 10 deep)"
+                    ),
+                });
+            }
+            stack.push(self.begin_joint(Some(j))?);
+        } else if kw(t, "End") {
+            self.require_items(open, tok)?;
+            self.end_site(tok, j)?;
+        } else if t == "}" {
+            self.require_items(open, tok)?;
+            stack.pop();
+        } else if kw(t, "MOTION") || kw(t, "ROOT") {
+            return Err(BvhError::Unclosed {
+                line: tok.line,
+                joint: self.joints[j].name.clone(),
+                opened: open.opened,
+                found: quote(t),
+            });
+        } else {
+            return Err(expected(tok, "OFFSET, CHANNELS, JOINT, End Site or `}`"));
+        }
+        Ok(())
     }
 
     fn joint_item(&self, j: usize, tok: Token<'_>, problem: &str) -> BvhError {
@@ -684,62 +713,7 @@ fn read_motion(
                 declared_line: frames_line,
             });
         }
-        let line_start = pos;
-        let mut count = 0usize;
-        loop {
-            while pos < n && is_space(bytes[pos]) {
-                pos += 1;
-            }
-            if pos >= n || bytes[pos] == b'\n' {
-                break;
-            }
-            let start = pos;
-            while pos < n && !is_space(bytes[pos]) && bytes[pos] != b'\n' {
-                pos += 1;
-            }
-            count += 1;
-            if count > channels {
-                return Err(BvhError::FrameValueCount {
-                    line,
-                    frame: frame + 1,
-                    expected: channels,
-                    found: count + count_tokens(&bytes[pos..]),
-                });
-            }
-            let token = &text[start..pos];
-            let Ok(v) = token.parse::<f64>() else {
-                return Err(BvhError::Expected {
-                    line,
-                    column: start - line_start + 1,
-                    expected: format!("a number (value {count} of frame {})", frame + 1),
-                    found: quote(token),
-                });
-            };
-            if !v.is_finite() {
-                return Err(BvhError::NonFinite {
-                    line,
-                    column: start - line_start + 1,
-                    what: format!("value {count} of frame {}", frame + 1),
-                    found: token.chars().take(QUOTE_MAX).collect(),
-                });
-            }
-            let limit = limits[count - 1];
-            if v.abs() > limit {
-                let kind = if limit == MAX_ANGLE_DEG {
-                    "a rotation in degrees"
-                } else {
-                    "a position in file units"
-                };
-                return Err(BvhError::OutOfRange {
-                    line,
-                    column: start - line_start + 1,
-                    what: format!("value {count} of frame {}, {kind},", frame + 1),
-                    found: token.chars().take(QUOTE_MAX).collect(),
-                    limit,
-                });
-            }
-            motion.push(v);
-        }
+        let count = frame_values(text, &mut pos, line, frame, limits, &mut motion)?;
         if count == 0 {
             if blank_lines == 0 {
                 first_blank = line;
@@ -764,10 +738,104 @@ fn read_motion(
             message: format!("{blank_lines} blank line(s) inside the motion ignored"),
         });
     }
-    // Anything after the declared frames: count the non-blank lines and ignore them.
+    let tail = bytes.get(pos..).unwrap_or(&[]);
+    warnings.extend(lines_after_frames(tail, line, frames, frames_line));
+    Ok(motion)
+}
+
+/// Reads the values of the motion line of frame `frame` (from 0) starting at byte `*pos` (line
+/// `line`) into `motion`, leaving `*pos` on its line feed (or the end); returns how many there
+/// are. Errors: more than `limits.len()`, or a value that is not a number within its limit.
+fn frame_values(
+    text: &str,
+    pos: &mut usize,
+    line: usize,
+    frame: usize,
+    limits: &[f64],
+    motion: &mut Vec<f64>,
+) -> Result<usize, BvhError> {
+    let (bytes, n, channels) = (text.as_bytes(), text.len(), limits.len());
+    let line_start = *pos;
+    let mut count = 0usize;
+    loop {
+        while *pos < n && is_space(bytes[*pos]) {
+            *pos += 1;
+        }
+        if *pos >= n || bytes[*pos] == b'\n' {
+            break;
+        }
+        let start = *pos;
+        while *pos < n && !is_space(bytes[*pos]) && bytes[*pos] != b'\n' {
+            *pos += 1;
+        }
+        count += 1;
+        if count > channels {
+            return Err(BvhError::FrameValueCount {
+                line,
+                frame: frame + 1,
+                expected: channels,
+                found: count + count_tokens(&bytes[*pos..]),
+            });
+        }
+        let token = &text[start..*pos];
+        let at = (line, start - line_start + 1);
+        motion.push(motion_value(token, limits[count - 1], at, count, frame)?);
+    }
+    Ok(count)
+}
+
+/// Value `count` (from 1) of frame `frame` (from 0), the text `token` at (line, column) `at`:
+/// a finite number no larger than `limit` in magnitude.
+fn motion_value(
+    token: &str,
+    limit: f64,
+    (line, column): (usize, usize),
+    count: usize,
+    frame: usize,
+) -> Result<f64, BvhError> {
+    let Ok(v) = token.parse::<f64>() else {
+        return Err(BvhError::Expected {
+            line,
+            column,
+            expected: format!("a number (value {count} of frame {})", frame + 1),
+            found: quote(token),
+        });
+    };
+    if !v.is_finite() {
+        return Err(BvhError::NonFinite {
+            line,
+            column,
+            what: format!("value {count} of frame {}", frame + 1),
+            found: token.chars().take(QUOTE_MAX).collect(),
+        });
+    }
+    if v.abs() > limit {
+        let kind = if limit == MAX_ANGLE_DEG {
+            "a rotation in degrees"
+        } else {
+            "a position in file units"
+        };
+        return Err(BvhError::OutOfRange {
+            line,
+            column,
+            what: format!("value {count} of frame {}, {kind},", frame + 1),
+            found: token.chars().take(QUOTE_MAX).collect(),
+            limit,
+        });
+    }
+    Ok(v)
+}
+
+/// The warning for the non-blank lines of `tail` (starting at line `line`) after the `frames`
+/// frames declared on line `frames_line`, which are ignored; `None` when there are none.
+fn lines_after_frames(
+    tail: &[u8],
+    line: usize,
+    frames: usize,
+    frames_line: usize,
+) -> Option<BvhWarning> {
     let mut extra = 0usize;
     let mut first_extra = 0usize;
-    let tail = bytes.get(pos..).unwrap_or(&[]);
     for (i, l) in tail.split(|&b| b == b'\n').enumerate() {
         if l.iter().any(|&b| !is_space(b)) {
             if extra == 0 {
@@ -776,15 +844,12 @@ fn read_motion(
             extra += 1;
         }
     }
-    if extra > 0 {
-        warnings.push(BvhWarning {
-            line: first_extra,
-            message: format!(
-                "{extra} line(s) after the {frames} frames declared on line {frames_line} ignored"
-            ),
-        });
-    }
-    Ok(motion)
+    (extra > 0).then(|| BvhWarning {
+        line: first_extra,
+        message: format!(
+            "{extra} line(s) after the {frames} frames declared on line {frames_line} ignored"
+        ),
+    })
 }
 
 /// Number of tokens on the rest of the current line of `bytes`.

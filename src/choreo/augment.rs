@@ -198,17 +198,49 @@ pub fn augment(db: &Database, target_segments: usize, seed: u64) -> Database {
 /// [`augment`], also saying how each segment was made.
 pub fn augment_with_variants(db: &Database, target_segments: usize, seed: u64) -> Augmented {
     let model = humanoid24();
-    let (alpha, axes) = (&db.params.alpha, db.params.eros_axes);
-    // The per-bar factor from the recomputed W to the stored intensity.
-    let factors: Vec<f64> = db
-        .segments
+    let factors = intensity_factors(db, &model);
+    let variants = choose_variants(db, target_segments, seed);
+    let segments: Vec<Segment> = variants
+        .par_iter()
+        .map(|v| variant_segment(db, &model, &factors, v))
+        .collect();
+    let pcas: Vec<&Pca> = segments.iter().map(|s| &s.eros).collect();
+    let weights = eros_weights(&pcas);
+    let mut sources = db.sources.clone();
+    for (i, src) in sources.iter_mut().enumerate() {
+        src.segments = segments.iter().filter(|s| s.clip == i).count();
+    }
+    Augmented {
+        database: Database {
+            format_version: db.format_version,
+            model: db.model.clone(),
+            params: db.params.clone(),
+            sources,
+            skipped: db.skipped.clone(),
+            segments,
+            eros_weights: weights,
+        },
+        variants,
+    }
+}
+
+/// Each segment's factor from the W recomputed on `model` to its stored intensity.
+fn intensity_factors(db: &Database, model: &Model) -> Vec<f64> {
+    let alpha = &db.params.alpha;
+    db.segments
         .par_iter()
         .map(|s| {
-            let (w, _) = w_of(&s.clip(&model), alpha);
+            let (w, _) = w_of(&s.clip(model), alpha);
             let mean = w.iter().sum::<f64>() / w.len().max(1) as f64;
             if mean > 0.0 { s.intensity / mean } else { 1.0 }
         })
-        .collect();
+        .collect()
+}
+
+/// The `target_segments` variants (module docs): the originals first, then mirror images and
+/// time offsets tier by tier (quarter-bar offsets and mirror images, eighth-bar offsets, the
+/// rest), each tier shuffled by `seed`.
+fn choose_variants(db: &Database, target_segments: usize, seed: u64) -> Vec<Variant> {
     let mut variants: Vec<Variant> = (0..db.segments.len().min(target_segments))
         .map(|source| Variant {
             source,
@@ -252,49 +284,33 @@ pub fn augment_with_variants(db: &Database, target_segments: usize, seed: u64) -
             variants.extend(t.iter().take(room));
         }
     }
-    let segments: Vec<Segment> = variants
-        .par_iter()
-        .map(|v| {
-            let s = &db.segments[v.source];
-            let n = s.frame_count();
-            let bar_s = s.end_s - s.start_s;
-            let mut clip = s.clip(&model);
-            let mut scale = vec![factors[v.source]; n];
-            if v.shift_frames > 0 {
-                let next = db.segments[v.source + 1].clip(&model);
-                clip.root_translation.extend(next.root_translation);
-                clip.root_rotation.extend(next.root_rotation);
-                clip.angles.extend(next.angles);
-                clip = frames(&clip, v.shift_frames, n);
-                for c in &mut scale[n - v.shift_frames..] {
-                    *c = factors[v.source + 1];
-                }
-            }
-            if v.mirrored {
-                clip = mirror_clip(&clip);
-            }
-            let start_s = s.start_s + bar_s * v.shift_frames as f64 / n as f64;
-            describe(&clip, s, start_s, &scale, alpha, axes)
-        })
-        .collect();
-    let pcas: Vec<&Pca> = segments.iter().map(|s| &s.eros).collect();
-    let weights = eros_weights(&pcas);
-    let mut sources = db.sources.clone();
-    for (i, src) in sources.iter_mut().enumerate() {
-        src.segments = segments.iter().filter(|s| s.clip == i).count();
+    variants
+}
+
+/// The segment of variant `v`: its source bar (continued into the next bar by its offset,
+/// mirrored if it is), described afresh with the sources' intensity `factors`.
+fn variant_segment(db: &Database, model: &Model, factors: &[f64], v: &Variant) -> Segment {
+    let (alpha, axes) = (&db.params.alpha, db.params.eros_axes);
+    let s = &db.segments[v.source];
+    let n = s.frame_count();
+    let bar_s = s.end_s - s.start_s;
+    let mut clip = s.clip(model);
+    let mut scale = vec![factors[v.source]; n];
+    if v.shift_frames > 0 {
+        let next = db.segments[v.source + 1].clip(model);
+        clip.root_translation.extend(next.root_translation);
+        clip.root_rotation.extend(next.root_rotation);
+        clip.angles.extend(next.angles);
+        clip = frames(&clip, v.shift_frames, n);
+        for c in &mut scale[n - v.shift_frames..] {
+            *c = factors[v.source + 1];
+        }
     }
-    Augmented {
-        database: Database {
-            format_version: db.format_version,
-            model: db.model.clone(),
-            params: db.params.clone(),
-            sources,
-            skipped: db.skipped.clone(),
-            segments,
-            eros_weights: weights,
-        },
-        variants,
+    if v.mirrored {
+        clip = mirror_clip(&clip);
     }
+    let start_s = s.start_s + bar_s * v.shift_frames as f64 / n as f64;
+    describe(&clip, s, start_s, &scale, alpha, axes)
 }
 
 #[cfg(test)]

@@ -172,6 +172,16 @@ impl Place {
         )
     }
 
+    /// The floor point of local (x, z).
+    fn floor(&self, x: f64, z: f64) -> DVec3 {
+        self.at(x, z, 0.0)
+    }
+
+    /// The feet's floor points standing square, `[left, right]`.
+    fn home(&self) -> [DVec3; 2] {
+        [self.floor(STANCE, 0.0), self.floor(-STANCE, 0.0)]
+    }
+
     /// Local coordinates (x, z) of a world point.
     fn local(&self, p: DVec3) -> (f64, f64) {
         let (s, c) = self.yaw.sin_cos();
@@ -263,203 +273,26 @@ fn move_poses(m: Move, p0: &Pose, at: Place, amp: f64, end: Arms) -> [Pose; 4] {
         q.drop = SOFT;
         q.waist = [0.0, 0.0];
     }
-    let floor = |x: f64, z: f64| at.at(x, z, 0.0);
-    let (l0, r0) = (at.local(p0.toes[0]), at.local(p0.toes[1]));
-    let home = [floor(STANCE, 0.0), floor(-STANCE, 0.0)];
+    let from = [at.local(p0.toes[0]), at.local(p0.toes[1])];
     let endarm = arm(end);
     match m {
         Move::StepTouch {
             side,
             step,
             pattern,
-        } => {
-            let d = step * amp;
-            let (lead, trail) = (foot(side), 1 - foot(side));
-            let from = [l0, r0];
-            let shifted = |i: usize| floor(from[i].0 + side * d, from[i].1);
-            p[0].toes[lead] = shifted(lead);
-            p[0].weight = weight_on(lead, 0.7);
-            p[0].drop = SOFT + 0.05 * amp;
-            p[1].toes = p[0].toes;
-            p[1].toes[trail] = shifted(trail);
-            p[1].weight = weight_on(lead, 0.6);
-            p[2].toes = p[1].toes;
-            p[2].toes[trail] = home[trail];
-            p[2].weight = weight_on(trail, 0.7);
-            p[2].drop = SOFT + 0.05 * amp;
-            p[3].toes = home;
-            p[3].weight = 0.5;
-            p[0].waist[1] = -6.0 * side;
-            p[2].waist[1] = 6.0 * side;
-            let (a, b) = match pattern % 3 {
-                0 => ([60.0, 15.0, 30.0], [-30.0, 15.0, 20.0]),
-                1 => (arm(Arms::Open), [70.0, -5.0, 70.0]),
-                _ => (arm(Arms::High), [120.0, 20.0, 80.0]),
-            };
-            match pattern % 3 {
-                0 => {
-                    p[0].arms[lead] = b;
-                    p[0].arms[trail] = a;
-                    p[1].arms = [arm(Arms::Low); 2];
-                    p[2].arms[lead] = a;
-                    p[2].arms[trail] = b;
-                }
-                _ => {
-                    p[0].arms = [a; 2];
-                    p[1].arms = [b; 2];
-                    p[2].arms = [a; 2];
-                }
-            }
-        }
+        } => step_touch(&mut p, at, amp, from, side, step, pattern),
         Move::Grapevine { side, step, high } => {
-            let d = step * amp;
-            let (lead, trail) = (foot(side), 1 - foot(side));
-            let lead_x = if lead == 0 { l0.0 } else { r0.0 };
-            let x1 = lead_x + side * d;
-            p[0].toes[lead] = floor(x1, 0.0);
-            p[0].weight = weight_on(lead, 0.7);
-            p[0].drop = SOFT + 0.04 * amp;
-            p[1].toes = p[0].toes;
-            p[1].toes[trail] = floor(x1 - side * 0.03, -0.2);
-            p[1].weight = weight_on(trail, 0.6);
-            p[1].drop = SOFT + 0.07 * amp;
-            let x3 = x1 + side * (STANCE + 0.5 * d);
-            p[2].toes = p[1].toes;
-            p[2].toes[lead] = floor(x3, 0.0);
-            p[2].weight = weight_on(lead, 0.7);
-            p[2].drop = SOFT + 0.04 * amp;
-            p[3].toes = p[2].toes;
-            p[3].toes[trail] = floor(x3 - side * 2.0 * STANCE, 0.0);
-            p[3].weight = 0.5;
-            let out = if high {
-                arm(Arms::High)
-            } else {
-                arm(Arms::Open)
-            };
-            p[0].arms = [out; 2];
-            p[1].arms = [arm(Arms::Front); 2];
-            p[2].arms = [out; 2];
-            p[1].waist = [8.0, 0.0];
+            let x0 = from[foot(side)].0;
+            grapevine(&mut p, at, amp, x0, side, step, high)
         }
-        Move::ArmWave { pattern } => {
-            p.iter_mut().for_each(|q| q.toes = home);
-            for (k, q) in p.iter_mut().enumerate() {
-                let down = k % 2 == 0;
-                q.drop = if down { SOFT + 0.06 * amp } else { SOFT };
-                q.weight = if k == 3 {
-                    0.5
-                } else if down {
-                    0.35
-                } else {
-                    0.65
-                };
-                q.waist[1] = if k == 3 {
-                    0.0
-                } else if down {
-                    8.0
-                } else {
-                    -8.0
-                };
-            }
-            match pattern % 3 {
-                0 => {
-                    p[0].arms = [arm(Arms::High), arm(Arms::Open)];
-                    p[1].arms = [arm(Arms::Open); 2];
-                    p[2].arms = [arm(Arms::Open), arm(Arms::High)];
-                }
-                1 => {
-                    let bent = [160.0, 30.0, 80.0];
-                    p[0].arms = [bent; 2];
-                    p[1].arms = [arm(Arms::High); 2];
-                    p[2].arms = [bent; 2];
-                }
-                _ => {
-                    let punch = [90.0, 0.0, 0.0];
-                    p[0].arms = [punch, arm(Arms::Hips)];
-                    p[1].arms = [arm(Arms::Hips), punch];
-                    p[2].arms = [punch, arm(Arms::Hips)];
-                }
-            }
-        }
-        Move::Turn { angle, high } => {
-            // Turn about the place's origin; the feet step alternately to their places under the
-            // new heading (the inside foot first), the other keeping its toe and heading.
-            let first = foot(angle);
-            let order = [first, 1 - first, first, 1 - first];
-            let yaws = [angle / 3.0, 2.0 * angle / 3.0, angle, angle];
-            for k in 0..4 {
-                let turned = Place {
-                    origin: at.origin,
-                    yaw: at.yaw + yaws[k],
-                };
-                if k > 0 {
-                    p[k].toes = p[k - 1].toes;
-                    p[k].heading = p[k - 1].heading;
-                }
-                let i = order[k];
-                let x = if i == 0 { STANCE } else { -STANCE };
-                p[k].toes[i] = turned.at(x, 0.0, 0.0);
-                p[k].heading[i] = turned.yaw;
-                p[k].yaw = turned.yaw;
-                p[k].weight = if k == 3 { 0.5 } else { weight_on(i, 0.65) };
-                p[k].drop = SOFT + if k % 2 == 0 { 0.04 * amp } else { 0.0 };
-                p[k].arms = if high {
-                    [arm(Arms::High); 2]
-                } else {
-                    [arm(Arms::Open); 2]
-                };
-            }
-        }
+        Move::ArmWave { pattern } => arm_wave(&mut p, at, amp, pattern),
+        Move::Turn { angle, high } => turn(&mut p, at, amp, angle, high),
         Move::Kick {
             side,
             front,
             height,
-        } => {
-            let (kick, support) = (foot(side), 1 - foot(side));
-            let hx = if kick == 0 { STANCE } else { -STANCE };
-            let h = height * amp;
-            let chamber = at.at(hx, 0.12, 0.22 * h / 0.45);
-            let out = if front {
-                at.at(hx, 0.45, h)
-            } else {
-                at.at(hx + side * 0.4 * h / 0.45, 0.05, 0.8 * h)
-            };
-            p[0].toes[kick] = chamber;
-            p[1].toes[kick] = out;
-            p[2].toes[kick] = chamber;
-            p[3].toes = home;
-            for q in &mut p[..3] {
-                q.weight = weight_on(support, 0.92);
-                q.drop = SOFT + 0.04;
-            }
-            p[3].weight = 0.5;
-            let (ka, sa) = (kick, support);
-            p[0].arms[ka] = arm(Arms::Hips);
-            p[0].arms[sa] = arm(Arms::Hips);
-            p[1].arms[ka] = arm(Arms::Open);
-            p[1].arms[sa] = arm(Arms::Front);
-            p[2].arms = p[0].arms;
-            p[1].waist = [if front { -5.0 } else { 0.0 }, -8.0 * side];
-        }
-        Move::KneeDrop { depth, pattern } => {
-            p.iter_mut().for_each(|q| q.toes = home);
-            let d = depth * amp;
-            let (down, up) = if pattern % 2 == 0 {
-                ([40.0, 20.0, 10.0], arm(Arms::High))
-            } else {
-                ([150.0, 40.0, 60.0], [170.0, 5.0, 0.0])
-            };
-            p[0].drop = SOFT + d;
-            p[0].waist = [18.0, 0.0];
-            p[0].arms = [down; 2];
-            p[1].arms = [up; 2];
-            p[2].drop = SOFT + d;
-            p[2].waist = [18.0, 0.0];
-            p[2].arms = [down; 2];
-            for q in &mut p {
-                q.weight = 0.5;
-            }
-        }
+        } => kick(&mut p, at, amp, side, front, height),
+        Move::KneeDrop { depth, pattern } => knee_drop(&mut p, at, amp, depth, pattern),
     }
     // Feet that do not turn keep their heading; the last pose stands square.
     if !matches!(m, Move::Turn { .. }) {
@@ -472,6 +305,218 @@ fn move_poses(m: Move, p0: &Pose, at: Place, amp: f64, end: Arms) -> [Pose; 4] {
     p[3].drop = SOFT;
     p[3].waist = [0.0, 0.0];
     p
+}
+
+/// [`Move::StepTouch`]'s poses: the lead foot steps `step` to `side` from the toes' local
+/// places `from`, the trail foot touches beside it, back home; one of three arm patterns.
+fn step_touch(
+    p: &mut [Pose; 4],
+    at: Place,
+    amp: f64,
+    from: [(f64, f64); 2],
+    side: f64,
+    step: f64,
+    pattern: u8,
+) {
+    let home = at.home();
+    let d = step * amp;
+    let (lead, trail) = (foot(side), 1 - foot(side));
+    let shifted = |i: usize| at.floor(from[i].0 + side * d, from[i].1);
+    p[0].toes[lead] = shifted(lead);
+    p[0].weight = weight_on(lead, 0.7);
+    p[0].drop = SOFT + 0.05 * amp;
+    p[1].toes = p[0].toes;
+    p[1].toes[trail] = shifted(trail);
+    p[1].weight = weight_on(lead, 0.6);
+    p[2].toes = p[1].toes;
+    p[2].toes[trail] = home[trail];
+    p[2].weight = weight_on(trail, 0.7);
+    p[2].drop = SOFT + 0.05 * amp;
+    p[3].toes = home;
+    p[3].weight = 0.5;
+    p[0].waist[1] = -6.0 * side;
+    p[2].waist[1] = 6.0 * side;
+    let (a, b) = match pattern % 3 {
+        0 => ([60.0, 15.0, 30.0], [-30.0, 15.0, 20.0]),
+        1 => (arm(Arms::Open), [70.0, -5.0, 70.0]),
+        _ => (arm(Arms::High), [120.0, 20.0, 80.0]),
+    };
+    match pattern % 3 {
+        0 => {
+            p[0].arms[lead] = b;
+            p[0].arms[trail] = a;
+            p[1].arms = [arm(Arms::Low); 2];
+            p[2].arms[lead] = a;
+            p[2].arms[trail] = b;
+        }
+        _ => {
+            p[0].arms = [a; 2];
+            p[1].arms = [b; 2];
+            p[2].arms = [a; 2];
+        }
+    }
+}
+
+/// [`Move::Grapevine`]'s poses: the lead foot (its toe at local x `x0`) steps to `side`, the
+/// trail foot crosses behind, step, close; arms open (or `high`).
+fn grapevine(p: &mut [Pose; 4], at: Place, amp: f64, x0: f64, side: f64, step: f64, high: bool) {
+    let d = step * amp;
+    let (lead, trail) = (foot(side), 1 - foot(side));
+    let x1 = x0 + side * d;
+    p[0].toes[lead] = at.floor(x1, 0.0);
+    p[0].weight = weight_on(lead, 0.7);
+    p[0].drop = SOFT + 0.04 * amp;
+    p[1].toes = p[0].toes;
+    p[1].toes[trail] = at.floor(x1 - side * 0.03, -0.2);
+    p[1].weight = weight_on(trail, 0.6);
+    p[1].drop = SOFT + 0.07 * amp;
+    let x3 = x1 + side * (STANCE + 0.5 * d);
+    p[2].toes = p[1].toes;
+    p[2].toes[lead] = at.floor(x3, 0.0);
+    p[2].weight = weight_on(lead, 0.7);
+    p[2].drop = SOFT + 0.04 * amp;
+    p[3].toes = p[2].toes;
+    p[3].toes[trail] = at.floor(x3 - side * 2.0 * STANCE, 0.0);
+    p[3].weight = 0.5;
+    let out = if high {
+        arm(Arms::High)
+    } else {
+        arm(Arms::Open)
+    };
+    p[0].arms = [out; 2];
+    p[1].arms = [arm(Arms::Front); 2];
+    p[2].arms = [out; 2];
+    p[1].waist = [8.0, 0.0];
+}
+
+/// [`Move::ArmWave`]'s poses: feet home, knees bouncing on every beat, one of three arm
+/// patterns.
+fn arm_wave(p: &mut [Pose; 4], at: Place, amp: f64, pattern: u8) {
+    let home = at.home();
+    p.iter_mut().for_each(|q| q.toes = home);
+    for (k, q) in p.iter_mut().enumerate() {
+        let down = k % 2 == 0;
+        q.drop = if down { SOFT + 0.06 * amp } else { SOFT };
+        q.weight = if k == 3 {
+            0.5
+        } else if down {
+            0.35
+        } else {
+            0.65
+        };
+        q.waist[1] = if k == 3 {
+            0.0
+        } else if down {
+            8.0
+        } else {
+            -8.0
+        };
+    }
+    match pattern % 3 {
+        0 => {
+            p[0].arms = [arm(Arms::High), arm(Arms::Open)];
+            p[1].arms = [arm(Arms::Open); 2];
+            p[2].arms = [arm(Arms::Open), arm(Arms::High)];
+        }
+        1 => {
+            let bent = [160.0, 30.0, 80.0];
+            p[0].arms = [bent; 2];
+            p[1].arms = [arm(Arms::High); 2];
+            p[2].arms = [bent; 2];
+        }
+        _ => {
+            let punch = [90.0, 0.0, 0.0];
+            p[0].arms = [punch, arm(Arms::Hips)];
+            p[1].arms = [arm(Arms::Hips), punch];
+            p[2].arms = [punch, arm(Arms::Hips)];
+        }
+    }
+}
+
+/// [`Move::Turn`]'s poses: four steps turning by `angle` about the place's origin; arms open
+/// (or `high`).
+fn turn(p: &mut [Pose; 4], at: Place, amp: f64, angle: f64, high: bool) {
+    // Turn about the place's origin; the feet step alternately to their places under the
+    // new heading (the inside foot first), the other keeping its toe and heading.
+    let first = foot(angle);
+    let order = [first, 1 - first, first, 1 - first];
+    let yaws = [angle / 3.0, 2.0 * angle / 3.0, angle, angle];
+    for k in 0..4 {
+        let turned = Place {
+            origin: at.origin,
+            yaw: at.yaw + yaws[k],
+        };
+        if k > 0 {
+            p[k].toes = p[k - 1].toes;
+            p[k].heading = p[k - 1].heading;
+        }
+        let i = order[k];
+        let x = if i == 0 { STANCE } else { -STANCE };
+        p[k].toes[i] = turned.at(x, 0.0, 0.0);
+        p[k].heading[i] = turned.yaw;
+        p[k].yaw = turned.yaw;
+        p[k].weight = if k == 3 { 0.5 } else { weight_on(i, 0.65) };
+        p[k].drop = SOFT + if k % 2 == 0 { 0.04 * amp } else { 0.0 };
+        p[k].arms = if high {
+            [arm(Arms::High); 2]
+        } else {
+            [arm(Arms::Open); 2]
+        };
+    }
+}
+
+/// [`Move::Kick`]'s poses: chamber, kick to the front (or the side) `height` high, chamber,
+/// home.
+fn kick(p: &mut [Pose; 4], at: Place, amp: f64, side: f64, front: bool, height: f64) {
+    let home = at.home();
+    let (kick, support) = (foot(side), 1 - foot(side));
+    let hx = if kick == 0 { STANCE } else { -STANCE };
+    let h = height * amp;
+    let chamber = at.at(hx, 0.12, 0.22 * h / 0.45);
+    let out = if front {
+        at.at(hx, 0.45, h)
+    } else {
+        at.at(hx + side * 0.4 * h / 0.45, 0.05, 0.8 * h)
+    };
+    p[0].toes[kick] = chamber;
+    p[1].toes[kick] = out;
+    p[2].toes[kick] = chamber;
+    p[3].toes = home;
+    for q in &mut p[..3] {
+        q.weight = weight_on(support, 0.92);
+        q.drop = SOFT + 0.04;
+    }
+    p[3].weight = 0.5;
+    let (ka, sa) = (kick, support);
+    p[0].arms[ka] = arm(Arms::Hips);
+    p[0].arms[sa] = arm(Arms::Hips);
+    p[1].arms[ka] = arm(Arms::Open);
+    p[1].arms[sa] = arm(Arms::Front);
+    p[2].arms = p[0].arms;
+    p[1].waist = [if front { -5.0 } else { 0.0 }, -8.0 * side];
+}
+
+/// [`Move::KneeDrop`]'s poses: the knees dropped `depth` in the first and third poses, one of
+/// two arm patterns.
+fn knee_drop(p: &mut [Pose; 4], at: Place, amp: f64, depth: f64, pattern: u8) {
+    let home = at.home();
+    p.iter_mut().for_each(|q| q.toes = home);
+    let d = depth * amp;
+    let (down, up) = if pattern.is_multiple_of(2) {
+        ([40.0, 20.0, 10.0], arm(Arms::High))
+    } else {
+        ([150.0, 40.0, 60.0], [170.0, 5.0, 0.0])
+    };
+    p[0].drop = SOFT + d;
+    p[0].waist = [18.0, 0.0];
+    p[0].arms = [down; 2];
+    p[1].arms = [up; 2];
+    p[2].drop = SOFT + d;
+    p[2].waist = [18.0, 0.0];
+    p[2].arms = [down; 2];
+    for q in p.iter_mut() {
+        q.weight = 0.5;
+    }
 }
 
 /// Orders of the six move families in a clip (cycled), one per clip (cycled).
@@ -717,56 +762,20 @@ pub fn generate(p: &AuthoredDance) -> Result<Vec<AuthoredClip>, AuthoredError> {
 fn generate_clip(p: &AuthoredDance, c: usize) -> AuthoredClip {
     let model = humanoid24();
     let plan = choreography(c, p.bars_per_clip);
-    // Every count's pose: the first stands square at the origin.
-    let neutral = Pose {
-        toes: [DVec3::new(STANCE, 0.0, 0.0), DVec3::new(-STANCE, 0.0, 0.0)],
-        heading: [0.0; 2],
-        weight: 0.5,
-        yaw: 0.0,
-        drop: SOFT,
-        waist: [0.0; 2],
-        arms: [arm(Arms::Low); 2],
-    };
-    let mut poses = vec![neutral];
-    for &(m, end) in &plan {
-        let last = *poses.last().expect("one pose at least");
-        let mid = 0.5 * (last.toes[0] + last.toes[1]);
-        let place = Place {
-            origin: DVec2::new(mid.x, mid.z),
-            yaw: last.yaw,
-        };
-        poses.extend(move_poses(m, &last, place, p.amplitude, end));
-    }
+    let poses = count_poses(&plan, p.amplitude);
     let beat = 60.0 / p.bpm;
     let counts = poses.len() - 1;
     // One more beat holding the last pose, so that the last bar is whole after its first beat.
     let frames = ((counts as f64 + 1.0) * beat * p.fps).ceil() as usize;
-    let dofs = model.dofs.len();
-    let dof = |n: &str| model.dof_index(n).expect("humanoid24 DOF");
+    let dofs = DanceDofs::of(&model);
     let legs = [Leg::of(&model, "left"), Leg::of(&model, "right")];
-    let leg_dofs = ["left", "right"].map(|s| {
-        [
-            dof(&format!("{s}_hip_flexion")),
-            dof(&format!("{s}_hip_abduction")),
-            dof(&format!("{s}_hip_rotation")),
-            dof(&format!("{s}_knee")),
-        ]
-    });
-    let arm_dofs = ["left", "right"].map(|s| {
-        [
-            dof(&format!("{s}_shoulder_flexion")),
-            dof(&format!("{s}_shoulder_abduction")),
-            dof(&format!("{s}_elbow_flexion")),
-        ]
-    });
-    let waist = [dof("waist_flexion"), dof("waist_lateral")];
     let stand = standing_height(&model);
     let mut motion = ModelClip {
         model: model.clone(),
         frame_time: 1.0 / p.fps,
         root_translation: Vec::with_capacity(frames),
         root_rotation: Vec::with_capacity(frames),
-        angles: Vec::with_capacity(frames * dofs),
+        angles: Vec::with_capacity(frames * dofs.count),
     };
     for f in 0..frames {
         let t = f as f64 / p.fps;
@@ -777,42 +786,8 @@ fn generate_clip(p: &AuthoredDance, c: usize) -> AuthoredClip {
         } else {
             between(&poses[k], &poses[k + 1], x - k as f64)
         };
-        let rot = DQuat::from_rotation_y(pose.yaw);
-        let over = pose.toes[0].lerp(pose.toes[1], pose.weight);
-        let back = rot * DVec3::new(0.0, 0.0, -BEHIND);
-        let mut pelvis = DVec3::new(over.x, 0.0, over.z) + back;
-        // The pelvis height: the planted toes at their full reach less the slack and the drop.
-        pelvis.y = f64::INFINITY;
-        for (i, leg) in legs.iter().enumerate() {
-            if pose.toes[i].y > 1e-9 {
-                continue;
-            }
-            let hip = pelvis + rot * leg.hip;
-            let flat = DVec2::new(hip.x - pose.toes[i].x, hip.z - pose.toes[i].z).length();
-            let reach = full_reach(leg) - SLACK - pose.drop;
-            pelvis.y = pelvis
-                .y
-                .min(pose.toes[i].y + (reach * reach - flat * flat).max(0.0).sqrt());
-        }
-        if !pelvis.y.is_finite() {
-            pelvis.y = stand - pose.drop;
-        }
-        let mut angles = vec![0.0; dofs];
-        for (i, leg) in legs.iter().enumerate() {
-            let square = pose.toes[i].y < SQUARE_BELOW;
-            let (h, knee) = leg_ik(leg, pelvis, rot, pose.toes[i], pose.heading[i], square);
-            for j in 0..3 {
-                angles[leg_dofs[i][j]] = h[j];
-            }
-            angles[leg_dofs[i][3]] = knee;
-        }
-        for i in 0..2 {
-            for j in 0..3 {
-                angles[arm_dofs[i][j]] = pose.arms[i][j].to_radians();
-            }
-        }
-        angles[waist[0]] = pose.waist[0].to_radians();
-        angles[waist[1]] = pose.waist[1].to_radians();
+        let (pelvis, rot) = pelvis_place(&pose, &legs, stand);
+        let angles = pose_angles(&pose, pelvis, rot, &legs, &dofs);
         motion.root_translation.push(pelvis);
         motion.root_rotation.push(rot);
         motion.angles.extend(angles);
@@ -823,6 +798,123 @@ fn generate_clip(p: &AuthoredDance, c: usize) -> AuthoredClip {
         families: plan.iter().map(|(m, _)| m.family()).collect(),
         motion,
     }
+}
+
+/// Every count's pose of the moves `plan`: the first stands square at the origin, each move
+/// adds its four from where the last left off.
+fn count_poses(plan: &[(Move, Arms)], amplitude: f64) -> Vec<Pose> {
+    let neutral = Pose {
+        toes: [DVec3::new(STANCE, 0.0, 0.0), DVec3::new(-STANCE, 0.0, 0.0)],
+        heading: [0.0; 2],
+        weight: 0.5,
+        yaw: 0.0,
+        drop: SOFT,
+        waist: [0.0; 2],
+        arms: [arm(Arms::Low); 2],
+    };
+    let mut poses = vec![neutral];
+    for &(m, end) in plan {
+        let last = *poses.last().expect("one pose at least");
+        let mid = 0.5 * (last.toes[0] + last.toes[1]);
+        let place = Place {
+            origin: DVec2::new(mid.x, mid.z),
+            yaw: last.yaw,
+        };
+        poses.extend(move_poses(m, &last, place, amplitude, end));
+    }
+    poses
+}
+
+/// The humanoid24 DOFs a pose sets.
+struct DanceDofs {
+    /// All DOFs of the model.
+    count: usize,
+    /// Each leg's hip flexion, abduction and rotation and knee, `[left, right]`.
+    legs: [[usize; 4]; 2],
+    /// Each arm's shoulder flexion and abduction and elbow flexion, `[left, right]`.
+    arms: [[usize; 3]; 2],
+    /// The waist's flexion and lateral bend.
+    waist: [usize; 2],
+}
+
+impl DanceDofs {
+    fn of(model: &Model) -> DanceDofs {
+        let dof = |n: &str| model.dof_index(n).expect("humanoid24 DOF");
+        DanceDofs {
+            count: model.dofs.len(),
+            legs: ["left", "right"].map(|s| {
+                [
+                    dof(&format!("{s}_hip_flexion")),
+                    dof(&format!("{s}_hip_abduction")),
+                    dof(&format!("{s}_hip_rotation")),
+                    dof(&format!("{s}_knee")),
+                ]
+            }),
+            arms: ["left", "right"].map(|s| {
+                [
+                    dof(&format!("{s}_shoulder_flexion")),
+                    dof(&format!("{s}_shoulder_abduction")),
+                    dof(&format!("{s}_elbow_flexion")),
+                ]
+            }),
+            waist: [dof("waist_flexion"), dof("waist_lateral")],
+        }
+    }
+}
+
+/// The pelvis of `pose`: behind the weighted toes, as high as the planted toes' full reach
+/// less the slack and the drop allow (standing height less the drop when none is planted),
+/// turned to the pose's yaw.
+fn pelvis_place(pose: &Pose, legs: &[Leg; 2], stand: f64) -> (DVec3, DQuat) {
+    let rot = DQuat::from_rotation_y(pose.yaw);
+    let over = pose.toes[0].lerp(pose.toes[1], pose.weight);
+    let back = rot * DVec3::new(0.0, 0.0, -BEHIND);
+    let mut pelvis = DVec3::new(over.x, 0.0, over.z) + back;
+    // The pelvis height: the planted toes at their full reach less the slack and the drop.
+    pelvis.y = f64::INFINITY;
+    for (i, leg) in legs.iter().enumerate() {
+        if pose.toes[i].y > 1e-9 {
+            continue;
+        }
+        let hip = pelvis + rot * leg.hip;
+        let flat = DVec2::new(hip.x - pose.toes[i].x, hip.z - pose.toes[i].z).length();
+        let reach = full_reach(leg) - SLACK - pose.drop;
+        pelvis.y = pelvis
+            .y
+            .min(pose.toes[i].y + (reach * reach - flat * flat).max(0.0).sqrt());
+    }
+    if !pelvis.y.is_finite() {
+        pelvis.y = stand - pose.drop;
+    }
+    (pelvis, rot)
+}
+
+/// The joint angles of `pose` with the pelvis at `pelvis` turned by `rot`: the legs by
+/// [`leg_ik`] to the toes, the arms and the waist as the pose has them.
+fn pose_angles(
+    pose: &Pose,
+    pelvis: DVec3,
+    rot: DQuat,
+    legs: &[Leg; 2],
+    dofs: &DanceDofs,
+) -> Vec<f64> {
+    let mut angles = vec![0.0; dofs.count];
+    for (i, leg) in legs.iter().enumerate() {
+        let square = pose.toes[i].y < SQUARE_BELOW;
+        let (h, knee) = leg_ik(leg, pelvis, rot, pose.toes[i], pose.heading[i], square);
+        for j in 0..3 {
+            angles[dofs.legs[i][j]] = h[j];
+        }
+        angles[dofs.legs[i][3]] = knee;
+    }
+    for i in 0..2 {
+        for j in 0..3 {
+            angles[dofs.arms[i][j]] = pose.arms[i][j].to_radians();
+        }
+    }
+    angles[dofs.waist[0]] = pose.waist[0].to_radians();
+    angles[dofs.waist[1]] = pose.waist[1].to_radians();
+    angles
 }
 
 #[cfg(test)]

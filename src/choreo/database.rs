@@ -486,12 +486,12 @@ impl Database {
             e => e.to_string(),
         })?;
         let model = humanoid24();
-        let dofs = model.dofs.len();
-        let points = model.skeleton().point_parents().len();
-        let links = points - 1;
-        let n = self.params.bar_frames;
+        let shape = SegmentShape {
+            frames: self.params.bar_frames,
+            dofs: model.dofs.len(),
+            points: model.skeleton().point_parents().len(),
+        };
         let finite = |v: &[f64]| v.iter().position(|x| !x.is_finite());
-        let finite3 = |v: &[glam::DVec3]| v.iter().position(|x| !x.is_finite());
         let mut counts = vec![0usize; self.sources.len()];
         for (i, s) in self.segments.iter().enumerate() {
             let seg = format!("segment {i} (bar {} of source {})", s.bar, s.clip);
@@ -503,65 +503,48 @@ impl Database {
                 ));
             };
             *c += 1;
-            let lengths = [
-                ("root_translation", s.root_translation.len(), n),
-                ("root_rotation", s.root_rotation.len(), n),
-                ("angles", s.angles.len(), n * dofs),
-                ("first_directions", s.first_directions.len(), links),
-                ("last_directions", s.last_directions.len(), links),
-                ("first_velocities", s.first_velocities.len(), points),
-                ("last_velocities", s.last_velocities.len(), points),
-            ];
-            for (field, got, want) in lengths {
-                if got != want {
-                    return Err(format!(
-                        "{seg}: {field} holds {got} values, {want} expected ({n} frames of \
-                         humanoid24's {dofs} DOFs and {points} points)"
-                    ));
-                }
-            }
-            if !(s.start_s.is_finite() && s.end_s.is_finite() && s.start_s < s.end_s) {
-                return Err(format!(
-                    "{seg}: the bar spans {} to {} s, not a finite start before its end",
-                    s.start_s, s.end_s
-                ));
-            }
-            let bad = [
-                ("intensity", finite(std::slice::from_ref(&s.intensity))),
-                ("angles", finite(&s.angles)),
-                ("root_translation", finite3(&s.root_translation)),
-                ("first_directions", finite3(&s.first_directions)),
-                ("last_directions", finite3(&s.last_directions)),
-                ("first_velocities", finite3(&s.first_velocities)),
-                ("last_velocities", finite3(&s.last_velocities)),
-                ("eros.values", finite(&s.eros.values)),
-            ];
-            if let Some((field, Some(k))) = bad.into_iter().find(|(_, k)| k.is_some()) {
-                return Err(format!("{seg}: {field}[{k}] is not a finite number"));
-            }
-            if let Some(k) = s.root_rotation.iter().position(|q| !q.is_finite()) {
-                return Err(format!("{seg}: root_rotation[{k}] is not a finite number"));
-            }
-            let axes = self.eros_weights.len();
-            let dim = self.segments[0].eros.vectors.first().map_or(0, Vec::len);
-            if s.eros.values.len() != axes
-                || s.eros.vectors.len() != axes
-                || s.eros.vectors.iter().any(|v| v.len() != dim)
-            {
-                return Err(format!(
-                    "{seg}: eros holds {} values and {} axes, the database {axes} Eros weights \
-                     (and axes of {dim} values)",
-                    s.eros.values.len(),
-                    s.eros.vectors.len()
-                ));
-            }
-            if s.eros.vectors.iter().any(|v| finite(v).is_some()) {
-                return Err(format!(
-                    "{seg}: eros.vectors holds a number that is not finite"
-                ));
-            }
+            check_segment(&seg, s, &shape)?;
+            self.check_eros(&seg, s)?;
         }
-        for (k, (src, &got)) in self.sources.iter().zip(&counts).enumerate() {
+        self.check_sources(&counts)?;
+        if let Some(k) = finite(&self.eros_weights) {
+            return Err(format!("eros_weights[{k}] is not a finite number"));
+        }
+        Ok(())
+    }
+
+    /// A segment's Eros (as `seg` names it): a value and an axis per Eros weight of the
+    /// database, axes as long as the first segment's, every number finite.
+    fn check_eros(&self, seg: &str, s: &Segment) -> Result<(), String> {
+        let axes = self.eros_weights.len();
+        let dim = self.segments[0].eros.vectors.first().map_or(0, Vec::len);
+        if s.eros.values.len() != axes
+            || s.eros.vectors.len() != axes
+            || s.eros.vectors.iter().any(|v| v.len() != dim)
+        {
+            return Err(format!(
+                "{seg}: eros holds {} values and {} axes, the database {axes} Eros weights \
+                 (and axes of {dim} values)",
+                s.eros.values.len(),
+                s.eros.vectors.len()
+            ));
+        }
+        if s.eros
+            .vectors
+            .iter()
+            .any(|v| v.iter().any(|x| !x.is_finite()))
+        {
+            return Err(format!(
+                "{seg}: eros.vectors holds a number that is not finite"
+            ));
+        }
+        Ok(())
+    }
+
+    /// Every source's segment count matching the segments that name it (`counts`), and its
+    /// numbers finite.
+    fn check_sources(&self, counts: &[usize]) -> Result<(), String> {
+        for (k, (src, &got)) in self.sources.iter().zip(counts).enumerate() {
             let name = format!("source {k} ({})", src.file);
             if src.segments != got {
                 return Err(format!(
@@ -583,9 +566,6 @@ impl Database {
                     src.fps, src.beat.tempo_bpm, src.beat.first_beat_s, src.window
                 ));
             }
-        }
-        if let Some(k) = finite(&self.eros_weights) {
-            return Err(format!("eros_weights[{k}] is not a finite number"));
         }
         Ok(())
     }
@@ -638,6 +618,62 @@ impl Database {
     pub fn segments_of(&self, clip: usize) -> impl Iterator<Item = &Segment> {
         self.segments.iter().filter(move |s| s.clip == clip)
     }
+}
+
+/// The sizes a segment must have: its frames, and humanoid24's DOFs and points.
+struct SegmentShape {
+    frames: usize,
+    dofs: usize,
+    points: usize,
+}
+
+/// A segment's (as `seg` names it) fields of the lengths `shape` gives, its bar a finite span
+/// and its numbers finite.
+fn check_segment(seg: &str, s: &Segment, shape: &SegmentShape) -> Result<(), String> {
+    let (n, dofs, points) = (shape.frames, shape.dofs, shape.points);
+    let links = points - 1;
+    let finite = |v: &[f64]| v.iter().position(|x| !x.is_finite());
+    let finite3 = |v: &[glam::DVec3]| v.iter().position(|x| !x.is_finite());
+    let lengths = [
+        ("root_translation", s.root_translation.len(), n),
+        ("root_rotation", s.root_rotation.len(), n),
+        ("angles", s.angles.len(), n * dofs),
+        ("first_directions", s.first_directions.len(), links),
+        ("last_directions", s.last_directions.len(), links),
+        ("first_velocities", s.first_velocities.len(), points),
+        ("last_velocities", s.last_velocities.len(), points),
+    ];
+    for (field, got, want) in lengths {
+        if got != want {
+            return Err(format!(
+                "{seg}: {field} holds {got} values, {want} expected ({n} frames of \
+                 humanoid24's {dofs} DOFs and {points} points)"
+            ));
+        }
+    }
+    if !(s.start_s.is_finite() && s.end_s.is_finite() && s.start_s < s.end_s) {
+        return Err(format!(
+            "{seg}: the bar spans {} to {} s, not a finite start before its end",
+            s.start_s, s.end_s
+        ));
+    }
+    let bad = [
+        ("intensity", finite(std::slice::from_ref(&s.intensity))),
+        ("angles", finite(&s.angles)),
+        ("root_translation", finite3(&s.root_translation)),
+        ("first_directions", finite3(&s.first_directions)),
+        ("last_directions", finite3(&s.last_directions)),
+        ("first_velocities", finite3(&s.first_velocities)),
+        ("last_velocities", finite3(&s.last_velocities)),
+        ("eros.values", finite(&s.eros.values)),
+    ];
+    if let Some((field, Some(k))) = bad.into_iter().find(|(_, k)| k.is_some()) {
+        return Err(format!("{seg}: {field}[{k}] is not a finite number"));
+    }
+    if let Some(k) = s.root_rotation.iter().position(|q| !q.is_finite()) {
+        return Err(format!("{seg}: root_rotation[{k}] is not a finite number"));
+    }
+    Ok(())
 }
 
 #[cfg(test)]

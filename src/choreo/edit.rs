@@ -604,7 +604,12 @@ mod tests {
         // This database has no boundary data: Generate says so.
         assert!(matches!(e.generate(), Err(EditError::Transition(_))));
         assert!(e.search(8).unwrap_err().to_string().contains("0 to 7"));
-        // Searching a bar until nothing is left: 40 segments = 6 × 6 + 4.
+    }
+
+    #[test]
+    fn searching_a_bar_until_nothing_is_left_says_it_is_exhausted() {
+        let mut e = edit();
+        // 40 segments = 6 × 6 + 4.
         for _ in 0..6 {
             assert_eq!(e.search(1).unwrap().len(), 6);
         }
@@ -616,7 +621,10 @@ mod tests {
                 segments: 40
             })
         );
-        // Construction and restoring check their input.
+    }
+
+    #[test]
+    fn construction_and_restoring_check_their_input() {
         let db = Arc::new(random_db(40, 9));
         assert_eq!(
             Edit::new(

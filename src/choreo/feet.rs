@@ -34,10 +34,12 @@
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 
-use crate::analysis::{ContactConfig, ContactReference, foot_points, ground_contacts_against};
+use crate::analysis::{
+    ContactConfig, ContactReference, Contacts, PointRef, foot_points, ground_contacts_against,
+};
 use crate::humanoid::ModelClip;
 use crate::humanoid::leg_ik::{Leg, frame_globals, reach};
-use crate::skeleton::Transform;
+use crate::skeleton::{Skeleton, Transform};
 
 /// Most rounds of IK per frame and leg: the target corrected by the foot's residual each round
 /// (about halved each round), until it is under 0.1 mm.
@@ -191,44 +193,28 @@ pub fn plant_feet(clip: &mut ModelClip, p: &PlantParams) -> Planting {
     if !p.enabled || n < 2 || feet.iter().any(Vec::is_empty) || legs.iter().any(Option::is_none) {
         return report;
     }
-    let rest = rest_sole_heights(clip);
-    let d = clip.dof_count();
-    // Foot points of every frame.
+    let model = Feet {
+        rest: rest_sole_heights(clip),
+        skeleton,
+        points: feet,
+    };
+    let rest = &model.rest;
     let mut g = vec![];
-    let tracks = |clip: &ModelClip, f: usize, g: &mut Vec<Transform>| -> [Vec<DVec3>; 2] {
-        frame_globals(
-            &clip.model,
-            clip.root_translation[f],
-            clip.root_rotation[f],
-            clip.frame_angles(f),
-            g,
-        );
-        [0, 1].map(|s| feet[s].iter().map(|&q| point(&skeleton, g, q)).collect())
-    };
-    let before: Vec<[Vec<DVec3>; 2]> = (0..n).map(|f| tracks(clip, f, &mut g)).collect();
-    let sole = |pts: &[DVec3], side: usize| -> f64 {
-        pts.iter()
-            .zip(&rest[side])
-            .map(|(x, r)| x.y - r)
-            .fold(f64::INFINITY, f64::min)
-    };
-    // Contact against the floor y = 0 and the rest heights.
+    let before: Vec<[Vec<DVec3>; 2]> = (0..n).map(|f| model.positions(clip, f, &mut g)).collect();
     let config = ContactConfig::default();
-    let reference = ContactReference {
-        floor_y_m: 0.0,
-        rest_heights_m: rest.clone().map(|v| v.into_iter().map(Some).collect()),
-    };
-    let side_track =
-        |s: usize| -> Vec<Vec<DVec3>> { before.iter().map(|b| b[s].clone()).collect() };
-    let (left, right) = (side_track(0), side_track(1));
-    let contacts =
-        ground_contacts_against(&left, &right, &[], clip.frame_time, &config, &reference);
+    let contacts = floor_contacts(clip, &before, rest, &config);
     let blend = (p.blend_s / clip.frame_time).round().max(1.0) as usize;
 
     // The correction of every frame of each foot (module docs).
     // Per frame and foot: the correction and the foot point whose place it is measured on.
     let mut targets: [Vec<Option<(DVec3, usize)>>; 2] = [vec![None; n], vec![None; n]];
     for (side, spans) in [&contacts.left, &contacts.right].into_iter().enumerate() {
+        let foot = FootTrack {
+            before: &before,
+            side,
+            rest: &rest[side],
+            frame_time: clip.frame_time,
+        };
         let on: Vec<bool> = (0..n)
             .map(|f| {
                 let t = f as f64 * clip.frame_time;
@@ -239,144 +225,291 @@ pub fn plant_feet(clip: &mut ModelClip, p: &PlantParams) -> Planting {
             .collect();
         let planted = runs(&on);
         report.spans += planted.len();
-        let mut corr: Vec<Option<DVec3>> = vec![None; n];
-        let mut key = vec![0usize; n];
-        for &(a, b) in &planted {
-            // The contact point: lowest relative to its rest height on average over the span.
-            let k = (0..feet[side].len())
-                .min_by(|&i, &j| {
-                    let mean = |i: usize| -> f64 {
-                        (a..b)
-                            .map(|f| before[f][side][i].y - rest[side][i])
-                            .sum::<f64>()
-                    };
-                    mean(i).total_cmp(&mean(j))
-                })
-                .expect("a foot has points");
-            let anchor = (a..b)
-                .map(|f| before[f][side][k] * DVec3::new(1.0, 0.0, 1.0))
-                .sum::<DVec3>()
-                / (b - a) as f64;
-            // Locked only when the contact point slides: faster on average over the span than
-            // a foot point at rest moves.
-            let path: f64 = (a + 1..b)
-                .map(|f| {
-                    let d = before[f][side][k] - before[f - 1][side][k];
-                    DVec3::new(d.x, 0.0, d.z).length()
-                })
-                .sum();
-            let slides = path / ((b - a) as f64 * clip.frame_time) > config.rest_speed_mps;
-            if slides && p.lock {
-                report.locked += 1;
-            }
-            for f in a..b {
-                key[f] = k;
-                let pt = before[f][side][k];
-                let horizontal = if p.lock && slides {
-                    DVec3::new(anchor.x - pt.x, 0.0, anchor.z - pt.z)
-                } else {
-                    DVec3::ZERO
-                };
-                corr[f] = Some(horizontal);
-            }
-        }
-        // Free frames: fades from the neighbouring spans, and no sole under the floor.
-        for f in 0..n {
-            if on[f] {
-                continue;
-            }
-            let prev = planted.iter().rev().find(|s| s.1 <= f);
-            let next = planted.iter().find(|s| s.0 > f);
-            key[f] = match (prev, next) {
-                (Some(&(_, pe)), Some(&(ns, _))) => {
-                    key[if f + 1 - pe <= ns - f { pe - 1 } else { ns }]
-                }
-                (Some(&(_, pe)), None) => key[pe - 1],
-                (None, Some(&(ns, _))) => key[ns],
-                (None, None) => 0,
-            };
-            // The correction and its rate (per frame) at the span edges next to f.
-            let edge_out = |pe: usize| -> (DVec3, DVec3) {
-                let c = corr[pe - 1].unwrap_or_default();
-                let v = if pe >= 2 && on[pe - 2] {
-                    c - corr[pe - 2].unwrap_or_default()
-                } else {
-                    DVec3::ZERO
-                };
-                (c, v)
-            };
-            let edge_in = |ns: usize| -> (DVec3, DVec3) {
-                let c = corr[ns].unwrap_or_default();
-                let v = if ns + 1 < n && on[ns + 1] {
-                    corr[ns + 1].unwrap_or_default() - c
-                } else {
-                    DVec3::ZERO
-                };
-                (c, v)
-            };
-            let c = match (prev, next) {
-                (Some(&(_, pe)), Some(&(ns, _))) if ns - pe <= 2 * blend => {
-                    // From the one span's edge to the other's, position and rate matched.
-                    let ((c0, v0), (c1, v1)) = (edge_out(pe), edge_in(ns));
-                    hermite(c0, v0, c1, v1, ns + 1 - pe, f + 1 - pe)
-                }
-                _ => {
-                    let out = prev.map_or(DVec3::ZERO, |&(_, pe)| {
-                        let (c0, v0) = edge_out(pe);
-                        if f + 1 - pe > blend {
-                            DVec3::ZERO
-                        } else {
-                            hermite(c0, v0, DVec3::ZERO, DVec3::ZERO, blend + 1, f + 1 - pe)
-                        }
-                    });
-                    let inn = next.map_or(DVec3::ZERO, |&(ns, _)| {
-                        let (c1, v1) = edge_in(ns);
-                        if ns - f > blend {
-                            DVec3::ZERO
-                        } else {
-                            hermite(
-                                DVec3::ZERO,
-                                DVec3::ZERO,
-                                c1,
-                                v1,
-                                blend + 1,
-                                blend + 1 - (ns - f),
-                            )
-                        }
-                    });
-                    out + inn
-                }
-            };
-            if c.length_squared() > 0.0 {
-                corr[f] = Some(c);
-            }
-        }
-        // The lift out of the floor, and the horizontal corrections, smoothed over time (a
-        // Gaussian of σ = smooth_s); then no sole under the floor.
-        let lift: Vec<f64> = (0..n)
-            .map(|f| (-sole(&before[f][side], side)).max(0.0))
-            .collect();
-        for f in 0..n {
-            if lift[f] > 0.0 {
-                corr[f] = Some(corr[f].unwrap_or_default() + DVec3::Y * lift[f]);
-            }
-        }
-        let raw: Vec<DVec3> = corr.iter().map(|c| c.unwrap_or_default()).collect();
-        let smooth = gaussian(&raw, p.smooth_s / clip.frame_time);
-        for f in 0..n {
-            if corr[f].is_none() && smooth[f].length_squared() < 1e-12 {
-                continue;
-            }
-            let mut c = smooth[f];
-            // No sole under the floor: the vertical correction only lifts.
-            c.y = c.y.max(lift[f]);
-            report.max_correction_m = report.max_correction_m.max(c.length());
-            targets[side][f] = Some((c, key[f]));
-        }
+        let (mut corr, mut key) = hold_spans(&foot, &planted, p, &config, &mut report);
+        fade_free_frames(&on, &planted, blend, &mut corr, &mut key);
+        targets[side] = smooth_and_floor(&foot, &corr, &key, p, &mut report);
+    }
+    reach_targets(clip, &legs, &model, &before, &targets, &mut report);
+    report
+}
+
+/// The model's feet: its skeleton, each foot's points ([`foot_points`]) and their rest sole
+/// heights ([`rest_sole_heights`]), `[left, right]`.
+struct Feet {
+    skeleton: Skeleton,
+    points: [Vec<PointRef>; 2],
+    rest: [Vec<f64>; 2],
+}
+
+impl Feet {
+    /// The foot points of both feet at frame `f` of `clip`, world space.
+    fn positions(&self, clip: &ModelClip, f: usize, g: &mut Vec<Transform>) -> [Vec<DVec3>; 2] {
+        frame_globals(
+            &clip.model,
+            clip.root_translation[f],
+            clip.root_rotation[f],
+            clip.frame_angles(f),
+            g,
+        );
+        [0, 1].map(|s| {
+            self.points[s]
+                .iter()
+                .map(|&q| point(&self.skeleton, g, q))
+                .collect()
+        })
+    }
+}
+
+/// A foot's sole height: the lowest of its points' heights above their rest heights.
+fn sole_height(pts: &[DVec3], rest: &[f64]) -> f64 {
+    pts.iter()
+        .zip(rest)
+        .map(|(x, r)| x.y - r)
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// Both feet's contact spans against the floor y = 0 and the rest heights `rest`.
+fn floor_contacts(
+    clip: &ModelClip,
+    before: &[[Vec<DVec3>; 2]],
+    rest: &[Vec<f64>; 2],
+    config: &ContactConfig,
+) -> Contacts {
+    let reference = ContactReference {
+        floor_y_m: 0.0,
+        rest_heights_m: rest.clone().map(|v| v.into_iter().map(Some).collect()),
+    };
+    let side_track =
+        |s: usize| -> Vec<Vec<DVec3>> { before.iter().map(|b| b[s].clone()).collect() };
+    let (left, right) = (side_track(0), side_track(1));
+    ground_contacts_against(&left, &right, &[], clip.frame_time, config, &reference)
+}
+
+/// One foot's points over the clip as assembled, with their rest heights.
+struct FootTrack<'a> {
+    /// Foot points of both feet, per frame.
+    before: &'a [[Vec<DVec3>; 2]],
+    /// Which foot: 0 left, 1 right.
+    side: usize,
+    /// Rest sole height of each of this foot's points.
+    rest: &'a [f64],
+    /// Seconds per frame.
+    frame_time: f64,
+}
+
+impl FootTrack<'_> {
+    /// Point `i` of the foot at frame `f`.
+    fn at(&self, f: usize, i: usize) -> DVec3 {
+        self.before[f][self.side][i]
     }
 
-    // The legs sent there.
+    /// The foot's points at frame `f`.
+    fn points(&self, f: usize) -> &[DVec3] {
+        &self.before[f][self.side]
+    }
+
+    /// The contact point of span `[a, b)`: the point lowest relative to its rest height on
+    /// average over the span.
+    fn contact_point(&self, a: usize, b: usize) -> usize {
+        (0..self.rest.len())
+            .min_by(|&i, &j| {
+                let mean = |i: usize| -> f64 {
+                    (a..b).map(|f| self.at(f, i).y - self.rest[i]).sum::<f64>()
+                };
+                mean(i).total_cmp(&mean(j))
+            })
+            .expect("a foot has points")
+    }
+}
+
+/// The corrections inside the contact spans `planted` (zero, or with `lock` the pull back to
+/// the anchor of a sliding span), and each frame's contact point; `None` outside the spans.
+fn hold_spans(
+    foot: &FootTrack,
+    planted: &[(usize, usize)],
+    p: &PlantParams,
+    config: &ContactConfig,
+    report: &mut Planting,
+) -> (Vec<Option<DVec3>>, Vec<usize>) {
+    let n = foot.before.len();
+    let mut corr: Vec<Option<DVec3>> = vec![None; n];
+    let mut key = vec![0usize; n];
+    for &(a, b) in planted {
+        let k = foot.contact_point(a, b);
+        let anchor = (a..b)
+            .map(|f| foot.at(f, k) * DVec3::new(1.0, 0.0, 1.0))
+            .sum::<DVec3>()
+            / (b - a) as f64;
+        // Locked only when the contact point slides: faster on average over the span than
+        // a foot point at rest moves.
+        let path: f64 = (a + 1..b)
+            .map(|f| {
+                let d = foot.at(f, k) - foot.at(f - 1, k);
+                DVec3::new(d.x, 0.0, d.z).length()
+            })
+            .sum();
+        let slides = path / ((b - a) as f64 * foot.frame_time) > config.rest_speed_mps;
+        if slides && p.lock {
+            report.locked += 1;
+        }
+        for f in a..b {
+            key[f] = k;
+            let pt = foot.at(f, k);
+            let horizontal = if p.lock && slides {
+                DVec3::new(anchor.x - pt.x, 0.0, anchor.z - pt.z)
+            } else {
+                DVec3::ZERO
+            };
+            corr[f] = Some(horizontal);
+        }
+    }
+    (corr, key)
+}
+
+/// The free frames (not `on`): the contact point of the nearer neighbouring span, and the
+/// corrections of the neighbouring spans faded out over `blend` frames (module docs).
+fn fade_free_frames(
+    on: &[bool],
+    planted: &[(usize, usize)],
+    blend: usize,
+    corr: &mut [Option<DVec3>],
+    key: &mut [usize],
+) {
+    for f in 0..on.len() {
+        if on[f] {
+            continue;
+        }
+        let prev = planted.iter().rev().find(|s| s.1 <= f);
+        let next = planted.iter().find(|s| s.0 > f);
+        key[f] = match (prev, next) {
+            (Some(&(_, pe)), Some(&(ns, _))) => key[if f + 1 - pe <= ns - f { pe - 1 } else { ns }],
+            (Some(&(_, pe)), None) => key[pe - 1],
+            (None, Some(&(ns, _))) => key[ns],
+            (None, None) => 0,
+        };
+        let c = faded_correction(f, prev.map(|s| s.1), next.map(|s| s.0), on, corr, blend);
+        if c.length_squared() > 0.0 {
+            corr[f] = Some(c);
+        }
+    }
+}
+
+/// The correction of free frame `f` between the span ending at `prev_end` and the one
+/// starting at `next_start`: a Hermite curve from the one's edge to the other's when they are
+/// closer than two blends, else each edge's correction faded to 0 over `blend` frames.
+fn faded_correction(
+    f: usize,
+    prev_end: Option<usize>,
+    next_start: Option<usize>,
+    on: &[bool],
+    corr: &[Option<DVec3>],
+    blend: usize,
+) -> DVec3 {
+    let n = on.len();
+    // The correction and its rate (per frame) at the span edges next to f.
+    let edge_out = |pe: usize| -> (DVec3, DVec3) {
+        let c = corr[pe - 1].unwrap_or_default();
+        let v = if pe >= 2 && on[pe - 2] {
+            c - corr[pe - 2].unwrap_or_default()
+        } else {
+            DVec3::ZERO
+        };
+        (c, v)
+    };
+    let edge_in = |ns: usize| -> (DVec3, DVec3) {
+        let c = corr[ns].unwrap_or_default();
+        let v = if ns + 1 < n && on[ns + 1] {
+            corr[ns + 1].unwrap_or_default() - c
+        } else {
+            DVec3::ZERO
+        };
+        (c, v)
+    };
+    match (prev_end, next_start) {
+        (Some(pe), Some(ns)) if ns - pe <= 2 * blend => {
+            // From the one span's edge to the other's, position and rate matched.
+            let ((c0, v0), (c1, v1)) = (edge_out(pe), edge_in(ns));
+            hermite(c0, v0, c1, v1, ns + 1 - pe, f + 1 - pe)
+        }
+        _ => {
+            let out = prev_end.map_or(DVec3::ZERO, |pe| {
+                let (c0, v0) = edge_out(pe);
+                if f + 1 - pe > blend {
+                    DVec3::ZERO
+                } else {
+                    hermite(c0, v0, DVec3::ZERO, DVec3::ZERO, blend + 1, f + 1 - pe)
+                }
+            });
+            let inn = next_start.map_or(DVec3::ZERO, |ns| {
+                let (c1, v1) = edge_in(ns);
+                if ns - f > blend {
+                    DVec3::ZERO
+                } else {
+                    hermite(
+                        DVec3::ZERO,
+                        DVec3::ZERO,
+                        c1,
+                        v1,
+                        blend + 1,
+                        blend + 1 - (ns - f),
+                    )
+                }
+            });
+            out + inn
+        }
+    }
+}
+
+/// The lift out of the floor added to the corrections, the whole smoothed over time (a
+/// Gaussian of σ = smooth_s), then no sole under the floor: each frame's final correction and
+/// contact point, `None` where there is nothing to do.
+fn smooth_and_floor(
+    foot: &FootTrack,
+    corr: &[Option<DVec3>],
+    key: &[usize],
+    p: &PlantParams,
+    report: &mut Planting,
+) -> Vec<Option<(DVec3, usize)>> {
+    let n = corr.len();
+    let mut corr = corr.to_vec();
+    let lift: Vec<f64> = (0..n)
+        .map(|f| (-sole_height(foot.points(f), foot.rest)).max(0.0))
+        .collect();
     for f in 0..n {
+        if lift[f] > 0.0 {
+            corr[f] = Some(corr[f].unwrap_or_default() + DVec3::Y * lift[f]);
+        }
+    }
+    let raw: Vec<DVec3> = corr.iter().map(|c| c.unwrap_or_default()).collect();
+    let smooth = gaussian(&raw, p.smooth_s / foot.frame_time);
+    let mut targets = vec![None; n];
+    for f in 0..n {
+        if corr[f].is_none() && smooth[f].length_squared() < 1e-12 {
+            continue;
+        }
+        let mut c = smooth[f];
+        // No sole under the floor: the vertical correction only lifts.
+        c.y = c.y.max(lift[f]);
+        report.max_correction_m = report.max_correction_m.max(c.length());
+        targets[f] = Some((c, key[f]));
+    }
+    targets
+}
+
+/// The legs sent to their targets: each foot moved by its correction, the ankle reached by IK
+/// and the foot's residual added to the ankle's target, [`IK_ROUNDS`] times at most.
+fn reach_targets(
+    clip: &mut ModelClip,
+    legs: &[Option<Leg>; 2],
+    model: &Feet,
+    before: &[[Vec<DVec3>; 2]],
+    targets: &[Vec<Option<(DVec3, usize)>>; 2],
+    report: &mut Planting,
+) {
+    let d = clip.dof_count();
+    let rest = &model.rest;
+    let mut g = vec![];
+    for f in 0..clip.frame_count() {
         for side in 0..2 {
             let Some((c, k)) = targets[side][f] else {
                 continue;
@@ -388,17 +521,17 @@ pub fn plant_feet(clip: &mut ModelClip, p: &PlantParams) -> Planting {
             let leg = legs[side].expect("checked above");
             // Where the foot's points should go: each moved by c.
             let want: Vec<DVec3> = before[f][side].iter().map(|x| *x + c).collect();
-            let want_sole = sole(&want, side);
+            let want_sole = sole_height(&want, &rest[side]);
             let mut ankle_target = g_ankle(clip, f, leg, &mut g) + c;
             let mut residual = 0.0;
             for _ in 0..IK_ROUNDS {
                 let (t, q) = (clip.root_translation[f], clip.root_rotation[f]);
                 let angles = &mut clip.angles[f * d..(f + 1) * d];
                 reach(&clip.model, leg, t, q, angles, ankle_target);
-                let now = tracks(clip, f, &mut g)[side].clone();
+                let now = model.positions(clip, f, &mut g)[side].clone();
                 // The residual of the foot: its sole height, and its key point's horizontal
                 // place.
-                let dy = want_sole - sole(&now, side);
+                let dy = want_sole - sole_height(&now, &rest[side]);
                 let dxz = (want[k] - now[k]) * DVec3::new(1.0, 0.0, 1.0);
                 let r = dxz + DVec3::Y * dy;
                 residual = r.length();
@@ -410,7 +543,6 @@ pub fn plant_feet(clip: &mut ModelClip, p: &PlantParams) -> Planting {
             report.max_residual_m = report.max_residual_m.max(residual);
         }
     }
-    report
 }
 
 /// The ankle of `leg` at frame `f` of `clip`.

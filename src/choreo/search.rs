@@ -377,32 +377,10 @@ impl SearchIndex {
         state: &mut BarSearch,
         p: &SearchParams,
     ) -> Result<Vec<usize>, SearchError> {
-        p.check()?;
-        if !bar_intensity.is_finite() {
-            return Err(SearchError::Intensity {
-                value: bar_intensity,
-            });
-        }
+        self.check_round(bar_intensity, state, p)?;
         let n = self.segments;
-        if let Some(&segment) = state.shown.iter().chain(&state.liked).find(|&&s| s >= n) {
-            return Err(SearchError::NoSuchSegment {
-                segment,
-                segments: n,
-            });
-        }
         let mut cache = self.take_cache(state);
-        // Max Sim over L_l: one pass over the segments for the likes not yet accounted for.
-        let new_likes = &state.liked[cache.liked.len()..];
-        if !new_likes.is_empty() {
-            for (m, ms) in cache.ms.iter_mut().enumerate() {
-                for &l in new_likes {
-                    if let Some(x) = self.sim_above(m, l, *ms) {
-                        *ms = ms.max(x);
-                    }
-                }
-            }
-            cache.liked.extend_from_slice(new_likes);
-        }
+        self.add_likes(&mut cache, &state.liked);
         let (tau, rho) = (p.tau(state.round), p.rho);
         let mut is_shown = vec![false; n];
         for &s in &state.shown {
@@ -453,6 +431,46 @@ impl SearchIndex {
             state.round += 1;
         }
         Ok(picks)
+    }
+
+    /// [`round`](Self::round)'s checks: valid parameters, a finite bar intensity, and shown and
+    /// liked segments of this index.
+    fn check_round(
+        &self,
+        bar_intensity: f64,
+        state: &BarSearch,
+        p: &SearchParams,
+    ) -> Result<(), SearchError> {
+        p.check()?;
+        if !bar_intensity.is_finite() {
+            return Err(SearchError::Intensity {
+                value: bar_intensity,
+            });
+        }
+        let n = self.segments;
+        if let Some(&segment) = state.shown.iter().chain(&state.liked).find(|&&s| s >= n) {
+            return Err(SearchError::NoSuchSegment {
+                segment,
+                segments: n,
+            });
+        }
+        Ok(())
+    }
+
+    /// Max Sim over L_l (`liked`): one pass over the segments for the likes the cache has not
+    /// yet accounted for.
+    fn add_likes(&self, cache: &mut Cache, liked: &[usize]) {
+        let new_likes = &liked[cache.liked.len()..];
+        if !new_likes.is_empty() {
+            for (m, ms) in cache.ms.iter_mut().enumerate() {
+                for &l in new_likes {
+                    if let Some(x) = self.sim_above(m, l, *ms) {
+                        *ms = ms.max(x);
+                    }
+                }
+            }
+            cache.liked.extend_from_slice(new_likes);
+        }
     }
 
     /// The state's cache if it belongs to this index and its S_n and L_l are prefixes of the

@@ -500,19 +500,9 @@ pub fn boundary(
     (dirs, speeds_at(f))
 }
 
-/// Cuts `clip` into bars of [`BEATS_PER_BAR`] counts from `beat`, each resampled to
-/// `params.bar_frames` frames at the times start + k·bar/bar_frames; `params.alpha` weighs each
-/// point in the motion intensity (missing weights count 1). A clip shorter than a bar is an
-/// error.
-pub fn cut_segments(
-    clip: &ModelClip,
-    name: &str,
-    clip_index: usize,
-    beat: &Beat,
-    params: &BuildParams,
-) -> Result<Vec<Segment>, SegmentError> {
-    let (bar_frames, alpha) = (params.bar_frames, &params.alpha);
-    params.check()?;
+/// Errors unless `beat` (of the clip `name`) has a tempo in range and a first beat at a time
+/// ≥ 0 s.
+fn check_beat(name: &str, beat: &Beat) -> Result<(), SegmentError> {
     check_tempo("the tempo", beat.tempo_bpm).map_err(|message| SegmentError::Tempo {
         clip: name.to_string(),
         message,
@@ -526,6 +516,42 @@ pub fn cut_segments(
             ),
         });
     }
+    Ok(())
+}
+
+/// The motion intensity of the bar from `start_s` to `end_s` at the clip's own timing, over the
+/// frames of the bar, the points weighted by `alpha` (1 past its end).
+fn bar_intensity(clip: &ModelClip, start_s: f64, end_s: f64, alpha: &[f64]) -> f64 {
+    let fps = 1.0 / clip.frame_time;
+    let first = (start_s * fps).round() as usize;
+    let last = ((end_s * fps).round() as usize).min(clip.frame_count() - 1);
+    let real = clip
+        .window(
+            first as f64 * clip.frame_time,
+            (last + 1) as f64 * clip.frame_time,
+        )
+        .map(|w| w.to_clip().point_frames())
+        .unwrap_or_default();
+    let ones: Vec<f64> = (0..real.first().map_or(0, |p| p.len()))
+        .map(|i| alpha.get(i).copied().unwrap_or(1.0))
+        .collect();
+    mean_motion_intensity(&real, fps, &ones)
+}
+
+/// Cuts `clip` into bars of [`BEATS_PER_BAR`] counts from `beat`, each resampled to
+/// `params.bar_frames` frames at the times start + k·bar/bar_frames; `params.alpha` weighs each
+/// point in the motion intensity (missing weights count 1). A clip shorter than a bar is an
+/// error.
+pub fn cut_segments(
+    clip: &ModelClip,
+    name: &str,
+    clip_index: usize,
+    beat: &Beat,
+    params: &BuildParams,
+) -> Result<Vec<Segment>, SegmentError> {
+    let (bar_frames, alpha) = (params.bar_frames, &params.alpha);
+    params.check()?;
+    check_beat(name, beat)?;
     let bar_s = beat.bar_s();
     // The clip spans frames × frame time (as [`crate::skeleton::Clip::duration`]); the last
     // resampled frame of a bar lies a bar/bar_frames before its end.
@@ -540,26 +566,12 @@ pub fn cut_segments(
             tempo_bpm: beat.tempo_bpm,
         });
     }
-    let fps = 1.0 / clip.frame_time;
     let parents = clip.model.skeleton().point_parents();
     let mut segments = vec![];
     for bar in 0..bars as usize {
         let start_s = beat.first_beat_s + bar as f64 * bar_s;
         let end_s = start_s + bar_s;
-        // Intensity at the clip's own timing, over the frames of the bar.
-        let first = (start_s * fps).round() as usize;
-        let last = ((end_s * fps).round() as usize).min(clip.frame_count() - 1);
-        let real = clip
-            .window(
-                first as f64 * clip.frame_time,
-                (last + 1) as f64 * clip.frame_time,
-            )
-            .map(|w| w.to_clip().point_frames())
-            .unwrap_or_default();
-        let ones: Vec<f64> = (0..real.first().map_or(0, |p| p.len()))
-            .map(|i| alpha.get(i).copied().unwrap_or(1.0))
-            .collect();
-        let intensity = mean_motion_intensity(&real, fps, &ones);
+        let intensity = bar_intensity(clip, start_s, end_s, alpha);
 
         let times: Vec<f64> = (0..bar_frames)
             .map(|k| start_s + bar_s * k as f64 / bar_frames as f64)

@@ -96,6 +96,48 @@ pub enum KeyframeError {
     Content { path: String, message: String },
 }
 
+/// Key `i`'s root values within their bounds and its DOFs those of `model` (named
+/// `model_name`), at finite angles within ±[`MAX_KEY_ANGLE_DEG`]; otherwise what is wrong.
+fn check_key(i: usize, k: &Key, model: &Model, model_name: &str) -> Result<(), String> {
+    let root = [
+        ("forward", k.forward, MAX_KEY_POSITION_M, "m"),
+        ("lateral", k.lateral, MAX_KEY_POSITION_M, "m"),
+        ("pitch", k.pitch, MAX_KEY_ANGLE_DEG, "°"),
+        ("turn", k.turn, MAX_KEY_ANGLE_DEG, "°"),
+    ];
+    for (name, v, max, unit) in root {
+        if let Some(v) = v
+            && !(v.is_finite() && v.abs() <= max)
+        {
+            return Err(format!(
+                "key {i} (t = {}): {name} {v} is beyond ±{max} {unit}",
+                k.t
+            ));
+        }
+    }
+    for (name, v) in &k.dofs {
+        if v.is_finite() && v.abs() > MAX_KEY_ANGLE_DEG {
+            return Err(format!(
+                "key {i} (t = {}): '{name}' is {v}°, beyond ±{MAX_KEY_ANGLE_DEG}°",
+                k.t
+            ));
+        }
+        if model.dof_index(name).is_none() {
+            return Err(format!(
+                "key {i} (t = {}): '{name}' is not a DOF of {}",
+                k.t, model_name
+            ));
+        }
+        if !v.is_finite() {
+            return Err(format!(
+                "key {i} (t = {}): '{name}' is not a finite angle",
+                k.t
+            ));
+        }
+    }
+    Ok(())
+}
+
 impl KeyframeClip {
     /// Parses RON text and checks it; `origin` names the source in errors.
     pub fn parse(text: &str, origin: &str) -> Result<KeyframeClip, KeyframeError> {
@@ -143,41 +185,8 @@ impl KeyframeClip {
                 ));
             }
             last = k.t;
-            let root = [
-                ("forward", k.forward, MAX_KEY_POSITION_M, "m"),
-                ("lateral", k.lateral, MAX_KEY_POSITION_M, "m"),
-                ("pitch", k.pitch, MAX_KEY_ANGLE_DEG, "°"),
-                ("turn", k.turn, MAX_KEY_ANGLE_DEG, "°"),
-            ];
-            for (name, v, max, unit) in root {
-                if let Some(v) = v
-                    && !(v.is_finite() && v.abs() <= max)
-                {
-                    return bad(format!(
-                        "key {i} (t = {}): {name} {v} is beyond ±{max} {unit}",
-                        k.t
-                    ));
-                }
-            }
-            for (name, v) in &k.dofs {
-                if v.is_finite() && v.abs() > MAX_KEY_ANGLE_DEG {
-                    return bad(format!(
-                        "key {i} (t = {}): '{name}' is {v}°, beyond ±{MAX_KEY_ANGLE_DEG}°",
-                        k.t
-                    ));
-                }
-                if model.dof_index(name).is_none() {
-                    return bad(format!(
-                        "key {i} (t = {}): '{name}' is not a DOF of {}",
-                        k.t, c.model
-                    ));
-                }
-                if !v.is_finite() {
-                    return bad(format!(
-                        "key {i} (t = {}): '{name}' is not a finite angle",
-                        k.t
-                    ));
-                }
+            if let Err(message) = check_key(i, k, &model, &c.model) {
+                return bad(message);
             }
         }
         for &(a, b) in &c.flights {

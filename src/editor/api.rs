@@ -177,7 +177,20 @@ fn route(s: &mut Session, method: &str, path: &str, query: &str, b: &[u8]) -> Re
     if get && !b.is_empty() {
         return Err(Reply::error(400, &format!("GET {path} takes no body")));
     }
-    let ok = |v: Value| Ok(Reply::json(200, &v));
+    if get {
+        get_route(s, path, query)
+    } else {
+        post_route(s, path, b)
+    }
+}
+
+/// A 200 answer of `v` as JSON.
+fn ok(v: Value) -> Result<Reply, Reply> {
+    Ok(Reply::json(200, &v))
+}
+
+/// The answer to `GET path` (one of [`GETS`]) with the query `query`.
+fn get_route(s: &mut Session, path: &str, query: &str) -> Result<Reply, Reply> {
     match path {
         "/api/state" => ok(state(s)),
         "/api/bars" => ok(bars(s)),
@@ -211,6 +224,13 @@ fn route(s: &mut Session, method: &str, path: &str, query: &str, b: &[u8]) -> Re
                 .collect();
             audio(s.song(), &spans, query)
         }
+        _ => Err(Reply::error(404, &format!("no route {path}"))),
+    }
+}
+
+/// The answer to `POST path` (one of [`POSTS`]) with the body `b`.
+fn post_route(s: &mut Session, path: &str, b: &[u8]) -> Result<Reply, Reply> {
+    match path {
         "/api/search" => {
             let BarBody { bar } = body(b)?;
             s.edit_mut().search(bar).map_err(|e| fail(e.into()))?;
@@ -221,24 +241,8 @@ fn route(s: &mut Session, method: &str, path: &str, query: &str, b: &[u8]) -> Re
             s.edit_mut().start_over(bar).map_err(|e| fail(e.into()))?;
             candidates(s, bar)
         }
-        "/api/search-params" => {
-            let TauBody { tau0, tau_decay } = body(b)?;
-            let mut p = s.edit().search_params().clone();
-            p.tau0 = tau0.unwrap_or(p.tau0);
-            p.tau_decay = tau_decay.unwrap_or(p.tau_decay);
-            s.edit_mut()
-                .set_search_params(p)
-                .map_err(|e| fail(e.into()))?;
-            ok(json!(s.edit().search_params()))
-        }
-        "/api/like" | "/api/unlike" => {
-            let BarSegmentBody { bar, segment } = body(b)?;
-            s.edit_mut()
-                .like(bar, segment, path == "/api/like")
-                .map_err(|e| fail(e.into()))?;
-            let liked = &s.edit().bar_search(bar).map_err(|e| fail(e.into()))?.liked;
-            ok(json!({ "bar": bar, "liked": liked }))
-        }
+        "/api/search-params" => search_params(s, b),
+        "/api/like" | "/api/unlike" => like(s, path == "/api/like", b),
         "/api/set" => {
             let BarSegmentBody { bar, segment } = body(b)?;
             s.edit_mut().set(bar, segment).map_err(|e| fail(e.into()))?;
@@ -249,18 +253,7 @@ fn route(s: &mut Session, method: &str, path: &str, query: &str, b: &[u8]) -> Re
             s.edit_mut().unpin(bar).map_err(|e| fail(e.into()))?;
             ok(state(s))
         }
-        "/api/undo" | "/api/redo" => {
-            let Empty {} = body(b)?;
-            let c = if path == "/api/undo" {
-                s.edit_mut().undo()
-            } else {
-                s.edit_mut().redo()
-            }
-            .map_err(|e| fail(e.into()))?;
-            let mut v = state(s);
-            v["change"] = json!(c);
-            ok(v)
-        }
+        "/api/undo" | "/api/redo" => undo_redo(s, path == "/api/undo", b),
         "/api/generate" => {
             let Empty {} = body(b)?;
             s.generate().map_err(fail)?;
@@ -283,6 +276,45 @@ fn route(s: &mut Session, method: &str, path: &str, query: &str, b: &[u8]) -> Re
         }
         _ => Err(Reply::error(404, &format!("no route {path}"))),
     }
+}
+
+/// `POST /api/search-params`: the search's τ₀ and τ decay, each kept when not given; answers
+/// the parameters now.
+fn search_params(s: &mut Session, b: &[u8]) -> Result<Reply, Reply> {
+    let TauBody { tau0, tau_decay } = body(b)?;
+    let mut p = s.edit().search_params().clone();
+    p.tau0 = tau0.unwrap_or(p.tau0);
+    p.tau_decay = tau_decay.unwrap_or(p.tau_decay);
+    s.edit_mut()
+        .set_search_params(p)
+        .map_err(|e| fail(e.into()))?;
+    ok(json!(s.edit().search_params()))
+}
+
+/// `POST /api/like` (`liked`) or `/api/unlike`: a bar's candidate segment liked or not;
+/// answers the bar's liked segments.
+fn like(s: &mut Session, liked: bool, b: &[u8]) -> Result<Reply, Reply> {
+    let BarSegmentBody { bar, segment } = body(b)?;
+    s.edit_mut()
+        .like(bar, segment, liked)
+        .map_err(|e| fail(e.into()))?;
+    let liked = &s.edit().bar_search(bar).map_err(|e| fail(e.into()))?.liked;
+    ok(json!({ "bar": bar, "liked": liked }))
+}
+
+/// `POST /api/undo` (`undo`) or `/api/redo`: answers the state with the change undone or
+/// redone.
+fn undo_redo(s: &mut Session, undo: bool, b: &[u8]) -> Result<Reply, Reply> {
+    let Empty {} = body(b)?;
+    let c = if undo {
+        s.edit_mut().undo()
+    } else {
+        s.edit_mut().redo()
+    }
+    .map_err(|e| fail(e.into()))?;
+    let mut v = state(s);
+    v["change"] = json!(c);
+    ok(v)
 }
 
 /// `GET /api/audio.wav` over `song` and its bars' spans `bars` (s), `query` without its `?`:

@@ -134,24 +134,8 @@ fn replace_pins(text: &str, value: &str) -> Option<String> {
     let mut value_span: Option<(usize, usize)> = None;
     while i < b.len() {
         let c = b[i];
-        if c == b'/' && b.get(i + 1) == Some(&b'/') {
-            i = text[i..].find('\n').map_or(b.len(), |n| i + n);
-            continue;
-        }
-        if c == b'/' && b.get(i + 1) == Some(&b'*') {
-            let mut nest = 1;
-            i += 2;
-            while i < b.len() && nest > 0 {
-                if b[i] == b'/' && b.get(i + 1) == Some(&b'*') {
-                    nest += 1;
-                    i += 2;
-                } else if b[i] == b'*' && b.get(i + 1) == Some(&b'/') {
-                    nest -= 1;
-                    i += 2;
-                } else {
-                    i += 1;
-                }
-            }
+        if let Some(end) = comment_end(text, i) {
+            i = end;
             continue;
         }
         if c.is_ascii_whitespace() {
@@ -160,22 +144,8 @@ fn replace_pins(text: &str, value: &str) -> Option<String> {
         }
         let start = i;
         match c {
-            b'"' | b'\'' => {
-                i += 1;
-                while i < b.len() && b[i] != c {
-                    i += if b[i] == b'\\' { 2 } else { 1 };
-                }
-                i += 1;
-            }
-            b'r' if matches!(b.get(i + 1), Some(b'"' | b'#')) => {
-                let hashes = b[i + 1..].iter().take_while(|&&h| h == b'#').count();
-                let close = format!("\"{}", "#".repeat(hashes));
-                let open = i + 1 + hashes + 1;
-                i = text
-                    .get(open..)?
-                    .find(&close)
-                    .map(|n| open + n + close.len())?;
-            }
+            b'"' | b'\'' => i = quoted_end(b, i),
+            b'r' if matches!(b.get(i + 1), Some(b'"' | b'#')) => i = raw_string_end(text, i)?,
             b'(' | b'[' | b'{' => {
                 depth += 1;
                 i += 1;
@@ -188,36 +158,19 @@ fn replace_pins(text: &str, value: &str) -> Option<String> {
                 }
                 if depth == 0 {
                     // The scene's closing parenthesis.
-                    if let Some((a, z)) = value_span {
-                        return Some(format!("{}{value}{}", &text[..a], &text[z..]));
-                    }
-                    let at = last_sig?;
-                    let comma = if text[..at].ends_with([',', '(']) {
-                        ""
-                    } else {
-                        ","
-                    };
-                    return Some(format!(
-                        "{}{comma}\n    pins: {value},{}",
-                        &text[..at],
-                        &text[at..]
-                    ));
+                    return with_pins(text, value, value_span, last_sig);
                 }
             }
             _ if c.is_ascii_alphanumeric() || c == b'_' => {
                 while i < b.len() && (b[i].is_ascii_alphanumeric() || b[i] == b'_') {
                     i += 1;
                 }
-                if depth == 1 && &text[start..i] == "pins" && value_span.is_none() {
-                    let rest = &text[i..];
-                    let colon = rest.len() - rest.trim_start().len();
-                    if rest.trim_start().starts_with(':') {
-                        let after = i + colon + 1;
-                        let ws = text[after..].len() - text[after..].trim_start().len();
-                        if text[after + ws..].starts_with('[') {
-                            pins_at = Some(after + ws);
-                        }
-                    }
+                if depth == 1
+                    && &text[start..i] == "pins"
+                    && value_span.is_none()
+                    && let Some(v) = list_after_colon(text, i)
+                {
+                    pins_at = Some(v);
                 }
             }
             _ => i += 1,
@@ -227,6 +180,94 @@ fn replace_pins(text: &str, value: &str) -> Option<String> {
         }
     }
     None
+}
+
+/// The end of the comment (`//` to the line's end, or a nested `/* … */`) that starts at byte
+/// `i` of `text`; `None` when none starts there.
+fn comment_end(text: &str, i: usize) -> Option<usize> {
+    let b = text.as_bytes();
+    if b[i] != b'/' {
+        return None;
+    }
+    match b.get(i + 1) {
+        Some(b'/') => Some(text[i..].find('\n').map_or(b.len(), |n| i + n)),
+        Some(b'*') => {
+            let mut nest = 1;
+            let mut i = i + 2;
+            while i < b.len() && nest > 0 {
+                if b[i] == b'/' && b.get(i + 1) == Some(&b'*') {
+                    nest += 1;
+                    i += 2;
+                } else if b[i] == b'*' && b.get(i + 1) == Some(&b'/') {
+                    nest -= 1;
+                    i += 2;
+                } else {
+                    i += 1;
+                }
+            }
+            Some(i)
+        }
+        _ => None,
+    }
+}
+
+/// The end (past the closing quote) of the string or character whose opening quote is byte `i`
+/// of `b`, escapes skipped.
+fn quoted_end(b: &[u8], i: usize) -> usize {
+    let c = b[i];
+    let mut i = i + 1;
+    while i < b.len() && b[i] != c {
+        i += if b[i] == b'\\' { 2 } else { 1 };
+    }
+    i + 1
+}
+
+/// The end of the raw string `r#"…"#` that starts at byte `i` of `text`; `None` when unclosed.
+fn raw_string_end(text: &str, i: usize) -> Option<usize> {
+    let b = text.as_bytes();
+    let hashes = b[i + 1..].iter().take_while(|&&h| h == b'#').count();
+    let close = format!("\"{}", "#".repeat(hashes));
+    let open = i + 1 + hashes + 1;
+    text.get(open..)?
+        .find(&close)
+        .map(|n| open + n + close.len())
+}
+
+/// Where the list value starts after a field name that ends at byte `i` of `text`: its `[`
+/// after the colon; `None` when no colon and list follow.
+fn list_after_colon(text: &str, i: usize) -> Option<usize> {
+    let rest = &text[i..];
+    let colon = rest.len() - rest.trim_start().len();
+    if !rest.trim_start().starts_with(':') {
+        return None;
+    }
+    let after = i + colon + 1;
+    let ws = text[after..].len() - text[after..].trim_start().len();
+    text[after + ws..].starts_with('[').then_some(after + ws)
+}
+
+/// `text` with the pins' value at `value_span` replaced by `value`, or with no pins field the
+/// field added after the last significant byte `last_sig` before the closing parenthesis.
+fn with_pins(
+    text: &str,
+    value: &str,
+    value_span: Option<(usize, usize)>,
+    last_sig: Option<usize>,
+) -> Option<String> {
+    if let Some((a, z)) = value_span {
+        return Some(format!("{}{value}{}", &text[..a], &text[z..]));
+    }
+    let at = last_sig?;
+    let comma = if text[..at].ends_with([',', '(']) {
+        ""
+    } else {
+        ","
+    };
+    Some(format!(
+        "{}{comma}\n    pins: {value},{}",
+        &text[..at],
+        &text[at..]
+    ))
 }
 
 #[cfg(test)]

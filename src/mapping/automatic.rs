@@ -528,62 +528,151 @@ fn detect_inner(
         return Err("the skeleton has no joints".into());
     }
     let tree = Tree::new(skeleton, globals);
+    let chains = find_chains(&tree, skeleton)?;
+    let mut notes = vec![chains_note(&tree, skeleton, &chains)];
+
+    // Spine: waist, neck, head.
+    let (_, _, spine_found) = place(&tree, skeleton, &chains.spine, syn, "spine", |v| {
+        spine_slots(v, chains.chest)
+    })?;
+    let neck_node = spine_found[1].node;
+
+    // Legs and arms, sides not yet told.
+    let legs = place_pair(&tree, skeleton, &chains.legs, syn, "leg", leg_slots)?;
+    let mut arms = place_pair(&tree, skeleton, &chains.arms, syn, "arm", arm_slots)?;
+    stand_in_clavicles(&mut arms, neck_node);
+    let [(legs_first_left, leg_conf), (arms_first_left, arm_conf)] =
+        tell_limb_sides(&tree, &legs, &arms, &mut notes)?;
+
+    // Assemble.
+    let mut by_landmark: BTreeMap<String, (usize, f64, String)> = BTreeMap::new();
+    by_landmark.insert(
+        "pelvis".into(),
+        pelvis_landmark(&tree, skeleton, syn, chains.pelvis),
+    );
+    for f in spine_found {
+        by_landmark.insert(f.role.into(), (f.node, f.confidence, f.reason));
+    }
+    let sided = [
+        (legs.found, legs_first_left, leg_conf),
+        (arms.found, arms_first_left, arm_conf),
+    ];
+    for (found, first_left, conf) in sided {
+        insert_sided(&mut by_landmark, found, first_left, conf);
+    }
+    let mut landmarks = BTreeMap::new();
+    let mut findings = vec![];
+    for l in LANDMARKS {
+        let (node, confidence, reason) = by_landmark.remove(l).expect("every landmark placed");
+        let source = tree.name(skeleton, node);
+        landmarks.insert(l.to_string(), source.clone());
+        findings.push(Finding {
+            landmark: l.into(),
+            source,
+            confidence,
+            reason,
+        });
+    }
+    let detect = detect_joints(&landmarks);
+    Ok(AutoMapping {
+        mapping: Mapping {
+            format_version: FORMAT_VERSION,
+            name: "automatic".into(),
+            detect,
+            landmarks,
+        },
+        findings,
+        notes,
+    })
+}
+
+/// The note naming the chains found by structure: the pelvis, the chest hub, the four limb
+/// ends and the head.
+fn chains_note(tree: &Tree, skeleton: &Skeleton, chains: &Chains) -> String {
     let Chains {
         pelvis,
         chest,
         spine,
         legs,
         arms,
-    } = find_chains(&tree, skeleton)?;
-    let up = tree.up;
+    } = chains;
     let h = tree.height;
-    let mut notes = vec![format!(
+    format!(
         "chains by structure (first frame, height {h:.3} m): pelvis '{}', chest hub '{}', limb ends \
          '{}', '{}', '{}', '{}', head '{}'",
-        tree.name(skeleton, pelvis),
-        tree.name(skeleton, chest),
+        tree.name(skeleton, *pelvis),
+        tree.name(skeleton, *chest),
         tree.name(skeleton, *legs[0].last().expect("path")),
         tree.name(skeleton, *legs[1].last().expect("path")),
         tree.name(skeleton, *arms[0].last().expect("path")),
         tree.name(skeleton, *arms[1].last().expect("path")),
         tree.name(skeleton, *spine.last().expect("path")),
-    )];
+    )
+}
 
-    // Spine: waist, neck, head.
-    let (_, _, spine_found) = place(&tree, skeleton, &spine, syn, "spine", |v| {
-        spine_slots(v, chest)
-    })?;
-    let neck_node = spine_found[1].node;
+/// A pair of limbs placed, sides not yet told.
+struct LimbPair {
+    /// Each limb's landmarks.
+    found: Vec<Vec<Found>>,
+    /// Where each limb's slots were placed.
+    placed: Vec<Vec<Placed>>,
+    /// The side each limb's names carry.
+    named: (Side, Side),
+}
 
-    // Legs and arms, sides not yet told.
-    let mut leg_found = vec![];
-    let mut leg_views = vec![];
-    for leg in &legs {
-        let (v, _, f) = place(&tree, skeleton, leg, syn, "leg", leg_slots)?;
-        leg_found.push(f);
-        leg_views.push(v);
+/// Places the landmarks of a pair of limb chains, `what` ("leg", "arm"), by their `slots`.
+fn place_pair(
+    tree: &Tree,
+    skeleton: &Skeleton,
+    chains: &[Vec<usize>; 2],
+    syn: &Synonyms,
+    what: &str,
+    slots: impl Fn(&ChainView) -> Result<Vec<Slot>, String>,
+) -> Result<LimbPair, String> {
+    let mut found = vec![];
+    let mut placed = vec![];
+    let mut named = vec![];
+    for chain in chains {
+        let (v, p, f) = place(tree, skeleton, chain, syn, what, &slots)?;
+        found.push(f);
+        placed.push(p);
+        named.push(v.named_side());
     }
-    let mut arm_found = vec![];
-    let mut arm_views = vec![];
-    for arm in &arms {
-        let (v, placed, mut f) = place(&tree, skeleton, arm, syn, "arm", arm_slots)?;
-        // No clavicle joint (the arm starts at the chest hub): the neck base stands in for the
-        // clavicle's inner end, as in the engine's own fall21 skeleton.
+    Ok(LimbPair {
+        found,
+        placed,
+        named: (named[0], named[1]),
+    })
+}
+
+/// An arm without a clavicle joint (it starts at the chest hub) gets the neck base `neck_node`
+/// as its clavicle's inner end, as in the engine's own fall21 skeleton.
+fn stand_in_clavicles(arms: &mut LimbPair, neck_node: usize) {
+    for (placed, f) in arms.placed.iter().zip(&mut arms.found) {
         if placed[0].index == 0 && !placed[0].by_name {
             f[0].node = neck_node;
             f[0].confidence = 0.6;
             f[0].reason = "no clavicle joint: the neck base stands in for its inner end".into();
         }
-        arm_found.push(f);
-        arm_views.push(v);
     }
+}
 
-    // Sides by geometry: forward from the feet, left = up × forward.
+/// Whether the first leg and the first arm are the left ones and how sure that is: by geometry
+/// (forward from the feet, left = up × forward), else by the sides the names carry; the notes
+/// say how.
+fn tell_limb_sides(
+    tree: &Tree,
+    legs: &LimbPair,
+    arms: &LimbPair,
+    notes: &mut Vec<String>,
+) -> Result<[(bool, f64); 2], String> {
+    let (up, h) = (tree.up, tree.height);
+    let (leg_found, arm_found) = (&legs.found, &arms.found);
     let pos = |f: &[Found], role: &str| -> DVec3 {
         tree.nodes[f.iter().find(|x| x.role == role).expect("role placed").node].pos
     };
     let mut forward = DVec3::ZERO;
-    for f in &leg_found {
+    for f in leg_found {
         let d = pos(f, "toe") - pos(f, "ankle");
         forward += d - up * d.dot(up);
     }
@@ -604,7 +693,7 @@ fn detect_inner(
     let (legs_first_left, leg_conf, leg_note) = tell_sides(
         "legs",
         geometric(pos(&leg_found[0], "hip"), pos(&leg_found[1], "hip")),
-        (leg_views[0].named_side(), leg_views[1].named_side()),
+        legs.named,
     )?;
     let (arms_first_left, arm_conf, arm_note) = tell_sides(
         "arms",
@@ -612,56 +701,42 @@ fn detect_inner(
             pos(&arm_found[0], "shoulder"),
             pos(&arm_found[1], "shoulder"),
         ),
-        (arm_views[0].named_side(), arm_views[1].named_side()),
+        arms.named,
     )?;
     notes.push(leg_note);
     notes.push(arm_note);
+    Ok([(legs_first_left, leg_conf), (arms_first_left, arm_conf)])
+}
 
-    // Assemble.
-    let mut by_landmark: BTreeMap<String, (usize, f64, String)> = BTreeMap::new();
-    by_landmark.insert(
-        "pelvis".into(),
-        pelvis_landmark(&tree, skeleton, syn, pelvis),
-    );
-    for f in spine_found {
-        by_landmark.insert(f.role.into(), (f.node, f.confidence, f.reason));
-    }
-    let sided = [
-        (leg_found, legs_first_left, leg_conf),
-        (arm_found, arms_first_left, arm_conf),
-    ];
-    for (found, first_left, conf) in sided {
-        for (k, chain) in found.into_iter().enumerate() {
-            let side = if (k == 0) == first_left {
-                "left"
-            } else {
-                "right"
-            };
-            for f in chain {
-                by_landmark.insert(
-                    format!("{side}_{}", f.role),
-                    (
-                        f.node,
-                        f.confidence * conf,
-                        format!("{}; {side} side ({})", f.reason, side_word(conf)),
-                    ),
-                );
-            }
+/// Inserts the landmarks of a pair of limbs `found` under their sides (the first is the left
+/// one when `first_left`), their confidences scaled by the sides' `conf`.
+fn insert_sided(
+    by_landmark: &mut BTreeMap<String, (usize, f64, String)>,
+    found: Vec<Vec<Found>>,
+    first_left: bool,
+    conf: f64,
+) {
+    for (k, chain) in found.into_iter().enumerate() {
+        let side = if (k == 0) == first_left {
+            "left"
+        } else {
+            "right"
+        };
+        for f in chain {
+            by_landmark.insert(
+                format!("{side}_{}", f.role),
+                (
+                    f.node,
+                    f.confidence * conf,
+                    format!("{}; {side} side ({})", f.reason, side_word(conf)),
+                ),
+            );
         }
     }
-    let mut landmarks = BTreeMap::new();
-    let mut findings = vec![];
-    for l in LANDMARKS {
-        let (node, confidence, reason) = by_landmark.remove(l).expect("every landmark placed");
-        let source = tree.name(skeleton, node);
-        landmarks.insert(l.to_string(), source.clone());
-        findings.push(Finding {
-            landmark: l.into(),
-            source,
-            confidence,
-            reason,
-        });
-    }
+}
+
+/// The joints the mapping's `detect` lists: those of the pelvis, hips and shoulders, each once.
+fn detect_joints(landmarks: &BTreeMap<String, String>) -> Vec<String> {
     let mut detect: Vec<String> = vec![];
     for l in [
         "pelvis",
@@ -675,16 +750,7 @@ fn detect_inner(
             detect.push(j);
         }
     }
-    Ok(AutoMapping {
-        mapping: Mapping {
-            format_version: FORMAT_VERSION,
-            name: "automatic".into(),
-            detect,
-            landmarks,
-        },
-        findings,
-        notes,
-    })
+    detect
 }
 
 /// The pelvis: where the legs and the head chain part (`part`), or the nearest joint at or

@@ -94,11 +94,44 @@ fn target_frame(
 ) -> Option<DQuat> {
     let joint = &model.joints[j];
     let (side, role) = split_side(&joint.name);
-    let l = |name: &str| p.get(&format!("{side}{name}"));
-    let parent_frame = joint
-        .parent
-        .and_then(|q| targets[q])
-        .unwrap_or(DQuat::IDENTITY);
+    let link = Link {
+        p,
+        side,
+        parent: joint
+            .parent
+            .and_then(|q| targets[q])
+            .unwrap_or(DQuat::IDENTITY),
+        rest_dir: rest_dirs[j],
+    };
+    match role {
+        "pelvis" | "waist" | "neck" => torso_frame(role, &link),
+        "clavicle" | "shoulder" | "elbow" | "wrist" => arm_frame(role, &link, model, targets),
+        "hip" | "knee" | "ankle" => leg_frame(role, &link),
+        _ => None,
+    }
+}
+
+/// What a link's target frame is built from: the frame's landmarks, the link's side, its
+/// parent's target frame and its rest direction.
+struct Link<'a> {
+    p: &'a Points<'a>,
+    /// "left_", "right_" or "".
+    side: &'a str,
+    parent: DQuat,
+    rest_dir: DVec3,
+}
+
+impl Link<'_> {
+    /// The landmark `name` on the link's side.
+    fn l(&self, name: &str) -> DVec3 {
+        self.p.get(&format!("{}{name}", self.side))
+    }
+}
+
+/// The target frame of the pelvis (the hip line, the waist above), the waist (up to the neck,
+/// the shoulder line) or the neck (up to the head).
+fn torso_frame(role: &str, link: &Link) -> Option<DQuat> {
+    let (p, parent_frame) = (link.p, link.parent);
     match role {
         "pelvis" => frame_from(
             p.get("left_hip") - p.get("right_hip"),
@@ -114,18 +147,27 @@ fn target_frame(
             DVec3::Y,
             DVec3::X,
         ),
-        "neck" => frame_from(
-            p.get("head") - l("neck"),
+        _ => frame_from(
+            p.get("head") - link.l("neck"),
             parent_frame * DVec3::X,
             parent_frame * DVec3::Z,
             DVec3::Y,
             DVec3::X,
         ),
+    }
+}
+
+/// The target frame of an arm's clavicle, upper arm (shoulder), forearm (elbow) or hand
+/// (wrist).
+fn arm_frame(role: &str, link: &Link, model: &Model, targets: &[Option<DQuat>]) -> Option<DQuat> {
+    let l = |name: &str| link.l(name);
+    let parent_frame = link.parent;
+    match role {
         "clavicle" => frame_from(
             l("shoulder") - l("clavicle"),
             parent_frame * DVec3::Z,
             parent_frame * DVec3::Y,
-            rest_dirs[j],
+            link.rest_dir,
             DVec3::Z,
         ),
         "shoulder" => {
@@ -145,13 +187,21 @@ fn target_frame(
             DVec3::NEG_Y,
             DVec3::X,
         ),
-        "wrist" => frame_from(
+        _ => frame_from(
             l("hand") - l("wrist"),
             parent_frame * DVec3::Z,
             parent_frame * DVec3::X,
-            rest_dirs[j],
+            link.rest_dir,
             DVec3::Z,
         ),
+    }
+}
+
+/// The target frame of a leg's thigh (hip), shin (knee) or foot (ankle).
+fn leg_frame(role: &str, link: &Link) -> Option<DQuat> {
+    let l = |name: &str| link.l(name);
+    let parent_frame = link.parent;
+    match role {
         "hip" => {
             let thigh = l("knee") - l("hip");
             let t = thigh.normalize_or_zero();
@@ -166,14 +216,13 @@ fn target_frame(
             DVec3::NEG_Y,
             DVec3::X,
         ),
-        "ankle" => frame_from(
+        _ => frame_from(
             l("toe") - l("ankle"),
             parent_frame * DVec3::X,
             parent_frame * DVec3::Y,
-            rest_dirs[j],
+            link.rest_dir,
             DVec3::X,
         ),
-        _ => None,
     }
 }
 
@@ -181,7 +230,54 @@ fn target_frame(
 /// time), root translation (the pelvis landmark, metres) and root orientation, on a copy of the
 /// model whose offsets are the source's (median landmark geometry).
 pub fn retarget(clip: &Clip, mapping: &Mapping, model: &Model) -> Result<ModelClip, MappingError> {
-    // Landmarks this model needs: one per joint, plus those of End Sites, plus the hints'.
+    let names = needed_landmarks(model);
+    let resolved: Vec<Landmark> = names
+        .iter()
+        .map(|n| mapping.resolve(&clip.skeleton, n))
+        .collect::<Result<_, _>>()?;
+    let lm = LandmarkTracks {
+        positions: landmark_positions(clip, &resolved),
+        names,
+        frames: clip.frame_count(),
+    };
+
+    // Rest directions of the links (the clavicle's, hand's and foot's are not straight down).
+    let n = model.joints.len();
+    let rest_dirs: Vec<DVec3> = (0..n).map(|j| model.link_direction(j)).collect();
+
+    // Target frames per frame and link.
+    let (frames, k) = (lm.frames, lm.names.len());
+    let mut targets = vec![None; frames * n];
+    let mut row = vec![None; n];
+    for f in 0..frames {
+        let p = Points {
+            names: &lm.names,
+            pos: &lm.positions[f * k..(f + 1) * k],
+        };
+        for j in 0..n {
+            let t = target_frame(model, j, &p, &row, &rest_dirs);
+            row[j] = t;
+        }
+        targets[f * n..(f + 1) * n].copy_from_slice(&row);
+    }
+
+    let mapped_model = mapped_model(model, &lm, &targets);
+    let pelvis_lm = lm.index(&model.joints[0].name);
+    let (angles, root_rotation) = dof_angles(model, &targets, &rest_dirs, frames);
+    let root_translation = (0..frames)
+        .map(|f| lm.positions[f * k + pelvis_lm])
+        .collect();
+    Ok(ModelClip {
+        model: mapped_model,
+        frame_time: clip.frame_time,
+        root_translation,
+        root_rotation,
+        angles,
+    })
+}
+
+/// The landmarks `model` needs: one per joint, plus those of End Sites, plus the hints'.
+fn needed_landmarks(model: &Model) -> Vec<String> {
     let mut names: Vec<String> = vec![];
     let mut need = |n: String| {
         if !names.contains(&n) {
@@ -210,19 +306,16 @@ pub fn retarget(clip: &Clip, mapping: &Mapping, model: &Model) -> Result<ModelCl
             need(format!("{side}{n}"));
         }
     }
-    let resolved: Vec<Landmark> = names
-        .iter()
-        .map(|n| mapping.resolve(&clip.skeleton, n))
-        .collect::<Result<_, _>>()?;
+    names
+}
 
-    // Landmark positions for every frame.
-    let frames = clip.frame_count();
-    let k = names.len();
-    let mut positions = Vec::with_capacity(frames * k);
+/// The positions of the `resolved` landmarks in every frame of `clip`, frame by frame.
+fn landmark_positions(clip: &Clip, resolved: &[Landmark]) -> Vec<DVec3> {
+    let mut positions = Vec::with_capacity(clip.frame_count() * resolved.len());
     let mut g = vec![];
-    for f in 0..frames {
+    for f in 0..clip.frame_count() {
         clip.globals(f, &mut g);
-        for lm in &resolved {
+        for lm in resolved {
             let t = g[lm.joint];
             let e = if lm.end_site {
                 clip.skeleton.joints[lm.joint].end_site.unwrap_or_default()
@@ -232,33 +325,37 @@ pub fn retarget(clip: &Clip, mapping: &Mapping, model: &Model) -> Result<ModelCl
             positions.push(t.translation + t.rotation * e);
         }
     }
+    positions
+}
 
-    // Rest directions of the links (the clavicle's, hand's and foot's are not straight down).
-    let n = model.joints.len();
-    let rest_dirs: Vec<DVec3> = (0..n).map(|j| model.link_direction(j)).collect();
+/// The landmarks' positions over the clip: `positions[f * names.len() + i]` is landmark
+/// `names[i]` at frame `f`.
+struct LandmarkTracks {
+    names: Vec<String>,
+    positions: Vec<DVec3>,
+    frames: usize,
+}
 
-    // Target frames per frame and link.
-    let mut targets = vec![None; frames * n];
-    let mut row = vec![None; n];
-    for f in 0..frames {
-        let p = Points {
-            names: &names,
-            pos: &positions[f * k..(f + 1) * k],
-        };
-        for j in 0..n {
-            let t = target_frame(model, j, &p, &row, &rest_dirs);
-            row[j] = t;
-        }
-        targets[f * n..(f + 1) * n].copy_from_slice(&row);
+impl LandmarkTracks {
+    /// The index of landmark `name`.
+    fn index(&self, name: &str) -> usize {
+        self.names
+            .iter()
+            .position(|x| x == name)
+            .expect("needed above")
     }
+}
 
-    // Offsets and end sites: median of the landmark geometry in the parent's target frame.
-    let index = |name: &str| names.iter().position(|x| x == name).expect("needed above");
+/// A copy of `model` with the source's offsets and End Sites: the median of the landmark
+/// geometry in the parent's target frame (the model's own where the source gives none).
+fn mapped_model(model: &Model, lm: &LandmarkTracks, targets: &[Option<DQuat>]) -> Model {
+    let (n, k, frames) = (model.joints.len(), lm.names.len(), lm.frames);
+    let positions = &lm.positions;
     let mut mapped_model = model.clone();
     for j in 0..n {
-        let me = index(&model.joints[j].name);
+        let me = lm.index(&model.joints[j].name);
         if let Some(pj) = model.joints[j].parent {
-            let parent = index(&model.joints[pj].name);
+            let parent = lm.index(&model.joints[pj].name);
             mapped_model.joints[j].offset = median_local(frames, |f| {
                 let q = targets[f * n + pj]?;
                 Some(q.inverse() * (positions[f * k + me] - positions[f * k + parent]))
@@ -266,7 +363,7 @@ pub fn retarget(clip: &Clip, mapping: &Mapping, model: &Model) -> Result<ModelCl
             .unwrap_or(model.joints[j].offset);
         }
         if let Some(e) = end_landmark(&model.joints[j].name) {
-            let end = index(&e);
+            let end = lm.index(&e);
             mapped_model.joints[j].end_site = median_local(frames, |f| {
                 let q = targets[f * n + j]?;
                 Some(q.inverse() * (positions[f * k + end] - positions[f * k + me]))
@@ -274,14 +371,23 @@ pub fn retarget(clip: &Clip, mapping: &Mapping, model: &Model) -> Result<ModelCl
             .or(model.joints[j].end_site);
         }
     }
-    let pelvis_lm = index(&model.joints[0].name);
     mapped_model.height = height_of(&mapped_model);
+    mapped_model
+}
 
-    // DOF angles, parents first, from the achieved parent frame.
+/// The DOF angles of every frame (`frames` × DOFs) and the root's rotation, parents first,
+/// each joint's from its parent's achieved frame and the link's target (`targets`, frame by
+/// frame), unwrapped against the frame before.
+fn dof_angles(
+    model: &Model,
+    targets: &[Option<DQuat>],
+    rest_dirs: &[DVec3],
+    frames: usize,
+) -> (Vec<f64>, Vec<DQuat>) {
+    let n = model.joints.len();
     let dofs = model.dofs.len();
     let mut angles = vec![0.0; frames * dofs];
     let mut root_rotation = Vec::with_capacity(frames);
-    let mut root_translation = Vec::with_capacity(frames);
     let mut achieved = vec![DQuat::IDENTITY; n];
     let joint_axes: Vec<Vec<DVec3>> = (0..n).map(|j| model.joint_axes(j)).collect();
     for f in 0..frames {
@@ -317,15 +423,8 @@ pub fn retarget(clip: &Clip, mapping: &Mapping, model: &Model) -> Result<ModelCl
             achieved[j] = parent * local_rotation(joint.kind, axes, &out[..m]);
         }
         root_rotation.push(achieved[0]);
-        root_translation.push(positions[f * k + pelvis_lm]);
     }
-    Ok(ModelClip {
-        model: mapped_model,
-        frame_time: clip.frame_time,
-        root_translation,
-        root_rotation,
-        angles,
-    })
+    (angles, root_rotation)
 }
 
 /// Componentwise median of the vectors `sample(f)` over frames (skipping `None`).

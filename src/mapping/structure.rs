@@ -261,17 +261,19 @@ fn segment_distance(x: DVec3, a: DVec3, b: DVec3) -> f64 {
     (x - (a + ab * t)).length()
 }
 
-/// The five chains of the tree, or why it is not a humanoid.
-pub(crate) fn find_chains(tree: &Tree, skeleton: &Skeleton) -> Result<Chains, String> {
-    if tree.height <= 1e-9 {
-        return Err("the figure has no height in the frame used".into());
-    }
-    let names = |v: &[usize]| -> String {
-        v.iter()
-            .map(|&n| tree.name(skeleton, n))
-            .collect::<Vec<_>>()
-            .join(", ")
-    };
+/// The names of the nodes `v`, comma-separated.
+fn node_names(tree: &Tree, skeleton: &Skeleton, v: &[usize]) -> String {
+    v.iter()
+        .map(|&n| tree.name(skeleton, n))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// The limb ends, lowest first (relative to the lowest's height along up, `floor`), with the
+/// second lowest's relative height. Errors: fewer than five ends, or more than two on the
+/// floor.
+fn limb_ends_by_height(tree: &Tree, skeleton: &Skeleton) -> Result<(Vec<usize>, f64, f64), String> {
+    let names = |v: &[usize]| node_names(tree, skeleton, v);
     let mut ends = limb_ends(tree);
     if ends.len() < 5 {
         return Err(format!(
@@ -301,6 +303,16 @@ pub(crate) fn find_chains(tree: &Tree, skeleton: &Skeleton) -> Result<Chains, St
             names(&on_floor)
         ));
     }
+    Ok((ends, floor, second))
+}
+
+/// The five chains of the tree, or why it is not a humanoid.
+pub(crate) fn find_chains(tree: &Tree, skeleton: &Skeleton) -> Result<Chains, String> {
+    if tree.height <= 1e-9 {
+        return Err("the figure has no height in the frame used".into());
+    }
+    let names = |v: &[usize]| node_names(tree, skeleton, v);
+    let (ends, floor, second) = limb_ends_by_height(tree, skeleton)?;
     let feet = [ends[0], ends[1]];
     let upper = &ends[2..];
     if upper.len() != 3 {

@@ -12,6 +12,7 @@ use serde::{Deserialize, Serialize};
 use super::error::{PrimitiveError, Result, require_finite, require_positive};
 use super::learn::LearnConfig;
 use super::primitive::{Learned, Primitive};
+use super::rollout::Samples;
 use super::trajectory::Trajectory;
 
 /// Times (seconds) closer than this count as equal when classifying an arrangement.
@@ -284,6 +285,52 @@ pub fn blend(
     relearn: Relearn,
     config: &LearnConfig,
 ) -> Result<BlendResult> {
+    same_dofs(a, b)?;
+    require_positive("dt", dt)?;
+    gamma.validate()?;
+    let arrangement = placement.arrangement()?;
+    if relearn == Relearn::SplitAtBEnd && !arrangement.b_ends_first() {
+        return Err(PrimitiveError::InvalidPlacement {
+            reason: format!("split at t_Be needs B to end before A; {arrangement:?} ends together"),
+        });
+    }
+    // Step 1: place and time-scale.
+    let pa = a.with_duration(placement.a_end - placement.a_start)?;
+    let pb = b.with_duration(placement.b_end - placement.b_start)?;
+    let (t0, t1) = placement.span();
+    let n = ((t1 - t0) / dt - 1e-9).ceil().max(1.0) as usize;
+    let step = (t1 - t0) / n as f64;
+    let times: Vec<f64> = (0..=n)
+        .map(|k| t0 + (t1 - t0) * k as f64 / n as f64)
+        .collect();
+
+    // Step 2: roll out each over its own span (local times clamped into [0, τ]).
+    let ra = RolledOut::roll_out(&pa, &times, placement.a_start, placement.a_end)?;
+    let rb = RolledOut::roll_out(&pb, &times, placement.b_start, placement.b_end)?;
+
+    // Step 3: mix on the overlap, copy outside it.
+    let values = mix(&times, placement.overlap(), gamma, &ra, &rb);
+    let trajectory = Trajectory::new(step, a.names(), values)?;
+    let b_end_frame = (((placement.b_end - t0) / step).round() as usize).min(n);
+
+    // Step 4: learn again.
+    let name = format!("{}+{}", a.name, b.name);
+    let primitives = match relearn {
+        Relearn::No => Vec::new(),
+        Relearn::Whole => vec![Primitive::learn(&name, &trajectory, config)?],
+        Relearn::SplitAtBEnd => split_at_b_end(&name, &trajectory, b_end_frame, n, &ra, config)?,
+    };
+    Ok(BlendResult {
+        arrangement,
+        start_time: t0,
+        trajectory,
+        b_end_frame,
+        primitives,
+    })
+}
+
+/// Errors unless `a` and `b` drive the same DOFs.
+fn same_dofs(a: &Primitive, b: &Primitive) -> Result<()> {
     if a.names() != b.names() {
         return Err(PrimitiveError::DofMismatch {
             what: format!(
@@ -297,104 +344,123 @@ pub fn blend(
             ),
         });
     }
-    require_positive("dt", dt)?;
-    gamma.validate()?;
-    let arrangement = placement.arrangement()?;
-    if relearn == Relearn::SplitAtBEnd && !arrangement.b_ends_first() {
-        return Err(PrimitiveError::InvalidPlacement {
-            reason: format!("split at t_Be needs B to end before A; {arrangement:?} ends together"),
-        });
-    }
-    // Step 1: place and time-scale.
-    let pa = a.with_duration(placement.a_end - placement.a_start)?;
-    let pb = b.with_duration(placement.b_end - placement.b_start)?;
-    let (t0, t1) = placement.span();
-    let (o0, o1) = placement.overlap();
-    let n = ((t1 - t0) / dt - 1e-9).ceil().max(1.0) as usize;
-    let step = (t1 - t0) / n as f64;
-    let times: Vec<f64> = (0..=n)
-        .map(|k| t0 + (t1 - t0) * k as f64 / n as f64)
-        .collect();
-    let in_span = |t: f64, s: f64, e: f64| t >= s - TIME_EPS && t <= e + TIME_EPS;
+    Ok(())
+}
 
-    // Step 2: roll out each over its own span (local times clamped into [0, τ]).
-    let local = |p: &Primitive, s: f64, e: f64| -> Vec<f64> {
-        times
+/// Whether time `t` lies in the span [s, e] (within [`TIME_EPS`]).
+fn in_span(t: f64, s: f64, e: f64) -> bool {
+    t >= s - TIME_EPS && t <= e + TIME_EPS
+}
+
+/// A primitive rolled out over its span [start, end] of the blend's sample times.
+struct RolledOut {
+    /// The samples at the blend's times inside the span.
+    samples: Samples,
+    /// The first of the blend's times inside the span.
+    first: usize,
+    start: f64,
+    end: f64,
+    /// DOFs.
+    dofs: usize,
+}
+
+impl RolledOut {
+    /// `p` rolled out at those of `times` in [start, end], local times clamped into [0, τ].
+    fn roll_out(p: &Primitive, times: &[f64], start: f64, end: f64) -> Result<RolledOut> {
+        let local: Vec<f64> = times
             .iter()
-            .filter(|t| in_span(**t, s, e))
-            .map(|t| (t - s).clamp(0.0, p.duration))
-            .collect()
-    };
-    let la = local(&pa, placement.a_start, placement.a_end);
-    let lb = local(&pb, placement.b_start, placement.b_end);
-    let ra = pa.sample(&la, None)?;
-    let rb = pb.sample(&lb, None)?;
-    let first_a = times
-        .iter()
-        .position(|t| in_span(*t, placement.a_start, placement.a_end))
-        .unwrap_or(0);
-    let first_b = times
-        .iter()
-        .position(|t| in_span(*t, placement.b_start, placement.b_end))
-        .unwrap_or(0);
+            .filter(|t| in_span(**t, start, end))
+            .map(|t| (t - start).clamp(0.0, p.duration))
+            .collect();
+        let samples = p.sample(&local, None)?;
+        let first = times
+            .iter()
+            .position(|t| in_span(*t, start, end))
+            .unwrap_or(0);
+        Ok(RolledOut {
+            samples,
+            first,
+            start,
+            end,
+            dofs: p.dofs.len(),
+        })
+    }
 
-    // Step 3: mix on the overlap, copy outside it.
-    let d = a.dofs.len();
+    /// Whether time `t` lies in the span.
+    fn covers(&self, t: f64) -> bool {
+        in_span(t, self.start, self.end)
+    }
+
+    /// The row of the blend's sample `k` in the samples.
+    fn row(&self, k: usize) -> usize {
+        k.wrapping_sub(self.first)
+    }
+
+    /// The angles at the blend's sample `k`.
+    fn frame(&self, k: usize) -> &[f64] {
+        let (i, d) = (self.row(k), self.dofs);
+        &self.samples.values[i * d..(i + 1) * d]
+    }
+}
+
+/// θ_new at `times`: γ·A + (1 − γ)·B on the overlap (o0, o1), A or B alone outside it.
+fn mix(
+    times: &[f64],
+    (o0, o1): (f64, f64),
+    gamma: &Gamma,
+    ra: &RolledOut,
+    rb: &RolledOut,
+) -> Vec<f64> {
+    let d = ra.dofs;
     let mut values = Vec::with_capacity(times.len() * d);
     for (k, t) in times.iter().enumerate() {
-        let have_a = in_span(*t, placement.a_start, placement.a_end);
-        let have_b = in_span(*t, placement.b_start, placement.b_end);
-        let ia = k.wrapping_sub(first_a);
-        let ib = k.wrapping_sub(first_b);
+        let have_a = ra.covers(*t);
+        let have_b = rb.covers(*t);
+        let (ia, ib) = (ra.row(k), rb.row(k));
         if have_a && have_b && in_span(*t, o0, o1) {
             let g = gamma.at((t - o0) / (o1 - o0));
             for j in 0..d {
-                values.push(g * ra.value(ia, j) + (1.0 - g) * rb.value(ib, j));
+                values.push(g * ra.samples.value(ia, j) + (1.0 - g) * rb.samples.value(ib, j));
             }
         } else if have_a {
-            values.extend_from_slice(&ra.values[ia * d..(ia + 1) * d]);
+            values.extend_from_slice(ra.frame(k));
         } else {
-            values.extend_from_slice(&rb.values[ib * d..(ib + 1) * d]);
+            values.extend_from_slice(rb.frame(k));
         }
     }
-    let trajectory = Trajectory::new(step, a.names(), values)?;
-    let b_end_frame = (((placement.b_end - t0) / step).round() as usize).min(n);
+    values
+}
 
-    // Step 4: learn again.
-    let name = format!("{}+{}", a.name, b.name);
-    let primitives = match relearn {
-        Relearn::No => Vec::new(),
-        Relearn::Whole => vec![Primitive::learn(&name, &trajectory, config)?],
-        Relearn::SplitAtBEnd => {
-            if b_end_frame < 3 || n - b_end_frame < 3 {
-                return Err(PrimitiveError::InvalidPlacement {
-                    reason: format!(
-                        "splitting at t_Be leaves {} and {} frames; each part needs at least 4 (use a smaller dt)",
-                        b_end_frame + 1,
-                        n - b_end_frame + 1
-                    ),
-                });
-            }
-            let first = trajectory.slice_frames(0, b_end_frame)?;
-            let mut second = trajectory.slice_frames(b_end_frame, n)?;
-            // At t_Be itself θ_new is B's end pose; after it, A alone. The second primitive starts
-            // from A's side (the right limit), so it learns A's continuous course; connecting it to
-            // the first (see `connect`) pulls B's end state smoothly onto that course.
-            let ia = b_end_frame.wrapping_sub(first_a);
-            second.values[..d].copy_from_slice(&ra.values[ia * d..(ia + 1) * d]);
-            vec![
-                Primitive::learn(&format!("{name} (to B's end)"), &first, config)?,
-                Primitive::learn(&format!("{name} (after B's end)"), &second, config)?,
-            ]
-        }
-    };
-    Ok(BlendResult {
-        arrangement,
-        start_time: t0,
-        trajectory,
-        b_end_frame,
-        primitives,
-    })
+/// The blend `trajectory` (frames 0 … `n`) learned again as two primitives, up to B's end
+/// (frame `b_end_frame`) and after it, the second starting from A's side (`ra`).
+fn split_at_b_end(
+    name: &str,
+    trajectory: &Trajectory,
+    b_end_frame: usize,
+    n: usize,
+    ra: &RolledOut,
+    config: &LearnConfig,
+) -> Result<Vec<Learned>> {
+    if b_end_frame < 3 || n - b_end_frame < 3 {
+        return Err(PrimitiveError::InvalidPlacement {
+            reason: format!(
+                "splitting at t_Be leaves {} and {} frames; each part needs at least 4 (use a smaller dt)",
+                b_end_frame + 1,
+                n - b_end_frame + 1
+            ),
+        });
+    }
+    let d = ra.dofs;
+    let first = trajectory.slice_frames(0, b_end_frame)?;
+    let mut second = trajectory.slice_frames(b_end_frame, n)?;
+    // At t_Be itself θ_new is B's end pose; after it, A alone. The second primitive starts
+    // from A's side (the right limit), so it learns A's continuous course; connecting it to
+    // the first (see `connect`) pulls B's end state smoothly onto that course.
+    second.values[..d].copy_from_slice(ra.frame(b_end_frame));
+    Ok(vec![
+        Primitive::learn(&format!("{name} (to B's end)"), &first, config)?,
+        Primitive::learn(&format!("{name} (after B's end)"), &second, config)?,
+    ])
 }
 
 #[cfg(test)]

@@ -115,12 +115,8 @@ pub struct Connected {
     pub end_state: DofState,
 }
 
-/// Plays `sequence` back to back — the first from its demonstrated start or from `start`, every
-/// later one from the end state of the one before, handed over without a step in acceleration
-/// ([`HandOver`]) — and samples it every `dt` seconds over the total duration Σ τ_i. All
-/// primitives must have the same DOF names in the same order.
-pub fn connect(sequence: &[Primitive], dt: f64, start: Option<&DofState>) -> Result<Connected> {
-    require_positive("dt", dt)?;
+/// The DOF names of a non-empty `sequence` whose primitives all drive the same DOFs.
+fn sequence_dofs(sequence: &[Primitive]) -> Result<Vec<String>> {
     let first = sequence
         .first()
         .ok_or_else(|| PrimitiveError::InvalidParameter {
@@ -141,6 +137,16 @@ pub fn connect(sequence: &[Primitive], dt: f64, start: Option<&DofState>) -> Res
             });
         }
     }
+    Ok(names)
+}
+
+/// Plays `sequence` back to back — the first from its demonstrated start or from `start`, every
+/// later one from the end state of the one before, handed over without a step in acceleration
+/// ([`HandOver`]) — and samples it every `dt` seconds over the total duration Σ τ_i. All
+/// primitives must have the same DOF names in the same order.
+pub fn connect(sequence: &[Primitive], dt: f64, start: Option<&DofState>) -> Result<Connected> {
+    require_positive("dt", dt)?;
+    let names = sequence_dofs(sequence)?;
     let total: f64 = sequence.iter().map(|p| p.duration).sum();
     let frames = (total / dt + 1e-6).floor() as usize + 1;
     let d = names.len();

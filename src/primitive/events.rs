@@ -95,14 +95,9 @@ pub(crate) fn median(v: &[f64]) -> f64 {
     }
 }
 
-/// Finds Start, Bend, Leap and Land of a jump in the root height `root_y` (metres, one per frame
-/// every `dt` seconds) and, optionally, foot heights (`feet[f][k]`, metres). See the module docs.
-pub fn find_jump_events(
-    root_y: &[f64],
-    dt: f64,
-    feet: Option<&[Vec<f64>]>,
-    config: &EventConfig,
-) -> Result<JumpEvents> {
+/// [`find_jump_events`]'s checks: positive step and configuration, finite root heights, at
+/// least 8 frames.
+fn check_event_inputs(root_y: &[f64], dt: f64, config: &EventConfig) -> Result<()> {
     require_positive("dt", dt)?;
     require_positive("smoothing", config.smoothing)?;
     require_positive("onset_threshold", config.onset_threshold)?;
@@ -115,6 +110,36 @@ pub fn find_jump_events(
             what: format!("root height has {n} frames; need at least 8"),
         });
     }
+    Ok(())
+}
+
+/// The lowest of the foot heights `feet` (each of `n` finite frames, smoothed by a Gaussian of
+/// σ = `sigma` frames) in every frame.
+fn lowest_foot(feet: &[Vec<f64>], n: usize, sigma: f64) -> Result<Vec<f64>> {
+    for (f, h) in feet.iter().enumerate() {
+        if h.len() != n {
+            return Err(PrimitiveError::InvalidTrajectory {
+                what: format!("foot {f} has {} frames, root has {n}", h.len()),
+            });
+        }
+        require_finite(&format!("feet[{f}]"), h)?;
+    }
+    let smoothed: Vec<Vec<f64>> = feet.iter().map(|h| gaussian_smooth(h, sigma)).collect();
+    Ok((0..n)
+        .map(|k| smoothed.iter().map(|h| h[k]).fold(f64::INFINITY, f64::min))
+        .collect())
+}
+
+/// Finds Start, Bend, Leap and Land of a jump in the root height `root_y` (metres, one per frame
+/// every `dt` seconds) and, optionally, foot heights (`feet[f][k]`, metres). See the module docs.
+pub fn find_jump_events(
+    root_y: &[f64],
+    dt: f64,
+    feet: Option<&[Vec<f64>]>,
+    config: &EventConfig,
+) -> Result<JumpEvents> {
+    check_event_inputs(root_y, dt, config)?;
+    let n = root_y.len();
     let y = gaussian_smooth(root_y, config.smoothing / dt);
     let leap = (0..n).max_by(|a, b| y[*a].total_cmp(&y[*b])).unwrap_or(0);
     if leap == 0 || leap == n - 1 {
@@ -157,21 +182,7 @@ pub fn find_jump_events(
     };
     let land = match feet {
         Some(feet) if !feet.is_empty() => {
-            for (f, h) in feet.iter().enumerate() {
-                if h.len() != n {
-                    return Err(PrimitiveError::InvalidTrajectory {
-                        what: format!("foot {f} has {} frames, root has {n}", h.len()),
-                    });
-                }
-                require_finite(&format!("feet[{f}]"), h)?;
-            }
-            let smoothed: Vec<Vec<f64>> = feet
-                .iter()
-                .map(|h| gaussian_smooth(h, config.smoothing / dt))
-                .collect();
-            let lowest: Vec<f64> = (0..n)
-                .map(|k| smoothed.iter().map(|h| h[k]).fold(f64::INFINITY, f64::min))
-                .collect();
+            let lowest = lowest_foot(feet, n, config.smoothing / dt)?;
             let level = median(&lowest[..nb]) + config.foot_contact_margin;
             if lowest[leap] <= level {
                 return Err(PrimitiveError::EventsNotFound {

@@ -139,21 +139,9 @@ pub fn learn_dofs(
     basis: &Basis,
     config: &LearnConfig,
 ) -> Result<Vec<DofPrimitive>> {
-    demo.validate()?;
+    check_learn(demo, config)?;
     let n = demo.frames();
-    if n < 4 {
-        return Err(PrimitiveError::InvalidTrajectory {
-            what: format!("need at least 4 frames to learn, got {n}"),
-        });
-    }
     let f = config.formulation;
-    f.validate()?;
-    if !(config.degenerate_fraction >= 0.0 && config.degenerate_fraction.is_finite()) {
-        return Err(PrimitiveError::InvalidParameter {
-            field: "degenerate_fraction".into(),
-            reason: format!("must be ≥ 0 and finite, got {}", config.degenerate_fraction),
-        });
-    }
     let canonical = f.canonical();
     let nk = basis.len();
     let dofs = demo.dofs();
@@ -167,14 +155,7 @@ pub fn learn_dofs(
     derivatives(x, dofs, du, &mut d1, &mut d2);
     let starts = &x[..dofs];
     let goals = &x[(n - 1) * dofs..];
-    let mut lo = starts.to_vec();
-    let mut hi = starts.to_vec();
-    for row in x.chunks_exact(dofs) {
-        for j in 0..dofs {
-            lo[j] = if row[j] < lo[j] { row[j] } else { lo[j] };
-            hi[j] = if row[j] > hi[j] { row[j] } else { hi[j] };
-        }
-    }
+    let (lo, hi) = dof_ranges(x, dofs);
     let mut zd = vec![0.0; dofs * n];
     if let Formulation::Ijspeert2002 {
         alpha_z, beta_z, ..
@@ -220,8 +201,61 @@ pub fn learn_dofs(
         .collect();
 
     let mut out = out;
-    let weights = match config.regression {
-        Regression::LocallyWeighted => lwr(basis, &phases, &targets, dofs),
+    let weights = regress(config.regression, basis, &phases, &targets, dofs)?;
+    for (j, d) in out.iter_mut().enumerate() {
+        for (i, w) in d.weights.iter_mut().enumerate() {
+            *w = weights[i * dofs + j];
+        }
+    }
+    Ok(out)
+}
+
+/// [`learn_dofs`]'s checks: a valid demonstration of at least 4 frames, a valid formulation
+/// and a degenerate fraction ≥ 0.
+fn check_learn(demo: &Trajectory, config: &LearnConfig) -> Result<()> {
+    demo.validate()?;
+    let n = demo.frames();
+    if n < 4 {
+        return Err(PrimitiveError::InvalidTrajectory {
+            what: format!("need at least 4 frames to learn, got {n}"),
+        });
+    }
+    config.formulation.validate()?;
+    if !(config.degenerate_fraction >= 0.0 && config.degenerate_fraction.is_finite()) {
+        return Err(PrimitiveError::InvalidParameter {
+            field: "degenerate_fraction".into(),
+            reason: format!("must be ≥ 0 and finite, got {}", config.degenerate_fraction),
+        });
+    }
+    Ok(())
+}
+
+/// The lowest and highest value of each DOF over the frames of `x` (frames × dofs).
+fn dof_ranges(x: &[f64], dofs: usize) -> (Vec<f64>, Vec<f64>) {
+    let starts = &x[..dofs];
+    let mut lo = starts.to_vec();
+    let mut hi = starts.to_vec();
+    for row in x.chunks_exact(dofs) {
+        for j in 0..dofs {
+            lo[j] = if row[j] < lo[j] { row[j] } else { lo[j] };
+            hi[j] = if row[j] > hi[j] { row[j] } else { hi[j] };
+        }
+    }
+    (lo, hi)
+}
+
+/// The weights (kernels × dofs) that fit the forcing `targets` (frames × dofs) at `phases` by
+/// `regression`. Errors: a ridge λ that is negative or not finite, or normal equations that are
+/// not positive definite.
+fn regress(
+    regression: Regression,
+    basis: &Basis,
+    phases: &[super::canonical::Phase],
+    targets: &[f64],
+    dofs: usize,
+) -> Result<Vec<f64>> {
+    Ok(match regression {
+        Regression::LocallyWeighted => lwr(basis, phases, targets, dofs),
         Regression::Ridge { lambda } => {
             if !(lambda >= 0.0 && lambda.is_finite()) {
                 return Err(PrimitiveError::InvalidParameter {
@@ -229,15 +263,9 @@ pub fn learn_dofs(
                     reason: format!("must be ≥ 0 and finite, got {lambda}"),
                 });
             }
-            ridge(basis, &phases, &targets, dofs, lambda)?
+            ridge(basis, phases, targets, dofs, lambda)?
         }
-    };
-    for (j, d) in out.iter_mut().enumerate() {
-        for (i, w) in d.weights.iter_mut().enumerate() {
-            *w = weights[i * dofs + j];
-        }
-    }
-    Ok(out)
+    })
 }
 
 /// The paper's LWR: `w_i = Σ_t ψ_i gate F / Σ_t ψ_i gate²` per kernel and DOF. `targets` is
@@ -287,23 +315,7 @@ fn ridge(
     lambda: f64,
 ) -> Result<Vec<f64>> {
     let nk = basis.len();
-    let kernels = basis.kernels();
-    // Pass 1: the design rows Φ_t· (gated normalised activations) of every frame, compactly.
-    let mut phi = vec![0.0; nk];
-    // (frame, first kernel of its window, its activations in `acts`).
-    let mut rows: Vec<(usize, usize, std::ops::Range<usize>)> = Vec::with_capacity(phases.len());
-    let mut acts: Vec<f64> = Vec::with_capacity(phases.len() * 16);
-    let mut band = 1usize;
-    for (k, p) in phases.iter().enumerate() {
-        if p.gate == 0.0 {
-            continue;
-        }
-        let r = kernels.normalized(p.x, &mut phi);
-        band = band.max(r.end - r.start);
-        let at = acts.len();
-        acts.extend(phi[r.clone()].iter().map(|v| v * p.gate));
-        rows.push((k, r.start, at..acts.len()));
-    }
+    let DesignRows { rows, acts, band } = design_rows(basis, phases);
     // Pass 2: ΦᵀΦ in upper band storage, ab[a·band + (b − a)] for a ≤ b < a + band, and ΦᵀF.
     let mut ab = vec![0.0; nk * band];
     let mut atb = vec![0.0; nk * dofs]; // kernels × dofs
@@ -334,11 +346,16 @@ fn ridge(
         field: "regression.lambda".into(),
         reason: "normal equations not positive definite; increase lambda".into(),
     })?;
+    Ok(banded_solve(&l, nk, band, dofs, atb))
+}
+
+/// Solves L Lᵀ W = B for all `dofs` columns of B (`b`, `nk` rows, contiguous) at once, L the
+/// banded Cholesky factor of [`banded_cholesky`] (band `band`).
+fn banded_solve(l: &[f64], nk: usize, band: usize, dofs: usize, b: Vec<f64>) -> Vec<f64> {
     let bw = band - 1;
     // L in lower band storage: l[i·band + (i − j)] for i − bw ≤ j ≤ i.
     let lij = |i: usize, j: usize| l[i * band + (i - j)];
-    // Solve L Lᵀ W = B for all DOF columns at once (rows of B are contiguous).
-    let mut w = atb;
+    let mut w = b;
     for i in 0..nk {
         let (done, rest) = w.split_at_mut(i * dofs);
         let wi = &mut rest[..dofs];
@@ -368,7 +385,37 @@ fn ridge(
             *x *= inv;
         }
     }
-    Ok(w)
+    w
+}
+
+/// The design rows Φ_t· (gated normalised activations) of every frame with a non-zero gate,
+/// compactly.
+struct DesignRows {
+    /// (frame, first kernel of its window, its activations in `acts`).
+    rows: Vec<(usize, usize, std::ops::Range<usize>)>,
+    acts: Vec<f64>,
+    /// The widest window: the band of ΦᵀΦ.
+    band: usize,
+}
+
+/// [`ridge`]'s pass 1: the design rows of the frames at `phases`.
+fn design_rows(basis: &Basis, phases: &[super::canonical::Phase]) -> DesignRows {
+    let kernels = basis.kernels();
+    let mut phi = vec![0.0; basis.len()];
+    let mut rows: Vec<(usize, usize, std::ops::Range<usize>)> = Vec::with_capacity(phases.len());
+    let mut acts: Vec<f64> = Vec::with_capacity(phases.len() * 16);
+    let mut band = 1usize;
+    for (k, p) in phases.iter().enumerate() {
+        if p.gate == 0.0 {
+            continue;
+        }
+        let r = kernels.normalized(p.x, &mut phi);
+        band = band.max(r.end - r.start);
+        let at = acts.len();
+        acts.extend(phi[r.clone()].iter().map(|v| v * p.gate));
+        rows.push((k, r.start, at..acts.len()));
+    }
+    DesignRows { rows, acts, band }
 }
 
 /// Cholesky A = L Lᵀ of a symmetric positive-definite n × n matrix given in upper band storage

@@ -16,6 +16,7 @@ use std::borrow::Cow;
 use std::path::Path;
 use std::sync::OnceLock;
 
+use ab_glyph::FontRef;
 use rayon::prelude::*;
 use tiny_skia::Pixmap;
 
@@ -149,60 +150,8 @@ pub fn animation_gif(tracks: &[Track], fps: f64, path: &Path) -> Result<(), Rend
     };
     let cam = Camera::fit(tracks, eye, mpp, pad, limits);
     let style = Style::for_height(PANEL_HEIGHT);
-
-    // Layout: header (time), then per track a label row and its panel, then the key.
-    let header = (style.text * 1.8) as u32;
-    let label_row = (style.text * 1.6) as u32;
-    let footer = (style.small * 2.4) as u32;
-    let block_w = cam.width;
-    let n = tracks.len() as u64;
-    let row = n * block_w as u64 + (n - 1) * TRACK_GAP as u64;
-    let height = MARGIN + header + label_row + PANEL_HEIGHT + footer;
-    sheet_size(row + 2 * MARGIN as u64, height as u64)?;
-    let row_w = row as u32;
-    let caption = cam.eye.caption();
-    let key_w = key_width(font, mpp, row_w as f64 * 0.6, style, Some(&caption)) as u32;
-    let width = 2 * MARGIN + row_w.max(key_w);
-    let (Ok(w16), Ok(h16)) = (u16::try_from(width), u16::try_from(height)) else {
-        return Err(RenderError::InvalidArgument(format!(
-            "a {width}×{height} picture exceeds the GIF limit of 65535 pixels a side"
-        )));
-    };
-
-    // The unchanging sheet: labels, empty panels, key.
-    let mut sheet = new_pixmap(width, height, WHITE)?;
-    let panel_y = MARGIN + header + label_row;
-    let label_base = (MARGIN + header) as f32 + ascent(font, style.text);
-    let mut origins = Vec::new();
-    let background = panel_background(&cam, font, style, false)?;
-    for (i, track) in tracks.iter().enumerate() {
-        let x = MARGIN + i as u32 * (block_w + TRACK_GAP);
-        let lx = x as f32;
-        draw_text(
-            &mut sheet,
-            font,
-            &track.label,
-            (lx, label_base),
-            Pen {
-                size: style.text,
-                rgb: INK,
-                align: Align::Left,
-            },
-        );
-        blit(&mut sheet, &background, x, panel_y);
-        origins.push(x);
-    }
-    let key_base = (panel_y + PANEL_HEIGHT) as f32 + style.small * 1.7;
-    draw_key(
-        &mut sheet,
-        font,
-        MARGIN as f32,
-        key_base,
-        mpp,
-        row_w as f64 * 0.6,
-        style,
-        Some(&caption),
-    );
+    let page = Page::draw(tracks, &cam, font, style, mpp)?;
+    let (width, panel_y) = (page.width, page.panel_y);
 
     let duration = tracks.iter().map(Track::duration).fold(0.0, f64::max);
     let steps = (duration * fps + 1e-9).floor();
@@ -215,11 +164,11 @@ pub fn animation_gif(tracks: &[Track], fps: f64, path: &Path) -> Result<(), Rend
     let bodies: Vec<Body> = tracks.iter().map(Body::of).collect();
     let lut = lookup();
     let time_base = MARGIN as f32 + ascent(font, style.text);
-    let mut still = vec![0u8; (width * height) as usize];
-    quantise_into(&mut still, width as usize, &sheet, 0, 0, lut);
+    let mut still = vec![0u8; (width * page.height) as usize];
+    quantise_into(&mut still, width as usize, &page.sheet, 0, 0, lut);
     // The strip that holds the time label.
-    let clock = tiny_skia::IntRect::from_xywh(0, 0, width, MARGIN + header)
-        .and_then(|r| sheet.clone_rect(r))
+    let clock = tiny_skia::IntRect::from_xywh(0, 0, width, MARGIN + page.header)
+        .and_then(|r| page.sheet.clone_rect(r))
         .ok_or_else(|| RenderError::Encode("empty GIF header".into()))?;
 
     // Frame k: the still page with the clock and the panels drawn over it, as palette indices.
@@ -235,26 +184,136 @@ pub fn animation_gif(tracks: &[Track], fps: f64, path: &Path) -> Result<(), Rend
         };
         draw_text(&mut strip, font, &label, (MARGIN as f32, time_base), pen);
         quantise_into(&mut img, width as usize, &strip, 0, 0, lut);
-        for ((track, &origin), body) in tracks.iter().zip(&origins).zip(&bodies) {
-            let mut panel = background.clone();
+        for ((track, &origin), body) in tracks.iter().zip(&page.origins).zip(&bodies) {
+            let mut panel = page.background.clone();
             draw_body(&mut panel, &cam, track, body, track.frame_at(t), style);
             quantise_into(&mut img, width as usize, &panel, origin, panel_y, lut);
         }
         img
     };
+    let bytes = encode_gif(&page, frames, fps, render)?;
+    write(path, &bytes)
+}
 
+/// The GIF's unchanging page: header row (the time), per track a label and an empty panel, the
+/// key under them.
+struct Page {
+    /// The page drawn: labels, empty panels, key.
+    sheet: Pixmap,
+    /// Size (pixels).
+    width: u32,
+    height: u32,
+    /// The size as GIF stores it.
+    size16: (u16, u16),
+    /// Height of the header row that holds the time (pixels).
+    header: u32,
+    /// Top of the panels (pixels).
+    panel_y: u32,
+    /// Left edge of each track's panel (pixels).
+    origins: Vec<u32>,
+    /// An empty panel (floor and shadow-free background).
+    background: Pixmap,
+}
+
+impl Page {
+    /// Lays out and draws the page for `tracks` seen by `cam` at `mpp` metres a pixel. Errors:
+    /// a page too large (for the sheet, or over GIF's 65535 pixels a side).
+    fn draw(
+        tracks: &[Track],
+        cam: &Camera,
+        font: &FontRef,
+        style: Style,
+        mpp: f64,
+    ) -> Result<Page, RenderError> {
+        // Layout: header (time), then per track a label row and its panel, then the key.
+        let header = (style.text * 1.8) as u32;
+        let label_row = (style.text * 1.6) as u32;
+        let footer = (style.small * 2.4) as u32;
+        let block_w = cam.width;
+        let n = tracks.len() as u64;
+        let row = n * block_w as u64 + (n - 1) * TRACK_GAP as u64;
+        let height = MARGIN + header + label_row + PANEL_HEIGHT + footer;
+        sheet_size(row + 2 * MARGIN as u64, height as u64)?;
+        let row_w = row as u32;
+        let caption = cam.eye.caption();
+        let key_w = key_width(font, mpp, row_w as f64 * 0.6, style, Some(&caption)) as u32;
+        let width = 2 * MARGIN + row_w.max(key_w);
+        let (Ok(w16), Ok(h16)) = (u16::try_from(width), u16::try_from(height)) else {
+            return Err(RenderError::InvalidArgument(format!(
+                "a {width}×{height} picture exceeds the GIF limit of 65535 pixels a side"
+            )));
+        };
+
+        // The unchanging sheet: labels, empty panels, key.
+        let mut sheet = new_pixmap(width, height, WHITE)?;
+        let panel_y = MARGIN + header + label_row;
+        let label_base = (MARGIN + header) as f32 + ascent(font, style.text);
+        let mut origins = Vec::new();
+        let background = panel_background(cam, font, style, false)?;
+        for (i, track) in tracks.iter().enumerate() {
+            let x = MARGIN + i as u32 * (block_w + TRACK_GAP);
+            let lx = x as f32;
+            draw_text(
+                &mut sheet,
+                font,
+                &track.label,
+                (lx, label_base),
+                Pen {
+                    size: style.text,
+                    rgb: INK,
+                    align: Align::Left,
+                },
+            );
+            blit(&mut sheet, &background, x, panel_y);
+            origins.push(x);
+        }
+        let key_base = (panel_y + PANEL_HEIGHT) as f32 + style.small * 1.7;
+        draw_key(
+            &mut sheet,
+            font,
+            MARGIN as f32,
+            key_base,
+            mpp,
+            row_w as f64 * 0.6,
+            style,
+            Some(&caption),
+        );
+        Ok(Page {
+            sheet,
+            width,
+            height,
+            size16: (w16, h16),
+            header,
+            panel_y,
+            origins,
+            background,
+        })
+    }
+}
+
+/// The looping GIF of `frames` frames of `page`'s size, frame k drawn by `render` (palette
+/// indices) and shown at time k/`fps`: drawn and LZW-compressed in parallel chunks, each frame
+/// after the first only its changed part, an unchanged frame adding its delay to the one
+/// before.
+fn encode_gif(
+    page: &Page,
+    frames: usize,
+    fps: f64,
+    render: impl Fn(usize) -> Vec<u8> + Sync + Send,
+) -> Result<Vec<u8>, RenderError> {
+    let (w16, h16) = page.size16;
     let mut pal: Vec<u8> = palette().into_iter().flatten().collect();
     pal.extend([255, 255, 255]); // TRANSPARENT: never drawn, marks unchanged pixels
     let gif_err = |e: gif::EncodingError| RenderError::Encode(format!("GIF: {e}"));
     let mut encoder = gif::Encoder::new(Vec::new(), w16, h16, &pal).map_err(gif_err)?;
     encoder.set_repeat(gif::Repeat::Infinite).map_err(gif_err)?;
-    let (w, h) = (width as usize, height as usize);
+    let (w, h) = (page.width as usize, page.height as usize);
     let mut previous: Option<Vec<u8>> = None;
     // A frame waits until the next one is known: an unchanged next frame only adds its delay.
     let mut pending: Option<gif::Frame<'static>> = None;
     for start in (0..frames).step_by(CHUNK) {
         let end = (start + CHUNK).min(frames);
-        let images: Vec<Vec<u8>> = (start..end).into_par_iter().map(render).collect();
+        let images: Vec<Vec<u8>> = (start..end).into_par_iter().map(&render).collect();
         let mut batch: Vec<Option<gif::Frame<'static>>> = Vec::with_capacity(images.len());
         for (i, img) in images.into_iter().enumerate() {
             let k = start + i;
@@ -295,8 +354,7 @@ pub fn animation_gif(tracks: &[Track], fps: f64, path: &Path) -> Result<(), Rend
     if let Some(p) = pending {
         encoder.write_lzw_pre_encoded_frame(&p).map_err(gif_err)?;
     }
-    let bytes = encoder.into_inner().map_err(gif_err)?;
-    write(path, &bytes)
+    encoder.into_inner().map_err(gif_err)
 }
 
 /// Palette index that marks a pixel as unchanged from the previous frame.

@@ -4,6 +4,9 @@
 
 use std::path::Path;
 
+use ab_glyph::FontRef;
+use tiny_skia::Pixmap;
+
 use super::camera::{Camera, Eye, PanelLimits, View, scale_for};
 use super::canvas::{
     INK, Style, WHITE, blit, draw_body, draw_key, encode_png, key_width, new_pixmap,
@@ -326,6 +329,31 @@ fn draw_facing(
     draw_columns(tracks, &times, &labels, &cam, style, mpp, path)
 }
 
+/// The row of column labels along the top of the sheet, each centred over its column.
+fn draw_column_labels(
+    sheet: &mut Pixmap,
+    font: &FontRef,
+    labels: &[String],
+    cam: &Camera,
+    style: Style,
+) {
+    let time_base = MARGIN as f32 + ascent(font, style.small);
+    for (j, s) in labels.iter().enumerate() {
+        let cx = (MARGIN + j as u32 * (cam.width + GAP)) as f32 + cam.width as f32 * 0.5;
+        draw_text(
+            sheet,
+            font,
+            s,
+            (cx, time_base),
+            Pen {
+                size: style.small,
+                rgb: INK,
+                align: Align::Centre,
+            },
+        );
+    }
+}
+
 /// The sheet of a filmstrip: a column per instant with its label above, a row per track.
 fn draw_columns(
     tracks: &[Track],
@@ -357,21 +385,7 @@ fn draw_columns(
 
     let x0 = MARGIN;
     let mut y = MARGIN;
-    let time_base = y as f32 + ascent(font, style.small);
-    for (j, s) in labels.iter().enumerate() {
-        let cx = (x0 + j as u32 * (cam.width + GAP)) as f32 + cam.width as f32 * 0.5;
-        draw_text(
-            &mut sheet,
-            font,
-            s,
-            (cx, time_base),
-            Pen {
-                size: style.small,
-                rgb: INK,
-                align: Align::Centre,
-            },
-        );
-    }
+    draw_column_labels(&mut sheet, font, labels, cam, style);
     y += time_row;
     // The view's name is in the key, where no figure can cover it.
     let background = panel_background(cam, font, style, false)?;

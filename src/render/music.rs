@@ -4,6 +4,7 @@
 
 use std::path::Path;
 
+use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::RenderError;
@@ -80,131 +81,9 @@ pub fn music_png(
             .map_err(err)?;
         let panels = root.split_evenly((3, 1));
         let t_end = analysis.duration_s.max(1e-3);
-        let beat = RGBColor(150, 150, 150);
-        let bar = RGBColor(213, 94, 0);
-        let blue = RGBColor(0, 114, 178);
-
-        // Waveform.
-        let peak = samples.iter().fold(0f32, |m, s| m.max(s.abs())).max(1e-6) as f64;
-        let mut c = ChartBuilder::on(&panels[0])
-            .margin(10)
-            .x_label_area_size(30)
-            .y_label_area_size(70)
-            .build_cartesian_2d(0.0..t_end, -peak * 1.08..peak * 1.15)
-            .map_err(err)?;
-        c.configure_mesh()
-            .disable_mesh()
-            .y_desc("waveform")
-            .label_style(("sans-serif", 14))
-            .draw()
-            .map_err(err)?;
-        let cols = 1300usize;
-        let env = envelope(samples, cols);
-        c.draw_series(env.iter().enumerate().map(|(i, &(lo, hi))| {
-            let t = (i as f64 + 0.5) * t_end / cols as f64;
-            PathElement::new(vec![(t, lo), (t, hi)], blue)
-        }))
-        .map_err(err)?;
-        // Number the bars where a number fits after the previous one (about 7 px a digit on
-        // the plot's ~1300 px): every bar while they fit, and no number over a short bar's.
-        let s_per_px = t_end / cols as f64;
-        let mut free_from = f64::NEG_INFINITY;
-        for (k, b) in analysis.bars.iter().enumerate() {
-            c.draw_series(std::iter::once(PathElement::new(
-                vec![(b.start_s, -peak * 1.08), (b.start_s, peak * 1.15)],
-                bar.stroke_width(1),
-            )))
-            .map_err(err)?;
-            let label = format!("{}", k + 1);
-            if b.start_s >= free_from {
-                free_from = b.start_s + (7.0 * label.len() as f64 + 4.0) * s_per_px;
-                c.draw_series(std::iter::once(Text::new(
-                    label,
-                    (b.start_s, peak * 1.14),
-                    ("sans-serif", 12).into_font().color(&bar),
-                )))
-                .map_err(err)?;
-            }
-        }
-
-        // Onset envelope and beats.
-        let on = &analysis.onsets;
-        let top = on.values.iter().fold(0.0f64, |m, &v| m.max(v)).max(1e-9);
-        let mut c = ChartBuilder::on(&panels[1])
-            .margin(10)
-            .x_label_area_size(30)
-            .y_label_area_size(70)
-            .build_cartesian_2d(0.0..t_end, 0.0..top * 1.05)
-            .map_err(err)?;
-        c.configure_mesh()
-            .disable_mesh()
-            .y_desc("onset strength")
-            .label_style(("sans-serif", 14))
-            .draw()
-            .map_err(err)?;
-        for &b in &analysis.beats_s {
-            c.draw_series(std::iter::once(PathElement::new(
-                vec![(b, 0.0), (b, top * 1.05)],
-                beat,
-            )))
-            .map_err(err)?;
-        }
-        c.draw_series(LineSeries::new(
-            on.values
-                .iter()
-                .enumerate()
-                .map(|(i, &v)| (on.time_of(i as f64), v)),
-            blue,
-        ))
-        .map_err(err)?
-        .label("onset envelope")
-        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], blue));
-        c.draw_series(std::iter::once(PathElement::new(
-            vec![(0.0, 0.0), (0.0, 0.0)],
-            beat,
-        )))
-        .map_err(err)?
-        .label("beats (tracked)")
-        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], beat));
-        c.configure_series_labels()
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 14))
-            .draw()
-            .map_err(err)?;
-
-        // Bar intensity.
-        let (lo, hi) = analysis
-            .bars
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), b| {
-                (lo.min(b.rms_db), hi.max(b.rms_db))
-            });
-        let (lo, hi) = if lo.is_finite() {
-            (lo - 3.0, hi + 3.0)
-        } else {
-            (-60.0, 0.0)
-        };
-        let mut c = ChartBuilder::on(&panels[2])
-            .margin(10)
-            .x_label_area_size(40)
-            .y_label_area_size(70)
-            .build_cartesian_2d(0.0..t_end, lo..hi)
-            .map_err(err)?;
-        c.configure_mesh()
-            .disable_mesh()
-            .x_desc("time (s)")
-            .y_desc("bar RMS (dB re 1)")
-            .label_style(("sans-serif", 14))
-            .draw()
-            .map_err(err)?;
-        c.draw_series(analysis.bars.iter().map(|b| {
-            PathElement::new(
-                vec![(b.start_s, b.rms_db), (b.end_s, b.rms_db)],
-                bar.stroke_width(3),
-            )
-        }))
-        .map_err(err)?;
+        waveform_panel(&panels[0], analysis, samples, t_end)?;
+        onset_panel(&panels[1], analysis, t_end)?;
+        intensity_panel(&panels[2], analysis, t_end)?;
         root.present().map_err(err)?;
     }
     let rgba: Vec<u8> = rgb
@@ -218,4 +97,150 @@ pub fn music_png(
         path: path.to_path_buf(),
         source,
     })
+}
+
+/// One of the picture's three panels.
+type Panel<'a> = DrawingArea<BitMapBackend<'a>, Shift>;
+
+/// Colour of the beats.
+const BEAT: RGBColor = RGBColor(150, 150, 150);
+/// Colour of the bars.
+const BAR: RGBColor = RGBColor(213, 94, 0);
+/// Colour of the waveform and the onset envelope.
+const BLUE: RGBColor = RGBColor(0, 114, 178);
+
+/// The top panel: the waveform (each column's min to max) with the bars' starts, numbered.
+fn waveform_panel(
+    panel: &Panel,
+    analysis: &MusicAnalysis,
+    samples: &[f32],
+    t_end: f64,
+) -> Result<(), RenderError> {
+    let peak = samples.iter().fold(0f32, |m, s| m.max(s.abs())).max(1e-6) as f64;
+    let mut c = ChartBuilder::on(panel)
+        .margin(10)
+        .x_label_area_size(30)
+        .y_label_area_size(70)
+        .build_cartesian_2d(0.0..t_end, -peak * 1.08..peak * 1.15)
+        .map_err(err)?;
+    c.configure_mesh()
+        .disable_mesh()
+        .y_desc("waveform")
+        .label_style(("sans-serif", 14))
+        .draw()
+        .map_err(err)?;
+    let cols = 1300usize;
+    let env = envelope(samples, cols);
+    c.draw_series(env.iter().enumerate().map(|(i, &(lo, hi))| {
+        let t = (i as f64 + 0.5) * t_end / cols as f64;
+        PathElement::new(vec![(t, lo), (t, hi)], BLUE)
+    }))
+    .map_err(err)?;
+    // Number the bars where a number fits after the previous one (about 7 px a digit on
+    // the plot's ~1300 px): every bar while they fit, and no number over a short bar's.
+    let s_per_px = t_end / cols as f64;
+    let mut free_from = f64::NEG_INFINITY;
+    for (k, b) in analysis.bars.iter().enumerate() {
+        c.draw_series(std::iter::once(PathElement::new(
+            vec![(b.start_s, -peak * 1.08), (b.start_s, peak * 1.15)],
+            BAR.stroke_width(1),
+        )))
+        .map_err(err)?;
+        let label = format!("{}", k + 1);
+        if b.start_s >= free_from {
+            free_from = b.start_s + (7.0 * label.len() as f64 + 4.0) * s_per_px;
+            c.draw_series(std::iter::once(Text::new(
+                label,
+                (b.start_s, peak * 1.14),
+                ("sans-serif", 12).into_font().color(&BAR),
+            )))
+            .map_err(err)?;
+        }
+    }
+    Ok(())
+}
+
+/// The middle panel: the onset envelope and the beats tracked on it, with a legend.
+fn onset_panel(panel: &Panel, analysis: &MusicAnalysis, t_end: f64) -> Result<(), RenderError> {
+    let on = &analysis.onsets;
+    let top = on.values.iter().fold(0.0f64, |m, &v| m.max(v)).max(1e-9);
+    let mut c = ChartBuilder::on(panel)
+        .margin(10)
+        .x_label_area_size(30)
+        .y_label_area_size(70)
+        .build_cartesian_2d(0.0..t_end, 0.0..top * 1.05)
+        .map_err(err)?;
+    c.configure_mesh()
+        .disable_mesh()
+        .y_desc("onset strength")
+        .label_style(("sans-serif", 14))
+        .draw()
+        .map_err(err)?;
+    for &b in &analysis.beats_s {
+        c.draw_series(std::iter::once(PathElement::new(
+            vec![(b, 0.0), (b, top * 1.05)],
+            BEAT,
+        )))
+        .map_err(err)?;
+    }
+    c.draw_series(LineSeries::new(
+        on.values
+            .iter()
+            .enumerate()
+            .map(|(i, &v)| (on.time_of(i as f64), v)),
+        BLUE,
+    ))
+    .map_err(err)?
+    .label("onset envelope")
+    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLUE));
+    c.draw_series(std::iter::once(PathElement::new(
+        vec![(0.0, 0.0), (0.0, 0.0)],
+        BEAT,
+    )))
+    .map_err(err)?
+    .label("beats (tracked)")
+    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BEAT));
+    c.configure_series_labels()
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 14))
+        .draw()
+        .map_err(err)?;
+    Ok(())
+}
+
+/// The bottom panel: each bar's intensity (RMS in dB) as a step over the bar.
+fn intensity_panel(panel: &Panel, analysis: &MusicAnalysis, t_end: f64) -> Result<(), RenderError> {
+    let (lo, hi) = analysis
+        .bars
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), b| {
+            (lo.min(b.rms_db), hi.max(b.rms_db))
+        });
+    let (lo, hi) = if lo.is_finite() {
+        (lo - 3.0, hi + 3.0)
+    } else {
+        (-60.0, 0.0)
+    };
+    let mut c = ChartBuilder::on(panel)
+        .margin(10)
+        .x_label_area_size(40)
+        .y_label_area_size(70)
+        .build_cartesian_2d(0.0..t_end, lo..hi)
+        .map_err(err)?;
+    c.configure_mesh()
+        .disable_mesh()
+        .x_desc("time (s)")
+        .y_desc("bar RMS (dB re 1)")
+        .label_style(("sans-serif", 14))
+        .draw()
+        .map_err(err)?;
+    c.draw_series(analysis.bars.iter().map(|b| {
+        PathElement::new(
+            vec![(b.start_s, b.rms_db), (b.end_s, b.rms_db)],
+            BAR.stroke_width(3),
+        )
+    }))
+    .map_err(err)?;
+    Ok(())
 }

@@ -4,6 +4,7 @@
 use std::path::Path;
 
 use plotters::coord::Shift;
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 
 use super::text::register_plot_font;
@@ -271,15 +272,46 @@ fn legend_corner(plot: &Plot, x: (f64, f64), y: (f64, f64)) -> SeriesLabelPositi
     best.1
 }
 
+/// The chart a plot is drawn on: x and y in the plot's units.
+type Chart<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+
 /// Draws the plot on `root`, every length and font size multiplied by `k` (supersampling).
 fn draw<DB: DrawingBackend>(
     plot: &Plot,
     root: &DrawingArea<DB, Shift>,
     k: u32,
 ) -> Result<(), RenderError> {
-    let ki = k as i32;
     let font = |size: u32| ("sans-serif", size * k);
     root.fill(&WHITE).map_err(plot_err)?;
+    let (x, y) = axis_ranges(plot);
+    let chart = ChartBuilder::on(root)
+        .caption(&plot.title, font(26).into_font().color(&BLACK))
+        .margin(18 * k)
+        .x_label_area_size(56 * k)
+        .y_label_area_size(84 * k)
+        .build_cartesian_2d(x.0..x.1, y.0..y.1)
+        .map_err(plot_err)?;
+    let mut drawing = Drawing { chart, plot, k };
+    drawing.mesh(x, y)?;
+    drawing.markers(y)?;
+    drawing.curves(y)?;
+    drawing
+        .chart
+        .configure_series_labels()
+        .position(legend_corner(plot, x, y))
+        .margin(12 * k)
+        .legend_area_size(34 * k)
+        .background_style(WHITE.mix(0.9))
+        .border_style(RGBColor(160, 160, 160).stroke_width(k))
+        .label_font(font(16))
+        .draw()
+        .map_err(plot_err)?;
+    Ok(())
+}
+
+/// The x and y ranges of the plot: its points and markers with margins, and head-room along
+/// the top for the marker labels.
+fn axis_ranges(plot: &Plot) -> ((f64, f64), (f64, f64)) {
     let pts = || plot.series.iter().flat_map(|s| s.points.iter().copied());
     let xs = pts().map(|p| p.0).chain(plot.markers.iter().map(|m| m.0));
     let (x_lo, x_hi) = xs.fold((f64::INFINITY, f64::NEG_INFINITY), |a, v| {
@@ -294,105 +326,117 @@ fn draw<DB: DrawingBackend>(
         // Head-room for the marker labels along the top.
         y.1 += (y.1 - y.0) * 0.08;
     }
-    let mut chart = ChartBuilder::on(root)
-        .caption(&plot.title, font(26).into_font().color(&BLACK))
-        .margin(18 * k)
-        .x_label_area_size(56 * k)
-        .y_label_area_size(84 * k)
-        .build_cartesian_2d(x.0..x.1, y.0..y.1)
-        .map_err(plot_err)?;
-    // An axis of counts (generations, bars, frames: every x whole) is labelled with whole
-    // numbers only; otherwise each axis with the decimals its tick spacing needs (no "5000.0").
-    let counts =
-        pts().all(|p| p.0.fract() == 0.0) && plot.markers.iter().all(|m| m.0.fract() == 0.0);
-    let (dx, dy) = (decimals_for(x.1 - x.0), decimals_for(y.1 - y.0));
-    let x_labels = |v: &f64| {
-        if counts {
-            whole_label(*v)
-        } else {
-            fixed_label(*v, dx)
-        }
-    };
-    let y_labels = |v: &f64| fixed_label(*v, dy);
-    let mut mesh = chart.configure_mesh();
-    mesh.x_label_formatter(&x_labels)
-        .y_label_formatter(&y_labels);
-    mesh.x_desc(plot.x_label.as_str())
-        .y_desc(plot.y_label.as_str())
-        .axis_desc_style(font(19))
-        .label_style(font(16))
-        .bold_line_style(RGBColor(225, 225, 225).stroke_width(k))
-        .light_line_style(RGBColor(245, 245, 245).stroke_width(k))
-        .axis_style(RGBColor(90, 90, 90).stroke_width(k))
-        .max_light_lines(3)
-        .draw()
-        .map_err(plot_err)?;
+    (x, y)
+}
 
-    let grey = RGBColor(110, 110, 110);
-    for (i, (mx, label)) in plot.markers.iter().enumerate() {
-        chart
-            .draw_series(DashedLineSeries::new(
-                [(*mx, y.0), (*mx, y.1)],
-                6 * k,
-                4 * k,
-                grey.stroke_width(k),
-            ))
-            .map_err(plot_err)?;
-        // Stagger labels over three rows so that close events stay readable.
-        let row = (i % 3) as i32;
-        let text = EmptyElement::at((*mx, y.1))
-            + Text::new(
-                label.clone(),
-                (4 * ki, (4 + 18 * row) * ki),
-                font(15).into_font().color(&grey),
-            );
-        chart.draw_series(std::iter::once(text)).map_err(plot_err)?;
-    }
+/// A plot being drawn on its chart, every length and font size multiplied by `k`.
+struct Drawing<'a, 'p, DB: DrawingBackend> {
+    chart: Chart<'a, DB>,
+    plot: &'p Plot,
+    k: u32,
+}
 
-    // A series wholly hidden under a later one gets no legend entry, the one on top names both;
-    // one mostly hidden says under which.
-    let hidden = hidden_by(plot, y.1 - y.0);
-    let whole = |j: usize| hidden[j].is_some_and(|(_, c)| c >= 1.0);
-    for (i, s) in plot.series.iter().enumerate() {
-        let c = COLOURS[i % COLOURS.len()];
-        let style = c.stroke_width(2 * k);
-        let drawn = chart
-            .draw_series(LineSeries::new(s.points.iter().copied(), style))
-            .map_err(plot_err)?;
-        if !whole(i) {
-            let under: Vec<&str> = (0..i)
-                .filter(|&j| whole(j) && hidden[j].is_some_and(|(t, _)| t == i))
-                .map(|j| plot.series[j].name.as_str())
-                .collect();
-            let mut label = if under.is_empty() {
-                s.name.clone()
+impl<DB: DrawingBackend> Drawing<'_, '_, DB> {
+    /// The axes, their labels and the grid, for the ranges `x` and `y`.
+    fn mesh(&mut self, x: (f64, f64), y: (f64, f64)) -> Result<(), RenderError> {
+        let (chart, plot, k) = (&mut self.chart, self.plot, self.k);
+        let font = |size: u32| ("sans-serif", size * k);
+        let pts = || plot.series.iter().flat_map(|s| s.points.iter().copied());
+        // An axis of counts (generations, bars, frames: every x whole) is labelled with whole
+        // numbers only; otherwise each axis with the decimals its tick spacing needs (no "5000.0").
+        let counts =
+            pts().all(|p| p.0.fract() == 0.0) && plot.markers.iter().all(|m| m.0.fract() == 0.0);
+        let (dx, dy) = (decimals_for(x.1 - x.0), decimals_for(y.1 - y.0));
+        let x_labels = |v: &f64| {
+            if counts {
+                whole_label(*v)
             } else {
-                format!("{} = {} (overlap)", s.name, under.join(" = "))
-            };
-            if let Some((top, _)) = hidden[i] {
-                label.push_str(&format!(" (mostly under {})", plot.series[top].name));
+                fixed_label(*v, dx)
             }
-            drawn.label(label).legend(move |(lx, ly)| {
-                PathElement::new(vec![(lx, ly), (lx + 24 * ki, ly)], c.stroke_width(3 * k))
-            });
-        }
-        if s.points.len() <= 40 {
-            chart
-                .draw_series(s.points.iter().map(|&p| Circle::new(p, 3 * ki, c.filled())))
-                .map_err(plot_err)?;
-        }
+        };
+        let y_labels = |v: &f64| fixed_label(*v, dy);
+        let mut mesh = chart.configure_mesh();
+        mesh.x_label_formatter(&x_labels)
+            .y_label_formatter(&y_labels);
+        mesh.x_desc(plot.x_label.as_str())
+            .y_desc(plot.y_label.as_str())
+            .axis_desc_style(font(19))
+            .label_style(font(16))
+            .bold_line_style(RGBColor(225, 225, 225).stroke_width(k))
+            .light_line_style(RGBColor(245, 245, 245).stroke_width(k))
+            .axis_style(RGBColor(90, 90, 90).stroke_width(k))
+            .max_light_lines(3)
+            .draw()
+            .map_err(plot_err)
     }
-    chart
-        .configure_series_labels()
-        .position(legend_corner(plot, x, y))
-        .margin(12 * k)
-        .legend_area_size(34 * k)
-        .background_style(WHITE.mix(0.9))
-        .border_style(RGBColor(160, 160, 160).stroke_width(k))
-        .label_font(font(16))
-        .draw()
-        .map_err(plot_err)?;
-    Ok(())
+
+    /// The event markers: a dashed vertical line each, its label along the top (staggered over
+    /// three rows).
+    fn markers(&mut self, y: (f64, f64)) -> Result<(), RenderError> {
+        let (chart, plot, k) = (&mut self.chart, self.plot, self.k);
+        let ki = k as i32;
+        let grey = RGBColor(110, 110, 110);
+        for (i, (mx, label)) in plot.markers.iter().enumerate() {
+            chart
+                .draw_series(DashedLineSeries::new(
+                    [(*mx, y.0), (*mx, y.1)],
+                    6 * k,
+                    4 * k,
+                    grey.stroke_width(k),
+                ))
+                .map_err(plot_err)?;
+            // Stagger labels over three rows so that close events stay readable.
+            let row = (i % 3) as i32;
+            let text = EmptyElement::at((*mx, y.1))
+                + Text::new(
+                    label.clone(),
+                    (4 * ki, (4 + 18 * row) * ki),
+                    ("sans-serif", 15 * k).into_font().color(&grey),
+                );
+            chart.draw_series(std::iter::once(text)).map_err(plot_err)?;
+        }
+        Ok(())
+    }
+
+    /// The curves with their legend entries (dots on curves of 40 points or fewer); a curve wholly
+    /// hidden under a later one gets no entry, the one on top names both; one mostly hidden says
+    /// under which.
+    fn curves(&mut self, y: (f64, f64)) -> Result<(), RenderError> {
+        let (chart, plot, k) = (&mut self.chart, self.plot, self.k);
+        let ki = k as i32;
+        let hidden = hidden_by(plot, y.1 - y.0);
+        let whole = |j: usize| hidden[j].is_some_and(|(_, c)| c >= 1.0);
+        for (i, s) in plot.series.iter().enumerate() {
+            let c = COLOURS[i % COLOURS.len()];
+            let style = c.stroke_width(2 * k);
+            let drawn = chart
+                .draw_series(LineSeries::new(s.points.iter().copied(), style))
+                .map_err(plot_err)?;
+            if !whole(i) {
+                let under: Vec<&str> = (0..i)
+                    .filter(|&j| whole(j) && hidden[j].is_some_and(|(t, _)| t == i))
+                    .map(|j| plot.series[j].name.as_str())
+                    .collect();
+                let mut label = if under.is_empty() {
+                    s.name.clone()
+                } else {
+                    format!("{} = {} (overlap)", s.name, under.join(" = "))
+                };
+                if let Some((top, _)) = hidden[i] {
+                    label.push_str(&format!(" (mostly under {})", plot.series[top].name));
+                }
+                drawn.label(label).legend(move |(lx, ly)| {
+                    PathElement::new(vec![(lx, ly), (lx + 24 * ki, ly)], c.stroke_width(3 * k))
+                });
+            }
+            if s.points.len() <= 40 {
+                chart
+                    .draw_series(s.points.iter().map(|&p| Circle::new(p, 3 * ki, c.filled())))
+                    .map_err(plot_err)?;
+            }
+        }
+        Ok(())
+    }
 }
 
 #[cfg(test)]

@@ -3,6 +3,9 @@
 
 use std::path::Path;
 
+use ab_glyph::FontRef;
+use tiny_skia::Pixmap;
+
 use super::camera::{Camera, Eye, PanelLimits, View, scale_for};
 use super::canvas::{
     INK, Style, WHITE, blit, draw_body, draw_key, encode_png, key_width, new_pixmap,
@@ -38,23 +41,7 @@ pub fn pose_png(track: &Track, frame: usize, path: &Path) -> Result<(), RenderEr
     let turned_tracks = super::facing::with_frames(std::slice::from_ref(track), &turned);
     let track = &turned_tracks[0];
     let font = font()?;
-    let tracks = std::slice::from_ref(track);
-    let eyes = [
-        Eye::fixed(View::Front),
-        Eye::fixed(View::Side),
-        Eye::for_view(View::ThreeQuarter, tracks),
-    ];
-    // One scale for the three: the one that fits the tallest.
-    let (mpp, pad) = eyes
-        .iter()
-        .map(|e| scale_for(tracks, e, PANEL_HEIGHT))
-        .fold((0.0, 0.0), |a, b| if b.0 > a.0 { b } else { a });
-    let limits = PanelLimits {
-        height: PANEL_HEIGHT,
-        min_width: PANEL_HEIGHT * 11 / 20,
-        max_width: PANEL_HEIGHT * 2,
-    };
-    let cams = eyes.map(|e| Camera::fit(tracks, e, mpp, pad, limits));
+    let (cams, mpp) = pose_cameras(track);
     let style = Style::for_height(PANEL_HEIGHT);
 
     let header = (style.text * 2.0) as u32;
@@ -67,34 +54,7 @@ pub fn pose_png(track: &Track, frame: usize, path: &Path) -> Result<(), RenderEr
     sheet_size(width as u64, height as u64)?;
     let mut sheet = new_pixmap(width, height, WHITE)?;
 
-    let base = MARGIN as f32 + ascent(font, style.text);
-    draw_text(
-        &mut sheet,
-        font,
-        &track.label,
-        (MARGIN as f32, base),
-        Pen {
-            size: style.text,
-            rgb: INK,
-            align: Align::Left,
-        },
-    );
-    let when = format!(
-        "frame {frame}   t = {:.2} s",
-        frame as f64 * track.frame_time
-    );
-    let right = (width - MARGIN) as f32;
-    draw_text(
-        &mut sheet,
-        font,
-        &when,
-        (right, base),
-        Pen {
-            size: style.small,
-            rgb: INK,
-            align: Align::Right,
-        },
-    );
+    draw_header(&mut sheet, font, style, track, frame);
 
     let body = Body::of(track);
     let mut x = MARGIN + (width - 2 * MARGIN - panels_w) / 2;
@@ -117,4 +77,59 @@ pub fn pose_png(track: &Track, frame: usize, path: &Path) -> Result<(), RenderEr
         None,
     );
     write(path, &encode_png(&sheet)?)
+}
+
+/// The front, side and three-quarter cameras on `track`, at one scale (metres per pixel, also
+/// returned): the one that fits the tallest.
+fn pose_cameras(track: &Track) -> ([Camera; 3], f64) {
+    let tracks = std::slice::from_ref(track);
+    let eyes = [
+        Eye::fixed(View::Front),
+        Eye::fixed(View::Side),
+        Eye::for_view(View::ThreeQuarter, tracks),
+    ];
+    // One scale for the three: the one that fits the tallest.
+    let (mpp, pad) = eyes
+        .iter()
+        .map(|e| scale_for(tracks, e, PANEL_HEIGHT))
+        .fold((0.0, 0.0), |a, b| if b.0 > a.0 { b } else { a });
+    let limits = PanelLimits {
+        height: PANEL_HEIGHT,
+        min_width: PANEL_HEIGHT * 11 / 20,
+        max_width: PANEL_HEIGHT * 2,
+    };
+    (eyes.map(|e| Camera::fit(tracks, e, mpp, pad, limits)), mpp)
+}
+
+/// The header of the sheet: the track's label on the left, the frame and its time on the
+/// right.
+fn draw_header(sheet: &mut Pixmap, font: &FontRef, style: Style, track: &Track, frame: usize) {
+    let base = MARGIN as f32 + ascent(font, style.text);
+    draw_text(
+        sheet,
+        font,
+        &track.label,
+        (MARGIN as f32, base),
+        Pen {
+            size: style.text,
+            rgb: INK,
+            align: Align::Left,
+        },
+    );
+    let when = format!(
+        "frame {frame}   t = {:.2} s",
+        frame as f64 * track.frame_time
+    );
+    let right = (sheet.width() - MARGIN) as f32;
+    draw_text(
+        sheet,
+        font,
+        &when,
+        (right, base),
+        Pen {
+            size: style.small,
+            rgb: INK,
+            align: Align::Right,
+        },
+    );
 }

@@ -20,7 +20,7 @@ use super::{SceneError, page, write_output};
 use crate::choreo::authored::{AuthoredDance, generate};
 use crate::choreo::dance::{self, DanceParams};
 use crate::choreo::database::{BuildParams, ClipOutcome, Database, Manifest, OnRefusal};
-use crate::choreo::feet::PlantParams;
+use crate::choreo::feet::{PlantParams, Planting};
 use crate::choreo::fill::{FillParams, Pins};
 use crate::choreo::music::synth::{SynthSong, synthesize};
 use crate::choreo::music::{Bar, MusicAnalysis, MusicParams, analyze};
@@ -452,16 +452,7 @@ fn write_dance(
         bars,
         ..
     } = inputs;
-    let Generated {
-        dance: d,
-        figures:
-            DanceFigures {
-                music_rank,
-                motion_rank,
-                ..
-            },
-        ..
-    } = g;
+    let d = &g.dance;
     let bars_n = bars.len();
     // motion.bvh at the song's timing: the first frame held from t = 0 to the first bar.
     let (bvh, lead) = song_timed_bvh(d);
@@ -487,20 +478,10 @@ fn write_dance(
         .iter()
         .map(|&(a, b)| 0.5 * (a + b) as f64 * dclip.frame_time)
         .collect();
-    // Each column names its bar and the time of the frame it shows.
-    let labels: Vec<String> = mid
-        .iter()
-        .enumerate()
-        .map(|(b, &t)| {
-            let shown = track.frame_at(t) as f64 * track.frame_time;
-            let pinned = if pins.contains_key(&b) { " pinned" } else { "" };
-            format!("bar {b}{pinned} · {shown:.2} s")
-        })
-        .collect();
     filmstrip_at_png(
         std::slice::from_ref(&track),
         &mid,
-        &labels,
+        &bar_labels(&track, &mid, pins),
         View::ThreeQuarter,
         &out.join("filmstrip.png"),
     )?;
@@ -511,7 +492,52 @@ fn write_dance(
             &out.join("motion.gif"),
         )?;
     }
-    let intensity = Plot {
+    let intensity = intensity_plot(scene, g, pins);
+    plot(&intensity, &out.join("intensity.png"))?;
+    // On the page the same ranks stand at each bar's time in the song, under the playhead; the
+    // dance's frame 0 is the first bar's time in the song.
+    let mut motion = PageMotion::from_track(&track);
+    motion.start_s = d.start_s;
+    let timed = at_bar_times(intensity, bars);
+    page::write(
+        &Page {
+            title: format!("{}: dance", scene.name),
+            headline: page_headline(inputs, g),
+            motions: vec![motion],
+            plots: vec![page::timed(timed)],
+            song: Some(PageSong {
+                samples: samples.clone(),
+                sample_rate: *sample_rate,
+                start_s: 0.0,
+            }),
+            notes: vec![],
+        },
+        out,
+    )?;
+    Ok(lead)
+}
+
+/// Each filmstrip column's label: its bar (and whether it is pinned) and the time of the frame
+/// it shows, for columns at the bars' middle times `mid`.
+fn bar_labels(track: &Track, mid: &[f64], pins: &Pins) -> Vec<String> {
+    mid.iter()
+        .enumerate()
+        .map(|(b, &t)| {
+            let shown = track.frame_at(t) as f64 * track.frame_time;
+            let pinned = if pins.contains_key(&b) { " pinned" } else { "" };
+            format!("bar {b}{pinned} · {shown:.2} s")
+        })
+        .collect()
+}
+
+/// The plot of the music's and the motion's intensity rank per bar, the pinned bars marked.
+fn intensity_plot(scene: &DanceScene, g: &Generated, pins: &Pins) -> Plot {
+    let DanceFigures {
+        music_rank,
+        motion_rank,
+        ..
+    } = &g.figures;
+    Plot {
         title: format!("{}: music and motion intensity per bar", scene.name),
         x_label: "bar".into(),
         y_label: "percentile rank (RMS in song, W in database)".into(),
@@ -537,13 +563,12 @@ fn write_dance(
             .keys()
             .map(|&b| (b as f64, "pin".to_string()))
             .collect(),
-    };
-    plot(&intensity, &out.join("intensity.png"))?;
-    // On the page the same ranks stand at each bar's time in the song, under the playhead; the
-    // dance's frame 0 is the first bar's time in the song.
-    let mut motion = PageMotion::from_track(&track);
-    motion.start_s = d.start_s;
-    let at_bar_times = |x: f64| bars[(x as usize).min(bars_n - 1)].start_s;
+    }
+}
+
+/// The per-bar plot `intensity` with each bar put at its start time in the song.
+fn at_bar_times(intensity: Plot, bars: &[Bar]) -> Plot {
+    let at_bar_times = |x: f64| bars[(x as usize).min(bars.len() - 1)].start_s;
     let mut timed = intensity;
     timed.x_label = "time in the song at the bar's start (s)".into();
     for s in &mut timed.series {
@@ -554,22 +579,7 @@ fn write_dance(
     for m in &mut timed.markers {
         m.0 = at_bar_times(m.0);
     }
-    page::write(
-        &Page {
-            title: format!("{}: dance", scene.name),
-            headline: page_headline(inputs, g),
-            motions: vec![motion],
-            plots: vec![page::timed(timed)],
-            song: Some(PageSong {
-                samples: samples.clone(),
-                sample_rate: *sample_rate,
-                start_s: 0.0,
-            }),
-            notes: vec![],
-        },
-        out,
-    )?;
-    Ok(lead)
+    timed
 }
 
 /// The dance's headline figures in words, for the results page.
@@ -645,6 +655,7 @@ fn dance_report(
             })
         })
         .collect();
+    let (sources, skipped) = database_json(db);
     let dance_s = d.clip.frame_count() as f64 * d.clip.frame_time;
     let bars_s = bars[bars_n - 1].end_s - bars[0].start_s;
     json!({
@@ -656,26 +667,12 @@ fn dance_report(
         "bars": bars_n,
         "database": db_origin,
         "database_segments": db.segments.len(),
-        "database_sources": db.sources.iter().map(|s| json!({
-            "clip": clip_name(&s.file), "segments": s.segments,
-            "tempo_bpm": s.beat.tempo_bpm, "first_beat_s": s.beat.first_beat_s,
-            "tempo_from": format!("{:?}", s.beat.source),
-        })).collect::<Vec<_>>(),
-        "database_skipped": db.skipped.iter().map(|s| json!({
-            "clip": clip_name(&s.file), "reason": s.reason,
-        })).collect::<Vec<_>>(),
+        "database_sources": sources,
+        "database_skipped": skipped,
         "pins": pins.iter().map(|(b, s)| json!({"bar": b, "segment": s})).collect::<Vec<_>>(),
         "no_adjacent_repeat": scene.fill.no_adjacent_repeat,
         "fill_intensity_weight": scene.fill.intensity_weight,
-        "feet": {
-            "planted": scene.feet.enabled,
-            "locked": scene.feet.lock,
-            "contact_spans": planting.spans,
-            "contact_spans_locked": planting.locked,
-            "leg_frames_moved": planting.leg_frames,
-            "max_correction_m": planting.max_correction_m,
-            "max_residual_m": planting.max_residual_m,
-        },
+        "feet": feet_json(&scene.feet, planting),
         "per_bar": per_bar,
         "seams": seams,
         "metrics": metrics_json(g),
@@ -694,6 +691,38 @@ fn dance_report(
             danced; a segment's mean W(f) among the database's segments",
         "source_skeleton": "not written: the mapping retargets onto humanoid24 only (no inverse \
             retarget onto a source skeleton exists)",
+    })
+}
+
+/// The report's lines of the database's source clips (segments, tempo) and of those it skipped
+/// (why).
+fn database_json(db: &Database) -> (Vec<serde_json::Value>, Vec<serde_json::Value>) {
+    let sources = db
+        .sources
+        .iter()
+        .map(|s| {
+            json!({
+                "clip": clip_name(&s.file), "segments": s.segments,
+                "tempo_bpm": s.beat.tempo_bpm, "first_beat_s": s.beat.first_beat_s,
+                "tempo_from": format!("{:?}", s.beat.source),
+            })
+        })
+        .collect::<Vec<_>>();
+    let skipped = db.skipped.iter();
+    let skipped = skipped.map(|s| json!({"clip": clip_name(&s.file), "reason": s.reason}));
+    (sources, skipped.collect())
+}
+
+/// The report's feet: how they were to be planted and what planting did.
+fn feet_json(feet: &PlantParams, planting: &Planting) -> serde_json::Value {
+    json!({
+        "planted": feet.enabled,
+        "locked": feet.lock,
+        "contact_spans": planting.spans,
+        "contact_spans_locked": planting.locked,
+        "leg_frames_moved": planting.leg_frames,
+        "max_correction_m": planting.max_correction_m,
+        "max_residual_m": planting.max_residual_m,
     })
 }
 

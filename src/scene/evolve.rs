@@ -369,35 +369,43 @@ fn resumable(runs: &[EvolutionRun], config: &EvolveConfig) -> Result<(), String>
         else {
             continue;
         };
-        let mut diff = Vec::new();
-        differences(
-            &format!("{}, problem", r.name()),
-            &to_json(&r.problem),
-            &to_json(p),
-            &mut diff,
-        );
-        let ga = GaConfig {
-            seed: r.state.config.seed,
-            generations: r.state.config.generations,
-            ..config.ga.clone()
-        };
-        differences("ga", &to_json(&r.state.config), &to_json(&ga), &mut diff);
-        if !diff.is_empty() {
-            let more = diff.len().saturating_sub(3);
-            diff.truncate(3);
-            let mut why = diff.join("; ");
-            if more > 0 {
-                why.push_str(&format!("; and {more} more"));
-            }
-            return Err(why);
+        same_settings(r, p, config)?;
+    }
+    Ok(())
+}
+
+/// Errors unless run `r` of the checkpoint has the scene's problem `p` and GA settings (its
+/// seed and generations aside), and has not gone past the scene's generations: the first few
+/// differences.
+fn same_settings(r: &EvolutionRun, p: &FallProblem, config: &EvolveConfig) -> Result<(), String> {
+    let mut diff = Vec::new();
+    differences(
+        &format!("{}, problem", r.name()),
+        &to_json(&r.problem),
+        &to_json(p),
+        &mut diff,
+    );
+    let ga = GaConfig {
+        seed: r.state.config.seed,
+        generations: r.state.config.generations,
+        ..config.ga.clone()
+    };
+    differences("ga", &to_json(&r.state.config), &to_json(&ga), &mut diff);
+    if !diff.is_empty() {
+        let more = diff.len().saturating_sub(3);
+        diff.truncate(3);
+        let mut why = diff.join("; ");
+        if more > 0 {
+            why.push_str(&format!("; and {more} more"));
         }
-        if r.state.generation > config.ga.generations {
-            return Err(format!(
-                "ga.generations: the checkpoint is already at generation {}, the scene asks {} \
-                 (ga.generations may grow, not fall below the checkpoint's generation)",
-                r.state.generation, config.ga.generations
-            ));
-        }
+        return Err(why);
+    }
+    if r.state.generation > config.ga.generations {
+        return Err(format!(
+            "ga.generations: the checkpoint is already at generation {}, the scene asks {} \
+             (ga.generations may grow, not fall below the checkpoint's generation)",
+            r.state.generation, config.ga.generations
+        ));
     }
     Ok(())
 }
@@ -538,43 +546,8 @@ fn write_evolution(
     outcome: &EvolveOutcome,
     out: &Path,
 ) -> Result<Page, SceneError> {
-    for r in &outcome.runs {
-        let stem = format!(
-            "logbook_{}_seed{}",
-            r.problem.age_group.name(),
-            r.state.config.seed
-        );
-        write_output(
-            &out.join(format!("{stem}.csv")),
-            logbook::to_csv(&r.state.logbook).as_bytes(),
-        )?;
-        write_output(
-            &out.join(format!("{stem}.jsonl")),
-            logbook::to_json_lines(&r.state.logbook).as_bytes(),
-        )?;
-    }
-    let series = outcome
-        .groups
-        .iter()
-        .map(|g| {
-            let (seeds, curve) = outcome.mean_best_so_far(g.age_group);
-            Series {
-                name: format!("{}: mean of {seeds} seeds", g.age_group.name()),
-                points: curve
-                    .into_iter()
-                    .enumerate()
-                    .map(|(k, m)| (k as f64, m))
-                    .collect(),
-            }
-        })
-        .collect();
-    let fitness = Plot {
-        title: format!("Best damage so far: {}", scene.name),
-        x_label: "generation".into(),
-        y_label: "damage D (N)".into(),
-        series,
-        markers: vec![],
-    };
+    write_logbooks(outcome, out)?;
+    let fitness = fitness_plot(scene, outcome);
     plot(&fitness, &out.join("fitness.png"))?;
     for b in &outcome.best {
         let best = &outcome.runs[b.run];
@@ -614,6 +587,52 @@ fn write_evolution(
         plots: vec![page::timed(head), page::untimed(fitness)],
         ..Page::default()
     })
+}
+
+/// Writes each run's logbook as `logbook_<group>_seed<seed>.csv` and `.jsonl`.
+fn write_logbooks(outcome: &EvolveOutcome, out: &Path) -> Result<(), SceneError> {
+    for r in &outcome.runs {
+        let stem = format!(
+            "logbook_{}_seed{}",
+            r.problem.age_group.name(),
+            r.state.config.seed
+        );
+        write_output(
+            &out.join(format!("{stem}.csv")),
+            logbook::to_csv(&r.state.logbook).as_bytes(),
+        )?;
+        write_output(
+            &out.join(format!("{stem}.jsonl")),
+            logbook::to_json_lines(&r.state.logbook).as_bytes(),
+        )?;
+    }
+    Ok(())
+}
+
+/// The best damage so far per generation of each age group, the mean over its seeds.
+fn fitness_plot(scene: &EvolveFallScene, outcome: &EvolveOutcome) -> Plot {
+    let series = outcome
+        .groups
+        .iter()
+        .map(|g| {
+            let (seeds, curve) = outcome.mean_best_so_far(g.age_group);
+            Series {
+                name: format!("{}: mean of {seeds} seeds", g.age_group.name()),
+                points: curve
+                    .into_iter()
+                    .enumerate()
+                    .map(|(k, m)| (k as f64, m))
+                    .collect(),
+            }
+        })
+        .collect();
+    Plot {
+        title: format!("Best damage so far: {}", scene.name),
+        x_label: "generation".into(),
+        y_label: "damage D (N)".into(),
+        series,
+        markers: vec![],
+    }
 }
 
 /// The report of one best fall: the figures an evolved fall must not win by an artefact (peak

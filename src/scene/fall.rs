@@ -394,6 +394,61 @@ pub(super) fn fall_headline(who: &str, report: &serde_json::Value) -> String {
     )
 }
 
+/// The age groups to simulate and their configurations: the scene's, and with `compare_with`
+/// the other group's (its ranges, unless the scene reads them from a file, and its torques).
+fn fall_groups(scene: &FallScene, config: &FallConfig) -> Vec<(AgeGroup, FallConfig)> {
+    let mut groups = vec![(scene.age_group, config.clone())];
+    if let Some(other) = scene.compare_with {
+        let mut c = config.clone();
+        if scene.ranges_file.is_none() {
+            c.ranges = Ranges::Builtin(other);
+        }
+        c.torque_limits_nm = Some(torque_limits(other));
+        groups.push((other, c));
+    }
+    groups
+}
+
+/// Each fall's output file stem (`fall`, then `fall_<group>`) and label.
+fn named_falls<'r>(
+    scene: &FallScene,
+    results: &'r [FallResult],
+    groups: &[(AgeGroup, FallConfig)],
+) -> Vec<(String, String, &'r FallResult)> {
+    results
+        .iter()
+        .zip(groups)
+        .enumerate()
+        .map(|(k, (r, (g, _)))| {
+            let file = if k == 0 {
+                "fall".to_string()
+            } else {
+                format!("fall_{}", g.name())
+            };
+            (file, format!("{} ({})", scene.name, g.name()), r)
+        })
+        .collect()
+}
+
+/// The head height of every fall over time, the push marked (the paper's Fig. 3).
+fn head_plot(scene: &FallScene, results: &[FallResult], groups: &[(AgeGroup, FallConfig)]) -> Plot {
+    let push_end = scene.push.start_s + scene.push.duration_s;
+    Plot {
+        title: format!("Head height: {}", scene.name),
+        x_label: "time (s)".into(),
+        y_label: "head height (m)".into(),
+        series: results
+            .iter()
+            .zip(groups)
+            .map(|(r, (g, _))| head_height_series(g.name().into(), r))
+            .collect(),
+        markers: vec![
+            (scene.push.start_s, "push".into()),
+            (push_end, "push ends".into()),
+        ],
+    }
+}
+
 /// Runs a [`FallScene`]: writes `fall.bvh` (fall21 skeleton), `filmstrip.png`, `motion.gif`,
 /// `head_height.png` (the paper's Fig. 3) and returns the report. With `compare_with`, the same
 /// fall is also simulated for the other age group in a second World, in parallel, and drawn and
@@ -404,15 +459,7 @@ pub fn run_fall(
     out: &Path,
 ) -> Result<serde_json::Value, SceneError> {
     let (config, evolved_for) = scene.configure(base)?;
-    let mut groups = vec![(scene.age_group, config.clone())];
-    if let Some(other) = scene.compare_with {
-        let mut c = config.clone();
-        if scene.ranges_file.is_none() {
-            c.ranges = Ranges::Builtin(other);
-        }
-        c.torque_limits_nm = Some(torque_limits(other));
-        groups.push((other, c));
-    }
+    let groups = fall_groups(scene, &config);
     let configs: Vec<FallConfig> = groups.iter().map(|(_, c)| c.clone()).collect();
     let started = std::time::Instant::now();
     let results: Vec<FallResult> = run_parallel(&configs)
@@ -421,35 +468,9 @@ pub fn run_fall(
         .collect::<Result<_, _>>()?;
     let sim_wall = started.elapsed().as_secs_f64();
 
-    let named: Vec<(String, String, &FallResult)> = results
-        .iter()
-        .zip(&groups)
-        .enumerate()
-        .map(|(k, (r, (g, _)))| {
-            let file = if k == 0 {
-                "fall".to_string()
-            } else {
-                format!("fall_{}", g.name())
-            };
-            (file, format!("{} ({})", scene.name, g.name()), r)
-        })
-        .collect();
+    let named = named_falls(scene, &results, &groups);
     let motions = write_falls(&named, &scene.render, out)?;
-    let push_end = scene.push.start_s + scene.push.duration_s;
-    let head = Plot {
-        title: format!("Head height: {}", scene.name),
-        x_label: "time (s)".into(),
-        y_label: "head height (m)".into(),
-        series: results
-            .iter()
-            .zip(&groups)
-            .map(|(r, (g, _))| head_height_series(g.name().into(), r))
-            .collect(),
-        markers: vec![
-            (scene.push.start_s, "push".into()),
-            (push_end, "push ends".into()),
-        ],
-    };
+    let head = head_plot(scene, &results, &groups);
     plot(&head, &out.join("head_height.png"))?;
     if let Some(e) = evolved_for
         && groups.iter().all(|(g, _)| *g != e)

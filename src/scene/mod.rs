@@ -205,40 +205,11 @@ pub fn apply_overrides(scene: &Scene, assignments: &[String]) -> Result<Scene, S
             .ok_or_else(|| err("expected field.path=value".into()))?;
         let new = override_value(raw);
         // The top level is the scene kind: {"Show": {...}}.
-        let mut cur = value
+        let top = value
             .as_object_mut()
             .and_then(|o| o.values_mut().next())
             .ok_or_else(|| err("empty scene".into()))?;
-        let parts: Vec<&str> = path.split('.').collect();
-        for (i, part) in parts.iter().enumerate() {
-            let here = parts[..i].join(".");
-            let next = match cur {
-                serde_json::Value::Object(map) => {
-                    let keys: Vec<String> = map.keys().cloned().collect();
-                    map.get_mut(*part).ok_or_else(|| {
-                        err(format!(
-                            "no field '{part}' at '{here}'; fields there: {}",
-                            keys.join(", ")
-                        ))
-                    })?
-                }
-                serde_json::Value::Array(items) => {
-                    let len = items.len();
-                    let k: usize = part
-                        .parse()
-                        .map_err(|_| err(format!("'{here}' is a list: expected an index")))?;
-                    items.get_mut(k).ok_or_else(|| {
-                        err(format!("index {k} past the end of '{here}' ({len} items)"))
-                    })?
-                }
-                _ => {
-                    return Err(err(format!(
-                        "'{here}' is a value, it has no field '{part}'"
-                    )));
-                }
-            };
-            cur = next;
-        }
+        let cur = field_at(top, path).map_err(err)?;
         // A bare number for a one-number enum variant (`gamma=-1` where the scene has
         // `Constant(-0.5)`) keeps the variant and sets its number.
         let variant = match (&*cur, &new) {
@@ -254,42 +225,8 @@ pub fn apply_overrides(scene: &Scene, assignments: &[String]) -> Result<Scene, S
             None => new,
         };
     }
-    let scene: Scene = serde_path_to_error::deserialize(value).map_err(|e| {
-        // The field, written as an assignment's path (the scene kind left out).
-        let field = e
-            .path()
-            .iter()
-            .skip(1)
-            .map(|s| match s {
-                serde_path_to_error::Segment::Seq { index } => index.to_string(),
-                s => s.to_string(),
-            })
-            .collect::<Vec<_>>()
-            .join(".");
-        let message = e.inner().to_string();
-        // The last assignment that set this field or a field holding it.
-        let setter = assignments.iter().rev().find(|a| {
-            let p = a.split_once('=').map_or(a.as_str(), |(p, _)| p);
-            field == p || field.starts_with(&format!("{p}.")) || p.starts_with(&format!("{field}."))
-        });
-        match setter {
-            Some(a) => SceneError::Override {
-                assignment: a.clone(),
-                message: format!("field `{field}`: {message}"),
-            },
-            // Not a field any --set touched: the scene's own value, which survives its trip
-            // through JSON only when it is finite.
-            None => SceneError::Invalid(format!(
-                "field `{field}` of the scene itself (no --set names it): {message}{}",
-                if message.contains("null") {
-                    "; a NaN or infinite number in the scene file reads as null here: \
-                     write a finite number"
-                } else {
-                    ""
-                }
-            )),
-        }
-    })?;
+    let scene: Scene = serde_path_to_error::deserialize(value)
+        .map_err(|e| overridden_field_error(&e, assignments))?;
     if let Some(a) = assignments.iter().rev().find(|a| {
         a.split_once('=')
             .is_some_and(|(p, _)| p.trim() == "format_version")
@@ -302,6 +239,85 @@ pub fn apply_overrides(scene: &Scene, assignments: &[String]) -> Result<Scene, S
         })?;
     }
     Ok(scene)
+}
+
+/// The field at the dotted `path` (names of fields, indices of list items) inside `cur`, or
+/// why there is none.
+fn field_at<'v>(
+    mut cur: &'v mut serde_json::Value,
+    path: &str,
+) -> Result<&'v mut serde_json::Value, String> {
+    let parts: Vec<&str> = path.split('.').collect();
+    for (i, part) in parts.iter().enumerate() {
+        let here = parts[..i].join(".");
+        let next = match cur {
+            serde_json::Value::Object(map) => {
+                let keys: Vec<String> = map.keys().cloned().collect();
+                map.get_mut(*part).ok_or_else(|| {
+                    format!(
+                        "no field '{part}' at '{here}'; fields there: {}",
+                        keys.join(", ")
+                    )
+                })?
+            }
+            serde_json::Value::Array(items) => {
+                let len = items.len();
+                let k: usize = part
+                    .parse()
+                    .map_err(|_| format!("'{here}' is a list: expected an index"))?;
+                items
+                    .get_mut(k)
+                    .ok_or_else(|| format!("index {k} past the end of '{here}' ({len} items)"))?
+            }
+            _ => {
+                return Err(format!("'{here}' is a value, it has no field '{part}'"));
+            }
+        };
+        cur = next;
+    }
+    Ok(cur)
+}
+
+/// The error for a scene that does not read back after the `assignments`: naming the last
+/// assignment that set the field or a field holding it, or else the scene's own field.
+fn overridden_field_error(
+    e: &serde_path_to_error::Error<serde_json::Error>,
+    assignments: &[String],
+) -> SceneError {
+    // The field, written as an assignment's path (the scene kind left out).
+    let field = e
+        .path()
+        .iter()
+        .skip(1)
+        .map(|s| match s {
+            serde_path_to_error::Segment::Seq { index } => index.to_string(),
+            s => s.to_string(),
+        })
+        .collect::<Vec<_>>()
+        .join(".");
+    let message = e.inner().to_string();
+    // The last assignment that set this field or a field holding it.
+    let setter = assignments.iter().rev().find(|a| {
+        let p = a.split_once('=').map_or(a.as_str(), |(p, _)| p);
+        field == p || field.starts_with(&format!("{p}.")) || p.starts_with(&format!("{field}."))
+    });
+    match setter {
+        Some(a) => SceneError::Override {
+            assignment: a.clone(),
+            message: format!("field `{field}`: {message}"),
+        },
+        // Not a field any --set touched: the scene's own value, which survives its trip
+        // through JSON only when it is finite.
+        None => SceneError::Invalid(format!(
+            "field `{field}` of the scene itself (no --set names it): {message}{}",
+            if message.contains("null") {
+                "; a NaN or infinite number in the scene file reads as null here: \
+                 write a finite number"
+            } else {
+                ""
+            }
+        )),
+    }
 }
 
 /// The value of an override: JSON if it parses, else a list `[a, b, …]` whose items are
@@ -362,94 +378,107 @@ pub fn validate(scene: &Scene) -> Result<(), SceneError> {
              out/<name>/"
         )));
     }
-    let pictures = |frames: usize, gif: bool, fps: f64| -> Result<(), SceneError> {
-        if !(1..=MAX_FILMSTRIP_FRAMES).contains(&frames) {
-            return Err(SceneError::Invalid(format!(
-                "render.filmstrip_frames is {frames}, expected 1 to {MAX_FILMSTRIP_FRAMES}"
-            )));
-        }
-        if gif && !(fps.is_finite() && fps > 0.0 && fps <= crate::render::MAX_GIF_FPS) {
-            return Err(SceneError::Invalid(format!(
-                "render.gif_fps is {fps}, expected more than 0 and at most {}",
-                crate::render::MAX_GIF_FPS
-            )));
-        }
-        Ok(())
-    };
     match scene {
-        Scene::Show(s) => {
-            pictures(s.render.filmstrip_frames, s.render.gif, s.render.gif_fps)?;
-            // Without a model there are no DOFs: the plot is not drawn.
-            if let Some(name) = &s.model {
-                let model = crate::humanoid::Model::by_name(name)?;
-                for d in &s.render.plot {
-                    if model.dof_index(d).is_none() {
-                        return Err(SceneError::Invalid(format!(
-                            "render.plot: '{d}' is not a DOF of {}; its DOFs: {}",
-                            model.name,
-                            model.dof_names().join(", ")
-                        )));
-                    }
-                }
-            }
+        Scene::Show(s) => validate_show(s)?,
+        Scene::HighJump(s) => {
+            check_pictures(s.render.filmstrip_frames, s.render.gif, s.render.gif_fps)?
         }
-        Scene::HighJump(s) => pictures(s.render.filmstrip_frames, s.render.gif, s.render.gif_fps)?,
         Scene::JumpingKneeKick(s) => {
-            pictures(s.render.filmstrip_frames, s.render.gif, s.render.gif_fps)?
+            check_pictures(s.render.filmstrip_frames, s.render.gif, s.render.gif_fps)?
         }
-        Scene::Fall(s) => pictures(s.render.filmstrip_frames, s.render.gif, s.render.gif_fps)?,
-        Scene::ActiveKneeKick(s) => {
-            pictures(s.render.filmstrip_frames, s.render.gif, s.render.gif_fps)?;
-            let positive = |field: &str, x: f64| {
-                if x.is_finite() && x > 0.0 {
-                    Ok(())
-                } else {
-                    Err(SceneError::Invalid(format!(
-                        "{field} is {x}, expected a positive number"
-                    )))
-                }
-            };
-            positive("dt_s", s.dt_s)?;
-            positive("duration_s", s.duration_s)?;
-            positive("character.joint_omega", s.character.joint_omega)?;
-            positive("character.assist_omega", s.character.assist_omega)?;
-            if !(0.0..=1.0).contains(&s.character.assist) {
-                return Err(SceneError::Invalid(format!(
-                    "character.assist is {}, expected 0 (none) to 1 (full)",
-                    s.character.assist
-                )));
-            }
-            if let Some(d) = s.release_delay_s
-                && !(d.is_finite() && d >= 0.0)
-            {
-                return Err(SceneError::Invalid(format!(
-                    "release_delay_s is {d}, expected ≥ 0 or None"
-                )));
-            }
-            if !(s.push.start_s.is_finite()
-                && s.push.start_s >= 0.0
-                && s.push.start_s < s.duration_s)
-            {
-                return Err(SceneError::Invalid(format!(
-                    "push.start_s is {}, expected inside the run [0, {})",
-                    s.push.start_s, s.duration_s
-                )));
-            }
-            let links = crate::humanoid::body::humanoid24_body(1.70, 65.0, 9.81)
-                .map_err(|e| SceneError::Invalid(e.to_string()))?
-                .link_names;
-            if !links.contains(&s.push.link) {
-                return Err(SceneError::Invalid(format!(
-                    "push.link '{}' is not a humanoid24 link; links: {}",
-                    s.push.link,
-                    links.join(", ")
-                )));
-            }
+        Scene::Fall(s) => {
+            check_pictures(s.render.filmstrip_frames, s.render.gif, s.render.gif_fps)?
         }
+        Scene::ActiveKneeKick(s) => validate_active_knee_kick(s)?,
         Scene::EvolveFall(s) => {
-            pictures(s.render.filmstrip_frames, s.render.gif, s.render.gif_fps)?
+            check_pictures(s.render.filmstrip_frames, s.render.gif, s.render.gif_fps)?
         }
         Scene::Dance(s) => validate_dance(s)?,
+    }
+    Ok(())
+}
+
+/// Errors unless the picture settings are in range: 1 to [`MAX_FILMSTRIP_FRAMES`] filmstrip
+/// frames, and with a GIF a frame rate above 0 and at most [`crate::render::MAX_GIF_FPS`].
+fn check_pictures(frames: usize, gif: bool, fps: f64) -> Result<(), SceneError> {
+    if !(1..=MAX_FILMSTRIP_FRAMES).contains(&frames) {
+        return Err(SceneError::Invalid(format!(
+            "render.filmstrip_frames is {frames}, expected 1 to {MAX_FILMSTRIP_FRAMES}"
+        )));
+    }
+    if gif && !(fps.is_finite() && fps > 0.0 && fps <= crate::render::MAX_GIF_FPS) {
+        return Err(SceneError::Invalid(format!(
+            "render.gif_fps is {fps}, expected more than 0 and at most {}",
+            crate::render::MAX_GIF_FPS
+        )));
+    }
+    Ok(())
+}
+
+/// [`validate`]'s checks of a `Show` scene: its pictures, and its model's plotted DOFs.
+fn validate_show(s: &ShowScene) -> Result<(), SceneError> {
+    check_pictures(s.render.filmstrip_frames, s.render.gif, s.render.gif_fps)?;
+    // Without a model there are no DOFs: the plot is not drawn.
+    if let Some(name) = &s.model {
+        let model = crate::humanoid::Model::by_name(name)?;
+        for d in &s.render.plot {
+            if model.dof_index(d).is_none() {
+                return Err(SceneError::Invalid(format!(
+                    "render.plot: '{d}' is not a DOF of {}; its DOFs: {}",
+                    model.name,
+                    model.dof_names().join(", ")
+                )));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// [`validate`]'s checks of an `ActiveKneeKick` scene: its pictures, positive times and
+/// rates, an assist from 0 to 1, a push inside the run on a humanoid24 link.
+fn validate_active_knee_kick(s: &ActiveKneeKickScene) -> Result<(), SceneError> {
+    check_pictures(s.render.filmstrip_frames, s.render.gif, s.render.gif_fps)?;
+    let positive = |field: &str, x: f64| {
+        if x.is_finite() && x > 0.0 {
+            Ok(())
+        } else {
+            Err(SceneError::Invalid(format!(
+                "{field} is {x}, expected a positive number"
+            )))
+        }
+    };
+    positive("dt_s", s.dt_s)?;
+    positive("duration_s", s.duration_s)?;
+    positive("character.joint_omega", s.character.joint_omega)?;
+    positive("character.assist_omega", s.character.assist_omega)?;
+    if !(0.0..=1.0).contains(&s.character.assist) {
+        return Err(SceneError::Invalid(format!(
+            "character.assist is {}, expected 0 (none) to 1 (full)",
+            s.character.assist
+        )));
+    }
+    if let Some(d) = s.release_delay_s
+        && !(d.is_finite() && d >= 0.0)
+    {
+        return Err(SceneError::Invalid(format!(
+            "release_delay_s is {d}, expected ≥ 0 or None"
+        )));
+    }
+    if !(s.push.start_s.is_finite() && s.push.start_s >= 0.0 && s.push.start_s < s.duration_s) {
+        return Err(SceneError::Invalid(format!(
+            "push.start_s is {}, expected inside the run [0, {})",
+            s.push.start_s, s.duration_s
+        )));
+    }
+    let links = crate::humanoid::body::humanoid24_body(1.70, 65.0, 9.81)
+        .map_err(|e| SceneError::Invalid(e.to_string()))?
+        .link_names;
+    if !links.contains(&s.push.link) {
+        return Err(SceneError::Invalid(format!(
+            "push.link '{}' is not a humanoid24 link; links: {}",
+            s.push.link,
+            links.join(", ")
+        )));
     }
     Ok(())
 }

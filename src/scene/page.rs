@@ -5,7 +5,9 @@ use std::path::{Path, PathBuf};
 
 use super::SceneError;
 use crate::experiments::fall::FallResult;
+use crate::humanoid::body::HumanBody;
 use crate::render::{Page, PageBox, PageEvent, PageMotion, PagePlot, Plot};
+use crate::skeleton::Clip;
 
 /// The page's file name in an output folder.
 pub const PAGE_FILE: &str = "index.html";
@@ -26,50 +28,8 @@ pub fn fall_motion(label: &str, r: &FallResult) -> Result<PageMotion, SceneError
             body.boxes.len()
         )));
     }
-    let mut g = Vec::new();
-    let boxes: Vec<Vec<PageBox>> = (0..clip.frame_count())
-        .map(|f| {
-            clip.globals(f, &mut g);
-            g.iter()
-                .zip(&body.boxes)
-                .map(|(t, b)| PageBox {
-                    center: t.translation + t.rotation * b.center,
-                    half_axes: [
-                        t.rotation * glam::DVec3::X * b.half.x,
-                        t.rotation * glam::DVec3::Y * b.half.y,
-                        t.rotation * glam::DVec3::Z * b.half.z,
-                    ],
-                })
-                .collect()
-        })
-        .collect();
-    let mut events: Vec<PageEvent> = r
-        .impacts
-        .iter()
-        .filter_map(|i| {
-            let t = i.touchdown_s?;
-            let point = body.link_names.iter().position(|n| *n == i.link);
-            // A link on the floor from the first frame (the feet of a standing start) did
-            // not hit it.
-            let how = if t < 0.5 / r.record_hz {
-                "is on the floor from the start".to_string()
-            } else {
-                format!(
-                    "touches the floor at {:.1} m/s",
-                    i.impact_velocity_m_s.abs()
-                )
-            };
-            Some(PageEvent {
-                time_s: t,
-                label: format!(
-                    "{} {how}; its peak floor force {:.0} N",
-                    i.link, i.peak_force_n
-                ),
-                tag: format!("{} {:.0} N", i.link, i.peak_force_n),
-                point,
-            })
-        })
-        .collect();
+    let boxes = contact_boxes(&clip, &body);
+    let mut events = touchdowns(r, &body);
     if let Some((k, f)) = r
         .frames
         .iter()
@@ -104,6 +64,58 @@ pub fn fall_motion(label: &str, r: &FallResult) -> Result<PageMotion, SceneError
             .collect(),
         events,
     })
+}
+
+/// The fall's contact boxes in every frame of `clip`, as `body` has them.
+fn contact_boxes(clip: &Clip, body: &HumanBody) -> Vec<Vec<PageBox>> {
+    let mut g = Vec::new();
+    (0..clip.frame_count())
+        .map(|f| {
+            clip.globals(f, &mut g);
+            g.iter()
+                .zip(&body.boxes)
+                .map(|(t, b)| PageBox {
+                    center: t.translation + t.rotation * b.center,
+                    half_axes: [
+                        t.rotation * glam::DVec3::X * b.half.x,
+                        t.rotation * glam::DVec3::Y * b.half.y,
+                        t.rotation * glam::DVec3::Z * b.half.z,
+                    ],
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// Each link's first touchdown in the fall `r` as an event (or that it is on the floor from
+/// the start), with its peak floor force.
+fn touchdowns(r: &FallResult, body: &HumanBody) -> Vec<PageEvent> {
+    r.impacts
+        .iter()
+        .filter_map(|i| {
+            let t = i.touchdown_s?;
+            let point = body.link_names.iter().position(|n| *n == i.link);
+            // A link on the floor from the first frame (the feet of a standing start) did
+            // not hit it.
+            let how = if t < 0.5 / r.record_hz {
+                "is on the floor from the start".to_string()
+            } else {
+                format!(
+                    "touches the floor at {:.1} m/s",
+                    i.impact_velocity_m_s.abs()
+                )
+            };
+            Some(PageEvent {
+                time_s: t,
+                label: format!(
+                    "{} {how}; its peak floor force {:.0} N",
+                    i.link, i.peak_force_n
+                ),
+                tag: format!("{} {:.0} N", i.link, i.peak_force_n),
+                point,
+            })
+        })
+        .collect()
 }
 
 /// A plot whose x is time on the page's timeline (s).

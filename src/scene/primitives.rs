@@ -16,13 +16,13 @@ use super::{SceneError, draw_tracks, page, write_output};
 use crate::ecs::{
     Clock, Recorder, kinematic_schedule, new_world, run_ticks, spawn_primitive_character,
 };
-use crate::experiments::high_jump::{self, HighJumpConfig};
-use crate::experiments::knee_kick::{self, KneeKickConfig};
+use crate::experiments::high_jump::{self, HighJumpConfig, HighJumpOutcome};
+use crate::experiments::knee_kick::{self, KneeKickConfig, KneeKickOutcome};
 use crate::humanoid::{Model, ModelClip};
 use crate::primitive::{
     EventConfig, Gamma, JumpEvents, LearnConfig, Learned, Primitive, Trajectory,
 };
-use crate::render::{Figure, Page, PageMotion, Plot, Series, Track, plot};
+use crate::render::{Figure, Page, PageMotion, PagePlot, Plot, Series, Track, plot};
 
 /// Pictures of a primitive scene.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -241,12 +241,24 @@ pub fn run_high_jump(
         markers: vec![],
     };
     plot(&knee, &out.join("left_knee.png"))?;
-    let (p, whole) = (&hj.crouch_knee_flexion_deg, &hj.whole_clip_knee_flexion_deg);
-    let (fig, pred, plan) = (
-        &hj.figures,
-        &hj.primitives.prediction,
-        &hj.primitives.flight,
-    );
+    page::write(
+        &Page {
+            title: format!("{}: high jump", scene.name),
+            headline: high_jump_headline(&label, &hj),
+            motions,
+            plots: vec![page::timed(knee)],
+            ..Page::default()
+        },
+        out,
+    )?;
+    Ok(high_jump_report(&label, &hj))
+}
+
+/// The high jump's headline: each jump's apex, flight and crouch, and what extrapolating the
+/// two jumps predicts for the high one.
+fn high_jump_headline(label: &str, hj: &HighJumpOutcome) -> Vec<String> {
+    let (fig, pred) = (&hj.figures, &hj.primitives.prediction);
+    let p = &hj.crouch_knee_flexion_deg;
     let mut headline: Vec<String> = [
         ("low", &fig.low, p.low),
         ("normal", &fig.normal, p.normal),
@@ -266,17 +278,20 @@ pub fn run_high_jump(
          the high jump.",
         pred.apex_above_standing_m, pred.flight_s
     ));
-    page::write(
-        &Page {
-            title: format!("{}: high jump", scene.name),
-            headline,
-            motions,
-            plots: vec![page::timed(knee)],
-            ..Page::default()
-        },
-        out,
-    )?;
-    Ok(json!({
+    headline
+}
+
+/// The high jump's report: the jumps' figures, the prediction and the high jump's difference
+/// from it, the knee flexions, the fits and the floor corrections ([`run_high_jump`]).
+fn high_jump_report(label: &str, hj: &HighJumpOutcome) -> serde_json::Value {
+    let learned = &hj.primitives.learned;
+    let (p, whole) = (&hj.crouch_knee_flexion_deg, &hj.whole_clip_knee_flexion_deg);
+    let (fig, pred, plan) = (
+        &hj.figures,
+        &hj.primitives.prediction,
+        &hj.primitives.flight,
+    );
+    json!({
         "gamma": label,
         "jumps": { "low": fig.low, "normal": fig.normal, "high": fig.high },
         "prediction": pred,
@@ -299,7 +314,7 @@ pub fn run_high_jump(
         "high_duration_s": learned.high.primitive.duration,
         "ground_correction_m": hj.primitives.ground_correction_m,
         "floor_lift_m": { "low": hj.floor_lift_m.low, "normal": hj.floor_lift_m.normal, "high": hj.floor_lift_m.high },
-    }))
+    })
 }
 
 /// What the primitive reports' `flight` of every jump is measured against.
@@ -402,31 +417,7 @@ pub fn run_jumping_knee_kick(
         &scene.render,
         out,
     )?;
-    let markers = vec![
-        (ev.start, "Start".to_string()),
-        (ev.bend, "Bend".into()),
-        (ev.leap, "Leap".into()),
-        (ev.land, "Land".into()),
-    ];
-    let mut plots = vec![];
-    for dof in ["left_knee", "right_knee"] {
-        let series =
-            |label: &str, traj: &Trajectory, offset: f64| dof_series(label, traj, dof, offset);
-        let knee = Plot {
-            title: format!("{dof}: high jump, knee kick (placed Bend→Leap) and jumping knee kick"),
-            x_label: "time (s)".into(),
-            y_label: format!("{dof} flexion (deg)"),
-            series: vec![
-                series("high jump", &kk.jump_rollout, 0.0)?,
-                series("knee kick (time-scaled)", &kk.kick_placed_rollout, ev.bend)?,
-                series("jumping knee kick", &kk.connected.trajectory, 0.0)?,
-            ],
-            markers: markers.clone(),
-        };
-        plot(&knee, &out.join(format!("{dof}.png")))?;
-        plots.push(page::timed(knee));
-    }
-    let (j, gap, parts) = (&kk.junction, &kk.posture_gap_deg, &kk.parts);
+    let plots = knee_plots(&kk, out)?;
     page::write(
         &Page {
             title: format!("{}: jumping knee kick", scene.name),
@@ -449,7 +440,51 @@ pub fn run_jumping_knee_kick(
         },
         out,
     )?;
-    Ok(json!({
+    Ok(knee_kick_report(scene, &kk, ecs_gap))
+}
+
+/// The left and right knee's flexion over time in the high jump, the knee kick (placed Bend→Leap)
+/// and the jumping knee kick, the events marked: written as `left_knee.png` and
+/// `right_knee.png` into `out`, and returned for the page.
+fn knee_plots(kk: &KneeKickOutcome, out: &Path) -> Result<Vec<PagePlot>, SceneError> {
+    let ev = &kk.events;
+    let markers = vec![
+        (ev.start, "Start".to_string()),
+        (ev.bend, "Bend".into()),
+        (ev.leap, "Leap".into()),
+        (ev.land, "Land".into()),
+    ];
+    let ev = &kk.events;
+    let mut plots = vec![];
+    for dof in ["left_knee", "right_knee"] {
+        let series =
+            |label: &str, traj: &Trajectory, offset: f64| dof_series(label, traj, dof, offset);
+        let knee = Plot {
+            title: format!("{dof}: high jump, knee kick (placed Bend→Leap) and jumping knee kick"),
+            x_label: "time (s)".into(),
+            y_label: format!("{dof} flexion (deg)"),
+            series: vec![
+                series("high jump", &kk.jump_rollout, 0.0)?,
+                series("knee kick (time-scaled)", &kk.kick_placed_rollout, ev.bend)?,
+                series("jumping knee kick", &kk.connected.trajectory, 0.0)?,
+            ],
+            markers: markers.clone(),
+        };
+        plot(&knee, &out.join(format!("{dof}.png")))?;
+        plots.push(page::timed(knee));
+    }
+    Ok(plots)
+}
+
+/// The jumping knee kick's report: the γs, the figures, the state at the leap, the
+/// corrections, the events, the junction, the ECS check, the fits and the knee flexions.
+fn knee_kick_report(
+    scene: &JumpingKneeKickScene,
+    kk: &KneeKickOutcome,
+    ecs_gap: f64,
+) -> serde_json::Value {
+    let (ev, j, gap, parts) = (&kk.events, &kk.junction, &kk.posture_gap_deg, &kk.parts);
+    json!({
         "gamma": scene.gamma.label(),
         "jump_gamma": scene.jump.gamma.label(),
         "jump": kk.jump_figures,
@@ -482,5 +517,5 @@ pub fn run_jumping_knee_kick(
             "right_knee": kk.peak_knee_flexion_deg.right_knee,
             "left_knee": kk.peak_knee_flexion_deg.left_knee,
         },
-    }))
+    })
 }

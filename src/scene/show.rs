@@ -10,7 +10,7 @@ use super::source::{ClipSource, LoadedMotion, load_motion};
 use super::{SceneError, draw_tracks, page, write_output};
 use crate::analysis::clip_contacts;
 use crate::ecs::{Clock, Recorder, kinematic_schedule, new_world, spawn_clip_character};
-use crate::humanoid::Model;
+use crate::humanoid::{Model, ModelClip};
 use crate::mapping::effector_errors;
 use crate::render::{Figure, Page, PageMotion, Plot, Series, Track, plot, pose_png};
 use crate::skeleton::Clip;
@@ -82,26 +82,7 @@ pub fn run_show(
 ) -> Result<serde_json::Value, SceneError> {
     let motion = load_motion(&scene.clip, base)?;
     let mut report = json!({ "clip": scene.clip.file });
-    let (clip, model_clip) = match &scene.model {
-        Some(name) => {
-            let model = Model::by_name(name)?;
-            let m = motion.on_model(&model)?;
-            (m.to_clip(), Some(m))
-        }
-        None => (motion.clip(), None),
-    };
-    if let (
-        LoadedMotion::Captured {
-            clip: source,
-            mapping: Some(mapping),
-            ..
-        },
-        Some(m),
-    ) = (&motion, &model_clip)
-    {
-        report["mapping"] = json!(mapping.name);
-        report["effector_error_m"] = json!(effector_errors(source, mapping, m)?);
-    }
+    let (clip, model_clip) = shown_clip(scene, &motion, &mut report)?;
     let frames = play_through_ecs(&clip);
     let figure = Figure::of(&clip.skeleton);
     let label = match &scene.model {
@@ -140,28 +121,7 @@ pub fn run_show(
 
     if let Some(m) = &model_clip {
         write_output(&out.join("angles.csv"), m.angles_csv().as_bytes())?;
-        let mut series = vec![];
-        let mut peaks = serde_json::Map::new();
-        for name in &scene.render.plot {
-            let d = m.model.dof_index(name).ok_or_else(|| {
-                SceneError::Invalid(format!(
-                    "render.plot: '{name}' is not a DOF of {}",
-                    m.model.name
-                ))
-            })?;
-            let s = m.dof_series(d);
-            let max = s.iter().copied().fold(f64::MIN, f64::max).to_degrees();
-            let min = s.iter().copied().fold(f64::MAX, f64::min).to_degrees();
-            peaks.insert(name.clone(), json!({ "min_deg": min, "max_deg": max }));
-            series.push(Series {
-                name: name.clone(),
-                points: s
-                    .iter()
-                    .enumerate()
-                    .map(|(f, a)| (f as f64 * m.frame_time, a.to_degrees()))
-                    .collect(),
-            });
-        }
+        let (series, peaks) = plotted_angles(&scene.render.plot, m)?;
         if !series.is_empty() {
             let angles = Plot {
                 title: format!("{}: joint angles on {}", scene.name, m.model.name),
@@ -193,4 +153,66 @@ pub fn run_show(
     }
     page::write(&page, out)?;
     Ok(report)
+}
+
+/// The clip shown: the motion as loaded, or mapped onto the scene's model (with it the model's
+/// clip); a captured motion mapped onto a model puts its mapping and effector errors in
+/// `report`.
+fn shown_clip(
+    scene: &ShowScene,
+    motion: &LoadedMotion,
+    report: &mut serde_json::Value,
+) -> Result<(Clip, Option<ModelClip>), SceneError> {
+    let (clip, model_clip) = match &scene.model {
+        Some(name) => {
+            let model = Model::by_name(name)?;
+            let m = motion.on_model(&model)?;
+            (m.to_clip(), Some(m))
+        }
+        None => (motion.clip(), None),
+    };
+    if let (
+        LoadedMotion::Captured {
+            clip: source,
+            mapping: Some(mapping),
+            ..
+        },
+        Some(m),
+    ) = (motion, &model_clip)
+    {
+        report["mapping"] = json!(mapping.name);
+        report["effector_error_m"] = json!(effector_errors(source, mapping, m)?);
+    }
+    Ok((clip, model_clip))
+}
+
+/// The curves of the DOFs `names` of `m` (degrees over time) and each one's range (minimum and
+/// maximum, degrees). Errors: a name that is not a DOF of the model.
+fn plotted_angles(
+    names: &[String],
+    m: &ModelClip,
+) -> Result<(Vec<Series>, serde_json::Map<String, serde_json::Value>), SceneError> {
+    let mut series = vec![];
+    let mut peaks = serde_json::Map::new();
+    for name in names {
+        let d = m.model.dof_index(name).ok_or_else(|| {
+            SceneError::Invalid(format!(
+                "render.plot: '{name}' is not a DOF of {}",
+                m.model.name
+            ))
+        })?;
+        let s = m.dof_series(d);
+        let max = s.iter().copied().fold(f64::MIN, f64::max).to_degrees();
+        let min = s.iter().copied().fold(f64::MAX, f64::min).to_degrees();
+        peaks.insert(name.clone(), json!({ "min_deg": min, "max_deg": max }));
+        series.push(Series {
+            name: name.clone(),
+            points: s
+                .iter()
+                .enumerate()
+                .map(|(f, a)| (f as f64 * m.frame_time, a.to_degrees()))
+                .collect(),
+        });
+    }
+    Ok((series, peaks))
 }

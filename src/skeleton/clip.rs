@@ -106,6 +106,29 @@ struct ChannelPlan {
     pos: Vec<(usize, usize)>,
 }
 
+impl ChannelPlan {
+    /// The plan of joint `j`'s channels: its rotation axes and their channel indices in order,
+    /// and its position channels.
+    fn of(j: &BvhJoint) -> ChannelPlan {
+        let mut rot_axes = vec![];
+        let mut rot_idx = vec![];
+        let mut pos = vec![];
+        for (k, c) in j.channels.iter().enumerate() {
+            if c.is_rotation() {
+                rot_axes.push(c.axis());
+                rot_idx.push(j.first_channel + k);
+            } else {
+                pos.push((j.first_channel + k, c.axis()));
+            }
+        }
+        ChannelPlan {
+            rot_axes,
+            rot_idx,
+            pos,
+        }
+    }
+}
+
 impl Clip {
     /// Number of joints.
     pub fn joint_count(&self) -> usize {
@@ -200,28 +223,7 @@ impl Clip {
         };
         // Per joint: rotation axes and their channel indices, and the (channel index, axis) of
         // position channels.
-        let plans: Vec<ChannelPlan> = bvh
-            .joints
-            .iter()
-            .map(|j: &BvhJoint| {
-                let mut rot_axes = vec![];
-                let mut rot_idx = vec![];
-                let mut pos = vec![];
-                for (k, c) in j.channels.iter().enumerate() {
-                    if c.is_rotation() {
-                        rot_axes.push(c.axis());
-                        rot_idx.push(j.first_channel + k);
-                    } else {
-                        pos.push((j.first_channel + k, c.axis()));
-                    }
-                }
-                ChannelPlan {
-                    rot_axes,
-                    rot_idx,
-                    pos,
-                }
-            })
-            .collect();
+        let plans: Vec<ChannelPlan> = bvh.joints.iter().map(ChannelPlan::of).collect();
         let mut angles = Vec::with_capacity(3);
         for f in 0..frames {
             let values = bvh.frame(f);

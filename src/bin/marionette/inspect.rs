@@ -6,6 +6,7 @@ use std::path::PathBuf;
 use anyhow::{Context, Result};
 
 use marionette::analysis::{ContactConfig, clip_contacts};
+use marionette::bvh::Bvh;
 use marionette::skeleton::Clip;
 
 use crate::common::read_bvh;
@@ -58,6 +59,15 @@ pub fn inspect(args: Args) -> Result<()> {
         "height      {:.3} m (median vertical extent)",
         clip.median_vertical_extent()
     );
+    print_skeleton(&b);
+    print_mapping(&clip);
+    print_contacts(&clip);
+    Ok(())
+}
+
+/// Prints the skeleton: each joint indented by its depth, its channels, and whether it has an
+/// End Site.
+fn print_skeleton(b: &Bvh) {
     println!("skeleton:");
     // Depths in one pass (parents come first); indentation stops at INDENT_MAX levels.
     const INDENT_MAX: usize = 16;
@@ -82,11 +92,15 @@ pub fn inspect(args: Args) -> Result<()> {
             end
         );
     }
-    print_mapping(&clip);
+}
+
+/// Prints the ground contact and flight spans from the feet (the mapping's ankles and toes,
+/// else found by name).
+fn print_contacts(clip: &Clip) {
     // Ground contact and flight from the feet: the mapping's ankles and toes, else by name.
-    let Some(c) = clip_contacts(&clip, 0.03, 0.1) else {
+    let Some(c) = clip_contacts(clip, 0.03, 0.1) else {
         println!("contact     (no feet found: no joint named foot/toe/ankle on each side)");
-        return Ok(());
+        return;
     };
     let spans = |s: &[marionette::analysis::Span]| -> String {
         s.iter()
@@ -126,7 +140,6 @@ pub fn inspect(args: Args) -> Result<()> {
             f.duration()
         );
     }
-    Ok(())
 }
 
 // ---- The mapping section (landmarks onto the models) ----

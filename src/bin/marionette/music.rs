@@ -1,13 +1,13 @@
 //! `marionette music SONG`: a song's tempo, beats, bars and per-bar intensity; `--out PNG` draws
 //! them, `--json` prints one JSON object for other tools.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use serde::Serialize;
 
-use marionette::choreo::music::decode::decode_file;
-use marionette::choreo::music::{Bar, MusicParams, analyze};
+use marionette::choreo::music::decode::{Audio, decode_file};
+use marionette::choreo::music::{Bar, MusicAnalysis, MusicParams, analyze};
 use marionette::render::music_png;
 
 // The command's arguments (its help text is on `Command::Music`).
@@ -52,24 +52,7 @@ struct Report<'a> {
 
 /// Runs `music`: analyses the song, prints the report (or JSON) and draws the picture.
 pub fn music(args: Args) -> Result<()> {
-    let mut params = MusicParams {
-        downbeat: args.downbeat,
-        beats_per_bar: args.beats_per_bar,
-        ..MusicParams::default()
-    };
-    if let Some(c) = args.prior_bpm {
-        let (lo, hi) = (params.prior.min_bpm, params.prior.max_bpm);
-        if !(c.is_finite() && (lo..=hi).contains(&c)) {
-            anyhow::bail!(
-                "--prior-bpm is {c} BPM, outside the accepted range {lo} to {hi} BPM (the tempi \
-                 the analysis considers)"
-            );
-        }
-        params.prior.centre_bpm = c;
-    }
-    if let Some(o) = args.prior_octaves {
-        params.prior.octaves = o;
-    }
+    let params = music_params(&args)?;
     let audio = decode_file(&args.song)?;
     if let Some(w) = &audio.warning {
         eprintln!("warning: {}: {w}", args.song.display());
@@ -100,7 +83,41 @@ pub fn music(args: Args) -> Result<()> {
         println!("{}", serde_json::to_string(&r)?);
         return Ok(());
     }
-    println!("song        {}", args.song.display());
+    print_report(&args.song, &audio, &a, &params);
+    if let Some(out) = &args.out {
+        println!("picture     {}", out.display());
+    }
+    Ok(())
+}
+
+/// The analysis parameters the arguments ask for. Errors: a tempo prior outside the tempi the
+/// analysis considers.
+fn music_params(args: &Args) -> Result<MusicParams> {
+    let mut params = MusicParams {
+        downbeat: args.downbeat,
+        beats_per_bar: args.beats_per_bar,
+        ..MusicParams::default()
+    };
+    if let Some(c) = args.prior_bpm {
+        let (lo, hi) = (params.prior.min_bpm, params.prior.max_bpm);
+        if !(c.is_finite() && (lo..=hi).contains(&c)) {
+            anyhow::bail!(
+                "--prior-bpm is {c} BPM, outside the accepted range {lo} to {hi} BPM (the tempi \
+                 the analysis considers)"
+            );
+        }
+        params.prior.centre_bpm = c;
+    }
+    if let Some(o) = args.prior_octaves {
+        params.prior.octaves = o;
+    }
+    Ok(params)
+}
+
+/// Prints the text report of the analysis `a` of `song` (decoded as `audio`, analysed with
+/// `params`): the audio, tempo, beats and bars, and a line per bar.
+fn print_report(song: &Path, audio: &Audio, a: &MusicAnalysis, params: &MusicParams) {
+    println!("song        {}", song.display());
     println!(
         "audio       {:.3} s, {} Hz, {} channel(s) mixed to mono",
         a.duration_s, audio.sample_rate, audio.channels
@@ -137,8 +154,4 @@ pub fn music(args: Args) -> Result<()> {
             b.rms_db
         );
     }
-    if let Some(out) = &args.out {
-        println!("picture     {}", out.display());
-    }
-    Ok(())
 }

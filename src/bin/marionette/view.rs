@@ -126,77 +126,15 @@ pub fn view(args: Args) -> Result<()> {
                 input.display()
             );
         }
-        let mut files: Vec<PathBuf> = std::fs::read_dir(&input)
-            .with_context(|| format!("reading the folder {}", input.display()))?
-            .filter_map(|e| e.ok().map(|e| e.path()))
-            .filter(|p| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("bvh")))
-            .collect();
-        files.sort();
-        if files.is_empty() {
-            bail!(
-                "{}: no .bvh file in this folder (expected a scene's output folder or a folder of BVH files)",
-                input.display()
-            );
-        }
-        for f in &files {
-            // A scene's BVH files are written Y up on the floor y = 0: drawn as they are.
-            page.motions.push(motion(f, None, None, unit_scale)?);
-        }
-        let report = input.join("report.json");
-        if report.is_file() {
-            let text = std::fs::read_to_string(&report)
-                .with_context(|| format!("reading {}", report.display()))?;
-            let v: serde_json::Value = serde_json::from_str(&text).with_context(|| {
-                format!("{}: expected a scene's report (JSON)", report.display())
-            })?;
-            page.headline = headline(&v);
-        }
-        let song = input.join("song.wav");
-        if song.is_file() {
-            let a = marionette::choreo::music::decode::decode_file(&song)?;
-            page.song = Some(PageSong {
-                samples: a.samples,
-                sample_rate: a.sample_rate,
-                start_s: 0.0,
-            });
-        }
-        page.notes.push(format!(
-            "From the files in {}: the scene's own index.html there also has its plots and, for falls, the contact boxes.",
-            input.display()
-        ));
+        view_folder(&mut page, &input, unit_scale)?;
     } else {
-        let mut m = motion(&input, model.as_deref(), mapping.as_deref(), unit_scale)?;
-        if model.is_none()
-            && let Some(said) = stand_upright(&mut m)
-        {
-            page.notes.push(said);
-        }
-        let n = m.frames.len();
-        page.plots.push(PagePlot {
-            plot: Plot {
-                title: "height of the root above the floor".into(),
-                x_label: "time (s)".into(),
-                y_label: format!("{} height (m)", m.figure.names[0]),
-                series: vec![Series {
-                    name: m.figure.names[0].clone(),
-                    points: m
-                        .frames
-                        .iter()
-                        .enumerate()
-                        .map(|(k, f)| (k as f64 * m.frame_time, f[0].y))
-                        .collect(),
-                }],
-                markers: vec![],
-            },
-            time_axis: true,
-        });
-        page.headline.push(format!(
-            "{} points, {n} frames at {:.0} frames/s: {:.2} s.",
-            m.figure.names.len(),
-            1.0 / m.frame_time,
-            n.saturating_sub(1) as f64 * m.frame_time
-        ));
-        page.motions.push(m);
+        view_file(
+            &mut page,
+            &input,
+            model.as_deref(),
+            mapping.as_deref(),
+            unit_scale,
+        )?;
     }
     let out = out.unwrap_or_else(|| {
         PathBuf::from("out")
@@ -208,5 +146,92 @@ pub fn view(args: Args) -> Result<()> {
     }
     write_page(&page, &out)?;
     println!("{}", out.display());
+    Ok(())
+}
+
+/// The page of a folder: every BVH file in it (a scene's are Y up on the floor already), with a
+/// scene's report's headline and its song when they are there.
+fn view_folder(page: &mut Page, input: &Path, unit_scale: Option<f64>) -> Result<()> {
+    let mut files: Vec<PathBuf> = std::fs::read_dir(input)
+        .with_context(|| format!("reading the folder {}", input.display()))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("bvh")))
+        .collect();
+    files.sort();
+    if files.is_empty() {
+        bail!(
+            "{}: no .bvh file in this folder (expected a scene's output folder or a folder of BVH files)",
+            input.display()
+        );
+    }
+    for f in &files {
+        // A scene's BVH files are written Y up on the floor y = 0: drawn as they are.
+        page.motions.push(motion(f, None, None, unit_scale)?);
+    }
+    let report = input.join("report.json");
+    if report.is_file() {
+        let text = std::fs::read_to_string(&report)
+            .with_context(|| format!("reading {}", report.display()))?;
+        let v: serde_json::Value = serde_json::from_str(&text)
+            .with_context(|| format!("{}: expected a scene's report (JSON)", report.display()))?;
+        page.headline = headline(&v);
+    }
+    let song = input.join("song.wav");
+    if song.is_file() {
+        let a = marionette::choreo::music::decode::decode_file(&song)?;
+        page.song = Some(PageSong {
+            samples: a.samples,
+            sample_rate: a.sample_rate,
+            start_s: 0.0,
+        });
+    }
+    page.notes.push(format!(
+        "From the files in {}: the scene's own index.html there also has its plots and, for falls, the contact boxes.",
+        input.display()
+    ));
+    Ok(())
+}
+
+/// The page of a motion file (mapped onto `model` when given, else stood upright): the
+/// motion and its root's height over time.
+fn view_file(
+    page: &mut Page,
+    input: &Path,
+    model: Option<&str>,
+    mapping: Option<&Path>,
+    unit_scale: Option<f64>,
+) -> Result<()> {
+    let mut m = motion(input, model, mapping, unit_scale)?;
+    if model.is_none()
+        && let Some(said) = stand_upright(&mut m)
+    {
+        page.notes.push(said);
+    }
+    let n = m.frames.len();
+    page.plots.push(PagePlot {
+        plot: Plot {
+            title: "height of the root above the floor".into(),
+            x_label: "time (s)".into(),
+            y_label: format!("{} height (m)", m.figure.names[0]),
+            series: vec![Series {
+                name: m.figure.names[0].clone(),
+                points: m
+                    .frames
+                    .iter()
+                    .enumerate()
+                    .map(|(k, f)| (k as f64 * m.frame_time, f[0].y))
+                    .collect(),
+            }],
+            markers: vec![],
+        },
+        time_axis: true,
+    });
+    page.headline.push(format!(
+        "{} points, {n} frames at {:.0} frames/s: {:.2} s.",
+        m.figure.names.len(),
+        1.0 / m.frame_time,
+        n.saturating_sub(1) as f64 * m.frame_time
+    ));
+    page.motions.push(m);
     Ok(())
 }

@@ -4,10 +4,10 @@
 use std::fs::File;
 use std::path::Path;
 
-use symphonia::core::codecs::audio::AudioDecoderOptions;
+use symphonia::core::codecs::audio::{AudioDecoder, AudioDecoderOptions};
 use symphonia::core::errors::Error as SymphoniaError;
 use symphonia::core::formats::probe::Hint;
-use symphonia::core::formats::{FormatOptions, TrackType};
+use symphonia::core::formats::{FormatOptions, FormatReader, TrackType};
 use symphonia::core::io::MediaSourceStream;
 use symphonia::core::meta::MetadataOptions;
 
@@ -75,28 +75,7 @@ pub fn decode_file(path: &Path) -> Result<Audio, MusicError> {
         path: path.to_path_buf(),
         reason,
     })?;
-    let mut head = [0u8; 12];
-    let n = {
-        use std::io::{Read, Seek};
-        let mut n = 0;
-        while n < head.len() {
-            match file.read(&mut head[n..]) {
-                Ok(0) => break,
-                Ok(k) => n += k,
-                Err(reason) => {
-                    return Err(MusicError::Io {
-                        path: path.to_path_buf(),
-                        reason,
-                    });
-                }
-            }
-        }
-        file.rewind().map_err(|reason| MusicError::Io {
-            path: path.to_path_buf(),
-            reason,
-        })?;
-        n
-    };
+    let (head, n) = read_head(path, &mut file)?;
     if n == 0 {
         return Err(dec("the file is empty (0 bytes)".into()));
     }
@@ -113,29 +92,7 @@ pub fn decode_file(path: &Path) -> Result<Audio, MusicError> {
             FormatOptions::default(),
             MetadataOptions::default(),
         )
-        .map_err(|e| {
-            dec(match (kind, &e) {
-                (
-                    Some(k @ ("a WAV (RIFF) file" | "an OGG file" | "an MP3 file")),
-                    SymphoniaError::Unsupported(what),
-                ) => {
-                    format!("{k} in an unsupported codec or variant ({what})")
-                }
-                (kind, _) => match kind {
-                    Some(k @ ("a WAV (RIFF) file" | "an OGG file" | "an MP3 file")) => {
-                        format!("{k} by its first bytes, but its header is corrupt or cut ({e})")
-                    }
-                    Some(k) => format!(
-                        "{k} by its first bytes: an unsupported format (WAV, OGG/Vorbis and MP3 \
-                     are read) ({e})"
-                    ),
-                    None => format!(
-                        "not a WAV, OGG/Vorbis or MP3 file: its first bytes are {:02x?} ({e})",
-                        &head[..n]
-                    ),
-                },
-            })
-        })?;
+        .map_err(|e| dec(probe_failure(kind, &e, &head[..n])))?;
     let track = format
         .default_track(TrackType::Audio)
         .ok_or_else(|| dec("no audio track".into()))?;
@@ -156,25 +113,145 @@ pub fn decode_file(path: &Path) -> Result<Audio, MusicError> {
                 kind.unwrap_or("the file")
             ))
         })?;
-    let mut samples: Vec<f32> = Vec::with_capacity(expected);
+    let mixed = mix_packets(&mut *format, &mut *decoder, track_id, expected).map_err(dec)?;
+    if mixed.samples.is_empty() {
+        return Err(dec(if mixed.damaged > 0 {
+            let damaged = mixed.damaged;
+            format!("a corrupt stream: none of its {damaged} packets decodes")
+        } else if mixed.cut {
+            "cut short before its first sample".into()
+        } else {
+            "no audio samples in the file".into()
+        }));
+    }
+    let warning = mixed.warning(expected);
+    Ok(Audio {
+        samples: mixed.samples,
+        sample_rate: mixed.rate,
+        channels: mixed.channels,
+        warning,
+    })
+}
+
+/// The first (up to 12) bytes of `file`, and how many there are; the file rewound after.
+fn read_head(path: &Path, file: &mut File) -> Result<([u8; 12], usize), MusicError> {
+    use std::io::{Read, Seek};
+    let io = |reason| MusicError::Io {
+        path: path.to_path_buf(),
+        reason,
+    };
+    let mut head = [0u8; 12];
+    let mut n = 0;
+    while n < head.len() {
+        match file.read(&mut head[n..]) {
+            Ok(0) => break,
+            Ok(k) => n += k,
+            Err(reason) => return Err(io(reason)),
+        }
+    }
+    file.rewind().map_err(io)?;
+    Ok((head, n))
+}
+
+/// Why symphonia's probe failed, by what the first bytes `head` say the file is (`kind`): an
+/// unsupported codec or a corrupt header of a format read, or a format not read.
+fn probe_failure(kind: Option<&str>, e: &SymphoniaError, head: &[u8]) -> String {
+    match (kind, e) {
+        (
+            Some(k @ ("a WAV (RIFF) file" | "an OGG file" | "an MP3 file")),
+            SymphoniaError::Unsupported(what),
+        ) => {
+            format!("{k} in an unsupported codec or variant ({what})")
+        }
+        (kind, _) => match kind {
+            Some(k @ ("a WAV (RIFF) file" | "an OGG file" | "an MP3 file")) => {
+                format!("{k} by its first bytes, but its header is corrupt or cut ({e})")
+            }
+            Some(k) => format!(
+                "{k} by its first bytes: an unsupported format (WAV, OGG/Vorbis and MP3 \
+                     are read) ({e})"
+            ),
+            None => {
+                format!("not a WAV, OGG/Vorbis or MP3 file: its first bytes are {head:02x?} ({e})")
+            }
+        },
+    }
+}
+
+/// A track decoded and mixed to mono, and how its stream ended.
+struct Mixed {
+    /// Mono samples, the mean of the channels.
+    samples: Vec<f32>,
+    /// Sample rate (Hz), 0 before the first packet.
+    rate: u32,
+    /// Channels of the stream.
+    channels: usize,
+    /// The stream ended in the middle of a packet.
+    cut: bool,
+    /// Damaged packets skipped.
+    damaged: usize,
+}
+
+impl Mixed {
+    /// The warning for a stream read short of the `expected` samples its header states, cut in
+    /// the middle of a packet, or with damaged packets skipped.
+    fn warning(&self, expected: usize) -> Option<String> {
+        let (rate, damaged) = (self.rate, self.damaged);
+        let read_s = self.samples.len() as f64 / rate as f64;
+        let short = expected > 0 && self.samples.len() < expected;
+        let mut warning = (self.cut || short).then(|| {
+            if expected > 0 {
+                let total_s = expected as f64 / rate as f64;
+                format!(
+                    "read {read_s:.2} s of the {total_s:.2} s its header states ({:.0} %): the \
+                     file is cut short; the part read is analysed",
+                    100.0 * self.samples.len() as f64 / expected as f64
+                )
+            } else {
+                format!("the file ends in the middle of a packet: read {read_s:.2} s, analysed")
+            }
+        });
+        if damaged > 0 {
+            let d = format!("{damaged} damaged packet(s) skipped");
+            warning = Some(match warning {
+                Some(w) => format!("{w}; {d}"),
+                None => d,
+            });
+        }
+        warning
+    }
+}
+
+/// Every packet of track `track_id` decoded and mixed to mono (damaged ones skipped, a cut at
+/// the end tolerated); errors: a corrupt stream, a change of rate or channels, more than
+/// [`MAX_SAMPLES`].
+fn mix_packets(
+    format: &mut dyn FormatReader,
+    decoder: &mut dyn AudioDecoder,
+    track_id: u32,
+    expected: usize,
+) -> Result<Mixed, String> {
+    let mut m = Mixed {
+        samples: Vec::with_capacity(expected),
+        rate: 0,
+        channels: 0,
+        cut: false,
+        damaged: 0,
+    };
     let mut interleaved: Vec<f32> = Vec::new();
-    let mut rate = 0u32;
-    let mut channels = 0usize;
-    let mut cut = false;
-    let mut damaged = 0usize;
     loop {
         let packet = match format.next_packet() {
             Ok(Some(p)) => p,
             Ok(None) => break,
             Err(SymphoniaError::IoError(e)) if e.kind() == std::io::ErrorKind::UnexpectedEof => {
-                cut = true;
+                m.cut = true;
                 break;
             }
             Err(e) => {
-                return Err(dec(format!(
+                return Err(format!(
                     "corrupt stream after {:.2} s ({e})",
-                    samples.len() as f64 / rate.max(1) as f64
-                )));
+                    m.samples.len() as f64 / m.rate.max(1) as f64
+                ));
             }
         };
         if packet.track_id != track_id {
@@ -184,72 +261,38 @@ pub fn decode_file(path: &Path) -> Result<Audio, MusicError> {
             Ok(b) => b,
             // A damaged packet is skipped, as players do.
             Err(SymphoniaError::DecodeError(_)) => {
-                damaged += 1;
+                m.damaged += 1;
                 continue;
             }
-            Err(e) => return Err(dec(format!("decoding: {e}"))),
+            Err(e) => return Err(format!("decoding: {e}")),
         };
         let spec = buf.spec();
         let (r, c) = (spec.rate(), spec.channels().count());
         if c == 0 {
             continue;
         }
+        let (rate, channels) = (m.rate, m.channels);
         if rate == 0 {
-            (rate, channels) = (r, c);
+            (m.rate, m.channels) = (r, c);
         } else if r != rate || c != channels {
-            return Err(dec(format!(
+            return Err(format!(
                 "the stream changes from {channels} channels at {rate} Hz to {c} at {r} Hz"
-            )));
+            ));
         }
         interleaved.resize(buf.samples_interleaved(), 0.0);
         buf.copy_to_slice_interleaved(&mut interleaved);
-        if samples.len() + interleaved.len() / c > MAX_SAMPLES {
-            return Err(dec(format!(
+        if m.samples.len() + interleaved.len() / c > MAX_SAMPLES {
+            return Err(format!(
                 "longer than {} samples (two hours at 48 kHz)",
                 MAX_SAMPLES
-            )));
+            ));
         }
         let inv = 1.0 / c as f32;
-        samples.extend(
+        m.samples.extend(
             interleaved
                 .chunks_exact(c)
                 .map(|f| f.iter().sum::<f32>() * inv),
         );
     }
-    if samples.is_empty() {
-        return Err(dec(if damaged > 0 {
-            format!("a corrupt stream: none of its {damaged} packets decodes")
-        } else if cut {
-            "cut short before its first sample".into()
-        } else {
-            "no audio samples in the file".into()
-        }));
-    }
-    let read_s = samples.len() as f64 / rate as f64;
-    let short = expected > 0 && samples.len() < expected;
-    let mut warning = (cut || short).then(|| {
-        if expected > 0 {
-            let total_s = expected as f64 / rate as f64;
-            format!(
-                "read {read_s:.2} s of the {total_s:.2} s its header states ({:.0} %): the file \
-                 is cut short; the part read is analysed",
-                100.0 * samples.len() as f64 / expected as f64
-            )
-        } else {
-            format!("the file ends in the middle of a packet: read {read_s:.2} s, analysed")
-        }
-    });
-    if damaged > 0 {
-        let d = format!("{damaged} damaged packet(s) skipped");
-        warning = Some(match warning {
-            Some(w) => format!("{w}; {d}"),
-            None => d,
-        });
-    }
-    Ok(Audio {
-        samples,
-        sample_rate: rate,
-        channels,
-        warning,
-    })
+    Ok(m)
 }

@@ -135,6 +135,60 @@ impl Drum {
 /// Synthesizes `song` (see the module docs). Errors: parameters out of range or a song longer
 /// than an hour at 48 kHz.
 pub fn synthesize(song: &SynthSong) -> Result<SynthTrack, MusicError> {
+    check_song(song)?;
+    let sr = song.sample_rate as f64;
+    let beat = 60.0 / song.bpm;
+    let bar = beat * song.beats_per_bar as f64;
+    let duration = song.lead_in_s + song.bars as f64 * bar + song.tail_s;
+    if duration * sr > MAX_SAMPLES {
+        return Err(MusicError::Parameter {
+            name: "duration",
+            value: duration,
+            expected: "at most an hour at 48 kHz",
+        });
+    }
+    let n = (duration * sr).ceil() as usize;
+    let mut rng = Pcg64::seed_from_u64(song.seed);
+    let (beats_s, bars_s, hits) = drum_hits(song, &mut rng);
+    let span = |(a, b): (f64, f64)| {
+        let lo = ((a * sr).ceil() as usize).min(n);
+        let hi = ((b * sr).ceil() as usize).clamp(lo, n);
+        lo..hi
+    };
+    let regions: Vec<std::ops::Range<usize>> = bars_s.iter().map(|&s| span(s)).collect();
+    let noise_seed = song.seed.wrapping_add(0x9e37_79b9_7f4a_7c15);
+    let gains = bar_gains(song, &hits, &regions, n, noise_seed);
+    // The song: every hit at its bar's gain, then white noise at the SNR of each bar's level
+    // (the lead-in takes the first bar's, the tail the last's).
+    let mut x = vec![0.0f64; n];
+    let mut hr = Pcg64::seed_from_u64(noise_seed);
+    for &(b, t, a, d) in &hits {
+        hit(&mut x, sr, t, a * gains[b], d, &mut hr);
+    }
+    if let Some(snr) = song.snr_db {
+        for (i, v) in x.iter_mut().enumerate() {
+            let b = regions.partition_point(|r| r.end <= i).min(song.bars - 1);
+            let level = song.bar_levels_db[b % song.bar_levels_db.len()];
+            let a = 10f64.powf((level - snr) / 20.0) * 3f64.sqrt();
+            let u: f64 = rng.random_range(-1.0..1.0);
+            *v += a * u;
+        }
+    }
+    let bar_rms_db = regions
+        .iter()
+        .map(|r| 20.0 * rms(&x[r.clone()]).max(1e-12).log10())
+        .collect();
+    Ok(SynthTrack {
+        samples: x.iter().map(|&s| s as f32).collect(),
+        sample_rate: song.sample_rate,
+        beats_s,
+        bars_s,
+        bar_rms_db,
+    })
+}
+
+/// Errors unless every parameter of `song` is in its range.
+fn check_song(song: &SynthSong) -> Result<(), MusicError> {
     let bad = |name, value, expected| MusicError::Parameter {
         name,
         value,
@@ -174,19 +228,21 @@ pub fn synthesize(song: &SynthSong) -> Result<SynthTrack, MusicError> {
     if !(super::MIN_SAMPLE_RATE..=super::MAX_SAMPLE_RATE).contains(&song.sample_rate) {
         return Err(MusicError::SampleRate(song.sample_rate));
     }
-    let sr = song.sample_rate as f64;
+    Ok(())
+}
+
+/// One drum hit: (bar, time in s, amplitude, drum).
+type Hit = (usize, f64, f64, Drum);
+
+/// The beat times, the bars' (start, end) times and every drum hit of `song`: a kick on every
+/// beat (louder on the first, with the bass), a snare on the off beats, a hat on every beat and
+/// its swung half, each jittered by `rng`.
+fn drum_hits(song: &SynthSong, rng: &mut Pcg64) -> (Vec<f64>, Vec<(f64, f64)>, Vec<Hit>) {
     let beat = 60.0 / song.bpm;
     let bar = beat * song.beats_per_bar as f64;
-    let duration = song.lead_in_s + song.bars as f64 * bar + song.tail_s;
-    if duration * sr > MAX_SAMPLES {
-        return Err(bad("duration", duration, "at most an hour at 48 kHz"));
-    }
-    let n = (duration * sr).ceil() as usize;
-    let mut rng = Pcg64::seed_from_u64(song.seed);
     let mut beats_s = Vec::new();
     let mut bars_s = Vec::new();
-    // Every hit: (bar, time, amplitude, drum).
-    let mut hits: Vec<(usize, f64, f64, Drum)> = Vec::new();
+    let mut hits: Vec<Hit> = Vec::new();
     for b in 0..song.bars {
         let t_bar = song.lead_in_s + b as f64 * bar;
         bars_s.push((t_bar, t_bar + bar));
@@ -209,15 +265,24 @@ pub fn synthesize(song: &SynthSong) -> Result<SynthTrack, MusicError> {
             hits.push((b, t + song.swing * beat + jo, 0.25, Drum::Hat));
         }
     }
-    let span = |(a, b): (f64, f64)| {
-        let lo = ((a * sr).ceil() as usize).min(n);
-        let hi = ((b * sr).ceil() as usize).clamp(lo, n);
-        lo..hi
-    };
-    let rms = |v: &[f64]| (v.iter().map(|s| s * s).sum::<f64>() / v.len().max(1) as f64).sqrt();
-    let regions: Vec<std::ops::Range<usize>> = bars_s.iter().map(|&s| span(s)).collect();
-    // Each bar's own hits at unit gain, to find the gain that gives it its level.
-    let noise_seed = song.seed.wrapping_add(0x9e37_79b9_7f4a_7c15);
+    (beats_s, bars_s, hits)
+}
+
+/// Root mean square of `v` (0 when empty).
+fn rms(v: &[f64]) -> f64 {
+    (v.iter().map(|s| s * s).sum::<f64>() / v.len().max(1) as f64).sqrt()
+}
+
+/// Each bar's gain: its own hits at unit gain, alone in `n` samples, scaled to its level over
+/// its samples `regions[bar]`.
+fn bar_gains(
+    song: &SynthSong,
+    hits: &[Hit],
+    regions: &[std::ops::Range<usize>],
+    n: usize,
+    noise_seed: u64,
+) -> Vec<f64> {
+    let sr = song.sample_rate as f64;
     let mut gains = Vec::with_capacity(song.bars);
     let mut own = vec![0.0f64; n];
     for (b, r) in regions.iter().enumerate() {
@@ -229,33 +294,7 @@ pub fn synthesize(song: &SynthSong) -> Result<SynthTrack, MusicError> {
         let level = song.bar_levels_db[b % song.bar_levels_db.len()];
         gains.push(10f64.powf(level / 20.0) / rms(&own[r.clone()]).max(1e-12));
     }
-    // The song: every hit at its bar's gain, then white noise at the SNR of each bar's level
-    // (the lead-in takes the first bar's, the tail the last's).
-    let mut x = vec![0.0f64; n];
-    let mut hr = Pcg64::seed_from_u64(noise_seed);
-    for &(b, t, a, d) in &hits {
-        hit(&mut x, sr, t, a * gains[b], d, &mut hr);
-    }
-    if let Some(snr) = song.snr_db {
-        for (i, v) in x.iter_mut().enumerate() {
-            let b = regions.partition_point(|r| r.end <= i).min(song.bars - 1);
-            let level = song.bar_levels_db[b % song.bar_levels_db.len()];
-            let a = 10f64.powf((level - snr) / 20.0) * 3f64.sqrt();
-            let u: f64 = rng.random_range(-1.0..1.0);
-            *v += a * u;
-        }
-    }
-    let bar_rms_db = regions
-        .iter()
-        .map(|r| 20.0 * rms(&x[r.clone()]).max(1e-12).log10())
-        .collect();
-    Ok(SynthTrack {
-        samples: x.iter().map(|&s| s as f32).collect(),
-        sample_rate: song.sample_rate,
-        beats_s,
-        bars_s,
-        bar_rms_db,
-    })
+    gains
 }
 
 #[cfg(test)]

@@ -231,53 +231,8 @@ pub fn stand_upright(m: &mut PageMotion) -> Option<String> {
     if n == 0 || parents.is_empty() {
         return None;
     }
-    let depth = |mut i: usize| {
-        let mut d = 0;
-        while let Some(p) = parents[i] {
-            i = p;
-            d += 1;
-            if d > parents.len() {
-                break;
-            }
-        }
-        d
-    };
-    let chest = (0..parents.len())
-        .filter(|&i| parents[i].is_some() && parents.iter().filter(|p| **p == Some(i)).count() >= 3)
-        .max_by_key(|&i| depth(i));
-    let step = n.div_ceil(200).max(1);
-    let (mut up, mut along, mut side) = (DVec3::ZERO, DVec3::ZERO, DVec3::ZERO);
-    for f in m.frames.iter().step_by(step) {
-        if let Some(c) = chest {
-            up += f[c] - f[0];
-        }
-        for (i, p) in parents.iter().enumerate() {
-            if let Some(p) = p {
-                along += (f[i] - f[*p]).abs();
-            }
-            side += f[i] - f[0];
-        }
-    }
-    let (axis, sign) = if chest.is_some() && up.length() > 0.0 {
-        let a = up.abs();
-        let axis = if a.x >= a.y && a.x >= a.z {
-            0
-        } else if a.z > a.y {
-            2
-        } else {
-            1
-        };
-        (axis, up[axis].signum())
-    } else {
-        let axis = if along.x >= along.y && along.x >= along.z {
-            0
-        } else if along.z > along.y {
-            2
-        } else {
-            1
-        };
-        (axis, if side[axis] < 0.0 { -1.0 } else { 1.0 })
-    };
+    let chest = trunk_branch(parents);
+    let (axis, sign) = up_axis(&m.frames, parents, chest);
     let mut said = vec![];
     if axis != 1 || sign < 0.0 {
         // A proper rotation taking the found up direction to +Y.
@@ -312,6 +267,62 @@ pub fn stand_upright(m: &mut PageMotion) -> Option<String> {
         ));
     }
     (!said.is_empty()).then(|| format!("'{}' was {}.", m.label, said.join(" and ")))
+}
+
+/// The trunk's branching point: the deepest point with three or more children (the chest,
+/// where neck and arms meet), if any.
+fn trunk_branch(parents: &[Option<usize>]) -> Option<usize> {
+    let depth = |mut i: usize| {
+        let mut d = 0;
+        while let Some(p) = parents[i] {
+            i = p;
+            d += 1;
+            if d > parents.len() {
+                break;
+            }
+        }
+        d
+    };
+    (0..parents.len())
+        .filter(|&i| parents[i].is_some() && parents.iter().filter(|p| **p == Some(i)).count() >= 3)
+        .max_by_key(|&i| depth(i))
+}
+
+/// The figure's up axis (0, 1, 2 for X, Y, Z) and its sign over `frames` (about 200 of them):
+/// from the root to `chest`, else the axis its bones run along most, towards the side of the
+/// root holding most of its points.
+fn up_axis(frames: &[Vec<DVec3>], parents: &[Option<usize>], chest: Option<usize>) -> (usize, f64) {
+    let step = frames.len().div_ceil(200).max(1);
+    let (mut up, mut along, mut side) = (DVec3::ZERO, DVec3::ZERO, DVec3::ZERO);
+    for f in frames.iter().step_by(step) {
+        if let Some(c) = chest {
+            up += f[c] - f[0];
+        }
+        for (i, p) in parents.iter().enumerate() {
+            if let Some(p) = p {
+                along += (f[i] - f[*p]).abs();
+            }
+            side += f[i] - f[0];
+        }
+    }
+    if chest.is_some() && up.length() > 0.0 {
+        let axis = largest_axis(up.abs());
+        (axis, up[axis].signum())
+    } else {
+        let axis = largest_axis(along);
+        (axis, if side[axis] < 0.0 { -1.0 } else { 1.0 })
+    }
+}
+
+/// The axis (0, 1, 2) of the largest component of `a` (≥ 0), ties going to X, then to Y.
+fn largest_axis(a: DVec3) -> usize {
+    if a.x >= a.y && a.x >= a.z {
+        0
+    } else if a.z > a.y {
+        2
+    } else {
+        1
+    }
 }
 
 /// Numbers of motion data a motion takes per frame.
