@@ -161,8 +161,8 @@ fn pass2_articulated_inertias(
             uu: &mut uus[i],
         };
         let has_parent = body.parent.is_some();
-        // `p^a − I^a c`: the bias force the body passes on (before the inertia's product);
-        // `None` where nothing is passed on.
+        // `p^a − I^a c`: the bias force the body passes on (before the inertia's product; a
+        // root passes nothing on).
         let pa_a = match (&body.joint, model.joint_axes[i]) {
             (JointType::Pin { .. }, axes) => {
                 pin_pass2(ia, pa, (&ss[i], axes), joint, out, has_parent)
@@ -174,10 +174,10 @@ fn pass2_articulated_inertias(
                 rotational_pass2(ia, pa, (&ss[i], body.joint.nv()), joint, out, has_parent)
             }
             // No DOF: the whole articulated inertia and bias force reach the parent.
-            (JointType::Fixed, _) => Some(pa),
-            (JointType::Free, _) => None,
+            (JointType::Fixed, _) => pa,
+            (JointType::Free, _) => continue,
         };
-        if let (Some(pa_a), Some(p)) = (pa_a, body.parent) {
+        if let Some(p) = body.parent {
             let pa_a = pa_a + ia.apply(cs[i]);
             let x = &xups[i];
             ia_head[p] += ia.transform_to_parent_with(x, &rots[i]);
@@ -187,7 +187,7 @@ fn pass2_articulated_inertias(
 }
 
 /// Pass 2 for a revolute joint (`D` is 1×1): with a parent, `I^a = I^A − U D⁻¹ Uᵀ` in place
-/// and returns `p^A + U D⁻¹ u`.
+/// and returns `p^A + U D⁻¹ u` (a root's `p^A` as it is).
 #[inline(always)]
 fn pin_pass2(
     ia: &mut ArticulatedInertia,
@@ -196,7 +196,7 @@ fn pin_pass2(
     joint: JointInputs,
     out: JointSlots,
     has_parent: bool,
-) -> Option<ForceVec> {
+) -> ForceVec {
     // Revolute columns are pure rotations: S = [a; 0]; about a coordinate axis `a = ±e_k`,
     // `U` is ± column k of `[M; Hᵀ]` and `D = M_kk` (the same bits as the products, whose
     // other terms are zeros).
@@ -214,10 +214,10 @@ fn pin_pass2(
     out.dinv.x_axis.x = dinv;
     out.uu.x = uu;
     if !has_parent {
-        return None;
+        return pa;
     }
     ia.sub_outer(u, dinv);
-    Some(pa + u * (dinv * uu))
+    pa + u * (dinv * uu)
 }
 
 /// Pass 2 for a universal joint whose second axis `a2` is a coordinate axis (`D` is 2×2,
@@ -230,7 +230,7 @@ fn universal_pass2(
     joint: JointInputs,
     out: JointSlots,
     has_parent: bool,
-) -> Option<ForceVec> {
+) -> ForceVec {
     // The second column is the coordinate axis `a2` itself (taken as in a pin), the first
     // `R₂ᵀ a₁` (from the kinematics).
     let b = s[0].ang;
@@ -252,17 +252,15 @@ fn universal_pass2(
     *out.dinv = dinv;
     *out.uu = DVec3::new(uu0, uu1, 0.0);
     if !has_parent {
-        return None;
+        return pa;
     }
     let w = [
         u0 * dinv.x_axis.x + u1 * dinv.x_axis.y,
         u0 * dinv.y_axis.x + u1 * dinv.y_axis.y,
     ];
     ia.sub_products(&w, &u);
-    Some(
-        pa + u0 * (dinv.x_axis.x * uu0 + dinv.y_axis.x * uu1)
-            + u1 * (dinv.x_axis.y * uu0 + dinv.y_axis.y * uu1),
-    )
+    pa + u0 * (dinv.x_axis.x * uu0 + dinv.y_axis.x * uu1)
+        + u1 * (dinv.x_axis.y * uu0 + dinv.y_axis.y * uu1)
 }
 
 /// Pass 2 for a joint of `nv` rotational DOFs about general axes (ball, universal): `D`
@@ -275,7 +273,7 @@ fn rotational_pass2(
     joint: JointInputs,
     out: JointSlots,
     has_parent: bool,
-) -> Option<ForceVec> {
+) -> ForceVec {
     let mut u = [ForceVec::ZERO; 3];
     let mut d = DMat3::IDENTITY;
     let mut uu = DVec3::ZERO;
@@ -298,7 +296,7 @@ fn rotational_pass2(
     *out.dinv = dinv;
     *out.uu = uu;
     if !has_parent {
-        return None;
+        return pa;
     }
     ia.sub_u_dinv_ut(&u[..nv], &dinv);
     let w = dinv * uu;
@@ -306,7 +304,7 @@ fn rotational_pass2(
     for k in 0..nv {
         pa_a += u[k] * w[k];
     }
-    Some(pa_a)
+    pa_a
 }
 
 /// Pass 3 (root → leaves): `a' = Xup a_λ + c`, `q̈ = D⁻¹(u − Uᵀ a')`, `a = a' + S q̈`

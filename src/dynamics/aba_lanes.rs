@@ -301,10 +301,10 @@ fn pass2_articulated_inertias(
             (JointType::Universal { .. } | JointType::Ball { .. }, _) => {
                 rotational_pass2(ia, pa, (&ss[i], body.joint.nv()), joint, out, has_parent)
             }
-            (JointType::Fixed, _) => Some(pa),
-            (JointType::Free, _) => None,
+            (JointType::Fixed, _) => pa,
+            (JointType::Free, _) => continue,
         };
-        if let (Some(pa_a), Some(p)) = (pa_a, body.parent) {
+        if let Some(p) = body.parent {
             let pa_a = pa_a + ia.apply(cs[i]);
             let x = &xups[i];
             ia_head[p] += ia.transform_to_parent_with(x, &rots[i]);
@@ -314,7 +314,7 @@ fn pass2_articulated_inertias(
 }
 
 /// Pass 2 for a revolute joint (`D` is 1×1): with a parent, `I^a = I^A − U D⁻¹ Uᵀ` in place
-/// and returns `p^A + U D⁻¹ u`.
+/// and returns `p^A + U D⁻¹ u` (a root's `p^A` as it is).
 #[inline(always)]
 fn pin_pass2(
     ia: &mut Inertia4,
@@ -323,7 +323,7 @@ fn pin_pass2(
     joint: JointInputs,
     out: JointSlots,
     has_parent: bool,
-) -> Option<Force4> {
+) -> Force4 {
     let (u, d, uu) = match axes {
         JointAxes::One(ax) => coordinate_column(ia, ax.k, ax.sign, joint.tau(0), pa),
         _ => {
@@ -338,10 +338,10 @@ fn pin_pass2(
     out.dinv.x_axis.x = dinv;
     out.uu.x = uu;
     if !has_parent {
-        return None;
+        return pa;
     }
     ia.sub_outer(u, dinv);
-    Some(pa + u * (dinv * uu))
+    pa + u * (dinv * uu)
 }
 
 /// Pass 2 for a universal joint whose second axis `a2` is a coordinate axis (`D` is 2×2,
@@ -354,7 +354,7 @@ fn universal_pass2(
     joint: JointInputs,
     out: JointSlots,
     has_parent: bool,
-) -> Option<Force4> {
+) -> Force4 {
     let b = s[0];
     let u0 = ia.apply_angular(b);
     let (u1, d11, uu1) = coordinate_column(ia, a2.k, a2.sign, joint.tau(1), pa);
@@ -374,17 +374,15 @@ fn universal_pass2(
     *out.dinv = dinv;
     *out.uu = V3::new(uu0, uu1, F4::ZERO);
     if !has_parent {
-        return None;
+        return pa;
     }
     let w = [
         u0 * dinv.x_axis.x + u1 * dinv.x_axis.y,
         u0 * dinv.y_axis.x + u1 * dinv.y_axis.y,
     ];
     ia.sub_products(&w, &u);
-    Some(
-        pa + u0 * (dinv.x_axis.x * uu0 + dinv.y_axis.x * uu1)
-            + u1 * (dinv.x_axis.y * uu0 + dinv.y_axis.y * uu1),
-    )
+    pa + u0 * (dinv.x_axis.x * uu0 + dinv.y_axis.x * uu1)
+        + u1 * (dinv.x_axis.y * uu0 + dinv.y_axis.y * uu1)
 }
 
 /// Pass 2 for a joint of `nv` rotational DOFs about general axes (ball, universal): `D`
@@ -397,7 +395,7 @@ fn rotational_pass2(
     joint: JointInputs,
     out: JointSlots,
     has_parent: bool,
-) -> Option<Force4> {
+) -> Force4 {
     let mut u = [Force4::ZERO; 3];
     let mut d = M3::splat(&glam::DMat3::IDENTITY);
     let mut uu = V3::ZERO;
@@ -420,7 +418,7 @@ fn rotational_pass2(
     *out.dinv = dinv;
     *out.uu = uu;
     if !has_parent {
-        return None;
+        return pa;
     }
     if nv == 2 {
         ia.sub_u_dinv_ut(&[u[0], u[1]], &dinv);
@@ -432,7 +430,7 @@ fn rotational_pass2(
     for k in 0..nv {
         pa_a += u[k] * w.get(k);
     }
-    Some(pa_a)
+    pa_a
 }
 
 /// Pass 3 (root → leaves): `a' = Xup a_λ + c`, `q̈ = D⁻¹(u − Uᵀ a')`, `a = a' + S q̈`
