@@ -5,7 +5,7 @@
 //! taken on the model's structure (joint types and axes), which every lane shares.
 
 use super::aba::aba_passes;
-use super::axis_rotation::JointAxes;
+use super::axis_rotation::{CoordAxis, JointAxes};
 use super::data::Data;
 use super::joint::JointType;
 use super::kinematics::base_acceleration;
@@ -174,41 +174,76 @@ fn passes(
     f_ext: [&[ForceVec]; LANES],
     armature: [Option<&[f64]>; LANES],
 ) {
-    let n = model.nbodies();
-    let LaneBuffers {
-        xup,
-        rotation,
-        s,
-        c,
-        a,
-        ia,
-        pa,
-        u,
-        dinv,
-        uu,
-    } = lanes;
-    let (xups, rots, ss, cs) = (&mut xup[..n], &mut rotation[..n], &mut s[..n], &mut c[..n]);
-    let (accs, ias, pas) = (&mut a[..n], &mut ia[..n], &mut pa[..n]);
-    let (us, dinvs, uus) = (&mut u[..n], &mut dinv[..n], &mut uu[..n]);
     // Lanes whose joint structure differs (not bodies of one model) are each taken alone.
-    // (A loop, not `all`: an iterator adaptor left out of line would run without AVX2.)
-    let mut uniform = true;
-    for (i, rot) in rots.iter_mut().enumerate() {
-        match Rotation4::gather(std::array::from_fn(|l| &data[l].xup_rotation[i])) {
-            Some(r) => *rot = r,
-            None => {
-                uniform = false;
-                break;
-            }
-        }
-    }
-    if !uniform {
+    if !gather_rotations(model, lanes, &data) {
         for (l, d) in data.into_iter().enumerate() {
             aba_passes(model, d, tau[l], f_ext[l], armature[l], &[]);
         }
         return;
     }
-    // Gather the kinematics and the velocity-product forces.
+    pass1_bias_forces(model, lanes, &data, f_ext);
+    pass2_articulated_inertias(model, lanes, &tau, &armature);
+    pass3_accelerations(model, lanes, data, &tau);
+}
+
+/// The joint forces and armature of one body's joint in every lane, whose first DOF is `iv`.
+#[derive(Clone, Copy)]
+struct JointInputs<'a> {
+    tau: &'a [&'a [f64]; LANES],
+    armature: &'a [Option<&'a [f64]>; LANES],
+    iv: usize,
+}
+
+impl JointInputs<'_> {
+    /// `τ` of the joint's DOF `k`.
+    #[inline(always)]
+    fn tau(&self, k: usize) -> F4 {
+        F4::from_fn(|l| self.tau[l][self.iv + k])
+    }
+
+    /// The armature of the joint's DOF `k` (0 without armature).
+    #[inline(always)]
+    fn arm(&self, k: usize) -> F4 {
+        F4::from_fn(|l| self.armature[l].map_or(0.0, |a| a[self.iv + k]))
+    }
+}
+
+/// Where pass 2 leaves one body's `U`, `D⁻¹` and `u` for pass 3 (only the joint's DOFs are
+/// written).
+struct JointSlots<'a> {
+    u: &'a mut [Force4; 3],
+    dinv: &'a mut M3,
+    uu: &'a mut V3,
+}
+
+/// Gathers each body's joint rotation from the lanes; false if the lanes' rotations differ
+/// in structure (and the lanes must be taken alone).
+#[inline(always)]
+fn gather_rotations(model: &Model, lanes: &mut LaneBuffers, data: &[&mut Data; LANES]) -> bool {
+    let n = model.nbodies();
+    // (A loop, not `all`: an iterator adaptor left out of line would run without AVX2.)
+    for (i, rot) in lanes.rotation[..n].iter_mut().enumerate() {
+        match Rotation4::gather(std::array::from_fn(|l| &data[l].xup_rotation[i])) {
+            Some(r) => *rot = r,
+            None => return false,
+        }
+    }
+    true
+}
+
+/// The end of pass 1: gathers the lanes' kinematics (`Xup, S, c`) and starts each body's
+/// articulated inertia and bias force as its own, `I^A = I` and `p^A = v ×* I v − f_ext`
+/// (Featherstone 2008, Table 7.1).
+#[inline(always)]
+fn pass1_bias_forces(
+    model: &Model,
+    lanes: &mut LaneBuffers,
+    data: &[&mut Data; LANES],
+    f_ext: [&[ForceVec]; LANES],
+) {
+    let n = model.nbodies();
+    let (xups, ss, cs) = (&mut lanes.xup[..n], &mut lanes.s[..n], &mut lanes.c[..n]);
+    let (ias, pas) = (&mut lanes.ia[..n], &mut lanes.pa[..n]);
     for i in 0..n {
         let body = &model.bodies[i];
         xups[i] = Transform4::gather(std::array::from_fn(|l| &data[l].xup[i]));
@@ -222,103 +257,49 @@ fn passes(
         pas[i] = vi.cross_force(rigid_apply(&body.inertia, vi)) - Force4::from_fn(|l| f_ext[l][i]);
         ias[i] = Inertia4::splat(&model.inertia_blocks[i]);
     }
-    let tau_of = |k: usize| F4::from_fn(|l| tau[l][k]);
-    let arm = |k: usize| F4::from_fn(|l| armature[l].map_or(0.0, |a| a[k]));
+}
+
+/// Pass 2 (leaves → root): each joint's `U = I^A S`, `D = Sᵀ U` (+ armature) and
+/// `u = τ − Sᵀ p^A`; a body with a parent passes on `I^a = I^A − U D⁻¹ Uᵀ` and
+/// `p^a = p^A + I^a c + U D⁻¹ u`, accumulated into the parent as `Xupᵀ I^a Xup` and
+/// `Xupᵀ p^a` (Featherstone 2008, Table 7.1).
+#[inline(always)]
+fn pass2_articulated_inertias(
+    model: &Model,
+    lanes: &mut LaneBuffers,
+    tau: &[&[f64]; LANES],
+    armature: &[Option<&[f64]>; LANES],
+) {
+    let n = model.nbodies();
+    let (xups, rots) = (&lanes.xup[..n], &lanes.rotation[..n]);
+    let (ss, cs) = (&lanes.s[..n], &lanes.c[..n]);
+    let (ias, pas) = (&mut lanes.ia[..n], &mut lanes.pa[..n]);
+    let (us, dinvs, uus) = (&mut lanes.u[..n], &mut lanes.dinv[..n], &mut lanes.uu[..n]);
     for i in (0..n).rev() {
         let body = &model.bodies[i];
-        let iv = model.v_idx[i];
+        let joint = JointInputs {
+            tau,
+            armature,
+            iv: model.v_idx[i],
+        };
         let (ia_head, ia_tail) = ias.split_at_mut(i);
         let ia = &mut ia_tail[0];
         let pa = pas[i];
+        let out = JointSlots {
+            u: &mut us[i],
+            dinv: &mut dinvs[i],
+            uu: &mut uus[i],
+        };
         let has_parent = body.parent.is_some();
         let pa_a = match (&body.joint, model.joint_axes[i]) {
             (JointType::Pin { .. }, axes) => {
-                let (u, d, uu) = match axes {
-                    JointAxes::One(ax) => coordinate_column(ia, ax.k, ax.sign, tau_of(iv), pa),
-                    _ => {
-                        let a = ss[i][0];
-                        let u = ia.apply_angular(a);
-                        (u, a.dot(u.ang), tau_of(iv) - a.dot(pa.ang))
-                    }
-                };
-                let d = d + arm(iv);
-                let dinv = F4::splat(1.0) / d;
-                us[i][0] = u;
-                dinvs[i].x_axis.x = dinv;
-                uus[i].x = uu;
-                if !has_parent {
-                    continue;
-                }
-                ia.sub_outer(u, dinv);
-                pa + u * (dinv * uu)
+                pin_pass2(ia, pa, (&ss[i], axes), joint, out, has_parent)
             }
             (JointType::Universal { .. }, JointAxes::Two(_, a2)) => {
-                let b = ss[i][0];
-                let u0 = ia.apply_angular(b);
-                let (u1, d11, uu1) = coordinate_column(ia, a2.k, a2.sign, tau_of(iv + 1), pa);
-                let d00 = b.dot(u0.ang) + arm(iv);
-                let d11 = d11 + arm(iv + 1);
-                let (d01, d10) = (b.dot(u1.ang), u0.ang.get(a2.k) * a2.sign);
-                let uu0 = tau_of(iv) - b.dot(pa.ang);
-                let inv_det = F4::splat(1.0) / (d00 * d11 - d01 * d10);
-                let dinv = M3::from_cols(
-                    V3::new(d11 * inv_det, -d10 * inv_det, F4::ZERO),
-                    V3::new(-d01 * inv_det, d00 * inv_det, F4::ZERO),
-                    V3::new(F4::ZERO, F4::ZERO, F4::splat(1.0)),
-                );
-                let u = [u0, u1];
-                us[i][0] = u0;
-                us[i][1] = u1;
-                dinvs[i] = dinv;
-                uus[i] = V3::new(uu0, uu1, F4::ZERO);
-                if !has_parent {
-                    continue;
-                }
-                let w = [
-                    u0 * dinv.x_axis.x + u1 * dinv.x_axis.y,
-                    u0 * dinv.y_axis.x + u1 * dinv.y_axis.y,
-                ];
-                ia.sub_products(&w, &u);
-                pa + u0 * (dinv.x_axis.x * uu0 + dinv.y_axis.x * uu1)
-                    + u1 * (dinv.x_axis.y * uu0 + dinv.y_axis.y * uu1)
+                universal_pass2(ia, pa, (&ss[i], a2), joint, out, has_parent)
             }
             (JointType::Universal { .. } | JointType::Ball { .. }, _) => {
-                let nv = body.joint.nv();
-                let mut u = [Force4::ZERO; 3];
-                let mut d = M3::splat(&glam::DMat3::IDENTITY);
-                let mut uu = V3::ZERO;
-                for k in 0..nv {
-                    let a = ss[i][k];
-                    u[k] = ia.apply_angular(a);
-                    uu.set(k, tau_of(iv + k) - a.dot(pa.ang));
-                }
-                for r in 0..nv {
-                    for k in 0..nv {
-                        let mut e = ss[i][r].dot(u[k].ang);
-                        if r == k {
-                            e += arm(iv + k);
-                        }
-                        d.col_mut(k).set(r, e);
-                    }
-                }
-                let dinv = d.inverse();
-                us[i] = u;
-                dinvs[i] = dinv;
-                uus[i] = uu;
-                if !has_parent {
-                    continue;
-                }
-                if nv == 2 {
-                    ia.sub_u_dinv_ut(&[u[0], u[1]], &dinv);
-                } else {
-                    ia.sub_u_dinv_ut(&u, &dinv);
-                }
-                let w = dinv.mul_vec3(uu);
-                let mut pa_a = pa;
-                for k in 0..nv {
-                    pa_a += u[k] * w.get(k);
-                }
-                pa_a
+                rotational_pass2(ia, pa, (&ss[i], body.joint.nv()), joint, out, has_parent)
             }
             (JointType::Fixed, _) => pa,
             (JointType::Free, _) => continue,
@@ -330,6 +311,143 @@ fn passes(
             pas[p] += x.inv_apply_force(pa_a);
         }
     }
+}
+
+/// Pass 2 for a revolute joint (`D` is 1×1): with a parent, `I^a = I^A − U D⁻¹ Uᵀ` in place
+/// and returns `p^A + U D⁻¹ u` (a root's `p^A` as it is).
+#[inline(always)]
+fn pin_pass2(
+    ia: &mut Inertia4,
+    pa: Force4,
+    (s, axes): (&[V3; 3], JointAxes),
+    joint: JointInputs,
+    out: JointSlots,
+    has_parent: bool,
+) -> Force4 {
+    let (u, d, uu) = match axes {
+        JointAxes::One(ax) => coordinate_column(ia, ax.k, ax.sign, joint.tau(0), pa),
+        _ => {
+            let a = s[0];
+            let u = ia.apply_angular(a);
+            (u, a.dot(u.ang), joint.tau(0) - a.dot(pa.ang))
+        }
+    };
+    let d = d + joint.arm(0);
+    let dinv = F4::splat(1.0) / d;
+    out.u[0] = u;
+    out.dinv.x_axis.x = dinv;
+    out.uu.x = uu;
+    if !has_parent {
+        return pa;
+    }
+    ia.sub_outer(u, dinv);
+    pa + u * (dinv * uu)
+}
+
+/// Pass 2 for a universal joint whose second axis `a2` is a coordinate axis (`D` is 2×2,
+/// inverted in closed form): as [`pin_pass2`].
+#[inline(always)]
+fn universal_pass2(
+    ia: &mut Inertia4,
+    pa: Force4,
+    (s, a2): (&[V3; 3], CoordAxis),
+    joint: JointInputs,
+    out: JointSlots,
+    has_parent: bool,
+) -> Force4 {
+    let b = s[0];
+    let u0 = ia.apply_angular(b);
+    let (u1, d11, uu1) = coordinate_column(ia, a2.k, a2.sign, joint.tau(1), pa);
+    let d00 = b.dot(u0.ang) + joint.arm(0);
+    let d11 = d11 + joint.arm(1);
+    let (d01, d10) = (b.dot(u1.ang), u0.ang.get(a2.k) * a2.sign);
+    let uu0 = joint.tau(0) - b.dot(pa.ang);
+    let inv_det = F4::splat(1.0) / (d00 * d11 - d01 * d10);
+    let dinv = M3::from_cols(
+        V3::new(d11 * inv_det, -d10 * inv_det, F4::ZERO),
+        V3::new(-d01 * inv_det, d00 * inv_det, F4::ZERO),
+        V3::new(F4::ZERO, F4::ZERO, F4::splat(1.0)),
+    );
+    let u = [u0, u1];
+    out.u[0] = u0;
+    out.u[1] = u1;
+    *out.dinv = dinv;
+    *out.uu = V3::new(uu0, uu1, F4::ZERO);
+    if !has_parent {
+        return pa;
+    }
+    let w = [
+        u0 * dinv.x_axis.x + u1 * dinv.x_axis.y,
+        u0 * dinv.y_axis.x + u1 * dinv.y_axis.y,
+    ];
+    ia.sub_products(&w, &u);
+    pa + u0 * (dinv.x_axis.x * uu0 + dinv.y_axis.x * uu1)
+        + u1 * (dinv.x_axis.y * uu0 + dinv.y_axis.y * uu1)
+}
+
+/// Pass 2 for a joint of `nv` rotational DOFs about general axes (ball, universal): `D`
+/// (`nv`×`nv`) inverted as a 3×3 with ones beyond `nv`; as [`pin_pass2`].
+#[inline(always)]
+fn rotational_pass2(
+    ia: &mut Inertia4,
+    pa: Force4,
+    (s, nv): (&[V3; 3], usize),
+    joint: JointInputs,
+    out: JointSlots,
+    has_parent: bool,
+) -> Force4 {
+    let mut u = [Force4::ZERO; 3];
+    let mut d = M3::splat(&glam::DMat3::IDENTITY);
+    let mut uu = V3::ZERO;
+    for k in 0..nv {
+        let a = s[k];
+        u[k] = ia.apply_angular(a);
+        uu.set(k, joint.tau(k) - a.dot(pa.ang));
+    }
+    for r in 0..nv {
+        for k in 0..nv {
+            let mut e = s[r].dot(u[k].ang);
+            if r == k {
+                e += joint.arm(k);
+            }
+            d.col_mut(k).set(r, e);
+        }
+    }
+    let dinv = d.inverse();
+    *out.u = u;
+    *out.dinv = dinv;
+    *out.uu = uu;
+    if !has_parent {
+        return pa;
+    }
+    if nv == 2 {
+        ia.sub_u_dinv_ut(&[u[0], u[1]], &dinv);
+    } else {
+        ia.sub_u_dinv_ut(&u, &dinv);
+    }
+    let w = dinv.mul_vec3(uu);
+    let mut pa_a = pa;
+    for k in 0..nv {
+        pa_a += u[k] * w.get(k);
+    }
+    pa_a
+}
+
+/// Pass 3 (root → leaves): `a' = Xup a_λ + c`, `q̈ = D⁻¹(u − Uᵀ a')`, `a = a' + S q̈`
+/// (Featherstone 2008, Table 7.1); a free root's `a = (I^A)⁻¹(τ − p^A)` (`FDfb`). Writes each
+/// lane's `q̈` into its `data`.
+#[inline(always)]
+fn pass3_accelerations(
+    model: &Model,
+    lanes: &mut LaneBuffers,
+    data: [&mut Data; LANES],
+    tau: &[&[f64]; LANES],
+) {
+    let n = model.nbodies();
+    let (xups, ss, cs) = (&lanes.xup[..n], &lanes.s[..n], &lanes.c[..n]);
+    let (accs, ias, pas) = (&mut lanes.a[..n], &lanes.ia[..n], &lanes.pa[..n]);
+    let (us, dinvs, uus) = (&lanes.u[..n], &lanes.dinv[..n], &lanes.uu[..n]);
+    let tau_of = |k: usize| F4::from_fn(|l| tau[l][k]);
     let a0 = base_acceleration(model);
     let a0 = Motion4::new(V3::splat(a0.ang), V3::splat(a0.lin));
     let mut qdds = data.map(|d| &mut d.qdd[..]);

@@ -200,11 +200,8 @@ pub fn balance_base(
         Ok::<_, StepError>(())
     };
     let (mut r, mut r_try) = (vec![0.0; nb], vec![0.0; nb]);
-    let (mut col_p, mut col_m) = (vec![0.0; nb], vec![0.0; nb]);
     let mut jac = vec![0.0; nb * nb];
-    let mut z = vec![0.0; nv];
     let mut q_base = state.q.clone();
-    let eps = settings.difference_step;
     let (mut iterations, mut passes) = (0, 0);
     let no_convergence = |iterations, r: &[f64]| EquilibriumError::NoConvergence {
         iterations,
@@ -219,36 +216,16 @@ pub fn balance_base(
             }
             iterations += 1;
             q_base.copy_from_slice(&state.q);
-            // J[:, k] = (F(q ⊞ ε e_k) − F(q ⊞ −ε e_k)) / 2ε over the base coordinates.
-            for k in 0..nb {
-                z.fill(0.0);
-                z[base.start + k] = eps;
-                model.retract(&q_base, &z, &mut state.q);
-                eval(state, ws, &mut col_p)?;
-                z[base.start + k] = -eps;
-                model.retract(&q_base, &z, &mut state.q);
-                eval(state, ws, &mut col_m)?;
-                for i in 0..nb {
-                    jac[i * nb + k] = (col_p[i] - col_m[i]) / (2.0 * eps);
-                }
-            }
+            let probe = BaseProbe {
+                model,
+                base: &base,
+                q_base: &q_base,
+            };
+            probe.jacobian(settings.difference_step, state, ws, &mut eval, &mut jac)?;
             let mut dz: Vec<f64> = r.iter().map(|x| -x).collect();
             lu_solve(&mut jac, nb, &mut dz)?;
-            // Backtracking: the full step unless it raises the residual.
             let n0 = norm2(&r);
-            let mut t = 1.0;
-            loop {
-                z.fill(0.0);
-                for (k, d) in dz.iter().enumerate() {
-                    z[base.start + k] = t * d;
-                }
-                model.retract(&q_base, &z, &mut state.q);
-                eval(state, ws, &mut r_try)?;
-                if norm2(&r_try) < n0 || t < 1e-6 {
-                    break;
-                }
-                t *= 0.5;
-            }
+            probe.backtrack(&dz, n0, state, ws, &mut eval, &mut r_try)?;
             if norm2(&r_try) >= n0 {
                 state.q.copy_from_slice(&q_base);
                 return Err(no_convergence(iterations, &r));
@@ -267,6 +244,71 @@ pub fn balance_base(
                 anchor_passes: passes,
                 residual: max_abs(&r),
             });
+        }
+    }
+}
+
+/// Moves of the base coordinates `base` of `model` about the configuration `q_base`, with
+/// `eval` the base's imbalance `F` at `state` (see [`balance_base`]).
+struct BaseProbe<'a> {
+    model: &'a Model,
+    base: &'a Range<usize>,
+    q_base: &'a [f64],
+}
+
+impl BaseProbe<'_> {
+    /// `state.q = q_base ⊞ z`, `z` zero outside the base and `step(k)` on base coordinate `k`.
+    fn retract_base(&self, state: &mut State, step: impl Fn(usize) -> f64) {
+        let mut z = vec![0.0; self.model.nv];
+        for k in 0..self.base.len() {
+            z[self.base.start + k] = step(k);
+        }
+        self.model.retract(self.q_base, &z, &mut state.q);
+    }
+
+    /// The Jacobian by central differences, `J[:, k] = (F(q ⊞ ε e_k) − F(q ⊞ −ε e_k)) / 2ε`
+    /// over the base coordinates, into `jac` (row-major, nb × nb).
+    fn jacobian(
+        &self,
+        eps: f64,
+        state: &mut State,
+        ws: &mut StepWorkspace,
+        eval: &mut impl FnMut(&State, &mut StepWorkspace, &mut [f64]) -> Result<(), StepError>,
+        jac: &mut [f64],
+    ) -> Result<(), StepError> {
+        let nb = self.base.len();
+        let (mut col_p, mut col_m) = (vec![0.0; nb], vec![0.0; nb]);
+        for k in 0..nb {
+            self.retract_base(state, |j| if j == k { eps } else { 0.0 });
+            eval(state, ws, &mut col_p)?;
+            self.retract_base(state, |j| if j == k { -eps } else { 0.0 });
+            eval(state, ws, &mut col_m)?;
+            for i in 0..nb {
+                jac[i * nb + k] = (col_p[i] - col_m[i]) / (2.0 * eps);
+            }
+        }
+        Ok(())
+    }
+
+    /// Backtracking along the Newton step `dz`: the full step unless it raises the residual
+    /// norm `n0`, halved until it does not (or below 1e-6); `r_try` holds the residual there.
+    fn backtrack(
+        &self,
+        dz: &[f64],
+        n0: f64,
+        state: &mut State,
+        ws: &mut StepWorkspace,
+        eval: &mut impl FnMut(&State, &mut StepWorkspace, &mut [f64]) -> Result<(), StepError>,
+        r_try: &mut [f64],
+    ) -> Result<(), StepError> {
+        let mut t = 1.0;
+        loop {
+            self.retract_base(state, |k| t * dz[k]);
+            eval(state, ws, r_try)?;
+            if norm2(r_try) < n0 || t < 1e-6 {
+                return Ok(());
+            }
+            t *= 0.5;
         }
     }
 }

@@ -710,6 +710,14 @@ fn prepare(
         ws.tau[k] = tau;
         ws.damping[k] = damp;
     }
+    implicit_armature(ws, v, implicit)
+}
+
+/// The armature of the joint forces taken implicitly over the step `h`: `h·d` (damping), or
+/// `h d + h² k` with the torques corrected by `−h k v` ([`linearly_implicit::joint`]); returns
+/// whether the armature applies (not with [`Implicit::Explicit`]).
+#[inline(always)]
+fn implicit_armature(ws: &mut EvalScratch, v: &[f64], implicit: Implicit) -> bool {
     match implicit {
         Implicit::Damping(h) => {
             for k in 0..ws.armature.len() {

@@ -42,6 +42,7 @@ use crate::dynamics::forces::pd::PdTargets;
 use crate::dynamics::integrator::Integrator;
 use crate::dynamics::joint::quat_log;
 use crate::dynamics::kinematics::kinematics;
+use crate::dynamics::model::Model;
 use crate::humanoid::body::HumanBody;
 use crate::humanoid::ranges::{AgeGroup, RangeTable};
 use crate::humanoid::strength::{NoStrength, torque_limits_for};
@@ -384,6 +385,66 @@ pub fn spawn_physical_character(
     settings: &PhysicalSettings,
     reaction: Reaction,
 ) -> Result<Entity, CharacterError> {
+    check_physical_settings(settings)?;
+    let player = PrimitivePlayer::new(sequence)?;
+    let pose = player.pose();
+    let binding = ModelBinding::new(Arc::new(body.figure.clone()), &pose.names)?;
+    let model = &body.model;
+    let (q, v) = pose_configuration(&body, &binding, &pose);
+    let mut data = Data::new(model);
+    kinematics(model, &mut data, &q, &v);
+    let floor = floor_contact(&body, settings, &data)?;
+    // Gains from the joint-space inertia at the start pose.
+    let h = crate::dynamics::crba(model, &mut data, &q).to_vec();
+    let targets: Vec<f64> = binding
+        .dof_columns()
+        .iter()
+        .map(|&c| pose.theta[c])
+        .collect();
+    let pd = pd_targets(&body, settings, &h, targets)?;
+    let joint_limits = joint_limits(&body, settings)?;
+    let assist = new_root_assist(settings, model, &h);
+    let ndofs = body.dof_v.len();
+    let nlinks = model.nbodies();
+    let mut physics = PhysicsBundle::new(body.clone(), settings.integrator, q);
+    physics.state.v = v;
+    let log = CharacterLog {
+        dof_sq_error: vec![0.0; ndofs],
+        peak_torque_nm: vec![0.0; ndofs],
+        peak_force_after_push_n: vec![0.0; nlinks],
+        saturated_ticks: vec![0; ndofs],
+        demand_nm: vec![(0.0, 0.0); ndofs],
+        ..CharacterLog::default()
+    };
+    let mut entity = world.spawn((
+        drawn_body(name, &body),
+        physics,
+        (pose, player, binding, TrackPose),
+        (
+            PdController(pd),
+            FloorContact(Arc::new(floor.contact)),
+            ExternalForces::default(),
+            assist,
+            reaction,
+            log,
+            FeetOnFloor::new(floor.feet, floor.lowest),
+        ),
+    ));
+    if let Some(l) = joint_limits {
+        entity.insert(l);
+    }
+    if settings.feedforward {
+        entity.insert(Feedforward {
+            root: settings.assist_feedforward,
+            ..Feedforward::default()
+        });
+    }
+    Ok(entity.id())
+}
+
+/// The settings of [`spawn_physical_character`] in range: positive frequencies, a clearance
+/// ≥ 0 and an assistance in [0, 1].
+fn check_physical_settings(settings: &PhysicalSettings) -> Result<(), CharacterError> {
     for (field, x) in [
         ("joint_omega", settings.joint_omega),
         ("assist_omega", settings.assist_omega),
@@ -407,9 +468,26 @@ pub fn spawn_physical_character(
             message: format!("must lie in [0, 1], found {}", settings.assist),
         });
     }
-    let player = PrimitivePlayer::new(sequence)?;
-    let pose = player.pose();
-    let binding = ModelBinding::new(Arc::new(body.figure.clone()), &pose.names)?;
+    Ok(())
+}
+
+/// The floor a character stands on, and what it is measured from.
+struct StartFloor {
+    contact: ContactModel,
+    /// The feet's link indices.
+    feet: Vec<usize>,
+    /// The height of the start pose's lowest contact corner along the floor normal, metres.
+    lowest: f64,
+}
+
+/// The floor under the lowest corner of the start pose (kinematics in `data`), lowered by the
+/// feet's static sink under half the weight the floor carries each, and raised by the
+/// clearance; the links' tissue gains from their regions.
+fn floor_contact(
+    body: &HumanBody,
+    settings: &PhysicalSettings,
+    data: &Data,
+) -> Result<StartFloor, CharacterError> {
     let model = &body.model;
     let masses: Vec<f64> = model.bodies.iter().map(|b| b.inertia.mass).collect();
     let gains = body
@@ -421,10 +499,6 @@ pub fn spawn_physical_character(
                 .ok_or_else(|| CharacterError::Tissue(n.clone()))
         })
         .collect::<Result<Vec<_>, _>>()?;
-    let (q, v) = pose_configuration(&body, &binding, &pose);
-    // The floor under the lowest corner of the start pose.
-    let mut data = Data::new(model);
-    kinematics(model, &mut data, &q, &v);
     let mut params = settings.contact;
     let probe = ContactModel::new(&body.boxes, &masses, &gains, params);
     let lowest = probe
@@ -448,10 +522,22 @@ pub fn spawn_physical_character(
     let foot = feet.first().copied().unwrap_or(0);
     params.floor_height =
         lowest + probe.static_sink(foot, 0.5 * weight) - settings.floor_clearance_m;
-    let contact = ContactModel::new(&body.boxes, &masses, &gains, params);
-    // Gains from the joint-space inertia at the start pose.
-    let h = crate::dynamics::crba(model, &mut data, &q).to_vec();
-    let nv = model.nv;
+    Ok(StartFloor {
+        contact: ContactModel::new(&body.boxes, &masses, &gains, params),
+        feet,
+        lowest,
+    })
+}
+
+/// PD gains holding `targets` from the joint-space inertia `h` (nv×nv) at the start pose:
+/// `kp = ω² H_kk`, `kv = 2ζω H_kk`, with the strength's torque limits.
+fn pd_targets(
+    body: &HumanBody,
+    settings: &PhysicalSettings,
+    h: &[f64],
+    targets: Vec<f64>,
+) -> Result<PdTargets, CharacterError> {
+    let nv = body.model.nv;
     let hkk: Vec<f64> = body.dof_v.iter().map(|&k| h[k * nv + k]).collect();
     let (w, z) = (settings.joint_omega, settings.joint_zeta);
     let kp: Vec<f64> = hkk.iter().map(|i| w * w * i).collect();
@@ -460,35 +546,40 @@ pub fn spawn_physical_character(
         Some(g) => torque_limits_for(&body.figure, g)?,
         None => Vec::new(),
     };
-    let targets: Vec<f64> = binding
-        .dof_columns()
-        .iter()
-        .map(|&c| pose.theta[c])
-        .collect();
-    let pd = PdTargets::hold(targets, kp, kv).with_torque_limits(limits);
-    let joint_limits = match settings.joint_ranges {
-        Some(g) => {
-            let name = &body.figure.name;
-            let table =
-                RangeTable::builtin_for(name, g).ok_or_else(|| CharacterError::Setting {
-                    field: "joint_ranges",
-                    message: format!("no built-in {g:?} joint ranges for model {name}"),
-                })?;
-            let ranges = table
-                .for_model(&body.figure)
-                .map_err(|e| CharacterError::Setting {
-                    field: "joint_ranges",
-                    message: e.to_string(),
-                })?;
-            Some(JointLimits(JointRanges {
-                ranges,
-                params: JointLimitParams::default(),
-                limit_gains: Vec::new(),
-            }))
-        }
-        None => None,
+    Ok(PdTargets::hold(targets, kp, kv).with_torque_limits(limits))
+}
+
+/// The built-in joint ranges of the settings' group for the body's model, if asked for.
+fn joint_limits(
+    body: &HumanBody,
+    settings: &PhysicalSettings,
+) -> Result<Option<JointLimits>, CharacterError> {
+    let Some(g) = settings.joint_ranges else {
+        return Ok(None);
     };
-    let assist = RootAssist {
+    let name = &body.figure.name;
+    let table = RangeTable::builtin_for(name, g).ok_or_else(|| CharacterError::Setting {
+        field: "joint_ranges",
+        message: format!("no built-in {g:?} joint ranges for model {name}"),
+    })?;
+    let ranges = table
+        .for_model(&body.figure)
+        .map_err(|e| CharacterError::Setting {
+            field: "joint_ranges",
+            message: e.to_string(),
+        })?;
+    Ok(Some(JointLimits(JointRanges {
+        ranges,
+        params: JointLimitParams::default(),
+        limit_gains: Vec::new(),
+    })))
+}
+
+/// The root assistance of the settings, its rotational inertia the mean of the free root's
+/// diagonal of `h` (nv×nv).
+fn new_root_assist(settings: &PhysicalSettings, model: &Model, h: &[f64]) -> RootAssist {
+    let nv = model.nv;
+    RootAssist {
         strength: settings.assist,
         omega: settings.assist_omega,
         zeta: settings.assist_zeta,
@@ -499,43 +590,7 @@ pub fn spawn_physical_character(
         feedforward_torque: DVec3::ZERO,
         force: DVec3::ZERO,
         torque: DVec3::ZERO,
-    };
-    let ndofs = body.dof_v.len();
-    let nlinks = model.nbodies();
-    let mut physics = PhysicsBundle::new(body.clone(), settings.integrator, q);
-    physics.state.v = v;
-    let log = CharacterLog {
-        dof_sq_error: vec![0.0; ndofs],
-        peak_torque_nm: vec![0.0; ndofs],
-        peak_force_after_push_n: vec![0.0; nlinks],
-        saturated_ticks: vec![0; ndofs],
-        demand_nm: vec![(0.0, 0.0); ndofs],
-        ..CharacterLog::default()
-    };
-    let mut entity = world.spawn((
-        drawn_body(name, &body),
-        physics,
-        (pose, player, binding, TrackPose),
-        (
-            PdController(pd),
-            FloorContact(Arc::new(contact)),
-            ExternalForces::default(),
-            assist,
-            reaction,
-            log,
-            FeetOnFloor::new(feet, lowest),
-        ),
-    ));
-    if let Some(l) = joint_limits {
-        entity.insert(l);
     }
-    if settings.feedforward {
-        entity.insert(Feedforward {
-            root: settings.assist_feedforward,
-            ..Feedforward::default()
-        });
-    }
-    Ok(entity.id())
 }
 
 /// Pushes `entity` with `push` starting now (the body's time), e.g. from a game's input; the

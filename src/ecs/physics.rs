@@ -25,6 +25,7 @@ use crate::dynamics::forces::external::ExternalForce;
 use crate::dynamics::forces::limits::JointRanges;
 use crate::dynamics::forces::pd::PdTargets;
 use crate::dynamics::integrator::Integrator;
+use crate::dynamics::model::Model;
 use crate::dynamics::pipeline::{
     self, Forces, LaneBody, State, StepError, StepMonitor, StepSettings, StepWorkspace,
 };
@@ -181,119 +182,149 @@ pub fn step_bodies(
     let dt = clock.physics_dt();
     let mut together = Vec::new();
     for item in &mut q {
-        let (
-            body,
-            mut state,
-            pd,
-            limits,
-            contact,
-            external,
-            mut ws,
-            mut monitor,
-            mut status,
-            assist,
-        ) = item;
+        let (body, state, pd, limits, contact, external, ws, monitor, status, assist) = item;
         if !status.running() {
             continue;
         }
         let assisted = assist.and_then(RootAssist::external);
+        let one = (
+            body, state, pd, limits, contact, external, ws, monitor, status,
+        );
         if assisted.is_none() && matches!(body.integrator, Integrator::SemiImplicitEuler { .. }) {
-            together.push((
-                body, state, pd, limits, contact, external, ws, monitor, status,
-            ));
+            together.push(one);
             continue;
         }
-        let mut external = external.map_or(&[][..], |e| &e.0[..]);
-        if let Some(f) = assisted {
-            scratch.clear();
-            scratch.extend_from_slice(external);
-            scratch.push(f);
-            external = &scratch[..];
-        }
-        let forces = Forces {
-            dofs: &body.body.dof_v,
-            pd: pd.map(|p| &p.0),
-            limits: limits.map(|l| &l.0),
-            contact: contact.map(|c| &*c.0),
-            external,
-        };
-        let settings = StepSettings {
-            integrator: body.integrator,
-            dt,
-        };
-        for _ in 0..clock.substeps {
-            if let Err(e) = pipeline::step(
-                &body.body.model,
-                settings,
-                &forces,
-                &mut state.0,
-                &mut ws.0,
-                &mut monitor.0,
-            ) {
-                status.error = Some(Arc::new(e));
-                break;
-            }
-        }
+        step_alone(one, assisted, &mut scratch, dt, clock.substeps);
     }
     // The bodies of one model and scheme, in query order.
     while let Some(first) = together.first() {
         let (human, integrator) = (first.0.body.clone(), first.0.integrator);
-        let same = |b: &(&PhysicsBody, _, _, _, _, _, _, _, _)| {
-            Arc::ptr_eq(&b.0.body, &human) && b.0.integrator == integrator
-        };
-        let mut group = if together.iter().all(&same) {
+        let same = |b: &StepItem| Arc::ptr_eq(&b.0.body, &human) && b.0.integrator == integrator;
+        let mut group = if together.iter().all(same) {
             std::mem::take(&mut together)
         } else {
-            let (group, rest): (Vec<_>, Vec<_>) = together.into_iter().partition(|b| same(b));
+            let (group, rest): (Vec<_>, Vec<_>) = together.into_iter().partition(same);
             together = rest;
             group
         };
-        let model = &human.model;
         // Lane buffers per body, dropped with the last character of that body.
         lanes.retain(|(h, _)| Arc::strong_count(h) > 1);
         let k = match lanes.iter().position(|(h, _)| Arc::ptr_eq(h, &human)) {
             Some(k) => k,
             None => {
-                lanes.push((human.clone(), LaneData::new(model)));
+                lanes.push((human.clone(), LaneData::new(&human.model)));
                 lanes.len() - 1
             }
         };
-        let lane_data = &mut lanes[k].1;
         let settings = StepSettings { integrator, dt };
-        for _ in 0..clock.substeps {
-            let mut bodies: Vec<LaneBody> = group
-                .iter_mut()
-                .filter(|b| b.8.running())
-                .map(
-                    |(body, state, pd, limits, contact, external, ws, monitor, _)| LaneBody {
-                        forces: Forces {
-                            dofs: &body.body.dof_v,
-                            pd: pd.map(|p| &p.0),
-                            limits: limits.map(|l| &l.0),
-                            contact: contact.map(|c| &*c.0),
-                            external: external.map_or(&[][..], |e| &e.0[..]),
-                        },
-                        state: &mut state.0,
-                        ws: &mut ws.0,
-                        monitor: &mut monitor.0,
-                        result: Ok(()),
+        step_together(
+            &human.model,
+            settings,
+            clock.substeps,
+            &mut group,
+            &mut lanes[k].1,
+        );
+    }
+}
+
+/// One running body's components as the step takes them (its [`StepQuery`] without the
+/// assistance).
+type StepItem<'w> = (
+    &'w PhysicsBody,
+    Mut<'w, BodyState>,
+    Option<&'w PdController>,
+    Option<&'w JointLimits>,
+    Option<&'w FloorContact>,
+    Option<&'w ExternalForces>,
+    Mut<'w, PhysicsWorkspace>,
+    Mut<'w, PhysicsMonitor>,
+    Mut<'w, PhysicsStatus>,
+);
+
+/// Steps one body alone by `substeps` steps of `dt`, the assistance's force `assisted` (if
+/// any) joining its external forces; an error stops it.
+fn step_alone(
+    item: StepItem,
+    assisted: Option<ExternalForce>,
+    scratch: &mut Vec<ExternalForce>,
+    dt: f64,
+    substeps: u32,
+) {
+    let (body, mut state, pd, limits, contact, external, mut ws, mut monitor, mut status) = item;
+    let mut external = external.map_or(&[][..], |e| &e.0[..]);
+    if let Some(f) = assisted {
+        scratch.clear();
+        scratch.extend_from_slice(external);
+        scratch.push(f);
+        external = &scratch[..];
+    }
+    let forces = Forces {
+        dofs: &body.body.dof_v,
+        pd: pd.map(|p| &p.0),
+        limits: limits.map(|l| &l.0),
+        contact: contact.map(|c| &*c.0),
+        external,
+    };
+    let settings = StepSettings {
+        integrator: body.integrator,
+        dt,
+    };
+    for _ in 0..substeps {
+        if let Err(e) = pipeline::step(
+            &body.body.model,
+            settings,
+            &forces,
+            &mut state.0,
+            &mut ws.0,
+            &mut monitor.0,
+        ) {
+            status.error = Some(Arc::new(e));
+            break;
+        }
+    }
+}
+
+/// Steps the bodies of `group` (one model, one scheme) together by `substeps` steps through
+/// [`pipeline::step_lanes`]; an error stops its body and no other.
+fn step_together(
+    model: &Model,
+    settings: StepSettings,
+    substeps: u32,
+    group: &mut [StepItem],
+    lane_data: &mut LaneData,
+) {
+    for _ in 0..substeps {
+        let mut bodies: Vec<LaneBody> = group
+            .iter_mut()
+            .filter(|b| b.8.running())
+            .map(
+                |(body, state, pd, limits, contact, external, ws, monitor, _)| LaneBody {
+                    forces: Forces {
+                        dofs: &body.body.dof_v,
+                        pd: pd.map(|p| &p.0),
+                        limits: limits.map(|l| &l.0),
+                        contact: contact.map(|c| &*c.0),
+                        external: external.map_or(&[][..], |e| &e.0[..]),
                     },
-                )
-                .collect();
-            if bodies.is_empty() {
-                break;
-            }
-            pipeline::step_lanes(model, settings, &mut bodies, lane_data);
-            if bodies.iter().all(|b| b.result.is_ok()) {
-                continue;
-            }
-            let errors: Vec<Option<StepError>> =
-                bodies.into_iter().map(|b| b.result.err()).collect();
-            let mut errors = errors.into_iter();
-            for b in group.iter_mut().filter(|b| b.8.running()) {
-                if let Some(Some(e)) = errors.next() {
-                    b.8.error = Some(Arc::new(e));
-                }
+                    state: &mut state.0,
+                    ws: &mut ws.0,
+                    monitor: &mut monitor.0,
+                    result: Ok(()),
+                },
+            )
+            .collect();
+        if bodies.is_empty() {
+            break;
+        }
+        pipeline::step_lanes(model, settings, &mut bodies, lane_data);
+        if bodies.iter().all(|b| b.result.is_ok()) {
+            continue;
+        }
+        let errors: Vec<Option<StepError>> = bodies.into_iter().map(|b| b.result.err()).collect();
+        let mut errors = errors.into_iter();
+        for b in group.iter_mut().filter(|b| b.8.running()) {
+            if let Some(Some(e)) = errors.next() {
+                b.8.error = Some(Arc::new(e));
             }
         }
     }

@@ -18,7 +18,7 @@
 //! field. Numbers travel as shortest round-trip decimals, so genes and damages cross bit for bit.
 
 use std::io::{BufRead, BufReader, Read, Write};
-use std::process::{Child, Command, Stdio};
+use std::process::{Child, ChildStderr, ChildStdin, ChildStdout, Command, Stdio};
 use std::sync::{Arc, Mutex, mpsc};
 use std::time::{Duration, Instant};
 
@@ -302,55 +302,9 @@ impl JsonLines {
                 _ => return Err(err(format!("the worker `{name}` has no pipes"))),
             };
         let last = Arc::new(Mutex::new(LastSaid::default()));
-        let lock = |l: &Arc<Mutex<LastSaid>>| {
-            let l = l.clone();
-            move |f: &dyn Fn(&mut LastSaid)| f(&mut l.lock().unwrap_or_else(|e| e.into_inner()))
-        };
-        // Writes on a thread of its own: a worker that stops reading blocks it, not the GA.
-        let (to_worker, inbox) = mpsc::channel::<Vec<u8>>();
-        let note = lock(&last);
-        std::thread::spawn(move || {
-            let mut stdin = stdin;
-            for block in inbox {
-                if let Err(e) = stdin.write_all(&block).and_then(|_| stdin.flush()) {
-                    let e = e.to_string();
-                    note(&|l| l.stdin_error = Some(e.clone()));
-                    return;
-                }
-            }
-        });
-        let (outbox, from_worker) = mpsc::channel::<Option<String>>();
-        let note = lock(&last);
-        std::thread::spawn(move || {
-            let mut stdout = BufReader::new(stdout);
-            loop {
-                let mut line = String::new();
-                match (&mut stdout).take(MAX_LINE as u64 + 1).read_line(&mut line) {
-                    Ok(n) if n > 0 => {
-                        let said = shorten(&line);
-                        note(&|l| l.stdout = Some(said.clone()));
-                        if outbox.send(Some(line)).is_err() {
-                            return;
-                        }
-                    }
-                    _ => {
-                        let _ = outbox.send(None);
-                        return;
-                    }
-                }
-            }
-        });
-        let note = lock(&last);
-        std::thread::spawn(move || {
-            for line in BufReader::new(stderr).lines() {
-                let Ok(line) = line else { return };
-                let _ = writeln!(std::io::stderr(), "{line}");
-                if !line.trim().is_empty() {
-                    let said = shorten(&line);
-                    note(&|l| l.stderr = Some(said.clone()));
-                }
-            }
-        });
+        let to_worker = spawn_writer(stdin, noter(&last));
+        let from_worker = spawn_reader(stdout, noter(&last));
+        spawn_stderr_echo(stderr, noter(&last));
         let mut me = Self {
             child,
             name,
@@ -412,6 +366,74 @@ impl JsonLines {
     }
 }
 
+/// A handle through which a pipe's thread notes in `last` what the worker said.
+fn noter(last: &Arc<Mutex<LastSaid>>) -> impl Fn(&dyn Fn(&mut LastSaid)) + Send + 'static {
+    let l = last.clone();
+    move |f: &dyn Fn(&mut LastSaid)| f(&mut l.lock().unwrap_or_else(|e| e.into_inner()))
+}
+
+/// Writes to the worker's input on a thread of its own: a worker that stops reading blocks
+/// it, not the GA. A write that fails is noted and ends the thread.
+fn spawn_writer(
+    mut stdin: ChildStdin,
+    note: impl Fn(&dyn Fn(&mut LastSaid)) + Send + 'static,
+) -> mpsc::Sender<Vec<u8>> {
+    let (to_worker, inbox) = mpsc::channel::<Vec<u8>>();
+    std::thread::spawn(move || {
+        for block in inbox {
+            if let Err(e) = stdin.write_all(&block).and_then(|_| stdin.flush()) {
+                let e = e.to_string();
+                note(&|l| l.stdin_error = Some(e.clone()));
+                return;
+            }
+        }
+    });
+    to_worker
+}
+
+/// Reads the worker's output lines (each at most [`MAX_LINE`] bytes) on a thread of its own;
+/// `None` once the output ends.
+fn spawn_reader(
+    stdout: ChildStdout,
+    note: impl Fn(&dyn Fn(&mut LastSaid)) + Send + 'static,
+) -> mpsc::Receiver<Option<String>> {
+    let (outbox, from_worker) = mpsc::channel::<Option<String>>();
+    std::thread::spawn(move || {
+        let mut stdout = BufReader::new(stdout);
+        loop {
+            let mut line = String::new();
+            match (&mut stdout).take(MAX_LINE as u64 + 1).read_line(&mut line) {
+                Ok(n) if n > 0 => {
+                    let said = shorten(&line);
+                    note(&|l| l.stdout = Some(said.clone()));
+                    if outbox.send(Some(line)).is_err() {
+                        return;
+                    }
+                }
+                _ => {
+                    let _ = outbox.send(None);
+                    return;
+                }
+            }
+        }
+    });
+    from_worker
+}
+
+/// Passes the worker's standard error through to this process's, noting its last line.
+fn spawn_stderr_echo(stderr: ChildStderr, note: impl Fn(&dyn Fn(&mut LastSaid)) + Send + 'static) {
+    std::thread::spawn(move || {
+        for line in BufReader::new(stderr).lines() {
+            let Ok(line) = line else { return };
+            let _ = writeln!(std::io::stderr(), "{line}");
+            if !line.trim().is_empty() {
+                let said = shorten(&line);
+                note(&|l| l.stderr = Some(said.clone()));
+            }
+        }
+    });
+}
+
 impl Evaluator for JsonLines {
     fn evaluate(
         &mut self,
@@ -422,63 +444,13 @@ impl Evaluator for JsonLines {
         if let Some(why) = &self.broken {
             return Err(EvolveError::Evaluator(format!("failed before: {why}")));
         }
-        let err = |m: String| EvolveError::Evaluator(m);
-        let mut text = String::new();
-        for (index, g) in genomes.iter().enumerate() {
-            let line = Request::Genome(GenomeLine {
-                index,
-                genes: g.clone(),
-                refine,
-            });
-            text.push_str(&serde_json::to_string(&line).map_err(|e| err(e.to_string()))?);
-            text.push('\n');
-        }
-        let end = Request::Evaluate(BatchEnd {
-            count: genomes.len(),
-        });
-        text.push_str(&serde_json::to_string(&end).map_err(|e| err(e.to_string()))?);
-        text.push('\n');
-        self.send(text);
+        self.send(batch_text(genomes, refine)?);
         let n = genomes.len();
         let mut out: Vec<Option<Evaluation>> = vec![None; n];
         let mut got = 0;
-        let started = Instant::now();
-        let tick = (self.timeout / 3).min(PROGRESS_EVERY);
-        let mut next_note = started + tick;
+        let mut clock = BatchClock::start(self.timeout);
         loop {
-            let now = Instant::now();
-            let deadline = started + self.timeout;
-            if now >= deadline {
-                return Err(self.fail(format!(
-                    "answered {got} of the {n} genomes of generation {generation} in {:.1} s, \
-                     the batch timeout, and was stopped",
-                    self.timeout.as_secs_f64()
-                )));
-            }
-            let line = match self.from_worker.recv_timeout(next_note.min(deadline) - now) {
-                Ok(Some(line)) => line,
-                Ok(None) | Err(mpsc::RecvTimeoutError::Disconnected) => {
-                    let status = self.exit_status();
-                    return Err(self.fail(format!(
-                        "closed its output after {got} of the {n} replies of generation \
-                         {generation} ({status})"
-                    )));
-                }
-                Err(mpsc::RecvTimeoutError::Timeout) => {
-                    if Instant::now() >= next_note {
-                        let _ = writeln!(
-                            std::io::stderr(),
-                            "waiting for the worker `{}`: {got} of {n} replies of generation \
-                             {generation} after {:.1} s (it is stopped at {:.1} s)",
-                            self.name,
-                            started.elapsed().as_secs_f64(),
-                            self.timeout.as_secs_f64()
-                        );
-                        next_note += tick;
-                    }
-                    continue;
-                }
-            };
+            let line = self.next_line(&mut clock, got, n, generation)?;
             self.lines_read += 1;
             if line.trim().is_empty() {
                 continue;
@@ -514,6 +486,97 @@ impl Evaluator for JsonLines {
             got += 1;
         }
         Ok(out.into_iter().flatten().collect())
+    }
+}
+
+/// The request lines of a batch: one genome line each, then the batch end.
+fn batch_text(genomes: &[Genome], refine: u32) -> Result<String, EvolveError> {
+    let err = |m: String| EvolveError::Evaluator(m);
+    let mut text = String::new();
+    for (index, g) in genomes.iter().enumerate() {
+        let line = Request::Genome(GenomeLine {
+            index,
+            genes: g.clone(),
+            refine,
+        });
+        text.push_str(&serde_json::to_string(&line).map_err(|e| err(e.to_string()))?);
+        text.push('\n');
+    }
+    let end = Request::Evaluate(BatchEnd {
+        count: genomes.len(),
+    });
+    text.push_str(&serde_json::to_string(&end).map_err(|e| err(e.to_string()))?);
+    text.push('\n');
+    Ok(text)
+}
+
+/// When a batch started, and when the next progress line is due.
+struct BatchClock {
+    started: Instant,
+    tick: Duration,
+    next_note: Instant,
+}
+
+impl BatchClock {
+    fn start(timeout: Duration) -> Self {
+        let started = Instant::now();
+        let tick = (timeout / 3).min(PROGRESS_EVERY);
+        Self {
+            started,
+            tick,
+            next_note: started + tick,
+        }
+    }
+}
+
+impl JsonLines {
+    /// The worker's next line of the batch (`got` of its `n` replies of `generation` in),
+    /// writing a progress line while it waits; stops the worker at the batch timeout or when
+    /// its output closes.
+    fn next_line(
+        &mut self,
+        clock: &mut BatchClock,
+        got: usize,
+        n: usize,
+        generation: u64,
+    ) -> Result<String, EvolveError> {
+        loop {
+            let now = Instant::now();
+            let deadline = clock.started + self.timeout;
+            if now >= deadline {
+                return Err(self.fail(format!(
+                    "answered {got} of the {n} genomes of generation {generation} in {:.1} s, \
+                     the batch timeout, and was stopped",
+                    self.timeout.as_secs_f64()
+                )));
+            }
+            match self
+                .from_worker
+                .recv_timeout(clock.next_note.min(deadline) - now)
+            {
+                Ok(Some(line)) => return Ok(line),
+                Ok(None) | Err(mpsc::RecvTimeoutError::Disconnected) => {
+                    let status = self.exit_status();
+                    return Err(self.fail(format!(
+                        "closed its output after {got} of the {n} replies of generation \
+                         {generation} ({status})"
+                    )));
+                }
+                Err(mpsc::RecvTimeoutError::Timeout) => {
+                    if Instant::now() >= clock.next_note {
+                        let _ = writeln!(
+                            std::io::stderr(),
+                            "waiting for the worker `{}`: {got} of {n} replies of generation \
+                             {generation} after {:.1} s (it is stopped at {:.1} s)",
+                            self.name,
+                            clock.started.elapsed().as_secs_f64(),
+                            self.timeout.as_secs_f64()
+                        );
+                        clock.next_note += clock.tick;
+                    }
+                }
+            }
+        }
     }
 }
 
@@ -556,17 +619,7 @@ where
         .next()
         .ok_or_else(|| err("no header line".into()))?
         .map_err(|e| err(e.to_string()))?;
-    let header: Header = parse_line(&first, "request", 1).map_err(err)?;
-    if header.protocol != PROTOCOL {
-        return Err(err(format!(
-            "protocol '{}' is not '{PROTOCOL}'",
-            header.protocol
-        )));
-    }
-    let eval = serde_json::from_value(header.problem)
-        .map_err(|e| e.to_string())
-        .and_then(make)
-        .map_err(|e| err(format!("problem: {e}")))?;
+    let eval = read_problem(&first, make)?;
     let mut batch: Vec<(usize, Genome, u32)> = Vec::new();
     for (k, line) in lines.enumerate() {
         let at = k + 2;
@@ -580,25 +633,7 @@ where
             continue;
         }
         match parse_line::<Request>(&line, "request", at).map_err(err)? {
-            Request::Genome(GenomeLine {
-                index,
-                genes,
-                refine,
-            }) => {
-                if !(1..=MAX_REFINE).contains(&refine) {
-                    return Err(err(format!(
-                        "request line {at}, field `genome.refine`: must be 1..={MAX_REFINE}, \
-                         found {refine}"
-                    )));
-                }
-                if batch.iter().any(|b| b.0 == index) {
-                    return Err(err(format!(
-                        "request line {at}, field `genome.index`: genome {index} given twice \
-                         in a batch"
-                    )));
-                }
-                batch.push((index, genes, refine))
-            }
+            Request::Genome(g) => add_genome(&mut batch, g, at)?,
             Request::Evaluate(BatchEnd { count }) => {
                 if count != batch.len() {
                     return Err(err(format!(
@@ -607,42 +642,7 @@ where
                         batch.len()
                     )));
                 }
-                let mut results: Vec<Option<Evaluation>> = vec![None; batch.len()];
-                let mut levels: Vec<u32> = batch.iter().map(|b| b.2).collect();
-                levels.sort_unstable();
-                levels.dedup();
-                for level in levels {
-                    let at: Vec<usize> =
-                        (0..batch.len()).filter(|&i| batch[i].2 == level).collect();
-                    let genomes: Vec<Genome> = at.iter().map(|&i| batch[i].1.clone()).collect();
-                    for (i, r) in at.into_iter().zip(eval(&genomes, level)) {
-                        results[i] = Some(r);
-                    }
-                }
-                let mut text = String::new();
-                for ((index, _, _), r) in batch.iter().zip(results) {
-                    let index = *index;
-                    let r = r.unwrap_or_else(|| Err("not evaluated".into()));
-                    let reply = match r {
-                        Ok(value) if value.is_finite() && value >= 0.0 => {
-                            Reply::Damage(DamageLine { index, value })
-                        }
-                        Ok(value) => Reply::Error(ErrorLine {
-                            index,
-                            message: format!("damage {value} is negative or not finite"),
-                        }),
-                        Err(message) => Reply::Error(ErrorLine { index, message }),
-                    };
-                    text.push_str(&serde_json::to_string(&reply).map_err(|e| err(e.to_string()))?);
-                    text.push('\n');
-                }
-                let done = Reply::Done(BatchEnd { count: batch.len() });
-                text.push_str(&serde_json::to_string(&done).map_err(|e| err(e.to_string()))?);
-                text.push('\n');
-                output
-                    .write_all(text.as_bytes())
-                    .and_then(|_| output.flush())
-                    .map_err(|e| err(e.to_string()))?;
+                answer_batch(&eval, &batch, &mut output)?;
                 batch.clear();
             }
         }
@@ -654,6 +654,105 @@ where
         )));
     }
     Ok(())
+}
+
+/// The evaluator of the problem the header line `first` gives (of the protocol's version),
+/// built by `make`.
+fn read_problem<P, E>(
+    first: &str,
+    make: impl FnOnce(P) -> Result<E, String>,
+) -> Result<E, EvolveError>
+where
+    P: serde::de::DeserializeOwned,
+{
+    let err = |m: String| EvolveError::Evaluator(m);
+    let header: Header = parse_line(first, "request", 1).map_err(err)?;
+    if header.protocol != PROTOCOL {
+        return Err(err(format!(
+            "protocol '{}' is not '{PROTOCOL}'",
+            header.protocol
+        )));
+    }
+    serde_json::from_value(header.problem)
+        .map_err(|e| e.to_string())
+        .and_then(make)
+        .map_err(|e| err(format!("problem: {e}")))
+}
+
+/// Adds the genome of request line `at` to the batch: its refinement in range, its index new.
+fn add_genome(
+    batch: &mut Vec<(usize, Genome, u32)>,
+    GenomeLine {
+        index,
+        genes,
+        refine,
+    }: GenomeLine,
+    at: usize,
+) -> Result<(), EvolveError> {
+    let err = |m: String| EvolveError::Evaluator(m);
+    if !(1..=MAX_REFINE).contains(&refine) {
+        return Err(err(format!(
+            "request line {at}, field `genome.refine`: must be 1..={MAX_REFINE}, \
+             found {refine}"
+        )));
+    }
+    if batch.iter().any(|b| b.0 == index) {
+        return Err(err(format!(
+            "request line {at}, field `genome.index`: genome {index} given twice \
+             in a batch"
+        )));
+    }
+    batch.push((index, genes, refine));
+    Ok(())
+}
+
+/// Evaluates a batch, one call of `eval` per refinement level, and writes its replies and
+/// batch end to `output`.
+fn answer_batch<E, W>(
+    eval: &E,
+    batch: &[(usize, Genome, u32)],
+    output: &mut W,
+) -> Result<(), EvolveError>
+where
+    W: Write,
+    E: Fn(&[Genome], u32) -> Vec<Evaluation>,
+{
+    let err = |m: String| EvolveError::Evaluator(m);
+    let mut results: Vec<Option<Evaluation>> = vec![None; batch.len()];
+    let mut levels: Vec<u32> = batch.iter().map(|b| b.2).collect();
+    levels.sort_unstable();
+    levels.dedup();
+    for level in levels {
+        let at: Vec<usize> = (0..batch.len()).filter(|&i| batch[i].2 == level).collect();
+        let genomes: Vec<Genome> = at.iter().map(|&i| batch[i].1.clone()).collect();
+        for (i, r) in at.into_iter().zip(eval(&genomes, level)) {
+            results[i] = Some(r);
+        }
+    }
+    let mut text = String::new();
+    for ((index, _, _), r) in batch.iter().zip(results) {
+        let index = *index;
+        let r = r.unwrap_or_else(|| Err("not evaluated".into()));
+        let reply = match r {
+            Ok(value) if value.is_finite() && value >= 0.0 => {
+                Reply::Damage(DamageLine { index, value })
+            }
+            Ok(value) => Reply::Error(ErrorLine {
+                index,
+                message: format!("damage {value} is negative or not finite"),
+            }),
+            Err(message) => Reply::Error(ErrorLine { index, message }),
+        };
+        text.push_str(&serde_json::to_string(&reply).map_err(|e| err(e.to_string()))?);
+        text.push('\n');
+    }
+    let done = Reply::Done(BatchEnd { count: batch.len() });
+    text.push_str(&serde_json::to_string(&done).map_err(|e| err(e.to_string()))?);
+    text.push('\n');
+    output
+        .write_all(text.as_bytes())
+        .and_then(|_| output.flush())
+        .map_err(|e| err(e.to_string()))
 }
 
 #[cfg(test)]
@@ -688,11 +787,12 @@ mod tests {
             r#"{"evaluate": {"count": 2}}"#,
         ])
         .unwrap();
-        assert_eq!(
-            out,
-            "{\"damage\":{\"index\":0,\"value\":3.5}}\n{\"damage\":{\"index\":1,\"value\":2.0}}\n\
-             {\"done\":{\"count\":2}}\n"
-        );
+        let wanted = [
+            r#"{"damage":{"index":0,"value":3.5}}"#,
+            r#"{"damage":{"index":1,"value":2.0}}"#,
+            r#"{"done":{"count":2}}"#,
+        ];
+        assert_eq!(out, wanted.map(|l| format!("{l}\n")).concat());
     }
 
     /// Point 7 of issue 38: each of these was evaluated (or silently dropped) by protocol 2.
@@ -790,15 +890,16 @@ mod tests {
     #[test]
     fn a_negative_or_unfinished_damage_is_an_error_line() {
         let mut out = Vec::new();
-        serve(
-            format!(
-                "{{\"protocol\":\"{PROTOCOL}\",\"problem\":null}}\n\
-                 {{\"genome\":{{\"index\":0,\"genes\":[]}}}}\n{{\"evaluate\":{{\"count\":1}}}}\n"
-            )
-            .as_bytes(),
-            &mut out,
-            |_: serde_json::Value| Ok(|_: &[Genome], _: u32| vec![Ok(-5.0)]),
-        )
+        let input = [
+            format!(r#"{{"protocol":"{PROTOCOL}","problem":null}}"#),
+            r#"{"genome":{"index":0,"genes":[]}}"#.to_string(),
+            r#"{"evaluate":{"count":1}}"#.to_string(),
+        ]
+        .map(|l| l + "\n")
+        .concat();
+        serve(input.as_bytes(), &mut out, |_: serde_json::Value| {
+            Ok(|_: &[Genome], _: u32| vec![Ok(-5.0)])
+        })
         .unwrap();
         let out = String::from_utf8(out).unwrap();
         assert!(

@@ -270,8 +270,14 @@ impl GaState {
     /// generation so far, failures of generations so far. `Err` says what disagrees.
     pub fn consistency(&self) -> Result<(), String> {
         self.config.validate().map_err(|e| e.to_string())?;
+        self.individuals_consistency()?;
+        self.history_consistency()
+    }
+
+    /// One genome, fitness and check flag per individual, valid bounds, every gene within
+    /// them, every damage finite and ≥ 0 (the best's too).
+    fn individuals_consistency(&self) -> Result<(), String> {
         let n = self.config.population;
-        let g = self.generation;
         if self.population.len() != n {
             return Err(format!(
                 "population has {} genomes, ga.population is {n}",
@@ -288,24 +294,8 @@ impl GaState {
         }
         let b = &self.bounds;
         Bounds::new(b.lo.clone(), b.hi.clone()).map_err(|e| format!("bounds: {e}"))?;
-        let genome = |what: &str, x: &Genome| -> Result<(), String> {
-            if x.len() != b.len() {
-                return Err(format!(
-                    "{what} has {} genes, the bounds {}",
-                    x.len(),
-                    b.len()
-                ));
-            }
-            match (0..x.len()).find(|&k| !(b.lo[k]..=b.hi[k]).contains(&x[k])) {
-                Some(k) => Err(format!(
-                    "{what}: gene {k} = {} is outside its bounds [{}, {}]",
-                    x[k], b.lo[k], b.hi[k]
-                )),
-                None => Ok(()),
-            }
-        };
         for (i, x) in self.population.iter().enumerate() {
-            genome(&format!("genome {i}"), x)?;
+            self.genome_consistency(&format!("genome {i}"), x)?;
         }
         let damage = |d: f64| d.is_finite() && d >= 0.0;
         if let Some((i, f)) = self
@@ -319,14 +309,41 @@ impl GaState {
             ));
         }
         if let Some((x, f)) = &self.best {
-            genome("best genome", x)?;
+            self.genome_consistency("best genome", x)?;
             if !damage(*f) {
                 return Err(format!("best damage is {f}, not a damage (finite, ≥ 0)"));
             }
         }
         if let Some(x) = &self.initial_best {
-            genome("initial best genome", x)?;
+            self.genome_consistency("initial best genome", x)?;
         }
+        Ok(())
+    }
+
+    /// The genome `x` (named `what`) has one gene per bound, each within its bounds.
+    fn genome_consistency(&self, what: &str, x: &Genome) -> Result<(), String> {
+        let b = &self.bounds;
+        if x.len() != b.len() {
+            return Err(format!(
+                "{what} has {} genes, the bounds {}",
+                x.len(),
+                b.len()
+            ));
+        }
+        match (0..x.len()).find(|&k| !(b.lo[k]..=b.hi[k]).contains(&x[k])) {
+            Some(k) => Err(format!(
+                "{what}: gene {k} = {} is outside its bounds [{}, {}]",
+                x[k], b.lo[k], b.hi[k]
+            )),
+            None => Ok(()),
+        }
+    }
+
+    /// The generation within ga.generations, one logbook record per generation so far, the
+    /// evaluations as the last record says, failures of generations so far in order.
+    fn history_consistency(&self) -> Result<(), String> {
+        let n = self.config.population;
+        let g = self.generation;
         if g > self.config.generations {
             return Err(format!(
                 "generation {g} is past ga.generations = {}",
@@ -600,15 +617,21 @@ impl GaState {
         self.population = pop;
         self.fitness = fit;
         self.checked = checked;
+        // A child that inherits a parent's fitness counts as that parent's evaluation, which
+        // succeeded.
+        self.stop_if_too_many_failed(expected + copies);
+        Ok(())
+    }
+
+    /// Stops the GA ([`Self::stopped`]) if more than [`GaConfig::max_failed_share`] of this
+    /// generation's `children` evaluations failed, naming the first three failures.
+    fn stop_if_too_many_failed(&mut self, children: usize) {
         let failed: Vec<&(u64, usize, String)> = self
             .failures
             .iter()
             .rev()
             .take_while(|f| f.0 == self.generation)
             .collect();
-        // A child that inherits a parent's fitness counts as that parent's evaluation, which
-        // succeeded.
-        let children = expected + copies;
         if failed.len() as f64 > self.config.max_failed_share * children as f64 {
             let first: Vec<String> = failed
                 .iter()
@@ -625,7 +648,6 @@ impl GaState {
                 first.join("; ")
             ));
         }
-        Ok(())
     }
 
     /// The individuals the elite check ([`GaConfig::elite_check_tolerance`]) has yet to

@@ -9,6 +9,7 @@
 use std::collections::BTreeMap;
 use std::sync::Arc;
 
+use bevy_ecs::prelude::{Entity, World};
 use glam::DVec3;
 
 use crate::dynamics::forces::external::Push;
@@ -240,6 +241,51 @@ pub fn run_active(
         config.mass_kg,
         config.gravity,
     )?);
+    let (mut world, e) = spawn_active(config, &body, sequence)?;
+    let mut schedule = character_schedule();
+    let every = frame_stride(config);
+    let mut configurations = Vec::new();
+    for tick in 0..ticks as u64 {
+        schedule.run(&mut world);
+        if let Some(err) = world.get::<PhysicsStatus>(e).and_then(|s| s.error.clone()) {
+            return Err(ActiveError::Step((*err).clone()));
+        }
+        if (tick as usize).is_multiple_of(every) {
+            let q = &world.get::<BodyState>(e).expect("spawned with a state").q;
+            configurations.push(q.clone());
+        }
+    }
+    let log = world.get::<CharacterLog>(e).expect("log").clone();
+    let reaction = world.get::<Reaction>(e).expect("reaction").clone();
+    let feet = world.get::<FeetOnFloor>(e).expect("feet check");
+    let rec = world.get::<Recorder>(e).expect("recorder");
+    let pd = &world.get::<PdController>(e).expect("pd").0;
+    let excursion: Vec<f64> = if world.get::<JointLimits>(e).is_some() {
+        let m = &world.get::<PhysicsMonitor>(e).expect("monitor").0;
+        m.max_excursion.iter().map(|x| x.to_degrees()).collect()
+    } else {
+        Vec::new()
+    };
+    let b = &world.get::<PhysicsBody>(e).expect("body").body;
+    let motion = body_clip(b, &configurations, every as f64 * config.dt_s);
+    let mut o = outcome(config, b, pd, (&log, feet), &reaction, &rec.frames, motion);
+    o.range_excursion_deg = b
+        .figure
+        .dofs
+        .iter()
+        .zip(&excursion)
+        .map(|(d, x)| (d.name.clone(), *x))
+        .collect();
+    Ok(o)
+}
+
+/// A world holding the physical character playing `sequence`, with the config's key pose (the
+/// reaction's PD targets) and push.
+fn spawn_active(
+    config: &ActiveConfig,
+    body: &Arc<HumanBody>,
+    sequence: &[Primitive],
+) -> Result<(World, Entity), ActiveError> {
     let push_link = match &config.push {
         Some(p) => Some(
             body.link_index(&p.link)
@@ -291,41 +337,78 @@ pub fn run_active(
             .expect("spawned with external forces")
             .push(p.to_force(link));
     }
-    let mut schedule = character_schedule();
-    let every = frame_stride(config);
-    let mut configurations = Vec::new();
-    for tick in 0..ticks as u64 {
-        schedule.run(&mut world);
-        if let Some(err) = world.get::<PhysicsStatus>(e).and_then(|s| s.error.clone()) {
-            return Err(ActiveError::Step((*err).clone()));
-        }
-        if (tick as usize).is_multiple_of(every) {
-            let q = &world.get::<BodyState>(e).expect("spawned with a state").q;
-            configurations.push(q.clone());
-        }
-    }
-    let log = world.get::<CharacterLog>(e).expect("log").clone();
-    let reaction = world.get::<Reaction>(e).expect("reaction").clone();
-    let feet = world.get::<FeetOnFloor>(e).expect("feet check");
-    let rec = world.get::<Recorder>(e).expect("recorder");
-    let pd = &world.get::<PdController>(e).expect("pd").0;
-    let excursion: Vec<f64> = if world.get::<JointLimits>(e).is_some() {
-        let m = &world.get::<PhysicsMonitor>(e).expect("monitor").0;
-        m.max_excursion.iter().map(|x| x.to_degrees()).collect()
-    } else {
-        Vec::new()
-    };
-    let b = &world.get::<PhysicsBody>(e).expect("body").body;
-    let motion = body_clip(b, &configurations, every as f64 * config.dt_s);
-    let mut o = outcome(config, b, pd, (&log, feet), &reaction, &rec.frames, motion);
-    o.range_excursion_deg = b
+    Ok((world, e))
+}
+
+/// Each DOF's peak torque against its strength, and its demand: tracking error (`dof_rms_deg`),
+/// share of ticks saturated, demanded torques.
+fn torque_figures(
+    body: &HumanBody,
+    pd: &crate::dynamics::forces::pd::PdTargets,
+    log: &CharacterLog,
+    dof_rms_deg: &[(String, f64)],
+) -> (Vec<TorquePeak>, Vec<DofDemand>) {
+    let n = log.tracked_ticks.max(1) as f64;
+    let torques = body
         .figure
         .dofs
         .iter()
-        .zip(&excursion)
-        .map(|(d, x)| (d.name.clone(), *x))
+        .enumerate()
+        .map(|(d, dof)| {
+            let (lo, hi) = pd.torque_limits.get(d).copied().unwrap_or((0.0, 0.0));
+            TorquePeak {
+                dof: dof.name.clone(),
+                peak_nm: log.peak_torque_nm[d],
+                limit_nm: lo.abs().max(hi.abs()),
+            }
+        })
         .collect();
-    Ok(o)
+    let demands = dof_rms_deg
+        .iter()
+        .enumerate()
+        .map(|(d, (name, rms))| DofDemand {
+            dof: name.clone(),
+            rms_deg: *rms,
+            saturated_fraction: log.saturated_ticks[d] as f64 / n,
+            demand_nm: log.demand_nm[d],
+            limit_nm: pd.torque_limits.get(d).copied().unwrap_or((0.0, 0.0)),
+        })
+        .collect();
+    (torques, demands)
+}
+
+/// Each link's weighted peak floor force after the push, and their sum (the damage).
+fn link_damage(
+    config: &ActiveConfig,
+    body: &HumanBody,
+    log: &CharacterLog,
+) -> (Vec<LinkDamage>, f64) {
+    let links: Vec<LinkDamage> = body
+        .link_names
+        .iter()
+        .zip(&log.peak_force_after_push_n)
+        .map(|(l, f)| LinkDamage {
+            link: l.clone(),
+            peak_force_n: *f,
+            weight: config.damage_weights.get(l).copied().unwrap_or(1.0),
+        })
+        .collect();
+    let damage = links.iter().map(|l| l.weight * l.peak_force_n).sum();
+    (links, damage)
+}
+
+/// Each foot's time held down by the animation and its largest gap to the floor.
+fn foot_checks(config: &ActiveConfig, body: &HumanBody, feet: &FeetOnFloor) -> Vec<FootCheck> {
+    feet.links
+        .iter()
+        .enumerate()
+        .map(|(k, &l)| FootCheck {
+            link: body.link_names[l].clone(),
+            animated_down_s: feet.down_ticks[k] as f64 * config.dt_s,
+            max_gap_m: feet.max_gap_m[k],
+            max_gap_time_s: feet.max_gap_time_s[k],
+        })
+        .collect()
 }
 
 /// Ticks between kept frames.
@@ -391,31 +474,7 @@ fn outcome(
         .filter(|s| before(s.time_s))
         .map(|s| (s.pelvis_height_m - s.target_pelvis_height_m).abs())
         .fold(0.0, f64::max);
-    let torques = body
-        .figure
-        .dofs
-        .iter()
-        .enumerate()
-        .map(|(d, dof)| {
-            let (lo, hi) = pd.torque_limits.get(d).copied().unwrap_or((0.0, 0.0));
-            TorquePeak {
-                dof: dof.name.clone(),
-                peak_nm: log.peak_torque_nm[d],
-                limit_nm: lo.abs().max(hi.abs()),
-            }
-        })
-        .collect();
-    let demands = dof_rms_deg
-        .iter()
-        .enumerate()
-        .map(|(d, (name, rms))| DofDemand {
-            dof: name.clone(),
-            rms_deg: *rms,
-            saturated_fraction: log.saturated_ticks[d] as f64 / n,
-            demand_nm: log.demand_nm[d],
-            limit_nm: pd.torque_limits.get(d).copied().unwrap_or((0.0, 0.0)),
-        })
-        .collect();
+    let (torques, demands) = torque_figures(body, pd, log, &dof_rms_deg);
     let worst_tick = log
         .samples
         .iter()
@@ -427,28 +486,8 @@ fn outcome(
         max_bw: log.max_pull_n / weight,
         at_s: log.max_pull_time_s,
     };
-    let feet = feet
-        .links
-        .iter()
-        .enumerate()
-        .map(|(k, &l)| FootCheck {
-            link: body.link_names[l].clone(),
-            animated_down_s: feet.down_ticks[k] as f64 * config.dt_s,
-            max_gap_m: feet.max_gap_m[k],
-            max_gap_time_s: feet.max_gap_time_s[k],
-        })
-        .collect();
-    let links: Vec<LinkDamage> = body
-        .link_names
-        .iter()
-        .zip(&log.peak_force_after_push_n)
-        .map(|(l, f)| LinkDamage {
-            link: l.clone(),
-            peak_force_n: *f,
-            weight: config.damage_weights.get(l).copied().unwrap_or(1.0),
-        })
-        .collect();
-    let damage = links.iter().map(|l| l.weight * l.peak_force_n).sum();
+    let feet = foot_checks(config, body, feet);
+    let (links, damage) = link_damage(config, body, log);
     let every = frame_stride(config);
     let frames = all_frames.iter().step_by(every).cloned().collect();
     ActiveOutcome {

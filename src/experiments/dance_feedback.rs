@@ -207,6 +207,26 @@ type Trial = Vec<Row>;
 
 /// Runs the experiment on `db` (module docs).
 pub fn run(db: &Database, cfg: &FeedbackConfig) -> Result<FeedbackOutcome, FeedbackError> {
+    check_config(db, cfg)?;
+    let index = SearchIndex::new(db);
+    let n = index.len();
+    let trials: Vec<Trial> = (0..cfg.trials)
+        .into_par_iter()
+        .map(|t| run_trial(&index, cfg, t))
+        .collect::<Result<_, SearchError>>()?;
+    let rounds = (0..cfg.rounds)
+        .map(|k| round_outcome(cfg, &trials, k))
+        .collect();
+    Ok(FeedbackOutcome {
+        config: cfg.clone(),
+        segments: n,
+        rounds,
+    })
+}
+
+/// The search's settings, at least one round, trial and bar, two candidates a round and
+/// enough segments in `db` for every round's candidates.
+fn check_config(db: &Database, cfg: &FeedbackConfig) -> Result<(), FeedbackError> {
     cfg.search.check()?;
     let config = |message: String| Err(FeedbackError::Config { message });
     if cfg.rounds == 0 || cfg.trials == 0 || cfg.bars == 0 {
@@ -230,90 +250,84 @@ pub fn run(db: &Database, cfg: &FeedbackConfig) -> Result<FeedbackOutcome, Feedb
             segments: db.segments.len(),
         });
     }
-    let index = SearchIndex::new(db);
-    let n = index.len();
-    let trials: Vec<Trial> = (0..cfg.trials)
-        .into_par_iter()
-        .map(|t| {
-            let mut rng = Pcg64::seed_from_u64(
-                cfg.seed
-                    .wrapping_mul(0x9E37_79B9_7F4A_7C15)
-                    .wrapping_add(t as u64),
-            );
-            let target = rng.random_range(0..n);
-            let bar = rng.random_range(0..cfg.bars);
-            let q = if cfg.bars == 1 {
-                0.5
-            } else {
-                bar as f64 / (cfg.bars - 1) as f64
-            };
-            // The trial, and its twin whose likes the search is never told.
-            let (mut state, mut twin) = (BarSearch::new(), BarSearch::new());
-            let mut would_like = vec![];
-            let mut rows = Vec::with_capacity(cfg.rounds);
-            for _ in 0..cfg.rounds {
-                let shown = index.round(q, &mut state, &cfg.search)?;
-                let withheld = index.round(q, &mut twin, &cfg.search)?;
-                let sims: Vec<f64> = shown.iter().map(|&m| index.sim(m, target)).collect();
-                let best = sims.iter().copied().fold(0.0, f64::max);
-                let mean = sims.iter().sum::<f64>() / sims.len() as f64;
-                rows.push(Row {
-                    spread: index.mean_dissimilarity(&shown),
-                    best,
-                    mean,
-                    found: shown.contains(&target),
-                    pull: pull(&index, &shown, &state.liked),
-                    pull_withheld: pull(&index, &withheld, &would_like),
-                    changed: shown != withheld,
-                });
-                for m in closest(&index, &shown, target, cfg.liked_per_round) {
-                    state.like(m, true);
-                }
-                would_like.extend(closest(&index, &withheld, target, cfg.liked_per_round));
-            }
-            Ok(rows)
-        })
-        .collect::<Result<_, SearchError>>()?;
+    Ok(())
+}
+
+/// Trial `t`: a target segment and a bar drawn from the trial's seed, then the rounds of the
+/// search told the likes of the candidates closest to the target, beside its twin never told.
+fn run_trial(index: &SearchIndex, cfg: &FeedbackConfig, t: usize) -> Result<Trial, SearchError> {
+    let mut rng = Pcg64::seed_from_u64(
+        cfg.seed
+            .wrapping_mul(0x9E37_79B9_7F4A_7C15)
+            .wrapping_add(t as u64),
+    );
+    let target = rng.random_range(0..index.len());
+    let bar = rng.random_range(0..cfg.bars);
+    let q = if cfg.bars == 1 {
+        0.5
+    } else {
+        bar as f64 / (cfg.bars - 1) as f64
+    };
+    // The trial, and its twin whose likes the search is never told.
+    let (mut state, mut twin) = (BarSearch::new(), BarSearch::new());
+    let mut would_like = vec![];
+    let mut rows = Vec::with_capacity(cfg.rounds);
+    for _ in 0..cfg.rounds {
+        let shown = index.round(q, &mut state, &cfg.search)?;
+        let withheld = index.round(q, &mut twin, &cfg.search)?;
+        let sims: Vec<f64> = shown.iter().map(|&m| index.sim(m, target)).collect();
+        let best = sims.iter().copied().fold(0.0, f64::max);
+        let mean = sims.iter().sum::<f64>() / sims.len() as f64;
+        rows.push(Row {
+            spread: index.mean_dissimilarity(&shown),
+            best,
+            mean,
+            found: shown.contains(&target),
+            pull: pull(index, &shown, &state.liked),
+            pull_withheld: pull(index, &withheld, &would_like),
+            changed: shown != withheld,
+        });
+        for m in closest(index, &shown, target, cfg.liked_per_round) {
+            state.like(m, true);
+        }
+        would_like.extend(closest(index, &withheld, target, cfg.liked_per_round));
+    }
+    Ok(rows)
+}
+
+/// Round `k` over the trials: each figure's mean and standard deviation.
+fn round_outcome(cfg: &FeedbackConfig, trials: &[Trial], k: usize) -> RoundOutcome {
     let stats = |f: &dyn Fn(&Row) -> f64, k: usize| -> (f64, f64) {
         let xs: Vec<f64> = trials.iter().map(|t| f(&t[k])).collect();
         let m = xs.iter().sum::<f64>() / xs.len() as f64;
         let v = xs.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (xs.len().max(2) - 1) as f64;
         (m, v.sqrt())
     };
-    let rounds = (0..cfg.rounds)
-        .map(|k| {
-            let (mean_dissimilarity, sd_dissimilarity) = stats(&|r| r.spread, k);
-            let (target_similarity, sd_target_similarity) = stats(&|r| r.best, k);
-            let (mean_target_similarity, _) = stats(&|r| r.mean, k);
-            let (target_found, _) = stats(&|r| if r.found { 1.0 } else { 0.0 }, k);
-            let (changed, _) = stats(&|r| if r.changed { 1.0 } else { 0.0 }, k);
-            let after_likes = k > 0 && cfg.liked_per_round > 0;
-            let (with, withheld, gain) = (
-                stats(&|r| r.pull, k).0,
-                stats(&|r| r.pull_withheld, k).0,
-                stats(&|r| r.pull - r.pull_withheld, k).1 / (cfg.trials as f64).sqrt(),
-            );
-            RoundOutcome {
-                round: k,
-                tau: cfg.search.tau(k),
-                mean_dissimilarity,
-                sd_dissimilarity,
-                target_similarity,
-                sd_target_similarity,
-                mean_target_similarity,
-                target_found,
-                liked_similarity: after_likes.then_some(with),
-                liked_similarity_withheld: after_likes.then_some(withheld),
-                liked_gain_se: after_likes.then_some(gain),
-                changed,
-            }
-        })
-        .collect();
-    Ok(FeedbackOutcome {
-        config: cfg.clone(),
-        segments: n,
-        rounds,
-    })
+    let (mean_dissimilarity, sd_dissimilarity) = stats(&|r| r.spread, k);
+    let (target_similarity, sd_target_similarity) = stats(&|r| r.best, k);
+    let (mean_target_similarity, _) = stats(&|r| r.mean, k);
+    let (target_found, _) = stats(&|r| if r.found { 1.0 } else { 0.0 }, k);
+    let (changed, _) = stats(&|r| if r.changed { 1.0 } else { 0.0 }, k);
+    let after_likes = k > 0 && cfg.liked_per_round > 0;
+    let (with, withheld, gain) = (
+        stats(&|r| r.pull, k).0,
+        stats(&|r| r.pull_withheld, k).0,
+        stats(&|r| r.pull - r.pull_withheld, k).1 / (cfg.trials as f64).sqrt(),
+    );
+    RoundOutcome {
+        round: k,
+        tau: cfg.search.tau(k),
+        mean_dissimilarity,
+        sd_dissimilarity,
+        target_similarity,
+        sd_target_similarity,
+        mean_target_similarity,
+        target_found,
+        liked_similarity: after_likes.then_some(with),
+        liked_similarity_withheld: after_likes.then_some(withheld),
+        liked_gain_se: after_likes.then_some(gain),
+        changed,
+    }
 }
 
 /// The likes' pull: the mean Sim of `shown` to `liked` over every pair (0 for an empty set).

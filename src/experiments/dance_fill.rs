@@ -224,19 +224,7 @@ pub enum DanceFillError {
 /// Runs the experiment on `db` (module docs).
 pub fn run(db: &Database, cfg: &DanceFillConfig) -> Result<DanceFillOutcome, DanceFillError> {
     let n = db.segments.len();
-    check(n, cfg.bars, &Pins::new())?;
-    if cfg.pins_per_set > cfg.bars {
-        return Err(DanceFillError::Config(format!(
-            "{} pins per set on {} bars",
-            cfg.pins_per_set, cfg.bars
-        )));
-    }
-    if !(cfg.bar_s.is_finite() && cfg.bar_s > 0.0) {
-        return Err(DanceFillError::Config(format!(
-            "bar length {} s must be positive",
-            cfg.bar_s
-        )));
-    }
+    check_config(n, cfg)?;
     let table = TransitionTable::new(db, &cfg.fill.transition).map_err(FillError::from)?;
     let bars: Vec<Bar> = (0..cfg.bars)
         .map(|k| Bar {
@@ -287,18 +275,7 @@ pub fn run(db: &Database, cfg: &DanceFillConfig) -> Result<DanceFillOutcome, Dan
     let rows = STRATEGIES
         .iter()
         .zip(trials)
-        .map(|(&strategy, t)| {
-            let col = |f: fn(&Trial) -> f64| Spread::of(&t.iter().map(f).collect::<Vec<_>>());
-            StrategyRow {
-                strategy,
-                seam_jerk_mean: col(|t| t.seam_jerk_mean),
-                seam_jerk_peak: col(|t| t.seam_jerk_peak),
-                inside_jerk_mean: col(|t| t.inside_jerk_mean),
-                mean_s: col(|t| t.mean_s),
-                total_cost: col(|t| t.total_cost),
-                trials: t,
-            }
-        })
+        .map(|(&strategy, t)| strategy_row(strategy, t))
         .collect();
     Ok(DanceFillOutcome {
         segments: n,
@@ -307,6 +284,39 @@ pub fn run(db: &Database, cfg: &DanceFillConfig) -> Result<DanceFillOutcome, Dan
         aware_beats_random_jerk,
         aware_beats_intensity_jerk,
     })
+}
+
+/// A fill of `cfg.bars` bars from `n` segments is possible, with at most one pin per bar
+/// and bars of positive length.
+fn check_config(n: usize, cfg: &DanceFillConfig) -> Result<(), DanceFillError> {
+    check(n, cfg.bars, &Pins::new())?;
+    if cfg.pins_per_set > cfg.bars {
+        return Err(DanceFillError::Config(format!(
+            "{} pins per set on {} bars",
+            cfg.pins_per_set, cfg.bars
+        )));
+    }
+    if !(cfg.bar_s.is_finite() && cfg.bar_s > 0.0) {
+        return Err(DanceFillError::Config(format!(
+            "bar length {} s must be positive",
+            cfg.bar_s
+        )));
+    }
+    Ok(())
+}
+
+/// A strategy's row: the spread of each seam figure over its trials.
+fn strategy_row(strategy: Strategy, t: Vec<Trial>) -> StrategyRow {
+    let col = |f: fn(&Trial) -> f64| Spread::of(&t.iter().map(f).collect::<Vec<_>>());
+    StrategyRow {
+        strategy,
+        seam_jerk_mean: col(|t| t.seam_jerk_mean),
+        seam_jerk_peak: col(|t| t.seam_jerk_peak),
+        inside_jerk_mean: col(|t| t.inside_jerk_mean),
+        mean_s: col(|t| t.mean_s),
+        total_cost: col(|t| t.total_cost),
+        trials: t,
+    }
 }
 
 /// The dance of `segments` and its seam numbers.

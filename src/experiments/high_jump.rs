@@ -297,23 +297,7 @@ pub fn learn_primitives(
     let crouch_knee_flexion_deg = mix(gamma_at_bend, crouch(&low_clip)?, crouch(&normal_clip)?);
     let apex_root_m = mix(gamma_at_apex, fl.apex_root_m, fn_.apex_root_m);
 
-    // The paper's blend: A time-scaled to B's duration, both on [0, T].
-    let placement = BlendPlacement {
-        a_start: 0.0,
-        a_end: t,
-        b_start: 0.0,
-        b_end: t,
-    };
-    let result = blend(
-        &low.primitive,
-        &normal.primitive,
-        &placement,
-        &config.gamma,
-        dt,
-        Relearn::No,
-        &config.learn,
-    )?;
-    let mut blended = on_model(model, &result.trajectory)?;
+    let mut blended = blend_jumps(config, (&low.primitive, &normal.primitive), t, dt)?;
     let (take_off, land) = feet_leave_and_touch(&normal_clip, normal_flight, floor);
     let ground_correction_m = blended.keep_feet_on_floor(&[(take_off, land)], floor);
     let (high_clip, flight) =
@@ -342,6 +326,32 @@ pub fn learn_primitives(
         prediction,
         flight,
     })
+}
+
+/// The paper's blend of the low jump A and the normal jump B with `config.gamma`: A
+/// time-scaled to B's duration `t`, both on [0, T], played on the model at `dt`.
+fn blend_jumps(
+    config: &HighJumpConfig,
+    (low, normal): (&Primitive, &Primitive),
+    t: f64,
+    dt: f64,
+) -> Result<ModelClip, PrimitiveExperimentError> {
+    let placement = BlendPlacement {
+        a_start: 0.0,
+        a_end: t,
+        b_start: 0.0,
+        b_end: t,
+    };
+    let result = blend(
+        low,
+        normal,
+        &placement,
+        &config.gamma,
+        dt,
+        Relearn::No,
+        &config.learn,
+    )?;
+    on_model(&config.model, &result.trajectory)
 }
 
 /// Height above the floor under which a foot still stands on it when the flight's ends are
@@ -420,6 +430,27 @@ fn lengthen_flight(
     }
     let nf = nf.round() as usize;
     let shift = nf as isize - (fb - fa) as isize;
+    let mut out = stretch_flight(clip, fa, fb, nf);
+    let (y0, y1, arc_scale) = raise_arc(&mut out, fa, nf, apex_y)?;
+    let plan = FlightPlan {
+        blend_take_off_s: take_off,
+        blend_land_s: land,
+        take_off_root_m: y0,
+        land_root_m: y1,
+        normal_apex_root_m: normal_apex_y,
+        apex_root_m: apex_y,
+        extra_flight_s: extra,
+        stretch_s: shift as f64 * dt,
+        arc_scale,
+    };
+    Ok((out, plan))
+}
+
+/// `clip` with its flight frames `fa..=fb` stretched in time, linearly, over `nf` frames
+/// (joint angles, root path and orientation interpolated), the later frames following shifted.
+fn stretch_flight(clip: &ModelClip, fa: usize, fb: usize, nf: usize) -> ModelClip {
+    let (dt, n) = (clip.frame_time, clip.frame_count());
+    let shift = nf as isize - (fb - fa) as isize;
     let m = (n as isize + shift) as usize;
     let d = clip.dof_count();
     let mut out = ModelClip {
@@ -447,6 +478,17 @@ fn lengthen_flight(
         out.root_rotation
             .push(clip.root_rotation[i].slerp(clip.root_rotation[j], u));
     }
+    out
+}
+
+/// Scales the root's arc over the chord from take-off (frame `fa`) to landing (`fa + nf`) so
+/// that its top is at `apex_y`. Returns the root's take-off and landing heights and the scale.
+fn raise_arc(
+    out: &mut ModelClip,
+    fa: usize,
+    nf: usize,
+    apex_y: f64,
+) -> Result<(f64, f64, f64), PrimitiveExperimentError> {
     // The arc over the chord from take-off to landing, scaled so that its top is at `apex_y`.
     let (y0, y1) = (out.root_translation[fa].y, out.root_translation[fa + nf].y);
     let chord = |k: usize| y0 + (y1 - y0) * (k - fa) as f64 / nf as f64;
@@ -470,18 +512,7 @@ fn lengthen_flight(
         let y = &mut out.root_translation[k].y;
         *y = c + arc_scale * (*y - c);
     }
-    let plan = FlightPlan {
-        blend_take_off_s: take_off,
-        blend_land_s: land,
-        take_off_root_m: y0,
-        land_root_m: y1,
-        normal_apex_root_m: normal_apex_y,
-        apex_root_m: apex_y,
-        extra_flight_s: extra,
-        stretch_s: shift as f64 * dt,
-        arc_scale,
-    };
-    Ok((out, plan))
+    Ok((y0, y1, arc_scale))
 }
 
 /// Runs the high jump: [`learn_primitives`], then plays the three jumps and measures each one:

@@ -33,7 +33,7 @@ use super::jump_figures::{JumpFigures, jump_figures, jump_figures_against};
 use crate::humanoid::ModelClip;
 use crate::primitive::{
     Arrangement, BlendPlacement, Connected, EventConfig, Gamma, JumpEvents, Learned, Primitive,
-    ROOT_DOF_NAMES, Relearn, Trajectory, blend, connect, find_jump_events,
+    ROOT_DOF_NAMES, Relearn, Samples, Trajectory, blend, connect, find_jump_events,
 };
 
 /// The paper's γ for the kick: a ramp from 1 to 0, γ(t′) = 1 − t′.
@@ -170,36 +170,139 @@ pub fn run(config: &KneeKickConfig) -> Result<KneeKickOutcome, PrimitiveExperime
     let learn = &config.jump.learn;
     let jump = learn_primitives(&config.jump)?;
     let dt = jump.dt;
+    let played = play_jump(config, &jump)?;
+    let kick = Primitive::learn("knee_kick", &config.kick.to_trajectory(), learn)?;
+    let blended = blend_kick_into_jump(config, &jump, &played, &kick.primitive)?;
+    let (parts, landing_correction_m) = learn_parts(config, &jump, &blended)?;
+    let sequence: Vec<Primitive> = parts.iter().map(|l| l.primitive.clone()).collect();
+    let connected = connect(&sequence, dt, None)?;
+    let junction = connected.junctions.first();
+    let junction = JunctionFigures {
+        time_s: junction.map(|j| j.time),
+        max_angle_jump_deg: junction.map_or(0.0, |j| j.max_angle_jump.to_degrees()),
+        max_velocity_jump_deg_s: junction.map_or(0.0, |j| j.max_velocity_jump.to_degrees()),
+    };
+    // The floor constraint on the connected motion: the parts' DMP fits and the connection's
+    // pull reproduce the landing to within millimetres, which puts a foot that far through the
+    // floor; the root is lifted by the depth where it is.
+    let mut result_clip = on_model(model, &connected.trajectory)?;
+    let floor_lift_m = result_clip.lift_above_floor(jump.floor_y_m);
+    let checks = paper_checks(config, &jump, &played, &result_clip);
+    let ev = played.events;
+    let kick_rollout = rollout(&kick.primitive, dt)?;
+    let kick_clip = on_model(model, &kick_rollout)?;
+    let kick_placed_rollout = rollout(&kick.primitive.with_duration(ev.leap - ev.bend)?, dt)?;
+    let peak_knee_flexion_deg = KneePeaks {
+        right_knee: peak_deg(&connected.trajectory, "right_knee")?,
+        left_knee: peak_deg(&connected.trajectory, "left_knee")?,
+    };
+    Ok(KneeKickOutcome {
+        figures: jump_figures_against(&result_clip, &jump.contact_reference),
+        jump_figures: played.figures,
+        jump,
+        jump_rollout: played.rollout,
+        jump_clip: played.clip,
+        events: ev,
+        kick,
+        kick_rollout,
+        kick_clip,
+        kick_placed_rollout,
+        arrangement: blended.arrangement,
+        parts,
+        connected,
+        result_clip,
+        floor_lift_m,
+        junction,
+        posture_gap_deg: checks.posture_gap_deg,
+        feet_above_floor_after_landing_m: checks.feet_after_landing,
+        lands_with_both_feet: checks.lands_with_both_feet,
+        feet_above_floor_at_leap_m: checks.feet_above_floor_at_leap_m,
+        root_at_leap_minus_jump_apex_m: checks.root_at_leap_minus_jump_apex_m,
+        airborne_at_leap: checks.airborne_at_leap,
+        ground_correction_m: blended.ground_correction_m,
+        landing_correction_m,
+        peak_knee_flexion_deg,
+    })
+}
+
+/// The high jump A as played: its rollout on the model with the floor constraint, its
+/// events, figures and flight.
+struct PlayedJump {
+    rollout: Trajectory,
+    clip: ModelClip,
+    /// The root's height in each frame of `clip`, metres.
+    root_y: Vec<f64>,
+    events: JumpEvents,
+    figures: JumpFigures,
+    /// Take-off and landing (both feet off the floor between), seconds.
+    flight: (f64, f64),
+}
+
+/// Plays A and finds its events (Bend, Leap, Land) and flight.
+fn play_jump(
+    config: &KneeKickConfig,
+    jump: &HighJumpPrimitives,
+) -> Result<PlayedJump, PrimitiveExperimentError> {
     let floor = jump.floor_y_m;
-    let a = &jump.learned.high.primitive;
-    let jump_rollout = rollout(a, dt)?;
-    let mut jump_clip = on_model(model, &jump_rollout)?;
+    let rollout = rollout(&jump.learned.high.primitive, jump.dt)?;
+    let mut clip = on_model(&config.jump.model, &rollout)?;
     // The floor constraint on the rollout, as the high jump's own clips have it.
-    jump_clip.lift_above_floor(floor);
-    let (root_y, feet) = heights(&jump_clip);
-    let ev = find_jump_events(&root_y, dt, Some(&feet), &config.events)?;
+    clip.lift_above_floor(floor);
+    let (root_y, feet) = heights(&clip);
+    let events = find_jump_events(&root_y, jump.dt, Some(&feet), &config.events)?;
     // Reported as the high jump's scene measures it (against the normal jump's contacts); the
     // floor constraint below keeps the feet down outside the span where this clip's own feet
     // (their own rest heights) are off the floor.
-    let jump_fig = jump_figures_against(&jump_clip, &jump.contact_reference);
-    let flight = jump_figures(&jump_clip, floor).flight.ok_or_else(|| {
+    let figures = jump_figures_against(&clip, &jump.contact_reference);
+    let flight = jump_figures(&clip, floor).flight.ok_or_else(|| {
         PrimitiveExperimentError::NoFlight("the high jump never has both feet off the floor".into())
     })?;
+    Ok(PlayedJump {
+        rollout,
+        clip,
+        root_y,
+        events,
+        figures,
+        flight: (flight.start_s, flight.end_s),
+    })
+}
 
-    let kick_demo = &config.kick;
-    let kick = Primitive::learn("knee_kick", &kick_demo.to_trajectory(), learn)?;
+/// The kick B blended into A, with A's root, its feet stood on the floor before take-off.
+struct BlendedKick {
+    /// The blend's trajectory.
+    trajectory: Trajectory,
+    /// A sampled at the blend's frames.
+    on_a: Samples,
+    arrangement: Arrangement,
+    /// Frames of Leap (the end of B) and of A's landing.
+    leap: usize,
+    land: usize,
+    ground_correction_m: f64,
+}
+
+/// Blends B placed on [Bend, Leap] into A with `config.gamma`, takes the root from A and stands
+/// the feet on the floor up to take-off and from landing on (the correction zero at Leap).
+fn blend_kick_into_jump(
+    config: &KneeKickConfig,
+    jump: &HighJumpPrimitives,
+    played: &PlayedJump,
+    kick: &Primitive,
+) -> Result<BlendedKick, PrimitiveExperimentError> {
+    let a = &jump.learned.high.primitive;
+    let ev = &played.events;
     let placement = BlendPlacement {
         a_start: 0.0,
         a_end: a.duration,
         b_start: ev.bend,
         b_end: ev.leap,
     };
+    let learn = &config.jump.learn;
     let result = blend(
         a,
-        &kick.primitive,
+        kick,
         &placement,
         &config.gamma,
-        dt,
+        jump.dt,
         Relearn::No,
         learn,
     )?;
@@ -220,23 +323,44 @@ pub fn run(config: &KneeKickConfig) -> Result<KneeKickOutcome, PrimitiveExperime
     }
     let frame = |t: f64| ((t / step).round() as usize).min(n);
     let (take_off, leap, land) = (
-        frame(flight.start_s),
+        frame(played.flight.0),
         result.b_end_frame,
-        frame(flight.end_s),
+        frame(played.flight.1),
     );
-    let mut blended = on_model(model, &traj)?;
+    let mut blended = on_model(&config.jump.model, &traj)?;
     let ground_correction_m = stand_on_floor(
         &mut blended,
         0,
         &|k| k <= take_off || k >= land,
         leap,
-        floor,
+        jump.floor_y_m,
     );
-    let blended = blended.to_trajectory();
-    // Split at Leap; "land" starts from A's pose there (the right limit of the blend).
-    let first = blended.slice_frames(0, leap)?;
-    let mut second = blended.slice_frames(leap, n)?;
-    second.values[..d].copy_from_slice(&on_a.values[leap * d..(leap + 1) * d]);
+    Ok(BlendedKick {
+        trajectory: blended.to_trajectory(),
+        on_a,
+        arrangement: result.arrangement,
+        leap,
+        land,
+        ground_correction_m,
+    })
+}
+
+/// Re-learns the blend as two primitives split at Leap, "jumping knee kick" and "land" (from
+/// A's pose at Leap, the right limit of the blend), then "land" again from the landing as the
+/// connection plays it, its feet stood on the floor from Land on. Returns the two parts and
+/// the landing's largest correction, metres.
+fn learn_parts(
+    config: &KneeKickConfig,
+    jump: &HighJumpPrimitives,
+    blended: &BlendedKick,
+) -> Result<([Learned; 2], f64), PrimitiveExperimentError> {
+    let learn = &config.jump.learn;
+    let (leap, land) = (blended.leap, blended.land);
+    let traj = &blended.trajectory;
+    let (n, d) = (traj.frames() - 1, traj.dofs());
+    let first = traj.slice_frames(0, leap)?;
+    let mut second = traj.slice_frames(leap, n)?;
+    second.values[..d].copy_from_slice(&blended.on_a.values[leap * d..(leap + 1) * d]);
     let part = |name: &str, t: &Trajectory| -> Result<Learned, PrimitiveExperimentError> {
         let mut l = Primitive::learn(name, t, learn)?;
         l.primitive.name = name.into();
@@ -244,35 +368,43 @@ pub fn run(config: &KneeKickConfig) -> Result<KneeKickOutcome, PrimitiveExperime
     };
     let kick_part = part("jumping_knee_kick", &first)?;
     let land_part = part("land", &second)?;
-    // The landing as the connection plays it, its feet stood on the floor from Land on, learned
-    // again as "land".
     let played = connect(
         &[kick_part.primitive.clone(), land_part.primitive],
-        dt,
+        jump.dt,
         None,
     )?;
-    let mut landing = on_model(model, &played.trajectory)?;
+    let mut landing = on_model(&config.jump.model, &played.trajectory)?;
     let last = landing.frame_count() - 1;
-    let landing_correction_m =
-        stand_on_floor(&mut landing, leap, &|k| k >= land.min(last), leap, floor);
+    let landing_correction_m = stand_on_floor(
+        &mut landing,
+        leap,
+        &|k| k >= land.min(last),
+        leap,
+        jump.floor_y_m,
+    );
     let landing = landing.to_trajectory().slice_frames(leap, last)?;
-    let parts = [kick_part, part("land", &landing)?];
-    let sequence: Vec<Primitive> = parts.iter().map(|l| l.primitive.clone()).collect();
-    let connected = connect(&sequence, dt, None)?;
-    let junction = connected.junctions.first();
-    let junction = JunctionFigures {
-        time_s: junction.map(|j| j.time),
-        max_angle_jump_deg: junction.map_or(0.0, |j| j.max_angle_jump.to_degrees()),
-        max_velocity_jump_deg_s: junction.map_or(0.0, |j| j.max_velocity_jump.to_degrees()),
-    };
-    // The floor constraint on the connected motion: the parts' DMP fits and the connection's
-    // pull reproduce the landing to within millimetres, which puts a foot that far through the
-    // floor; the root is lifted by the depth where it is.
-    let mut result_clip = on_model(model, &connected.trajectory)?;
-    let floor_lift_m = result_clip.lift_above_floor(floor);
+    Ok(([kick_part, part("land", &landing)?], landing_correction_m))
+}
 
-    // Checks of the paper's figure: the jump's posture at Bend, the kick's at Leap, in the air at
-    // Leap, both feet down after landing.
+/// The paper's checks on the connected motion `result_clip`.
+struct PaperChecks {
+    posture_gap_deg: PostureGaps,
+    feet_above_floor_at_leap_m: [f64; 2],
+    airborne_at_leap: bool,
+    root_at_leap_minus_jump_apex_m: f64,
+    feet_after_landing: Vec<f64>,
+    lands_with_both_feet: bool,
+}
+
+/// Checks of the paper's figure: the jump's posture at Bend, the kick's at Leap, in the air at
+/// Leap, both feet down after landing.
+fn paper_checks(
+    config: &KneeKickConfig,
+    jump: &HighJumpPrimitives,
+    played: &PlayedJump,
+    result_clip: &ModelClip,
+) -> PaperChecks {
+    let (dt, floor, ev) = (jump.dt, jump.floor_y_m, &played.events);
     let frame_at = |t: f64| ((t / dt).round() as usize).min(result_clip.frame_count() - 1);
     let posture_gap = |a_clip: &ModelClip, fa: usize, fb: usize| -> f64 {
         a_clip
@@ -282,12 +414,12 @@ pub fn run(config: &KneeKickConfig) -> Result<KneeKickOutcome, PrimitiveExperime
             .map(|(x, y)| (x - y).abs().to_degrees())
             .fold(0.0, f64::max)
     };
-    let kick_end = kick_demo.frame_count() - 1;
+    let kick_end = config.kick.frame_count() - 1;
     let posture_gap_deg = PostureGaps {
-        jump_at_bend_deg: posture_gap(&jump_clip, frame_at(ev.bend), frame_at(ev.bend)),
-        kick_at_leap_deg: posture_gap(kick_demo, kick_end, frame_at(ev.leap)),
+        jump_at_bend_deg: posture_gap(&played.clip, frame_at(ev.bend), frame_at(ev.bend)),
+        kick_at_leap_deg: posture_gap(&config.kick, kick_end, frame_at(ev.leap)),
     };
-    let (result_root, result_feet) = heights(&result_clip);
+    let (result_root, result_feet) = heights(result_clip);
     let at_leap = frame_at(ev.leap);
     let feet_above_floor_at_leap_m = [
         result_feet[0][at_leap] - floor,
@@ -296,48 +428,21 @@ pub fn run(config: &KneeKickConfig) -> Result<KneeKickOutcome, PrimitiveExperime
     let airborne_at_leap = feet_above_floor_at_leap_m
         .iter()
         .all(|h| *h > super::jump_figures::CONTACT_THRESHOLD_M);
-    let root_at_leap_minus_jump_apex_m = result_root[at_leap] - root_y[frame_at(ev.leap)];
+    let root_at_leap_minus_jump_apex_m = result_root[at_leap] - played.root_y[frame_at(ev.leap)];
     let settle = frame_at(ev.land + SETTLE_AFTER_LAND_S);
     let feet_after_landing: Vec<f64> = result_feet
         .iter()
         .map(|foot| foot[settle.min(foot.len() - 1)] - floor)
         .collect();
     let lands_with_both_feet = feet_after_landing.iter().all(|h| h.abs() < FOOT_DOWN_M);
-
-    let kick_rollout = rollout(&kick.primitive, dt)?;
-    let kick_clip = on_model(model, &kick_rollout)?;
-    let kick_placed_rollout = rollout(&kick.primitive.with_duration(ev.leap - ev.bend)?, dt)?;
-    let peak_knee_flexion_deg = KneePeaks {
-        right_knee: peak_deg(&connected.trajectory, "right_knee")?,
-        left_knee: peak_deg(&connected.trajectory, "left_knee")?,
-    };
-    Ok(KneeKickOutcome {
-        figures: jump_figures_against(&result_clip, &jump.contact_reference),
-        jump_figures: jump_fig,
-        jump,
-        jump_rollout,
-        jump_clip,
-        events: ev,
-        kick,
-        kick_rollout,
-        kick_clip,
-        kick_placed_rollout,
-        arrangement: result.arrangement,
-        parts,
-        connected,
-        result_clip,
-        floor_lift_m,
-        junction,
+    PaperChecks {
         posture_gap_deg,
-        feet_above_floor_after_landing_m: feet_after_landing,
-        lands_with_both_feet,
         feet_above_floor_at_leap_m,
-        root_at_leap_minus_jump_apex_m,
         airborne_at_leap,
-        ground_correction_m,
-        landing_correction_m,
-        peak_knee_flexion_deg,
-    })
+        root_at_leap_minus_jump_apex_m,
+        feet_after_landing,
+        lands_with_both_feet,
+    }
 }
 
 /// Raises or lowers the root of frames `from..` of `clip` so that at every `ground` frame the

@@ -195,6 +195,53 @@ pub fn human_body(
     mass: f64,
     g: f64,
 ) -> Result<HumanBody, HumanError> {
+    check_subject(model, height, mass)?;
+    let fig = model.scaled_to_height(height);
+    // The girdle's mass comes out of the upper trunk (see [`CLAVICLE_SHARE`]).
+    let clavicles = fig
+        .joints
+        .iter()
+        .filter(|j| j.link.ends_with("clavicle"))
+        .count() as f64;
+    let subject = Subject {
+        h: height,
+        mass,
+        clavicles,
+    };
+    let mut bodies = Vec::with_capacity(fig.joints.len());
+    let mut boxes = Vec::with_capacity(fig.joints.len());
+    for j in &fig.joints {
+        let (inertia, bx) = link_inertia(&fig, j, &subject)?;
+        let x_tree = if j.parent.is_some() {
+            SpatialTransform::translation(j.offset)
+        } else {
+            SpatialTransform::IDENTITY
+        };
+        bodies.push(Body {
+            name: j.link.clone(),
+            joint_name: j.name.clone(),
+            parent: j.parent,
+            joint: joint_type(&fig, j),
+            x_tree,
+            inertia,
+        });
+        boxes.push(bx);
+    }
+    let model = Model::new(bodies, DVec3::new(0.0, -g, 0.0))?;
+    let dof_v = dof_velocity_indices(&fig, &model);
+    let link_names = fig.joints.iter().map(|j| j.link.clone()).collect();
+    Ok(HumanBody {
+        model,
+        figure: fig,
+        boxes,
+        dof_v,
+        link_names,
+    })
+}
+
+/// The subject's height (m) and mass (kg) within the ranges the tables cover, and a figure
+/// whose root is free.
+fn check_subject(model: &figure::Model, height: f64, mass: f64) -> Result<(), HumanError> {
     if !(1.0..=2.3).contains(&height) {
         return Err(HumanError::Subject {
             what: "height_m",
@@ -216,184 +263,217 @@ pub fn human_body(
     {
         return Err(HumanError::Root(root.name.clone()));
     }
-    let fig = model.scaled_to_height(height);
-    // The girdle's mass comes out of the upper trunk (see [`CLAVICLE_SHARE`]).
-    let clavicles = fig
-        .joints
+    Ok(())
+}
+
+/// What the segments' inertias are scaled to: standing height `h` (m), mass (kg) and the
+/// number of clavicles (whose mass comes out of the upper trunk).
+struct Subject {
+    h: f64,
+    mass: f64,
+    clavicles: f64,
+}
+
+/// The offset of the child of joint `j` whose joint name ends with `name`.
+fn child_offset(fig: &figure::Model, j: &figure::ModelJoint, name: &str) -> Option<DVec3> {
+    fig.joints
         .iter()
-        .filter(|j| j.link.ends_with("clavicle"))
-        .count() as f64;
-    let h = height;
-    let down = -DVec3::Y;
-    let mut bodies = Vec::with_capacity(fig.joints.len());
-    let mut boxes = Vec::with_capacity(fig.joints.len());
-    for j in &fig.joints {
-        let link = j
-            .link
-            .trim_start_matches("left_")
-            .trim_start_matches("right_");
-        let child_offset = |name: &str| {
-            fig.joints
-                .iter()
-                .find(|c| {
-                    c.parent.is_some_and(|p| fig.joints[p].name == j.name) && c.name.ends_with(name)
-                })
-                .map(|c| c.offset)
-        };
-        let (inertia, bx) = match link {
-            "pelvis" => {
-                // de Leva's lower trunk runs from the omphalion down to the hip-joint centres:
-                // here from the waist joint down to the hip line (the pelvis origin), so that
-                // pelvis and torso meet at the waist without overlapping.
-                let top = child_offset("waist").unwrap_or(DVec3::new(0.0, 0.07 * h, 0.0));
-                (
-                    segment(&DE_LEVA_LOWER_TRUNK, mass, top.y, top, down, 1),
-                    LinkBox {
-                        center: DVec3::new(0.0, 0.02 * h, 0.0),
-                        half: DVec3::new(0.095, 0.05, 0.06) * h,
-                    },
-                )
-            }
-            "torso" | "chest" => {
-                // Upper trunk (cervicale → xiphion) over middle trunk (xiphion → omphalion),
-                // filling the waist → neck span in de Leva's proportions.
-                let neck = child_offset("neck").unwrap_or(DVec3::new(0.0, 0.23 * h, 0.0));
-                let (lu, lm) = (
-                    table_length(&DE_LEVA_UPPER_TRUNK, h),
-                    table_length(&DE_LEVA_MIDDLE_TRUNK, h),
-                );
-                let scale = neck.y / (lu + lm);
-                let mut upt = segment(&DE_LEVA_UPPER_TRUNK, mass, lu * scale, neck, down, 1);
-                if clavicles > 0.0 {
-                    let keep = 1.0 - CLAVICLE_SHARE * clavicles;
-                    upt = Inertia::new(upt.mass * keep, upt.com, upt.inertia_com * keep);
-                }
-                let mpt = segment(
-                    &DE_LEVA_MIDDLE_TRUNK,
-                    mass,
-                    lm * scale,
-                    neck + down * (lu * scale),
-                    down,
-                    1,
-                );
-                (
-                    combine(upt, mpt),
-                    LinkBox {
-                        center: neck * 0.5,
-                        half: DVec3::new(0.10 * h, neck.y * 0.5, 0.06 * h),
-                    },
-                )
-            }
-            "head" => {
-                // Head + neck from the vertex (the head's end site) down to the neck joint.
-                let top =
-                    j.end_site
-                        .unwrap_or(DVec3::new(0.0, table_length(&DE_LEVA_HEAD, h), 0.0));
-                (
-                    segment(&DE_LEVA_HEAD, mass, top.y, top, down, 1),
-                    LinkBox {
-                        center: DVec3::new(0.0, top.y * 0.5, 0.01 * h),
-                        half: DVec3::new(0.045 * h, top.y * 0.5, 0.055 * h),
-                    },
-                )
-            }
-            "clavicle" => {
-                // A slender rod from the sterno-clavicular joint to the shoulder, as thick as
-                // the upper arm's box.
-                let end = child_offset("shoulder").unwrap_or(DVec3::new(0.11 * h, 0.0, 0.0));
-                let len = end.length();
-                let m = CLAVICLE_SHARE * DE_LEVA_UPPER_TRUNK.mass_pct / 100.0 * mass;
-                (
-                    rod(m, len, 0.025 * h, DVec3::ZERO, end / len),
-                    LinkBox {
-                        center: end * 0.5,
-                        half: DVec3::new(end.x.abs() * 0.5, 0.025 * h, 0.025 * h),
-                    },
-                )
-            }
-            "upper_arm" | "forearm" | "thigh" | "shin" => {
-                // From this joint to the next one down the limb.
-                let (row, width, child) = match link {
-                    "upper_arm" => (&DE_LEVA_UPPER_ARM, 0.05, "elbow"),
-                    "forearm" => (&DE_LEVA_FOREARM, 0.04, "wrist"),
-                    "thigh" => (&DE_LEVA_THIGH, 0.08, "knee"),
-                    _ => (&DE_LEVA_SHANK, 0.06, "ankle"),
-                };
-                let end = child_offset(child).unwrap_or(DVec3::new(0.0, -0.2 * h, 0.0));
-                let len = end.length();
-                (
-                    segment(row, mass, len, DVec3::ZERO, end / len, 1),
-                    LinkBox {
-                        center: end * 0.5,
-                        half: DVec3::new(width * h * 0.5, len * 0.5, width * h * 0.5),
-                    },
-                )
-            }
-            "hand" => {
-                // Wrist → third metacarpale (de Leva's length) inside the box to the fingertips.
-                let end = j.end_site.unwrap_or(DVec3::new(0.0, -0.108 * h, 0.0));
-                (
-                    segment(
-                        &DE_LEVA_HAND,
-                        mass,
-                        table_length(&DE_LEVA_HAND, h),
-                        DVec3::ZERO,
-                        down,
-                        1,
-                    ),
-                    LinkBox {
-                        center: end * 0.5,
-                        half: DVec3::new(0.01 * h, end.length() * 0.5, 0.025 * h),
-                    },
-                )
-            }
-            "foot" => {
-                // Heel → toe tip, de Leva's length ending at the toe end site.
-                let toe = j.end_site.unwrap_or(DVec3::new(0.0, -0.039 * h, 0.117 * h));
-                let l = table_length(&DE_LEVA_FOOT, h);
-                let heel = DVec3::new(0.0, toe.y * 0.5, toe.z - l);
-                let fwd = DVec3::Z;
-                (
-                    segment(&DE_LEVA_FOOT, mass, l, heel, fwd, 2),
-                    LinkBox {
-                        center: DVec3::new(0.0, toe.y * 0.5, toe.z - l * 0.5),
-                        half: DVec3::new(0.03 * h, -toe.y * 0.5, l * 0.5),
-                    },
-                )
-            }
-            _ => return Err(HumanError::UnknownLink(j.link.clone())),
-        };
-        let axes: Vec<DVec3> = j.dofs.iter().map(|&d| fig.dofs[d].axis).collect();
-        let joint = match j.kind {
-            JointKind::Free => JointType::Free,
-            JointKind::Ball => JointType::Ball {
-                axes: DMat3::from_cols(axes[0], axes[1], axes[2]),
-            },
-            JointKind::Universal => JointType::Universal {
-                axis1: axes[0],
-                axis2: axes[1],
-            },
-            JointKind::Pin => JointType::Pin { axis: axes[0] },
-            JointKind::Fixed => JointType::Fixed,
-        };
-        let x_tree = if j.parent.is_some() {
-            SpatialTransform::translation(j.offset)
-        } else {
-            SpatialTransform::IDENTITY
-        };
-        bodies.push(Body {
-            name: j.link.clone(),
-            joint_name: j.name.clone(),
-            parent: j.parent,
-            joint,
-            x_tree,
-            inertia,
-        });
-        boxes.push(bx);
+        .find(|c| c.parent.is_some_and(|p| fig.joints[p].name == j.name) && c.name.ends_with(name))
+        .map(|c| c.offset)
+}
+
+/// The inertia (de Leva's segment tables) and contact box of the link of joint `j`, by body
+/// part (the link name without its side).
+fn link_inertia(
+    fig: &figure::Model,
+    j: &figure::ModelJoint,
+    subject: &Subject,
+) -> Result<(Inertia, LinkBox), HumanError> {
+    let link = j
+        .link
+        .trim_start_matches("left_")
+        .trim_start_matches("right_");
+    Ok(match link {
+        "pelvis" => pelvis_link(fig, j, subject),
+        "torso" | "chest" => trunk_link(fig, j, subject),
+        "head" => head_link(j, subject),
+        "clavicle" => clavicle_link(fig, j, subject),
+        "upper_arm" | "forearm" | "thigh" | "shin" => limb_link(fig, j, link, subject),
+        "hand" => hand_link(j, subject),
+        "foot" => foot_link(j, subject),
+        _ => return Err(HumanError::UnknownLink(j.link.clone())),
+    })
+}
+
+/// De Leva's lower trunk runs from the omphalion down to the hip-joint centres: here from the
+/// waist joint down to the hip line (the pelvis origin), so that pelvis and torso meet at the
+/// waist without overlapping.
+fn pelvis_link(
+    fig: &figure::Model,
+    j: &figure::ModelJoint,
+    &Subject { h, mass, .. }: &Subject,
+) -> (Inertia, LinkBox) {
+    let top = child_offset(fig, j, "waist").unwrap_or(DVec3::new(0.0, 0.07 * h, 0.0));
+    (
+        segment(&DE_LEVA_LOWER_TRUNK, mass, top.y, top, DOWN, 1),
+        LinkBox {
+            center: DVec3::new(0.0, 0.02 * h, 0.0),
+            half: DVec3::new(0.095, 0.05, 0.06) * h,
+        },
+    )
+}
+
+/// Upper trunk (cervicale → xiphion) over middle trunk (xiphion → omphalion), filling the
+/// waist → neck span in de Leva's proportions.
+fn trunk_link(
+    fig: &figure::Model,
+    j: &figure::ModelJoint,
+    &Subject { h, mass, clavicles }: &Subject,
+) -> (Inertia, LinkBox) {
+    let neck = child_offset(fig, j, "neck").unwrap_or(DVec3::new(0.0, 0.23 * h, 0.0));
+    let (lu, lm) = (
+        table_length(&DE_LEVA_UPPER_TRUNK, h),
+        table_length(&DE_LEVA_MIDDLE_TRUNK, h),
+    );
+    let scale = neck.y / (lu + lm);
+    let mut upt = segment(&DE_LEVA_UPPER_TRUNK, mass, lu * scale, neck, DOWN, 1);
+    if clavicles > 0.0 {
+        let keep = 1.0 - CLAVICLE_SHARE * clavicles;
+        upt = Inertia::new(upt.mass * keep, upt.com, upt.inertia_com * keep);
     }
-    let model = Model::new(bodies, DVec3::new(0.0, -g, 0.0))?;
-    let dof_v = fig
-        .dofs
+    let mpt = segment(
+        &DE_LEVA_MIDDLE_TRUNK,
+        mass,
+        lm * scale,
+        neck + DOWN * (lu * scale),
+        DOWN,
+        1,
+    );
+    (
+        combine(upt, mpt),
+        LinkBox {
+            center: neck * 0.5,
+            half: DVec3::new(0.10 * h, neck.y * 0.5, 0.06 * h),
+        },
+    )
+}
+
+/// Head + neck from the vertex (the head's end site) down to the neck joint.
+fn head_link(j: &figure::ModelJoint, &Subject { h, mass, .. }: &Subject) -> (Inertia, LinkBox) {
+    let top = j
+        .end_site
+        .unwrap_or(DVec3::new(0.0, table_length(&DE_LEVA_HEAD, h), 0.0));
+    (
+        segment(&DE_LEVA_HEAD, mass, top.y, top, DOWN, 1),
+        LinkBox {
+            center: DVec3::new(0.0, top.y * 0.5, 0.01 * h),
+            half: DVec3::new(0.045 * h, top.y * 0.5, 0.055 * h),
+        },
+    )
+}
+
+/// A slender rod from the sterno-clavicular joint to the shoulder, as thick as the upper arm's
+/// box.
+fn clavicle_link(
+    fig: &figure::Model,
+    j: &figure::ModelJoint,
+    &Subject { h, mass, .. }: &Subject,
+) -> (Inertia, LinkBox) {
+    let end = child_offset(fig, j, "shoulder").unwrap_or(DVec3::new(0.11 * h, 0.0, 0.0));
+    let len = end.length();
+    let m = CLAVICLE_SHARE * DE_LEVA_UPPER_TRUNK.mass_pct / 100.0 * mass;
+    (
+        rod(m, len, 0.025 * h, DVec3::ZERO, end / len),
+        LinkBox {
+            center: end * 0.5,
+            half: DVec3::new(end.x.abs() * 0.5, 0.025 * h, 0.025 * h),
+        },
+    )
+}
+
+/// A long bone of arm or leg (`link` without its side): from this joint to the next one down
+/// the limb.
+fn limb_link(
+    fig: &figure::Model,
+    j: &figure::ModelJoint,
+    link: &str,
+    &Subject { h, mass, .. }: &Subject,
+) -> (Inertia, LinkBox) {
+    let (row, width, child) = match link {
+        "upper_arm" => (&DE_LEVA_UPPER_ARM, 0.05, "elbow"),
+        "forearm" => (&DE_LEVA_FOREARM, 0.04, "wrist"),
+        "thigh" => (&DE_LEVA_THIGH, 0.08, "knee"),
+        _ => (&DE_LEVA_SHANK, 0.06, "ankle"),
+    };
+    let end = child_offset(fig, j, child).unwrap_or(DVec3::new(0.0, -0.2 * h, 0.0));
+    let len = end.length();
+    (
+        segment(row, mass, len, DVec3::ZERO, end / len, 1),
+        LinkBox {
+            center: end * 0.5,
+            half: DVec3::new(width * h * 0.5, len * 0.5, width * h * 0.5),
+        },
+    )
+}
+
+/// Wrist → third metacarpale (de Leva's length) inside the box to the fingertips.
+fn hand_link(j: &figure::ModelJoint, &Subject { h, mass, .. }: &Subject) -> (Inertia, LinkBox) {
+    let end = j.end_site.unwrap_or(DVec3::new(0.0, -0.108 * h, 0.0));
+    (
+        segment(
+            &DE_LEVA_HAND,
+            mass,
+            table_length(&DE_LEVA_HAND, h),
+            DVec3::ZERO,
+            DOWN,
+            1,
+        ),
+        LinkBox {
+            center: end * 0.5,
+            half: DVec3::new(0.01 * h, end.length() * 0.5, 0.025 * h),
+        },
+    )
+}
+
+/// Heel → toe tip, de Leva's length ending at the toe end site.
+fn foot_link(j: &figure::ModelJoint, &Subject { h, mass, .. }: &Subject) -> (Inertia, LinkBox) {
+    let toe = j.end_site.unwrap_or(DVec3::new(0.0, -0.039 * h, 0.117 * h));
+    let l = table_length(&DE_LEVA_FOOT, h);
+    let heel = DVec3::new(0.0, toe.y * 0.5, toe.z - l);
+    let fwd = DVec3::Z;
+    (
+        segment(&DE_LEVA_FOOT, mass, l, heel, fwd, 2),
+        LinkBox {
+            center: DVec3::new(0.0, toe.y * 0.5, toe.z - l * 0.5),
+            half: DVec3::new(0.03 * h, -toe.y * 0.5, l * 0.5),
+        },
+    )
+}
+
+/// Downward in the figure's rest frame, `−y` (the bits of `-DVec3::Y`, zeros negative too):
+/// the long axis of trunk, head and hand.
+const DOWN: DVec3 = DVec3::new(-0.0, -1.0, -0.0);
+
+/// The dynamics joint of the figure's joint `j`, with its DOF axes.
+fn joint_type(fig: &figure::Model, j: &figure::ModelJoint) -> JointType {
+    let axes: Vec<DVec3> = j.dofs.iter().map(|&d| fig.dofs[d].axis).collect();
+    match j.kind {
+        JointKind::Free => JointType::Free,
+        JointKind::Ball => JointType::Ball {
+            axes: DMat3::from_cols(axes[0], axes[1], axes[2]),
+        },
+        JointKind::Universal => JointType::Universal {
+            axis1: axes[0],
+            axis2: axes[1],
+        },
+        JointKind::Pin => JointType::Pin { axis: axes[0] },
+        JointKind::Fixed => JointType::Fixed,
+    }
+}
+
+/// Each figure DOF's index in the model's velocity vector.
+fn dof_velocity_indices(fig: &figure::Model, model: &Model) -> Vec<usize> {
+    fig.dofs
         .iter()
         .map(|d| {
             let j = d.joint;
@@ -404,15 +484,7 @@ pub fn human_body(
                 .unwrap_or(0);
             model.v_idx[j] + k
         })
-        .collect();
-    let link_names = fig.joints.iter().map(|j| j.link.clone()).collect();
-    Ok(HumanBody {
-        model,
-        figure: fig,
-        boxes,
-        dof_v,
-        link_names,
-    })
+        .collect()
 }
 
 impl HumanBody {

@@ -145,71 +145,80 @@ pub fn to_mjcf(body: &HumanBody, ranges: &[(f64, f64)], gravity: f64) -> String 
         s,
         "    <geom name=\"floor\" type=\"plane\" size=\"10 10 0.1\" contype=\"0\" conaffinity=\"1\" quat=\"0.7071067811865476 -0.7071067811865476 0 0\"/>"
     );
-    fn write_body(s: &mut String, body: &HumanBody, b: usize, ranges: &[(f64, f64)], depth: usize) {
-        let pad = "  ".repeat(depth + 2);
-        let mb = &body.model.bodies[b];
-        let pos = if mb.parent.is_some() {
-            body.figure.joints[b].offset
-        } else {
-            DVec3::ZERO
-        };
-        let _ = writeln!(s, "{pad}<body name=\"{}\" pos=\"{}\">", mb.name, v3(pos));
-        let i = &mb.inertia;
-        let c = i.inertia_com;
-        let _ = writeln!(
-            s,
-            "{pad}  <inertial pos=\"{}\" mass=\"{}\" fullinertia=\"{} {} {} {} {} {}\"/>",
-            v3(i.com),
-            i.mass,
-            c.x_axis.x,
-            c.y_axis.y,
-            c.z_axis.z,
-            c.y_axis.x,
-            c.z_axis.x,
-            c.z_axis.y
-        );
-        match mb.joint {
-            JointType::Free => {
-                let _ = writeln!(s, "{pad}  <freejoint name=\"{}\"/>", mb.joint_name);
-            }
-            JointType::Ball { .. } => {
-                let _ = writeln!(
-                    s,
-                    "{pad}  <joint name=\"{}\" type=\"ball\" limited=\"false\"/>",
-                    mb.joint_name
-                );
-            }
-            _ => {
-                for (dof, axis) in revolutes(body, b) {
-                    let d = body.figure.dof_index(&dof).unwrap_or(0);
-                    let (lo, hi) = ranges[d];
-                    let _ = writeln!(
-                        s,
-                        "{pad}  <joint name=\"{dof}\" type=\"hinge\" axis=\"{}\" range=\"{lo} {hi}\" limited=\"true\"/>",
-                        v3(axis)
-                    );
-                }
-            }
-        }
-        let bx = &body.boxes[b];
-        let _ = writeln!(
-            s,
-            "{pad}  <geom name=\"{}_box\" type=\"box\" pos=\"{}\" size=\"{}\" contype=\"1\" conaffinity=\"0\"/>",
-            mb.name,
-            v3(bx.center),
-            v3(bx.half)
-        );
-        for (k, child) in body.model.bodies.iter().enumerate() {
-            if child.parent == Some(b) {
-                write_body(s, body, k, ranges, depth + 1);
-            }
-        }
-        let _ = writeln!(s, "{pad}</body>");
-    }
-    write_body(&mut s, body, 0, ranges, 0);
+    write_mjcf_body(&mut s, body, 0, ranges, 0);
     let _ = writeln!(s, "  </worldbody>");
     let _ = writeln!(s, "</mujoco>");
     s
+}
+
+/// Body `b` of `body` as an MJCF `<body>` at nesting `depth` (its inertial, joints and box),
+/// its children inside.
+fn write_mjcf_body(
+    s: &mut String,
+    body: &HumanBody,
+    b: usize,
+    ranges: &[(f64, f64)],
+    depth: usize,
+) {
+    let pad = "  ".repeat(depth + 2);
+    let mb = &body.model.bodies[b];
+    let pos = if mb.parent.is_some() {
+        body.figure.joints[b].offset
+    } else {
+        DVec3::ZERO
+    };
+    let _ = writeln!(s, "{pad}<body name=\"{}\" pos=\"{}\">", mb.name, v3(pos));
+    let i = &mb.inertia;
+    let c = i.inertia_com;
+    let _ = writeln!(
+        s,
+        "{pad}  <inertial pos=\"{}\" mass=\"{}\" fullinertia=\"{} {} {} {} {} {}\"/>",
+        v3(i.com),
+        i.mass,
+        c.x_axis.x,
+        c.y_axis.y,
+        c.z_axis.z,
+        c.y_axis.x,
+        c.z_axis.x,
+        c.z_axis.y
+    );
+    match mb.joint {
+        JointType::Free => {
+            let _ = writeln!(s, "{pad}  <freejoint name=\"{}\"/>", mb.joint_name);
+        }
+        JointType::Ball { .. } => {
+            let _ = writeln!(
+                s,
+                "{pad}  <joint name=\"{}\" type=\"ball\" limited=\"false\"/>",
+                mb.joint_name
+            );
+        }
+        _ => {
+            for (dof, axis) in revolutes(body, b) {
+                let d = body.figure.dof_index(&dof).unwrap_or(0);
+                let (lo, hi) = ranges[d];
+                let _ = writeln!(
+                    s,
+                    "{pad}  <joint name=\"{dof}\" type=\"hinge\" axis=\"{}\" range=\"{lo} {hi}\" limited=\"true\"/>",
+                    v3(axis)
+                );
+            }
+        }
+    }
+    let bx = &body.boxes[b];
+    let _ = writeln!(
+        s,
+        "{pad}  <geom name=\"{}_box\" type=\"box\" pos=\"{}\" size=\"{}\" contype=\"1\" conaffinity=\"0\"/>",
+        mb.name,
+        v3(bx.center),
+        v3(bx.half)
+    );
+    for (k, child) in body.model.bodies.iter().enumerate() {
+        if child.parent == Some(b) {
+            write_mjcf_body(s, body, k, ranges, depth + 1);
+        }
+    }
+    let _ = writeln!(s, "{pad}</body>");
 }
 
 #[cfg(test)]

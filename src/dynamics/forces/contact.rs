@@ -18,7 +18,7 @@
 use crate::dynamics::data::Data;
 use crate::dynamics::linearly_implicit;
 use crate::dynamics::spatial::{ArticulatedInertia, ForceVec, transpose_mul};
-use glam::DVec3;
+use glam::{DMat3, DVec3};
 use serde::{Deserialize, Serialize};
 
 /// A contact box on a link: centre and half-extents in the link frame (m).
@@ -134,6 +134,19 @@ pub struct ImplicitFloor {
     pub h: f64,
     /// Take the spring implicitly too.
     pub stiffness: bool,
+}
+
+/// One corner through the floor as its implicit terms need it: link `link`'s corner `cl`
+/// (body coordinates), its velocity `xd` (world) and `zd` along the normal, its friction
+/// spring's stretch, its friction force `ft`, and whether it has an anchor (`UPDATE` only).
+struct CornerMotion {
+    link: usize,
+    cl: DVec3,
+    xd: DVec3,
+    zd: f64,
+    stretch: DVec3,
+    ft: DVec3,
+    anchored: bool,
 }
 
 /// Contact state carried between steps: the friction anchor of each corner in contact.
@@ -317,11 +330,6 @@ impl ContactModel {
         let px = [n_body.x * cs[0].x, n_body.x * cs[1].x];
         let py = [n_body.y * cs[0].y, n_body.y * cs[2].y];
         let pz = [n_body.z * cs[0].z, n_body.z * cs[4].z];
-        // The friction spring's stretch `(x − a)_t` toward anchor `a`.
-        let stretch_to = |x: DVec3, a: DVec3| {
-            let d = x - a;
-            d - n * n.dot(d)
-        };
         for (k, &cl) in cs.iter().enumerate() {
             let z = z_origin + ((px[k & 1] + py[(k >> 1) & 1]) + pz[k >> 2]);
             if z >= 0.0 {
@@ -334,30 +342,7 @@ impl ContactModel {
             let xd = rot * (v.lin + v.ang.cross(cl));
             let zd = n.dot(xd);
             let fnorm = (-k_c * z - c_c * zd).max(0.0);
-            let stretch = match anchors[k] {
-                Some(a) if UPDATE => {
-                    let stretch = stretch_to(x, a);
-                    let max_stretch = p.friction * fnorm / (p.tangential_stiffness_per_kg * m);
-                    let s = stretch.length();
-                    if s > max_stretch {
-                        // Slip: the anchor is dragged to the cone's edge.
-                        let keep = if s > 0.0 { max_stretch / s } else { 0.0 };
-                        let a = (x - n * z) - stretch * keep;
-                        anchors[k] = Some(a);
-                        stretch_to(x, a)
-                    } else {
-                        stretch
-                    }
-                }
-                Some(a) => stretch_to(x, a),
-                None if UPDATE => {
-                    // A new contact anchors where it touches.
-                    let a = x - n * z;
-                    anchors[k] = Some(a);
-                    stretch_to(x, a)
-                }
-                None => DVec3::ZERO,
-            };
+            let stretch = self.corner_stretch::<UPDATE>(&mut anchors[k], x, z, fnorm, m);
             let ft = self.tangential_force(i, xd, zd, stretch, fnorm);
             depth = depth.max(-z);
             normal += fnorm;
@@ -367,34 +352,119 @@ impl ContactModel {
             if let Some((imp, ic)) = implicit.as_mut()
                 && fnorm > 0.0
             {
-                let j = ForceVec::at_point(rot.transpose() * n, cl);
-                if imp.stiffness {
-                    // I + h (c + h k) j jᵀ, and the force at the step end's position.
-                    let (w, df) = linearly_implicit::corner(imp.h, k_c, c_c, zd);
-                    ic.sub_outer(j, -w);
-                    f_body += j * df;
-                    // A sticking corner's friction spring and damper along both tangents, the
-                    // same way (a slipping one's force is the cone's, not linearised).
-                    if UPDATE && anchors[k].is_some() && ft == self.stuck_force(i, xd, zd, stretch)
-                    {
-                        let (kt, ct) = (
-                            p.tangential_stiffness_per_kg * m,
-                            p.tangential_damping_per_kg * m,
-                        );
-                        for t in tangents(n) {
-                            let jt = ForceVec::at_point(rot.transpose() * t, cl);
-                            let (w, df) = linearly_implicit::corner(imp.h, kt, ct, t.dot(xd));
-                            ic.sub_outer(jt, -w);
-                            f_body += jt * df;
-                        }
-                    }
-                } else {
-                    // I + h c j jᵀ.
-                    ic.sub_outer(j, -imp.h * c_c);
-                }
+                let corner = CornerMotion {
+                    link: i,
+                    cl,
+                    xd,
+                    zd,
+                    stretch,
+                    ft,
+                    anchored: UPDATE && anchors[k].is_some(),
+                };
+                self.implicit_corner(*imp, ic, &rot, &corner, &mut f_body);
             }
         }
         (f_body, normal, depth, power)
+    }
+
+    /// The friction spring's stretch `(x − a)_t` of a corner at `x`, `z` through the floor
+    /// (`z < 0`), toward its anchor `a`, for link mass `m` and the corner's normal force
+    /// `fnorm` (zero without an anchor). With `UPDATE` the anchor is first brought to this
+    /// state: a new contact anchors where it touches, and a spring that would leave the
+    /// friction cone (`k_t m |stretch| > μ f_n`) drags its anchor to the cone's edge (slip).
+    #[inline(always)]
+    fn corner_stretch<const UPDATE: bool>(
+        &self,
+        anchor: &mut Option<DVec3>,
+        x: DVec3,
+        z: f64,
+        fnorm: f64,
+        m: f64,
+    ) -> DVec3 {
+        let p = &self.params;
+        let n = p.floor_normal;
+        // The friction spring's stretch `(x − a)_t` toward anchor `a`.
+        let stretch_to = |x: DVec3, a: DVec3| {
+            let d = x - a;
+            d - n * n.dot(d)
+        };
+        match *anchor {
+            Some(a) if UPDATE => {
+                let stretch = stretch_to(x, a);
+                let max_stretch = p.friction * fnorm / (p.tangential_stiffness_per_kg * m);
+                let s = stretch.length();
+                if s > max_stretch {
+                    // Slip: the anchor is dragged to the cone's edge.
+                    let keep = if s > 0.0 { max_stretch / s } else { 0.0 };
+                    let a = (x - n * z) - stretch * keep;
+                    *anchor = Some(a);
+                    stretch_to(x, a)
+                } else {
+                    stretch
+                }
+            }
+            Some(a) => stretch_to(x, a),
+            None if UPDATE => {
+                // A new contact anchors where it touches.
+                let a = x - n * z;
+                *anchor = Some(a);
+                stretch_to(x, a)
+            }
+            None => DVec3::ZERO,
+        }
+    }
+
+    /// A pushing corner's dampers (and springs) taken implicitly over the step `imp.h`
+    /// ([`ContactParams::implicit_damping`]): `ic` gains `h c j jᵀ`, `j = [p × n; n]` the floor
+    /// normal as a unit force at the corner `p`; with `imp.stiffness`, `ic` gains
+    /// `h (c + h k) j jᵀ` and `f_body` the force `−h k ż j` ([`linearly_implicit::corner`]),
+    /// and a sticking corner's friction spring and damper the same along both floor tangents.
+    #[inline(always)]
+    fn implicit_corner(
+        &self,
+        imp: ImplicitFloor,
+        ic: &mut ArticulatedInertia,
+        rot: &DMat3,
+        corner: &CornerMotion,
+        f_body: &mut ForceVec,
+    ) {
+        let p = &self.params;
+        let n = p.floor_normal;
+        let &CornerMotion {
+            link,
+            cl,
+            xd,
+            zd,
+            stretch,
+            ft,
+            anchored,
+        } = corner;
+        let m = self.masses[link];
+        let (k_c, c_c) = self.corner_gains[link];
+        let j = ForceVec::at_point(rot.transpose() * n, cl);
+        if imp.stiffness {
+            // I + h (c + h k) j jᵀ, and the force at the step end's position.
+            let (w, df) = linearly_implicit::corner(imp.h, k_c, c_c, zd);
+            ic.sub_outer(j, -w);
+            *f_body += j * df;
+            // A sticking corner's friction spring and damper along both tangents, the same
+            // way (a slipping one's force is the cone's, not linearised).
+            if anchored && ft == self.stuck_force(link, xd, zd, stretch) {
+                let (kt, ct) = (
+                    p.tangential_stiffness_per_kg * m,
+                    p.tangential_damping_per_kg * m,
+                );
+                for t in tangents(n) {
+                    let jt = ForceVec::at_point(rot.transpose() * t, cl);
+                    let (w, df) = linearly_implicit::corner(imp.h, kt, ct, t.dot(xd));
+                    ic.sub_outer(jt, -w);
+                    *f_body += jt * df;
+                }
+            }
+        } else {
+            // I + h c j jᵀ.
+            ic.sub_outer(j, -imp.h * c_c);
+        }
     }
 
     /// Adds the contact force of every link to `f_ext` (body coordinates) after

@@ -219,49 +219,7 @@ pub fn advance(
             progress(runs);
             return stop(runs);
         }
-        // The elite checks, round by round, one batch per evaluator per round.
-        loop {
-            let todo: Vec<(usize, Vec<usize>)> = active
-                .iter()
-                .map(|&i| (i, runs[i].state.unchecked_elites()))
-                .filter(|t| !t.1.is_empty())
-                .collect();
-            if todo.is_empty() {
-                break;
-            }
-            let parts: Vec<(usize, Vec<Genome>)> = todo
-                .iter()
-                .map(|(i, idx)| {
-                    let pop = &runs[*i].state.population;
-                    (*i, idx.iter().map(|&k| pop[k].clone()).collect())
-                })
-                .collect();
-            // What the runs of evaluator `e` evaluate next if their checks hold, in the order
-            // the next generation's batch asks for it (a run that ends here asks for nothing),
-            // bred only if that evaluator asks.
-            let ahead = |e: usize| -> Vec<Genome> {
-                active
-                    .iter()
-                    .filter(|&&i| owner[i] == e)
-                    .filter_map(|&i| {
-                        let idx = todo.iter().find(|t| t.0 == i).map_or(&[][..], |t| &t.1[..]);
-                        let brood = runs[i].state.brood_if_checks_hold(idx)?;
-                        Some(brood.to_evaluate())
-                    })
-                    .flatten()
-                    .collect()
-            };
-            let holds =
-                |k: usize, r: &[Evaluation]| runs[todo[k].0].state.checks_hold(&todo[k].1, r);
-            let checks = Batch::Checks {
-                ahead: &ahead,
-                holds: &holds,
-            };
-            let results = evaluate_by_owner(evaluators, &owner, generation, &parts, checks)?;
-            for ((i, idx), r) in todo.iter().zip(results) {
-                runs[*i].state.receive_checks(idx, r)?;
-            }
-        }
+        check_elites(runs, evaluators, &owner, &active, generation)?;
         for &i in &active {
             runs[i].state.close();
         }
@@ -277,6 +235,59 @@ pub fn advance(
     }
     if !saved && let Some(c) = checkpointing {
         checkpoint::save(&c.dir, runs)?;
+    }
+    Ok(())
+}
+
+/// The elite checks of the `active` runs' generation `generation`, round by round, one batch
+/// per evaluator (`owner[run]`) per round, until no run has an elite left to check.
+fn check_elites(
+    runs: &mut [EvolutionRun],
+    evaluators: &mut [Box<dyn Evaluator>],
+    owner: &[usize],
+    active: &[usize],
+    generation: u64,
+) -> Result<(), EvolveError> {
+    loop {
+        let todo: Vec<(usize, Vec<usize>)> = active
+            .iter()
+            .map(|&i| (i, runs[i].state.unchecked_elites()))
+            .filter(|t| !t.1.is_empty())
+            .collect();
+        if todo.is_empty() {
+            break;
+        }
+        let parts: Vec<(usize, Vec<Genome>)> = todo
+            .iter()
+            .map(|(i, idx)| {
+                let pop = &runs[*i].state.population;
+                (*i, idx.iter().map(|&k| pop[k].clone()).collect())
+            })
+            .collect();
+        // What the runs of evaluator `e` evaluate next if their checks hold, in the order
+        // the next generation's batch asks for it (a run that ends here asks for nothing),
+        // bred only if that evaluator asks.
+        let ahead = |e: usize| -> Vec<Genome> {
+            active
+                .iter()
+                .filter(|&&i| owner[i] == e)
+                .filter_map(|&i| {
+                    let idx = todo.iter().find(|t| t.0 == i).map_or(&[][..], |t| &t.1[..]);
+                    let brood = runs[i].state.brood_if_checks_hold(idx)?;
+                    Some(brood.to_evaluate())
+                })
+                .flatten()
+                .collect()
+        };
+        let holds = |k: usize, r: &[Evaluation]| runs[todo[k].0].state.checks_hold(&todo[k].1, r);
+        let checks = Batch::Checks {
+            ahead: &ahead,
+            holds: &holds,
+        };
+        let results = evaluate_by_owner(evaluators, owner, generation, &parts, checks)?;
+        for ((i, idx), r) in todo.iter().zip(results) {
+            runs[*i].state.receive_checks(idx, r)?;
+        }
     }
     Ok(())
 }

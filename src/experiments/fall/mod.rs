@@ -94,7 +94,28 @@ fn validate(cfg: &FallConfig) -> Result<Resolved, SimError> {
     )?;
     validate_reaction(cfg, n)?;
     positive("settle_max_s", cfg.settle_max_s)?;
-    // Sizes are checked before anything is allocated or run.
+    check_run_size(cfg)?;
+    check_contact_and_limits(cfg)?;
+    let push_link = resolve_push(cfg, &body)?;
+    let weights = damage_weights(cfg, &body)?;
+    let table = match &cfg.ranges {
+        Ranges::Builtin(g) => RangeTable::builtin(*g),
+        Ranges::Table(t) => t.clone(),
+        Ranges::File(p) => RangeTable::load(p)?,
+    };
+    let ranges = table.for_model(&body.figure)?;
+    check_torque_limits(cfg, &body)?;
+    Ok(Resolved {
+        body,
+        push_link,
+        weights,
+        ranges,
+    })
+}
+
+/// The run's size (steps and recorded frames, checked before anything is allocated or run)
+/// and the push's start inside it.
+fn check_run_size(cfg: &FallConfig) -> Result<(), SimError> {
     let steps = cfg.duration_s / cfg.dt_s;
     if steps > MAX_STEPS as f64 {
         return Err(cfg_err(
@@ -128,6 +149,12 @@ fn validate(cfg: &FallConfig) -> Result<Resolved, SimError> {
             ),
         ));
     }
+    Ok(())
+}
+
+/// The floor contact's stiffnesses (> 0), damping and friction (≥ 0) and unit normal; the joint
+/// limits' gains (≥ 0).
+fn check_contact_and_limits(cfg: &FallConfig) -> Result<(), SimError> {
     let c = &cfg.contact;
     for (f, x) in [
         ("contact.stiffness_scale", c.stiffness_scale),
@@ -163,6 +190,11 @@ fn validate(cfg: &FallConfig) -> Result<Resolved, SimError> {
             format!("must be ≥ 0, found {zeta}"),
         ));
     }
+    Ok(())
+}
+
+/// The pushed link's index, the push's force finite, its duration ≥ 0, its direction non-zero.
+fn resolve_push(cfg: &FallConfig, body: &HumanBody) -> Result<usize, SimError> {
     let push_link = body.link_index(&cfg.push.link).ok_or_else(|| {
         cfg_err(
             "push.link",
@@ -181,6 +213,11 @@ fn validate(cfg: &FallConfig) -> Result<Resolved, SimError> {
             "force must be finite, duration ≥ 0 and direction non-zero",
         ));
     }
+    Ok(push_link)
+}
+
+/// The damage weight of each link: 1 unless `cfg.damage_weights` names it (weights ≥ 0).
+fn damage_weights(cfg: &FallConfig, body: &HumanBody) -> Result<Vec<f64>, SimError> {
     let mut weights = vec![1.0; body.link_names.len()];
     for (name, w) in &cfg.damage_weights {
         let i = body.link_index(name).ok_or_else(|| {
@@ -197,42 +234,38 @@ fn validate(cfg: &FallConfig) -> Result<Resolved, SimError> {
         }
         weights[i] = *w;
     }
-    let table = match &cfg.ranges {
-        Ranges::Builtin(g) => RangeTable::builtin(*g),
-        Ranges::Table(t) => t.clone(),
-        Ranges::File(p) => RangeTable::load(p)?,
+    Ok(weights)
+}
+
+/// The torque limits, if given: one finite (min ≤ 0, max ≥ 0) pair per DOF.
+fn check_torque_limits(cfg: &FallConfig, body: &HumanBody) -> Result<(), SimError> {
+    let Some(t) = &cfg.torque_limits_nm else {
+        return Ok(());
     };
-    let ranges = table.for_model(&body.figure)?;
-    if let Some(t) = &cfg.torque_limits_nm {
-        if t.len() != n {
-            return Err(cfg_err(
-                "torque_limits_nm",
-                format!(
-                    "needs {n} (min, max) pairs (one per fall21 DOF), found {}",
-                    t.len()
-                ),
-            ));
-        }
-        if let Some((d, (lo, hi))) = t
-            .iter()
-            .enumerate()
-            .find(|(_, (lo, hi))| !(lo.is_finite() && hi.is_finite() && *lo <= 0.0 && *hi >= 0.0))
-        {
-            return Err(cfg_err(
-                "torque_limits_nm",
-                format!(
-                    "{}: ({lo}, {hi}) must be finite with min ≤ 0 ≤ max",
-                    body.figure.dofs[d].name
-                ),
-            ));
-        }
+    let n = body.dof_v.len();
+    if t.len() != n {
+        return Err(cfg_err(
+            "torque_limits_nm",
+            format!(
+                "needs {n} (min, max) pairs (one per fall21 DOF), found {}",
+                t.len()
+            ),
+        ));
     }
-    Ok(Resolved {
-        body,
-        push_link,
-        weights,
-        ranges,
-    })
+    if let Some((d, (lo, hi))) = t
+        .iter()
+        .enumerate()
+        .find(|(_, (lo, hi))| !(lo.is_finite() && hi.is_finite() && *lo <= 0.0 && *hi >= 0.0))
+    {
+        return Err(cfg_err(
+            "torque_limits_nm",
+            format!(
+                "{}: ({lo}, {hi}) must be finite with min ≤ 0 ≤ max",
+                body.figure.dofs[d].name
+            ),
+        ));
+    }
+    Ok(())
 }
 
 /// Checks the reaction's fields of `cfg` (key pose, k_p, k_v: `n` finite values each, gains
@@ -594,7 +627,6 @@ fn settle(cfg: &FallConfig, ch: &FallCharacter) -> Result<(pipeline::State, Vec<
     let model = &body.model;
     let mut state = ch.physics.state.0.clone();
     let mut ws = pipeline::StepWorkspace::new(model);
-    let mut monitor = pipeline::StepMonitor::new(model.nbodies(), body.dof_v.len());
     let settings = StepSettings {
         integrator: ch.physics.body.integrator,
         dt: cfg.dt_s,
@@ -606,35 +638,7 @@ fn settle(cfg: &FallConfig, ch: &FallCharacter) -> Result<(pipeline::State, Vec<
         contact: Some(&ch.contact.0),
         external: &[],
     };
-    let relax = (-cfg.dt_s / SETTLE_TAU_S).exp();
-    let mut quiet_since: Option<f64> = None;
-    loop {
-        if state.time_s >= cfg.settle_max_s {
-            return Err(cfg_err(
-                "settle_max_s",
-                format!(
-                    "the standing body did not come to rest within {} s (stance gains too weak \
-                     or the stance pose out of balance)",
-                    cfg.settle_max_s
-                ),
-            ));
-        }
-        pipeline::step(model, settings, &forces, &mut state, &mut ws, &mut monitor)?;
-        state.v.iter_mut().for_each(|x| *x *= relax);
-        ws.eval.kinematics_at_step = None;
-        let data = ws.kinematics_of(model, &state);
-        let ke: f64 = (0..model.nbodies())
-            .map(|i| model.bodies[i].inertia.kinetic_energy(data.v[i]))
-            .sum();
-        if ke < SETTLED_KE_J {
-            let t0 = *quiet_since.get_or_insert(state.time_s);
-            if state.time_s - t0 >= SETTLED_HOLD_S {
-                break;
-            }
-        } else {
-            quiet_since = None;
-        }
-    }
+    relax_to_rest(cfg, model, settings, &forces, &mut state, &mut ws)?;
     let base = model.v_idx[0]..model.v_idx[0] + model.bodies[0].joint.nv();
     balance_base(
         model,
@@ -647,21 +651,7 @@ fn settle(cfg: &FallConfig, ch: &FallCharacter) -> Result<(pipeline::State, Vec<
     let hold = holding_torques(model, &forces, &state, &mut ws, &body.dof_v)?;
     let mut held = ch.pd.0.clone();
     held.feedforward = hold.clone();
-    let mut angles = vec![0.0; model.nv];
-    model.angles(&state.q, &mut angles);
-    for (d, &k) in body.dof_v.iter().enumerate() {
-        let (tau, _) = held.torque(d, angles[k], 0.0);
-        if held.saturates(d, tau) {
-            return Err(cfg_err(
-                "torque_limits_nm",
-                format!(
-                    "holding the settled stance needs {tau:.1} N·m at {}, at or beyond its \
-                     strength {:?} N·m",
-                    body.figure.dofs[d].name, held.torque_limits[d]
-                ),
-            ));
-        }
-    }
+    check_holding_strength(body, &held, &state)?;
     let mut qdd = vec![0.0; model.nv];
     let held_forces = Forces {
         pd: Some(&held),
@@ -678,6 +668,74 @@ fn settle(cfg: &FallConfig, ch: &FallCharacter) -> Result<(pipeline::State, Vec<
         ));
     }
     Ok((state, hold))
+}
+
+/// Steps the standing body with its velocities relaxed (time constant [`SETTLE_TAU_S`]) until
+/// its kinetic energy has stayed under [`SETTLED_KE_J`] for [`SETTLED_HOLD_S`]; an error if
+/// that takes `cfg.settle_max_s`.
+fn relax_to_rest(
+    cfg: &FallConfig,
+    model: &crate::dynamics::Model,
+    settings: StepSettings,
+    forces: &Forces,
+    state: &mut pipeline::State,
+    ws: &mut pipeline::StepWorkspace,
+) -> Result<(), SimError> {
+    let mut monitor = pipeline::StepMonitor::new(model.nbodies(), forces.dofs.len());
+    let relax = (-cfg.dt_s / SETTLE_TAU_S).exp();
+    let mut quiet_since: Option<f64> = None;
+    loop {
+        if state.time_s >= cfg.settle_max_s {
+            return Err(cfg_err(
+                "settle_max_s",
+                format!(
+                    "the standing body did not come to rest within {} s (stance gains too weak \
+                     or the stance pose out of balance)",
+                    cfg.settle_max_s
+                ),
+            ));
+        }
+        pipeline::step(model, settings, forces, state, ws, &mut monitor)?;
+        state.v.iter_mut().for_each(|x| *x *= relax);
+        ws.eval.kinematics_at_step = None;
+        let data = ws.kinematics_of(model, state);
+        let ke: f64 = (0..model.nbodies())
+            .map(|i| model.bodies[i].inertia.kinetic_energy(data.v[i]))
+            .sum();
+        if ke < SETTLED_KE_J {
+            let t0 = *quiet_since.get_or_insert(state.time_s);
+            if state.time_s - t0 >= SETTLED_HOLD_S {
+                return Ok(());
+            }
+        } else {
+            quiet_since = None;
+        }
+    }
+}
+
+/// The stance PD with its holding feedforward within each DOF's strength at the settled pose.
+fn check_holding_strength(
+    body: &HumanBody,
+    held: &PdTargets,
+    state: &pipeline::State,
+) -> Result<(), SimError> {
+    let model = &body.model;
+    let mut angles = vec![0.0; model.nv];
+    model.angles(&state.q, &mut angles);
+    for (d, &k) in body.dof_v.iter().enumerate() {
+        let (tau, _) = held.torque(d, angles[k], 0.0);
+        if held.saturates(d, tau) {
+            return Err(cfg_err(
+                "torque_limits_nm",
+                format!(
+                    "holding the settled stance needs {tau:.1} N·m at {}, at or beyond its \
+                     strength {:?} N·m",
+                    body.figure.dofs[d].name, held.torque_limits[d]
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// Simulates one pushed fall from `config` without a World (the same parts and steps as

@@ -9,6 +9,7 @@ use super::result::{
     FallFrame, FallResult, LinkImpact, PeakTorque, PelvisImpact, TorqueSaturation,
 };
 use crate::dynamics::data::Data;
+use crate::dynamics::forces::contact::ContactStats;
 use crate::dynamics::pipeline::{State, StepMonitor};
 use crate::humanoid::body::HumanBody;
 
@@ -225,55 +226,11 @@ impl FallRecorder {
     pub fn result(&self, body: &HumanBody, state: &State, monitor: &StepMonitor) -> FallResult {
         let c = &monitor.contact;
         let damage = self.weights.iter().zip(&c.peak).map(|(w, f)| w * f).sum();
-        let impacts = (0..body.link_names.len())
-            .map(|i| LinkImpact {
-                link: body.link_names[i].clone(),
-                touchdown_s: c.touchdown_s[i],
-                impact_velocity_m_s: -c.touchdown_velocity[i],
-                peak_force_n: c.peak[i],
-                impulse_n_s: c.impulse[i],
-                energy_absorbed_j: c.absorbed_j[i],
-                max_penetration_m: c.max_depth[i],
-                damage_weight: self.weights[i],
-                damage_n: self.weights[i] * c.peak[i],
-            })
-            .collect();
+        let impacts = self.link_impacts(body, c);
         let p = body.link_index("pelvis").unwrap_or(0);
         let pelvis_touch = c.touchdown_s[p];
-        let strength = body
-            .figure
-            .dofs
-            .iter()
-            .enumerate()
-            .filter_map(|(d, dof)| {
-                monitor.first_saturated_s[d].map(|first| TorqueSaturation {
-                    dof: dof.name.clone(),
-                    first_s: first,
-                    duration_s: monitor.saturated_s[d],
-                })
-            })
-            .collect();
-        let peak_torques = body
-            .figure
-            .dofs
-            .iter()
-            .enumerate()
-            .map(|(d, dof)| {
-                let peak = monitor.peak_torque[d];
-                let limit = match self.torque_limits.get(d) {
-                    Some(&(lo, _)) if peak < 0.0 => lo,
-                    Some(&(_, hi)) => hi,
-                    None => f64::INFINITY,
-                };
-                PeakTorque {
-                    dof: dof.name.clone(),
-                    peak_nm: peak,
-                    limit_nm: limit,
-                    fraction: if limit == 0.0 { 0.0 } else { peak / limit },
-                    bound: monitor.first_saturated_s[d].is_some(),
-                }
-            })
-            .collect();
+        let strength = torque_saturation(body, monitor);
+        let peak_torques = self.peak_torques(body, monitor);
         let mut standing = self.before_push;
         standing.settle_s = self.settle_s;
         let end = state.time_s;
@@ -309,6 +266,64 @@ impl FallRecorder {
             peak_torques,
         }
     }
+
+    /// Each link's impact: touchdown, velocity, peak force, impulse, energy, penetration and
+    /// its weighted share of the damage.
+    fn link_impacts(&self, body: &HumanBody, c: &ContactStats) -> Vec<LinkImpact> {
+        (0..body.link_names.len())
+            .map(|i| LinkImpact {
+                link: body.link_names[i].clone(),
+                touchdown_s: c.touchdown_s[i],
+                impact_velocity_m_s: -c.touchdown_velocity[i],
+                peak_force_n: c.peak[i],
+                impulse_n_s: c.impulse[i],
+                energy_absorbed_j: c.absorbed_j[i],
+                max_penetration_m: c.max_depth[i],
+                damage_weight: self.weights[i],
+                damage_n: self.weights[i] * c.peak[i],
+            })
+            .collect()
+    }
+
+    /// Each DOF's peak torque against its strength in the peak's direction.
+    fn peak_torques(&self, body: &HumanBody, monitor: &StepMonitor) -> Vec<PeakTorque> {
+        body.figure
+            .dofs
+            .iter()
+            .enumerate()
+            .map(|(d, dof)| {
+                let peak = monitor.peak_torque[d];
+                let limit = match self.torque_limits.get(d) {
+                    Some(&(lo, _)) if peak < 0.0 => lo,
+                    Some(&(_, hi)) => hi,
+                    None => f64::INFINITY,
+                };
+                PeakTorque {
+                    dof: dof.name.clone(),
+                    peak_nm: peak,
+                    limit_nm: limit,
+                    fraction: if limit == 0.0 { 0.0 } else { peak / limit },
+                    bound: monitor.first_saturated_s[d].is_some(),
+                }
+            })
+            .collect()
+    }
+}
+
+/// The DOFs whose torque reached their strength: when first, and for how long.
+fn torque_saturation(body: &HumanBody, monitor: &StepMonitor) -> Vec<TorqueSaturation> {
+    body.figure
+        .dofs
+        .iter()
+        .enumerate()
+        .filter_map(|(d, dof)| {
+            monitor.first_saturated_s[d].map(|first| TorqueSaturation {
+                dof: dof.name.clone(),
+                first_s: first,
+                duration_s: monitor.saturated_s[d],
+            })
+        })
+        .collect()
 }
 
 /// Whether the sum of the nonnegative `terms` (in order) stays below `limit`, adding only until
