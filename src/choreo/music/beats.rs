@@ -51,7 +51,16 @@ pub fn track_beats(
     period: f64,
     params: &BeatParams,
 ) -> Result<Vec<f64>, MusicError> {
-    let n = env.values.len();
+    check_params(env.values.len(), period, params)?;
+    let local = local_score(&env.values, period);
+    let (cum, back) = cumulative_score(&local, period, params.tightness);
+    let frames = read_back(&cum, &back, period);
+    let frames = trim_weak_ends(&frames, &local, params.trim);
+    Ok(frames.iter().map(|&f| refine(&local, f)).collect())
+}
+
+/// Checks the period (2 frames to the envelope's length `n`) and the parameters.
+fn check_params(n: usize, period: f64, params: &BeatParams) -> Result<(), MusicError> {
     if !(period.is_finite() && period >= 2.0 && period < n as f64) {
         return Err(MusicError::Parameter {
             name: "period",
@@ -85,7 +94,13 @@ pub fn track_beats(
             expected: "0 to 1",
         });
     }
-    let local = local_score(&env.values, period);
+    Ok(())
+}
+
+/// The cumulative score C(t) of every frame and its best predecessor (module docs), with
+/// predecessors from half to twice the period before.
+fn cumulative_score(local: &[f64], period: f64, tightness: f64) -> (Vec<f64>, Vec<Option<usize>>) {
+    let n = local.len();
     let lo = (period / 2.0).round() as usize;
     let hi = (2.0 * period).round() as usize;
     // Penalty per distance d = t − τ in lo..=hi.
@@ -94,7 +109,7 @@ pub fn track_beats(
             if d < lo.max(1) {
                 f64::INFINITY
             } else {
-                params.tightness * ((d as f64 / period).ln()).powi(2)
+                tightness * ((d as f64 / period).ln()).powi(2)
             }
         })
         .collect();
@@ -122,6 +137,12 @@ pub fn track_beats(
             _ => cum[t] = local[t],
         }
     }
+    (cum, back)
+}
+
+/// The beat frames read back along the predecessors from the best score in the final period.
+fn read_back(cum: &[f64], back: &[Option<usize>], period: f64) -> Vec<usize> {
+    let n = cum.len();
     let tail_from = n.saturating_sub(period.ceil() as usize);
     let mut t = (tail_from..n)
         .max_by(|&a, &b| cum[a].total_cmp(&cum[b]))
@@ -132,31 +153,35 @@ pub fn track_beats(
         t = p;
     }
     frames.reverse();
-    // Trim weak beats at both ends.
+    frames
+}
+
+/// The beats without the leading and trailing ones whose local score is below `trim` × the
+/// RMS local score at the beats.
+fn trim_weak_ends<'a>(frames: &'a [usize], local: &[f64], trim: f64) -> &'a [usize] {
     let rms =
         (frames.iter().map(|&f| local[f] * local[f]).sum::<f64>() / frames.len() as f64).sqrt();
-    let thresh = params.trim * rms;
+    let thresh = trim * rms;
     let first = frames.iter().position(|&f| local[f] >= thresh);
     let last = frames.iter().rposition(|&f| local[f] >= thresh);
-    let frames = match (first, last) {
+    match (first, last) {
         (Some(a), Some(b)) => &frames[a..=b],
         _ => &frames[..0],
-    };
-    Ok(frames
-        .iter()
-        .map(|&f| {
-            if f == 0 || f + 1 >= n {
-                return f as f64;
-            }
-            let (a, b, c) = (local[f - 1], local[f], local[f + 1]);
-            let d = a - 2.0 * b + c;
-            if d < 0.0 {
-                f as f64 + (0.5 * (a - c) / d).clamp(-0.5, 0.5)
-            } else {
-                f as f64
-            }
-        })
-        .collect())
+    }
+}
+
+/// Frame `f` refined to a fraction of a frame by a parabola through the local score.
+fn refine(local: &[f64], f: usize) -> f64 {
+    if f == 0 || f + 1 >= local.len() {
+        return f as f64;
+    }
+    let (a, b, c) = (local[f - 1], local[f], local[f + 1]);
+    let d = a - 2.0 * b + c;
+    if d < 0.0 {
+        f as f64 + (0.5 * (a - c) / d).clamp(-0.5, 0.5)
+    } else {
+        f as f64
+    }
 }
 
 /// The envelope over its standard deviation, smoothed by a Gaussian of σ = period/32 frames.

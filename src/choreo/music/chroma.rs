@@ -69,12 +69,7 @@ pub fn interval_chroma(
     let n_fft = ((params.window_s * sr).ceil() as usize)
         .next_power_of_two()
         .max(16);
-    let window: Vec<f32> = (0..n_fft)
-        .map(|i| {
-            let x = std::f64::consts::PI * i as f64 / n_fft as f64;
-            (x.sin() * x.sin()) as f32
-        })
-        .collect();
+    let window = super::onsets::hann(n_fft);
     let bin_hz = sr / n_fft as f64;
     let bins: Vec<(usize, usize)> = (1..n_fft / 2)
         .filter_map(|k| {

@@ -281,55 +281,10 @@ pub fn analyze(
     params: &MusicParams,
 ) -> Result<MusicAnalysis, MusicError> {
     check_samples(samples, sample_rate)?;
+    params.check()?;
     let bpb = params.beats_per_bar;
-    if !(1..=16).contains(&bpb) {
-        return Err(MusicError::Parameter {
-            name: "beats_per_bar",
-            value: bpb as f64,
-            expected: "1 to 16",
-        });
-    }
-    if let Some(d) = params.downbeat
-        && d >= bpb
-    {
-        return Err(MusicError::Parameter {
-            name: "downbeat",
-            value: d as f64,
-            expected: "0 to beats_per_bar − 1",
-        });
-    }
     let duration_s = samples.len() as f64 / sample_rate as f64;
-    let needed_s = 4.0 * 60.0 / params.prior.max_bpm;
-    if duration_s < needed_s {
-        return Err(MusicError::TooShort {
-            duration_s,
-            needed_s,
-            what: "four beats at the fastest tempo considered",
-        });
-    }
-    let peak = samples.iter().fold(0f32, |m, s| m.max(s.abs()));
-    let peak_db = 20.0 * (peak as f64).log10();
-    if peak_db < -90.0 {
-        return Err(MusicError::Silent { peak_db });
-    }
-    let env = onset_envelope(samples, sample_rate, &params.onsets)?;
-    if env.values.iter().all(|&v| v <= 0.0) {
-        return Err(MusicError::Silent { peak_db });
-    }
-    if params.rephase_sd.is_nan() || params.rephase_sd < 0.0 {
-        return Err(MusicError::Parameter {
-            name: "rephase_sd",
-            value: params.rephase_sd,
-            expected: "a non-negative number or inf",
-        });
-    }
-    if !(0.0..=1.0).contains(&params.min_beat_strength) {
-        return Err(MusicError::Parameter {
-            name: "min_beat_strength",
-            value: params.min_beat_strength,
-            expected: "0 to 1",
-        });
-    }
+    let env = audible_envelope(samples, sample_rate, params)?;
     let tempo = estimate_tempo(&env, &params.prior)?;
     if tempo.strength < params.min_beat_strength {
         return Err(MusicError::NoBeat {
@@ -338,23 +293,7 @@ pub fn analyze(
             threshold: params.min_beat_strength,
         });
     }
-    let mut beat_frames = track_beats(&env, tempo.period_frames, &params.beats)?;
-    // A level whose midpoints are as strong as its beats groups two beats (a backbeat); one
-    // whose chords change between its beats is every second beat, or off the beat.
-    let fastest = 60.0 * env.frame_rate() / params.prior.max_bpm;
-    let mut halves = None;
-    if tempo.period_frames / 2.0 >= fastest
-        && (beats::midpoint_ratio(&env, &beat_frames) >= params.beats.midpoint_ratio
-            || chroma::midpoint_harmony_ratio(halves.insert(tonal_halves(
-                samples,
-                sample_rate,
-                &times_of(&env, &beat_frames),
-                &params.chroma,
-            ))) >= params.beats.midpoint_harmony)
-    {
-        beat_frames = track_beats(&env, tempo.period_frames / 2.0, &params.beats)?;
-        halves = None;
-    }
+    let (beat_frames, halves) = beat_level(samples, sample_rate, &env, &tempo, params)?;
     let beats_s = times_of(&env, &beat_frames);
     if beats_s.len() < 2 {
         return Err(MusicError::TooFewBeats {
@@ -389,6 +328,100 @@ pub fn analyze(
         bars,
         onsets: env,
     })
+}
+
+impl MusicParams {
+    /// Checks the bar's parameters, the rephase cost and the least beat strength.
+    fn check(&self) -> Result<(), MusicError> {
+        let bpb = self.beats_per_bar;
+        if !(1..=16).contains(&bpb) {
+            return Err(MusicError::Parameter {
+                name: "beats_per_bar",
+                value: bpb as f64,
+                expected: "1 to 16",
+            });
+        }
+        if let Some(d) = self.downbeat
+            && d >= bpb
+        {
+            return Err(MusicError::Parameter {
+                name: "downbeat",
+                value: d as f64,
+                expected: "0 to beats_per_bar − 1",
+            });
+        }
+        if self.rephase_sd.is_nan() || self.rephase_sd < 0.0 {
+            return Err(MusicError::Parameter {
+                name: "rephase_sd",
+                value: self.rephase_sd,
+                expected: "a non-negative number or inf",
+            });
+        }
+        if !(0.0..=1.0).contains(&self.min_beat_strength) {
+            return Err(MusicError::Parameter {
+                name: "min_beat_strength",
+                value: self.min_beat_strength,
+                expected: "0 to 1",
+            });
+        }
+        Ok(())
+    }
+}
+
+/// The onset envelope of a song long enough for four beats at the fastest tempo considered and
+/// not silent (peak above −90 dB, some onset).
+fn audible_envelope(
+    samples: &[f32],
+    sample_rate: u32,
+    params: &MusicParams,
+) -> Result<OnsetEnvelope, MusicError> {
+    let duration_s = samples.len() as f64 / sample_rate as f64;
+    let needed_s = 4.0 * 60.0 / params.prior.max_bpm;
+    if duration_s < needed_s {
+        return Err(MusicError::TooShort {
+            duration_s,
+            needed_s,
+            what: "four beats at the fastest tempo considered",
+        });
+    }
+    let peak = samples.iter().fold(0f32, |m, s| m.max(s.abs()));
+    let peak_db = 20.0 * (peak as f64).log10();
+    if peak_db < -90.0 {
+        return Err(MusicError::Silent { peak_db });
+    }
+    let env = onset_envelope(samples, sample_rate, &params.onsets)?;
+    if env.values.iter().all(|&v| v <= 0.0) {
+        return Err(MusicError::Silent { peak_db });
+    }
+    Ok(env)
+}
+
+/// The beats at the comb's level, or tracked again twice as fast when that level's midpoints
+/// are as strong as its beats (a backbeat) or its chords change between its beats (every second
+/// beat, or off the beat); with the half-beat chroma of the returned beats when it was taken.
+fn beat_level(
+    samples: &[f32],
+    sample_rate: u32,
+    env: &OnsetEnvelope,
+    tempo: &TempoEstimate,
+    params: &MusicParams,
+) -> Result<(Vec<f64>, Option<Vec<Chroma>>), MusicError> {
+    let beat_frames = track_beats(env, tempo.period_frames, &params.beats)?;
+    let fastest = 60.0 * env.frame_rate() / params.prior.max_bpm;
+    let mut halves = None;
+    if tempo.period_frames / 2.0 >= fastest
+        && (beats::midpoint_ratio(env, &beat_frames) >= params.beats.midpoint_ratio
+            || chroma::midpoint_harmony_ratio(halves.insert(tonal_halves(
+                samples,
+                sample_rate,
+                &times_of(env, &beat_frames),
+                &params.chroma,
+            ))) >= params.beats.midpoint_harmony)
+    {
+        let faster = track_beats(env, tempo.period_frames / 2.0, &params.beats)?;
+        return Ok((faster, None));
+    }
+    Ok((beat_frames, halves))
 }
 
 /// Times (s) of envelope frames.

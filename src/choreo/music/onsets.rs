@@ -137,40 +137,13 @@ pub fn onset_envelope(
     sample_rate: u32,
     params: &OnsetParams,
 ) -> Result<OnsetEnvelope, MusicError> {
-    let check = |name, value: f64, lo: f64, hi: f64, expected| {
-        if value.is_finite() && value >= lo && value <= hi {
-            Ok(())
-        } else {
-            Err(MusicError::Parameter {
-                name,
-                value,
-                expected,
-            })
-        }
-    };
-    check("window_s", params.window_s, 0.005, 0.5, "0.005 to 0.5 s")?;
-    check("hop_s", params.hop_s, 0.001, 0.1, "0.001 to 0.1 s")?;
-    check(
-        "compression_db",
-        params.compression_db,
-        0.0,
-        120.0,
-        "0 to 120 dB",
-    )?;
-    check("detrend_s", params.detrend_s, 0.05, 10.0, "0.05 to 10 s")?;
-    check("low_hz", params.low_hz, 40.0, 2000.0, "40 to 2000 Hz")?;
+    params.check()?;
     let sr = sample_rate as f64;
     let n_fft = ((params.window_s * sr).ceil() as usize)
         .next_power_of_two()
         .max(16);
     let hop = ((params.hop_s * sr).round() as usize).max(1);
     let frames = samples.len().div_ceil(hop).max(1);
-    let window: Vec<f32> = (0..n_fft)
-        .map(|i| {
-            let x = std::f64::consts::PI * i as f64 / n_fft as f64;
-            (x.sin() * x.sin()) as f32
-        })
-        .collect();
     let edges = band_edges(n_fft, sample_rate);
     let bands = edges.len() - 1;
     let bin_hz = sr / n_fft as f64;
@@ -179,6 +152,53 @@ pub fn onset_envelope(
         .take_while(|&&e| e as f64 * bin_hz <= params.low_hz)
         .count()
         .max(1);
+    let power = band_power(samples, n_fft, hop, &edges);
+    let max = power.iter().fold(0f32, |m, &p| m.max(p)) as f64;
+    let gamma = 10f64.powf(params.compression_db / 10.0) / max.max(f64::MIN_POSITIVE);
+    // Element by element on the rayon pool: the same values whatever the threads.
+    let level: Vec<f64> = power
+        .par_iter()
+        .map(|&p| (gamma * p as f64).ln_1p())
+        .collect();
+    // Before the song is silence (L = 0), so a song that starts on a hit has an onset at 0.
+    let flux = |t: usize, range: std::ops::Range<usize>| -> f64 {
+        let n = range.len() as f64;
+        range
+            .map(|b| {
+                let prev = if t == 0 {
+                    0.0
+                } else {
+                    level[(t - 1) * bands + b]
+                };
+                (level[t * bands + b] - prev).max(0.0)
+            })
+            .sum::<f64>()
+            / n
+    };
+    let full: Vec<f64> = (0..frames)
+        .into_par_iter()
+        .map(|t| flux(t, 0..bands))
+        .collect();
+    let low: Vec<f64> = (0..frames)
+        .into_par_iter()
+        .map(|t| flux(t, 0..low_bands))
+        .collect();
+    let w = ((params.detrend_s * sr / hop as f64).round() as usize).max(1);
+    Ok(OnsetEnvelope {
+        sample_rate,
+        hop,
+        window: n_fft,
+        values: detrend(&full, w),
+        low: detrend(&low, w),
+    })
+}
+
+/// The power of each band between `edges` (FFT bins) in each Hann-windowed frame of `n_fft`
+/// samples centred every `hop` samples, frame-major.
+fn band_power(samples: &[f32], n_fft: usize, hop: usize, edges: &[usize]) -> Vec<f32> {
+    let frames = samples.len().div_ceil(hop).max(1);
+    let bands = edges.len() - 1;
+    let window = hann(n_fft);
     let mut planner = RealFftPlanner::<f32>::new();
     let fft: Arc<dyn RealToComplex<f32>> = planner.plan_fft_forward(n_fft);
     // Band power per frame, frame-major. Frames are independent: chunks of them run on the
@@ -209,34 +229,47 @@ pub fn onset_envelope(
                 }
             }
         });
-    let max = power.iter().fold(0f32, |m, &p| m.max(p)) as f64;
-    let gamma = 10f64.powf(params.compression_db / 10.0) / max.max(f64::MIN_POSITIVE);
-    let level: Vec<f64> = power.iter().map(|&p| (gamma * p as f64).ln_1p()).collect();
-    // Before the song is silence (L = 0), so a song that starts on a hit has an onset at 0.
-    let flux = |t: usize, range: std::ops::Range<usize>| -> f64 {
-        let n = range.len() as f64;
-        range
-            .map(|b| {
-                let prev = if t == 0 {
-                    0.0
-                } else {
-                    level[(t - 1) * bands + b]
-                };
-                (level[t * bands + b] - prev).max(0.0)
-            })
-            .sum::<f64>()
-            / n
-    };
-    let full: Vec<f64> = (0..frames).map(|t| flux(t, 0..bands)).collect();
-    let low: Vec<f64> = (0..frames).map(|t| flux(t, 0..low_bands)).collect();
-    let w = ((params.detrend_s * sr / hop as f64).round() as usize).max(1);
-    Ok(OnsetEnvelope {
-        sample_rate,
-        hop,
-        window: n_fft,
-        values: detrend(&full, w),
-        low: detrend(&low, w),
-    })
+    power
+}
+
+/// A Hann window of `n` samples, sin²(π i / n).
+pub(crate) fn hann(n: usize) -> Vec<f32> {
+    (0..n)
+        .map(|i| {
+            let x = std::f64::consts::PI * i as f64 / n as f64;
+            (x.sin() * x.sin()) as f32
+        })
+        .collect()
+}
+
+impl OnsetParams {
+    /// Checks each parameter against its range.
+    fn check(&self) -> Result<(), MusicError> {
+        let params = self;
+        let check = |name, value: f64, lo: f64, hi: f64, expected| {
+            if value.is_finite() && value >= lo && value <= hi {
+                Ok(())
+            } else {
+                Err(MusicError::Parameter {
+                    name,
+                    value,
+                    expected,
+                })
+            }
+        };
+        check("window_s", params.window_s, 0.005, 0.5, "0.005 to 0.5 s")?;
+        check("hop_s", params.hop_s, 0.001, 0.1, "0.001 to 0.1 s")?;
+        check(
+            "compression_db",
+            params.compression_db,
+            0.0,
+            120.0,
+            "0 to 120 dB",
+        )?;
+        check("detrend_s", params.detrend_s, 0.05, 10.0, "0.05 to 10 s")?;
+        check("low_hz", params.low_hz, 40.0, 2000.0, "40 to 2000 Hz")?;
+        Ok(())
+    }
 }
 
 #[cfg(test)]

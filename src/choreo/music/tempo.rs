@@ -55,6 +55,40 @@ impl Default for TempoPrior {
     }
 }
 
+impl TempoPrior {
+    /// Checks the range (10 ≤ min < max ≤ 600 BPM), the centre within it, a positive width and
+    /// a comb span of 0 to 30 s.
+    fn check(&self) -> Result<(), MusicError> {
+        let prior = self;
+        let bad = |name, value, expected| MusicError::Parameter {
+            name,
+            value,
+            expected,
+        };
+        if !(prior.min_bpm >= 10.0 && prior.min_bpm < prior.max_bpm && prior.max_bpm <= 600.0) {
+            return Err(bad(
+                "min_bpm/max_bpm",
+                prior.min_bpm,
+                "10 ≤ min_bpm < max_bpm ≤ 600",
+            ));
+        }
+        if !(prior.min_bpm..=prior.max_bpm).contains(&prior.centre_bpm) {
+            return Err(bad(
+                "centre_bpm",
+                prior.centre_bpm,
+                "a tempo within min_bpm to max_bpm",
+            ));
+        }
+        if !(prior.octaves > 0.0 && prior.octaves.is_finite()) {
+            return Err(bad("octaves", prior.octaves, "a positive width"));
+        }
+        if !(prior.comb_span_s > 0.0 && prior.comb_span_s <= 30.0) {
+            return Err(bad("comb_span_s", prior.comb_span_s, "0 to 30 s"));
+        }
+        Ok(())
+    }
+}
+
 /// The tempo found by [`estimate_tempo`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct TempoEstimate {
@@ -131,31 +165,7 @@ pub fn estimate_tempo(
     env: &OnsetEnvelope,
     prior: &TempoPrior,
 ) -> Result<TempoEstimate, MusicError> {
-    let bad = |name, value, expected| MusicError::Parameter {
-        name,
-        value,
-        expected,
-    };
-    if !(prior.min_bpm >= 10.0 && prior.min_bpm < prior.max_bpm && prior.max_bpm <= 600.0) {
-        return Err(bad(
-            "min_bpm/max_bpm",
-            prior.min_bpm,
-            "10 ≤ min_bpm < max_bpm ≤ 600",
-        ));
-    }
-    if !(prior.min_bpm..=prior.max_bpm).contains(&prior.centre_bpm) {
-        return Err(bad(
-            "centre_bpm",
-            prior.centre_bpm,
-            "a tempo within min_bpm to max_bpm",
-        ));
-    }
-    if !(prior.octaves > 0.0 && prior.octaves.is_finite()) {
-        return Err(bad("octaves", prior.octaves, "a positive width"));
-    }
-    if !(prior.comb_span_s > 0.0 && prior.comb_span_s <= 30.0) {
-        return Err(bad("comb_span_s", prior.comb_span_s, "0 to 30 s"));
-    }
+    prior.check()?;
     let fps = env.frame_rate();
     let n = env.values.len();
     let lag_of = |bpm: f64| 60.0 * fps / bpm;
