@@ -770,13 +770,7 @@ fn generate_clip(p: &AuthoredDance, c: usize) -> AuthoredClip {
     let dofs = DanceDofs::of(&model);
     let legs = [Leg::of(&model, "left"), Leg::of(&model, "right")];
     let stand = standing_height(&model);
-    let mut motion = ModelClip {
-        model: model.clone(),
-        frame_time: 1.0 / p.fps,
-        root_translation: Vec::with_capacity(frames),
-        root_rotation: Vec::with_capacity(frames),
-        angles: Vec::with_capacity(frames * dofs.count),
-    };
+    let mut motion = ModelClip::with_capacity(model.clone(), 1.0 / p.fps, frames);
     for f in 0..frames {
         let t = f as f64 / p.fps;
         let x = t / beat;

@@ -260,13 +260,7 @@ pub fn assemble(
     let bar_frames = bar_frames(bars, p, frames, dt)?;
     let w = p.seam_frames;
 
-    let mut clip = ModelClip {
-        model: model.clone(),
-        frame_time: dt,
-        root_translation: Vec::with_capacity(frames),
-        root_rotation: Vec::with_capacity(frames),
-        angles: Vec::with_capacity(frames * dofs),
-    };
+    let mut clip = ModelClip::with_capacity(model.clone(), dt, frames);
     // The carry-on of the previous bar: its rotation about Y and horizontal offset, and where
     // its segment ends (extrapolated to phase 1) in the dance.
     let mut end: Option<(DVec3, f64)> = None;

@@ -214,7 +214,6 @@ impl KeyframeClip {
         };
         let frames = (self.duration * self.fps).round().max(1.0) as usize;
         let dt = 1.0 / self.fps;
-        let dofs = model.dofs.len();
         // Per DOF (and root channel): the keys that name it.
         let series = |pick: &dyn Fn(&Key) -> Option<f64>| -> (Vec<f64>, Vec<f64>) {
             self.keys
@@ -233,13 +232,7 @@ impl KeyframeClip {
         let turn = series(&|k: &Key| k.turn.map(f64::to_radians));
         let at = |s: &(Vec<f64>, Vec<f64>), t: f64| pchip(&s.0, &s.1, t);
 
-        let mut clip = ModelClip {
-            model: model.clone(),
-            frame_time: dt,
-            root_translation: Vec::with_capacity(frames),
-            root_rotation: Vec::with_capacity(frames),
-            angles: Vec::with_capacity(frames * dofs),
-        };
+        let mut clip = ModelClip::with_capacity(model.clone(), dt, frames);
         for f in 0..frames {
             let t = f as f64 * dt;
             let angles: Vec<f64> = dof_keys.iter().map(|s| at(s, t)).collect();

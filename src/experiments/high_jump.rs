@@ -452,14 +452,7 @@ fn stretch_flight(clip: &ModelClip, fa: usize, fb: usize, nf: usize) -> ModelCli
     let (dt, n) = (clip.frame_time, clip.frame_count());
     let shift = nf as isize - (fb - fa) as isize;
     let m = (n as isize + shift) as usize;
-    let d = clip.dof_count();
-    let mut out = ModelClip {
-        model: clip.model.clone(),
-        frame_time: dt,
-        root_translation: Vec::with_capacity(m),
-        root_rotation: Vec::with_capacity(m),
-        angles: Vec::with_capacity(m * d),
-    };
+    let mut out = ModelClip::with_capacity(clip.model.clone(), dt, m);
     for k in 0..m {
         let src = if k <= fa {
             k as f64

@@ -29,6 +29,18 @@ pub struct ModelClip {
 }
 
 impl ModelClip {
+    /// An empty clip on `model` at `frame_time` seconds per frame, with room for `frames` frames.
+    pub fn with_capacity(model: Model, frame_time: f64, frames: usize) -> ModelClip {
+        let dofs = model.dofs.len();
+        ModelClip {
+            model,
+            frame_time,
+            root_translation: Vec::with_capacity(frames),
+            root_rotation: Vec::with_capacity(frames),
+            angles: Vec::with_capacity(frames * dofs),
+        }
+    }
+
     /// Number of frames.
     pub fn frame_count(&self) -> usize {
         self.root_translation.len()

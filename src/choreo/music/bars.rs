@@ -43,8 +43,8 @@ pub(super) fn at(x: &[f64], f: f64) -> f64 {
 }
 
 /// The standardised downbeat evidence z_i of each beat (module docs) from the onsets at each
-/// beat and the harmonic change at each beat (`harmony`, one per beat, or empty to leave it
-/// out): each feature enters as its rank among the beats (0 to 1), so that one outlier, as the
+/// beat and the harmonic change at each beat (`harmony`, one per beat; a slice of any other
+/// length, as the empty one of a song without tonality, leaves it out): each feature enters as its rank among the beats (0 to 1), so that one outlier, as the
 /// first onset of a song, does not outweigh the rest.
 pub fn downbeat_evidence(env: &OnsetEnvelope, beat_frames: &[f64], harmony: &[f64]) -> Vec<f64> {
     let n = beat_frames.len();

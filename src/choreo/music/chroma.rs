@@ -15,8 +15,9 @@
 //!
 //! Harmony means something only where there is pitch: the tonality of a song is the mean over
 //! its intervals of the cosine distance of their chroma from the flat profile (1/√12 each),
-//! near 0 for noise and drums (0.01 to 0.05 for the synthesized drum tracks) and 0.26 to 0.45
-//! for the piano arrangements of POP909. Below `min_tonality` the harmony is not used.
+//! near 0 for noise and drums (0.01 to 0.05 for five synthesized drum tracks of 68 to 150 BPM)
+//! and 0.26 to 0.45 for the first 12 of the 40 shared POP909 piano arrangements. Below
+//! `min_tonality` the harmony is not used.
 
 use std::sync::Arc;
 

@@ -408,20 +408,19 @@ fn beat_level(
 ) -> Result<(Vec<f64>, Option<Vec<Chroma>>), MusicError> {
     let beat_frames = track_beats(env, tempo.period_frames, &params.beats)?;
     let fastest = 60.0 * env.frame_rate() / params.prior.max_bpm;
-    let mut halves = None;
-    if tempo.period_frames / 2.0 >= fastest
-        && (beats::midpoint_ratio(env, &beat_frames) >= params.beats.midpoint_ratio
-            || chroma::midpoint_harmony_ratio(halves.insert(tonal_halves(
-                samples,
-                sample_rate,
-                &times_of(env, &beat_frames),
-                &params.chroma,
-            ))) >= params.beats.midpoint_harmony)
-    {
-        let faster = track_beats(env, tempo.period_frames / 2.0, &params.beats)?;
-        return Ok((faster, None));
+    if tempo.period_frames / 2.0 < fastest {
+        return Ok((beat_frames, None));
     }
-    Ok((beat_frames, halves))
+    let faster = || track_beats(env, tempo.period_frames / 2.0, &params.beats);
+    if beats::midpoint_ratio(env, &beat_frames) >= params.beats.midpoint_ratio {
+        return Ok((faster()?, None));
+    }
+    let times = times_of(env, &beat_frames);
+    let halves = tonal_halves(samples, sample_rate, &times, &params.chroma);
+    if chroma::midpoint_harmony_ratio(&halves) >= params.beats.midpoint_harmony {
+        return Ok((faster()?, None));
+    }
+    Ok((beat_frames, Some(halves)))
 }
 
 /// Times (s) of envelope frames.
