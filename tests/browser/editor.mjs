@@ -26,12 +26,16 @@ try {
     for (let i = 3; i < d.length; i += 4) if (d[i] > 0) lit++;
     return { segment: Number(c.dataset.segment), lit, pixels: cv.width * cv.height };
   }));
-  // Two snapshots of the first canvas some frames apart: an animated figure changes.
+  // Snapshots of the first canvas every 200 ms for up to 3 s: an animated figure changes (a
+  // renderer starved by a loaded machine may skip a few frames, a still figure never changes).
   const animated = () => page.$eval('#candidates .cand canvas', async (cv) => {
     const grab = () => cv.toDataURL();
     const a = grab();
-    await new Promise((r) => setTimeout(r, 400));
-    return a !== grab();
+    for (let k = 0; k < 15; k++) {
+      await new Promise((r) => setTimeout(r, 200));
+      if (a !== grab()) return true;
+    }
+    return false;
   });
 
   // Click bar 3 on the timeline (bars are equal in width).
