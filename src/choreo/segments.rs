@@ -3,15 +3,22 @@
 //! motion intensity, its Eros features and its boundary link directions and velocities.
 //!
 //! Dance capture has no music, so when no manifest gives a clip's tempo and first beat they are
-//! found from the motion itself (the kinematic beat): the speed curve v(f) = Σ_i |ẋ_i(f)| over
-//! every joint, its autocorrelation r(ℓ) = Σ_f (v(f) − v̄)(v(f+ℓ) − v̄) / ((n − ℓ) σ²) searched
-//! for the beat period between [`MIN_BPM`] and [`MAX_BPM`] (the highest local peak of r(ℓ)
-//! weighted by the music kernel's log-normal tempo prior, centre [`PRIOR_BPM`], σ one octave, so
-//! that the beat wins over the two-beat period whose r is as high; refined by a parabola through
-//! its neighbours); when the database is built for a song, the octave level of that beat
-//! nearest the song's tempo ([`kinematic_tempo`]); and the first beat the phase φ ∈ [0, T) whose
-//! beats φ + kT fall on the lowest mean speed (dancers
-//! mark the count with the minima of their speed).
+//! found from the motion itself (the kinematic beat, [`kinematic_beat`]):
+//!
+//! - the speed curve v(f) = Σ_i |ẋ_i(f)| over every joint ([`speed_curve`]), made steady
+//!   ([`steady_speed`]): pose jumps (a rest pose in the first frame, a glitch) clipped to
+//!   median + [`GLITCH_MADS`] robust deviations, and the trend, its Gaussian mean over one bar at
+//!   the slowest tempo, taken off so that a dance that speeds up or slows down keeps its beat;
+//! - its autocorrelation r(ℓ) = Σ_f v(f) v(f+ℓ) / ((n − ℓ) σ²) searched for the motion's period
+//!   between [`MAX_BPM`] and half [`MIN_BPM`] (two beats of the slowest tempo: a dance whose
+//!   clearest repeat is a step every other beat keeps its beat): the highest positive local peak
+//!   of r(ℓ) weighted by a log-normal tempo prior, σ one octave, centred on the song's tempo when
+//!   the database is built for one and else on [`PRIOR_BPM`] (so that the beat wins over the
+//!   two-beat period whose r is as high); refined by a parabola through its neighbours;
+//! - the octave level of that period within [`LEVEL_BPM`] nearest the song's tempo, or without a
+//!   song the period itself, doubled when slower than [`MIN_BPM`] ([`kinematic_tempo`]);
+//! - the first beat, the phase φ ∈ [0, T) whose beats φ + kT fall on the lowest mean steady
+//!   speed (dancers mark the count with the minima of their speed).
 
 use glam::{DQuat, DVec3};
 use serde::{Deserialize, Serialize};
@@ -46,16 +53,26 @@ pub fn check_tempo(what: &str, bpm: f64) -> Result<(), String> {
     }
 }
 
-/// Slowest tempo the kinematic beat looks for, beats per minute.
-pub const MIN_BPM: f64 = 60.0;
+/// Slowest tempo the kinematic beat looks for, beats per minute (a beat of 1.5 s: slow dances
+/// and ballads mark a count this long).
+pub const MIN_BPM: f64 = 40.0;
 
 /// Fastest tempo the kinematic beat looks for, beats per minute.
-pub const MAX_BPM: f64 = 180.0;
+pub const MAX_BPM: f64 = 200.0;
 
-/// The tempi between which a song may take the octave level of a clip's beat, BPM.
-pub const LEVEL_BPM: (f64, f64) = (40.0, 200.0);
+/// The tempi between which a song may take the octave level of a clip's beat, BPM: the beat
+/// search's own range.
+pub const LEVEL_BPM: (f64, f64) = (MIN_BPM, MAX_BPM);
 
-/// Centre of the log-normal tempo prior of the kinematic beat, BPM (σ one octave).
+/// Robust deviations (1.4826 × the median absolute deviation) above the median at which the
+/// speed curve is clipped before the beat is searched: a pose jump (a rest pose in a clip's
+/// first frame, a marker swap) moves every joint at once and reads tens of times the median
+/// speed, while the fastest dance moves stay within a few deviations; one such frame would
+/// otherwise carry most of the curve's variance and flatten its autocorrelation.
+pub const GLITCH_MADS: f64 = 6.0;
+
+/// Centre of the log-normal tempo prior of the kinematic beat when no song is given, BPM (σ one
+/// octave).
 pub const PRIOR_BPM: f64 = 120.0;
 
 /// Why a clip could not be cut into segments or a database built.
@@ -188,18 +205,70 @@ pub fn speed_curve(positions: &[Vec<DVec3>], fps: f64) -> Vec<f64> {
         .collect()
 }
 
-/// The beat of a speed curve sampled at `fps`: the beat period with the highest normalised
-/// autocorrelation between [`MIN_BPM`] and [`MAX_BPM`] (module docs), in BPM; `None` when the
-/// curve is too short for two periods of the slowest tempo or is constant.
-fn beat_tempo(speed: &[f64], fps: f64) -> Option<f64> {
+/// The speed curve made steady for the beat search (module docs): each value clipped to
+/// median + [`GLITCH_MADS`] × 1.4826 MAD (not at all when the MAD is 0), then its trend taken off, the Gaussian-weighted mean
+/// m(f) = Σ_g w(f − g) v(g) / Σ_g w(f − g) with σ one bar of [`BEATS_PER_BAR`] counts at
+/// [`MIN_BPM`] (6 s; the weights cut at ±3σ and at the curve's ends): it takes off drifts
+/// slower than about 30 s (half power at 0.03 Hz) and leaves every beat of the search range
+/// whole. Units as `speed`.
+pub fn steady_speed(speed: &[f64], fps: f64) -> Vec<f64> {
     let n = speed.len();
-    let min_lag = (fps * 60.0 / MAX_BPM).floor().max(1.0) as usize;
-    let max_lag = (fps * 60.0 / MIN_BPM).ceil() as usize;
-    if n < 2 * max_lag + 2 {
+    if n == 0 {
+        return vec![];
+    }
+    let median = |v: &mut Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        let m = v.len() / 2;
+        if v.len() % 2 == 1 {
+            v[m]
+        } else {
+            0.5 * (v[m - 1] + v[m])
+        }
+    };
+    let med = median(&mut speed.to_vec());
+    let mad = median(&mut speed.iter().map(|v| (v - med).abs()).collect());
+    // More than half the frames at one speed (a keyframed clip holding its poses): no spread to
+    // tell a glitch from a move by, so nothing is clipped.
+    let ceiling = if mad > 0.0 {
+        med + GLITCH_MADS * 1.4826 * mad
+    } else {
+        f64::INFINITY
+    };
+    let clipped: Vec<f64> = speed.iter().map(|&v| v.min(ceiling)).collect();
+    let sigma = BEATS_PER_BAR as f64 * 60.0 / MIN_BPM * fps;
+    let reach = (3.0 * sigma).ceil() as usize;
+    let w: Vec<f64> = (0..=reach)
+        .map(|d| (-0.5 * (d as f64 / sigma).powi(2)).exp())
+        .collect();
+    (0..n)
+        .map(|f| {
+            let (lo, hi) = (f.saturating_sub(reach), (f + reach).min(n - 1));
+            let (mut sum, mut weight) = (0.0, 0.0);
+            for (g, &v) in clipped.iter().enumerate().take(hi + 1).skip(lo) {
+                let k = w[f.abs_diff(g)];
+                sum += k * v;
+                weight += k;
+            }
+            clipped[f] - sum / weight
+        })
+        .collect()
+}
+
+/// The period of a steady speed curve ([`steady_speed`]) sampled at `fps`, in BPM: the
+/// highest positive peak of the normalised autocorrelation between [`MAX_BPM`] and half
+/// [`MIN_BPM`], weighted by the log-normal prior centred on `prior_bpm` (module docs; a curve
+/// shorter than two of the slowest periods is searched down to the slowest it holds twice);
+/// `None` when the curve is constant, holds no two periods of the fastest tempo, or has no
+/// positive peak.
+fn beat_tempo(steady: &[f64], fps: f64, prior_bpm: f64) -> Option<f64> {
+    let n = steady.len();
+    let min_lag = (fps * 60.0 / MAX_BPM).floor().max(2.0) as usize;
+    let max_lag = ((fps * 120.0 / MIN_BPM).ceil() as usize).min(n.saturating_sub(2) / 2);
+    if max_lag < min_lag + 1 {
         return None;
     }
-    let mean = speed.iter().sum::<f64>() / n as f64;
-    let c: Vec<f64> = speed.iter().map(|v| v - mean).collect();
+    let mean = steady.iter().sum::<f64>() / n as f64;
+    let c: Vec<f64> = steady.iter().map(|v| v - mean).collect();
     let var = c.iter().map(|x| x * x).sum::<f64>() / n as f64;
     if var <= 1e-12 {
         return None;
@@ -212,7 +281,7 @@ fn beat_tempo(speed: &[f64], fps: f64) -> Option<f64> {
     // The highest local maximum inside the range, weighted by the tempo prior.
     let prior = |k: usize| -> f64 {
         let bpm = 60.0 * fps / (min_lag - 1 + k) as f64;
-        (-0.5 * (bpm / PRIOR_BPM).log2().powi(2)).exp()
+        (-0.5 * (bpm / prior_bpm).log2().powi(2)).exp()
     };
     let mut best: Option<(usize, f64)> = None;
     for k in 1..rs.len() - 1 {
@@ -237,17 +306,24 @@ fn beat_tempo(speed: &[f64], fps: f64) -> Option<f64> {
     Some(60.0 * fps / lag)
 }
 
-/// The kinematic tempo of a speed curve sampled at `fps`, in BPM: its beat ([`beat_tempo`],
-/// between [`MIN_BPM`] and [`MAX_BPM`]); with the song's tempo `music_bpm`, the octave level
-/// of it (the beat × 2^k) nearest the song's tempo in log scale (|log2(tempo / music_bpm)|
-/// least) between [`LEVEL_BPM`]. A motion that repeats every beat repeats every two beats,
-/// and a beat halved still has the motion's own beats on every other count, so every level is
-/// a metrical level of the motion; the one nearest the song's makes its bars as long as the
-/// song's, so it is danced at its own speed (a bar of 5.9 s danced in 2 s would be three
-/// times as fast). `None` as [`beat_tempo`].
+/// The kinematic tempo of a speed curve sampled at `fps`, in BPM: the period of its steady curve
+/// ([`steady_speed`], [`beat_tempo`], the prior centred on the song's tempo `music_bpm` when
+/// given, else on [`PRIOR_BPM`]); with the song, the octave level of it (the period × 2^k)
+/// nearest the song's tempo in log scale (|log2(tempo / music_bpm)| least) between
+/// [`LEVEL_BPM`]; without, the period, doubled when slower than [`MIN_BPM`]. A motion that
+/// repeats every beat repeats every two beats, and a beat halved still has the motion's own
+/// beats on every other count, so every level is a metrical level of the motion; the one
+/// nearest the song's makes its bars as long as the song's, so it is danced at its own speed
+/// (a bar of 5.9 s danced in 2 s would be three times as fast). `None` as [`beat_tempo`].
 pub fn kinematic_tempo(speed: &[f64], fps: f64, music_bpm: Option<f64>) -> Option<f64> {
-    let beat = beat_tempo(speed, fps)?;
-    let Some(music) = music_bpm.filter(|m| m.is_finite() && *m > 0.0) else {
+    let music = music_bpm.filter(|m| m.is_finite() && *m > 0.0);
+    let period = beat_tempo(&steady_speed(speed, fps), fps, music.unwrap_or(PRIOR_BPM))?;
+    let beat = if period < MIN_BPM {
+        2.0 * period
+    } else {
+        period
+    };
+    let Some(music) = music else {
         return Some(beat);
     };
     let level = (-3..=3)
@@ -291,7 +367,8 @@ pub fn kinematic_first_beat(speed: &[f64], fps: f64, tempo_bpm: f64) -> f64 {
     best.0 / fps
 }
 
-/// The kinematic beat of a motion (tempo by autocorrelation, first beat by speed minima); with
+/// The kinematic beat of a motion (tempo by autocorrelation, first beat by the minima of the
+/// steady speed, module docs); with
 /// the song's tempo `music_bpm`, the octave level nearest it ([`kinematic_tempo`]).
 pub fn kinematic_beat(
     clip: &ModelClip,
@@ -305,16 +382,16 @@ pub fn kinematic_beat(
         message: format!(
             "no kinematic tempo between {MIN_BPM} and {MAX_BPM} BPM: the autocorrelation of the \
              speed curve has no positive peak there (no regular speed minima), or the motion is \
-             still or shorter than {:.1} s ({} frames at {:.1} fps); give tempo_bpm and \
-             first_beat_s in a manifest",
-            2.0 * 60.0 / MIN_BPM,
+             still or shorter than {:.1} s, two beats at {MAX_BPM} BPM ({} frames at {:.1} fps); \
+             give tempo_bpm and first_beat_s in a manifest",
+            2.0 * 60.0 / MAX_BPM,
             speed.len(),
             fps
         ),
     })?;
     Ok(Beat {
         tempo_bpm,
-        first_beat_s: kinematic_first_beat(&speed, fps, tempo_bpm),
+        first_beat_s: kinematic_first_beat(&steady_speed(&speed, fps), fps, tempo_bpm),
         source: if music_bpm.is_some() {
             TempoSource::KinematicMatched
         } else {
@@ -635,6 +712,75 @@ mod tests {
     }
 
     #[test]
+    fn slow_and_fast_dances_keep_their_beat() {
+        // 42 and 48 BPM were below the former 60 BPM floor.
+        for bpm in [42.0, 48.0] {
+            let s = beat_curve(bpm, 0.13, 120.0, 30.0);
+            let t = kinematic_tempo(&s, 120.0, None).unwrap();
+            assert!((t / bpm - 1.0).abs() < 0.01, "{bpm}: {t}");
+        }
+        // 190 BPM, above the former 180 ceiling: with its accent on every other beat the prior
+        // takes the two-beat level alone; a song near it takes the beat itself.
+        let s = beat_curve(190.0, 0.13, 120.0, 30.0);
+        let alone = kinematic_tempo(&s, 120.0, None).unwrap();
+        assert!((alone / 95.0 - 1.0).abs() < 0.01, "{alone}");
+        let matched = kinematic_tempo(&s, 120.0, Some(185.0)).unwrap();
+        assert!((matched / 190.0 - 1.0).abs() < 0.01, "{matched}");
+    }
+
+    #[test]
+    fn a_pose_jump_does_not_hide_the_beat() {
+        // A rest pose in the first frame: every joint jumps at once, 400 times the median speed.
+        let bpm = 97.3;
+        let mut s = beat_curve(bpm, 0.3, 120.0, 20.0);
+        s[0] = 600.0;
+        s[1] = 250.0;
+        let steady = steady_speed(&s, 120.0);
+        assert!(steady[0] < 10.0, "clipped: {}", steady[0]);
+        let t = kinematic_tempo(&s, 120.0, None).unwrap();
+        assert!((t / bpm - 1.0).abs() < 0.01, "{t}");
+        let f = kinematic_first_beat(&steady, 120.0, t);
+        assert!((f - 0.3).abs() < 0.02, "{f}");
+    }
+
+    #[test]
+    fn a_dance_that_speeds_up_keeps_its_beat() {
+        // The beat's depth and the mean speed both triple over the clip.
+        let (bpm, fps) = (71.0, 120.0);
+        let s: Vec<f64> = beat_curve(bpm, 0.0, fps, 40.0)
+            .iter()
+            .enumerate()
+            .map(|(f, v)| {
+                let g = 1.0 + 2.0 * f as f64 / (40.0 * fps);
+                v * g + 3.0 * g
+            })
+            .collect();
+        let t = kinematic_tempo(&s, fps, None).unwrap();
+        assert!((t / bpm - 1.0).abs() < 0.01, "{t}");
+        // Taking off a linear drift leaves the beat whole: in the middle third, the steady curve
+        // (more than 3σ from either end) is the beat less its mean to within 1 % of its swing.
+        let beat = beat_curve(bpm, 0.0, fps, 80.0);
+        let mean = beat.iter().sum::<f64>() / beat.len() as f64;
+        let drifting: Vec<f64> = (0..beat.len()).map(|f| beat[f] + 0.01 * f as f64).collect();
+        let steady = steady_speed(&drifting, fps);
+        let n = beat.len();
+        for f in n / 3..2 * n / 3 {
+            assert!(
+                (steady[f] - (beat[f] - mean)).abs() < 0.01 * 2.3,
+                "frame {f}"
+            );
+        }
+    }
+
+    #[test]
+    fn a_clip_of_a_few_beats_is_searched_at_the_tempi_it_holds() {
+        // 2.5 s: two beats at 60 BPM or faster, not at 40.
+        let s = beat_curve(150.0, 0.1, 120.0, 2.5);
+        let t = kinematic_tempo(&s, 120.0, None).unwrap();
+        assert!((t / 150.0 - 1.0).abs() < 0.02, "{t}");
+    }
+
+    #[test]
     fn a_song_takes_the_octave_level_of_the_beat_nearest_its_tempo() {
         let fps = 100.0;
         let near = |t: Option<f64>, bpm: f64| t.is_some_and(|t| (t / bpm - 1.0).abs() < 0.01);
@@ -666,5 +812,14 @@ mod tests {
     fn a_still_motion_has_no_tempo() {
         assert_eq!(kinematic_tempo(&[1.0; 2000], 120.0, None), None);
         assert_eq!(kinematic_tempo(&[1.0, 2.0], 120.0, None), None);
+        // Still more than half the time (a keyframed clip holding its poses): no glitch can be
+        // told, nothing is clipped, and the moves keep their beat.
+        let held: Vec<f64> = beat_curve(90.0, 0.0, 120.0, 20.0)
+            .iter()
+            .map(|v| (v - 1.8).max(0.0))
+            .collect();
+        assert!(held.iter().filter(|v| **v == 0.0).count() > held.len() / 2);
+        let t = kinematic_tempo(&held, 120.0, None).unwrap();
+        assert!((t / 90.0 - 1.0).abs() < 0.01, "{t}");
     }
 }
