@@ -70,7 +70,10 @@ fn bench(c: &mut Criterion) {
     let a = fill_dijkstra_with_table(&db, &table, &music, &pins, &p).unwrap();
     let b = fill_with_table(&db, &table, &music, &pins, &p).unwrap();
     assert_eq!(a, b, "Dijkstra and the DP agree");
-    eprintln!("64 bars: total cost {:.4}", a.total_cost);
+    eprintln!(
+        "64 bars: total cost {:.4}, κ taken {} of {} (seam budget {:?})",
+        a.total_cost, a.intensity_weight, p.intensity_weight, p.seam_budget
+    );
     let mut g = c.benchmark_group("choreo_fill");
     g.sample_size(10);
     g.bench_function("transition_table_2000", |bch| {

@@ -203,4 +203,57 @@ fn the_music_term_makes_the_fill_follow_the_music_and_zero_is_the_paper_s_fill()
     };
     let e = fill(&db, &music, &pins, &neg).unwrap_err().to_string();
     assert!(e.contains("intensity_weight"), "{e}");
+    let tight = FillParams {
+        seam_budget: Some(0.9),
+        ..FillParams::default()
+    };
+    let e = fill(&db, &music, &pins, &tight).unwrap_err().to_string();
+    assert!(e.contains("seam_budget is 0.9"), "{e}");
+}
+
+/// The seam budget: the default fill takes the largest κ of the halving ladder whose Σ C stays
+/// within 1.2× the paper's fill's, and the next κ up would break it; without a budget κ is
+/// taken as given, and a budget of 1 keeps the paper's seam cost.
+#[test]
+fn the_seam_budget_takes_the_largest_kappa_whose_seams_stay_within_it() {
+    use marionette::choreo::fill::{BUDGET_HALVINGS, DEFAULT_SEAM_BUDGET};
+    use marionette::choreo::relevance::percentile_ranks;
+    let db = generated_database(21, 6, 8).unwrap();
+    let bars = 24;
+    let loudness: Vec<f64> = (0..bars)
+        .map(|k| (k as f64 * 0.7).sin() + 0.01 * k as f64)
+        .collect();
+    let music = percentile_ranks(&loudness);
+    let pins = Pins::from([(3, 5)]);
+    let paper = fill(&db, &music, &pins, &FillParams::paper()).unwrap();
+    let p = FillParams::default();
+    let f = fill(&db, &music, &pins, &p).unwrap();
+    assert_eq!(f, fill_dijkstra(&db, &music, &pins, &p).unwrap());
+    let kappa = f.intensity_weight;
+    eprintln!(
+        "κ taken {kappa} of {}; Σ C {:.4} against the paper's {:.4}",
+        p.intensity_weight, f.total_cost, paper.total_cost
+    );
+    assert!(f.total_cost <= DEFAULT_SEAM_BUDGET * paper.total_cost);
+    let fixed = |kappa: f64| FillParams {
+        intensity_weight: kappa,
+        seam_budget: None,
+        ..FillParams::default()
+    };
+    // The κ taken is on the ladder, its fill the fixed-κ fill, and the rung above breaks the
+    // budget.
+    let rung = (p.intensity_weight / kappa).log2();
+    assert!(kappa > 0.0 && rung.fract() == 0.0 && rung <= BUDGET_HALVINGS as f64);
+    assert_eq!(f, fill(&db, &music, &pins, &fixed(kappa)).unwrap());
+    if kappa < p.intensity_weight {
+        let above = fill(&db, &music, &pins, &fixed(2.0 * kappa)).unwrap();
+        assert!(above.total_cost > DEFAULT_SEAM_BUDGET * paper.total_cost);
+    }
+    // A budget of 1: the seams cost what the paper's do.
+    let strict = FillParams {
+        seam_budget: Some(1.0),
+        ..FillParams::default()
+    };
+    let s = fill(&db, &music, &pins, &strict).unwrap();
+    assert!(s.total_cost <= paper.total_cost);
 }

@@ -4,7 +4,9 @@
 //! costs Σ_k C(s_k → s_{k+1}) + λ Σ_k |p_music(k) − p_motion(s_k)|, the two intensities as
 //! percentile ranks ([`super::relevance`]) and λ = κ·c̄ in units of the database's typical seam
 //! cost c̄ ([`FillParams::intensity_weight`]), so that a loud bar takes an intense segment and a
-//! quiet one a calm segment. λ = 0 ([`FillParams::paper`]) is the paper's fill. The music term
+//! quiet one a calm segment. λ = 0 ([`FillParams::paper`]) is the paper's fill. By default κ is
+//! the largest of a halving ladder whose path keeps Σ C within a budget of the paper's fill's
+//! ([`FillParams::seam_budget`]: the music may roughen the seams by so much and no more). The music term
 //! is a weight on the nodes (bar k, segment s): both algorithms below add it where a path
 //! enters a node, so they stay exact.
 //!
@@ -65,18 +67,36 @@ pub struct FillParams {
     /// ([`super::relevance`]), with λ = κ·c̄, c̄ the database's typical seam cost
     /// ([`TransitionTable::typical_cost`]): a bar whose segment is the whole rank range off
     /// its music costs κ good seams, whatever the database's scale of C. 0 is the paper's fill
-    /// (connection alone); the default [`DEFAULT_INTENSITY_WEIGHT`] makes loud bars take intense
-    /// segments.
+    /// (connection alone). With a [`FillParams::seam_budget`] it is the largest κ tried; the
+    /// default is [`DEFAULT_INTENSITY_WEIGHT`].
     #[serde(default = "default_intensity_weight")]
     pub intensity_weight: f64,
+    /// How much rougher than the paper's the seams may be for the music's sake: with `Some(b)`
+    /// the fill takes the largest κ of `intensity_weight` · 2^−j (j = 0 … [`BUDGET_HALVINGS`])
+    /// whose path's Σ C is at most b times the paper's fill's (κ = 0) through the same pins,
+    /// else the paper's fill; the κ taken is [`Fill::intensity_weight`]. `None`: κ =
+    /// `intensity_weight` as given. At least 1 (the paper's fill is the cheapest); default
+    /// [`DEFAULT_SEAM_BUDGET`].
+    #[serde(default = "default_seam_budget")]
+    pub seam_budget: Option<f64>,
 }
 
-/// The default κ of [`FillParams::intensity_weight`], from a sweep of κ = 0, ¼, ½ on the two
-/// tuning dances (the project's own `scenes/dance.ron` and the shared salsa scene): at ½ the
-/// intensity Spearman of the filled bars rises from 0.11 and −0.36 to 0.68 and 0.79, the seams'
-/// transition cost Σ C is 1.02× and 1.03× the paper's fill and their mean jerk 1.01× and
-/// 1.26×; at ¼ the jerk stays within 1.15× but the Spearman is 0.59 and 0.57.
-pub const DEFAULT_INTENSITY_WEIGHT: f64 = 0.5;
+/// The default largest κ of [`FillParams::intensity_weight`]: a bar whose segment is the whole
+/// rank range off its music costs two good seams. The seam budget lowers it where the
+/// database's seams cannot follow the music so cheaply.
+pub const DEFAULT_INTENSITY_WEIGHT: f64 = 2.0;
+
+/// The default [`FillParams::seam_budget`]: the music may make the seams' Σ C at most 1.2 times
+/// the paper's fill's.
+pub const DEFAULT_SEAM_BUDGET: f64 = 1.2;
+
+/// Halvings of κ the seam budget tries after the largest (κ down to 1/64 of it) before it
+/// takes the paper's fill.
+pub const BUDGET_HALVINGS: i32 = 6;
+
+fn default_seam_budget() -> Option<f64> {
+    Some(DEFAULT_SEAM_BUDGET)
+}
 
 fn default_intensity_weight() -> f64 {
     DEFAULT_INTENSITY_WEIGHT
@@ -87,12 +107,14 @@ fn yes() -> bool {
 }
 
 impl Default for FillParams {
-    /// Unit link weights, no adjacent repeat, κ = [`DEFAULT_INTENSITY_WEIGHT`].
+    /// Unit link weights, no adjacent repeat, κ up to [`DEFAULT_INTENSITY_WEIGHT`] within the
+    /// seam budget [`DEFAULT_SEAM_BUDGET`].
     fn default() -> FillParams {
         FillParams {
             transition: TransitionParams::default(),
             no_adjacent_repeat: true,
             intensity_weight: DEFAULT_INTENSITY_WEIGHT,
+            seam_budget: Some(DEFAULT_SEAM_BUDGET),
         }
     }
 }
@@ -120,6 +142,10 @@ pub struct Fill {
     /// from the music's, in percentile ranks (the path's cost is total_cost + λ times this).
     #[serde(default)]
     pub intensity_mismatch: f64,
+    /// The κ the path was found with ([`FillParams::intensity_weight`], lowered by the seam
+    /// budget where it had to be; 0 for the paper's fill).
+    #[serde(default)]
+    pub intensity_weight: f64,
 }
 
 /// Why bars could not be filled.
@@ -256,7 +282,8 @@ pub fn fill_dijkstra_with_table(
     solve(db, table, music, pins, p, |g| g.dijkstra())
 }
 
-/// Checks, builds the graph, finds the path with `path_of`.
+/// Checks, then finds the path with `path_of`: at κ = `p.intensity_weight`, or within the seam
+/// budget ([`FillParams::seam_budget`]) at the largest κ of the halving ladder that keeps it.
 fn solve(
     db: &Database,
     table: &TransitionTable,
@@ -272,10 +299,18 @@ fn solve(
             segments: db.segments.len(),
         });
     }
-    let lambda = p.intensity_weight;
-    if !(lambda.is_finite() && lambda >= 0.0) {
+    let kappa = p.intensity_weight;
+    if !(kappa.is_finite() && kappa >= 0.0) {
         return Err(FillError::Intensity {
-            message: format!("fill.intensity_weight is {lambda}: expected a number ≥ 0"),
+            message: format!("fill.intensity_weight is {kappa}: expected a number ≥ 0"),
+        });
+    }
+    if let Some(b) = p.seam_budget.filter(|b| !(b.is_finite() && *b >= 1.0)) {
+        return Err(FillError::Intensity {
+            message: format!(
+                "fill.seam_budget is {b}: expected a number ≥ 1 (the paper's fill is the \
+                 cheapest), or None"
+            ),
         });
     }
     if let Some((k, v)) = music
@@ -290,16 +325,33 @@ fn solve(
         });
     }
     let motion = relevance::motion_intensity(db);
-    let mut g = Graph::new(table, music.len(), pins, p.no_adjacent_repeat);
-    if lambda > 0.0 {
-        g.music = Some(Music {
-            music,
-            motion: &motion,
-            lambda: lambda * table.typical_cost,
-        });
+    let at = |kappa: f64| -> Result<Fill, FillError> {
+        let mut g = Graph::new(table, music.len(), pins, p.no_adjacent_repeat);
+        if kappa > 0.0 {
+            g.music = Some(Music {
+                music,
+                motion: &motion,
+                lambda: kappa * table.typical_cost,
+            });
+        }
+        let path = path_of(&g).ok_or(FillError::NoPath { segments: table.n })?;
+        let mut f = finish(db, path, &p.transition, music, &motion);
+        f.intensity_weight = kappa;
+        Ok(f)
+    };
+    let Some(budget) = p.seam_budget.filter(|_| kappa > 0.0) else {
+        return at(kappa);
+    };
+    // Σ C of the optimum never falls as κ grows (the parametric optimum of C + λM), so the
+    // first κ from the top that keeps the budget is the largest of the ladder that does.
+    let paper = at(0.0)?;
+    for j in 0..=BUDGET_HALVINGS {
+        let f = at(kappa * 2f64.powi(-j))?;
+        if f.total_cost <= budget * paper.total_cost {
+            return Ok(f);
+        }
     }
-    let path = path_of(&g).ok_or(FillError::NoPath { segments: table.n })?;
-    Ok(finish(db, path, &p.transition, music, &motion))
+    Ok(paper)
 }
 
 /// The fill of a path: its connections and their summed cost, and its intensity mismatch.
@@ -324,6 +376,7 @@ fn finish(
         connections,
         total_cost,
         intensity_mismatch,
+        intensity_weight: 0.0,
     }
 }
 
