@@ -85,6 +85,15 @@ fn bench(c: &mut Criterion) {
     g.bench_function("fill_with_table_64x2000", |bch| {
         bch.iter(|| black_box(fill_with_table(&db, &table, &music, &pins, &p).unwrap()))
     });
+    // The same fill at κ as given (no seam budget): one DP instead of the paper's and the top
+    // rung's together.
+    let fixed = FillParams {
+        seam_budget: None,
+        ..p.clone()
+    };
+    g.bench_function("fill_with_table_64x2000_fixed_kappa", |bch| {
+        bch.iter(|| black_box(fill_with_table(&db, &table, &music, &pins, &fixed).unwrap()))
+    });
     g.bench_function("fill_dijkstra_with_table_64x2000", |bch| {
         bch.iter(|| black_box(fill_dijkstra_with_table(&db, &table, &music, &pins, &p).unwrap()))
     });

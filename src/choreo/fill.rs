@@ -254,7 +254,7 @@ pub fn fill_with_table(
     pins: &Pins,
     p: &FillParams,
 ) -> Result<Fill, FillError> {
-    solve(db, table, music, pins, p, |g| g.dp())
+    solve(db, table, music, pins, p, dp_many)
 }
 
 /// The same fill by Dijkstra's algorithm (module docs), building the transition table first:
@@ -279,10 +279,12 @@ pub fn fill_dijkstra_with_table(
     pins: &Pins,
     p: &FillParams,
 ) -> Result<Fill, FillError> {
-    solve(db, table, music, pins, p, |g| g.dijkstra())
+    solve(db, table, music, pins, p, |gs| {
+        gs.iter().map(|g| g.dijkstra()).collect()
+    })
 }
 
-/// Checks, then finds the path with `path_of`: at κ = `p.intensity_weight`, or within the seam
+/// Checks, then finds the path with `paths_of` (the paths of several graphs on one table): at κ = `p.intensity_weight`, or within the seam
 /// budget ([`FillParams::seam_budget`]) at the largest κ of the halving ladder that keeps it.
 fn solve(
     db: &Database,
@@ -290,7 +292,7 @@ fn solve(
     music: &[f64],
     pins: &Pins,
     p: &FillParams,
-    path_of: fn(&Graph<'_>) -> Option<Vec<usize>>,
+    paths_of: fn(&[&Graph<'_>]) -> Vec<Option<Vec<usize>>>,
 ) -> Result<Fill, FillError> {
     check(db.segments.len(), music.len(), pins)?;
     if table.n != db.segments.len() {
@@ -325,7 +327,7 @@ fn solve(
         });
     }
     let motion = relevance::motion_intensity(db);
-    let at = |kappa: f64| -> Result<Fill, FillError> {
+    let graph = |kappa: f64| {
         let mut g = Graph::new(table, music.len(), pins, p.no_adjacent_repeat);
         if kappa > 0.0 {
             g.music = Some(Music {
@@ -334,20 +336,39 @@ fn solve(
                 lambda: kappa * table.typical_cost,
             });
         }
-        let path = path_of(&g).ok_or(FillError::NoPath { segments: table.n })?;
-        let mut f = finish(db, path, &p.transition, music, &motion);
-        f.intensity_weight = kappa;
-        Ok(f)
+        g
+    };
+    // The fills at `kappas`, found together (one pass over the table for the DP).
+    let fills = |kappas: &[f64]| -> Result<Vec<Fill>, FillError> {
+        let graphs: Vec<Graph<'_>> = kappas.iter().map(|&k| graph(k)).collect();
+        let refs: Vec<&Graph<'_>> = graphs.iter().collect();
+        paths_of(&refs)
+            .into_iter()
+            .zip(kappas)
+            .map(|(path, &kappa)| {
+                let path = path.ok_or(FillError::NoPath { segments: table.n })?;
+                let mut f = finish(db, path, &p.transition, music, &motion);
+                f.intensity_weight = kappa;
+                Ok(f)
+            })
+            .collect()
     };
     let Some(budget) = p.seam_budget.filter(|_| kappa > 0.0) else {
-        return at(kappa);
+        return Ok(fills(&[kappa])?.remove(0));
     };
     // Σ C of the optimum never falls as κ grows (the parametric optimum of C + λM), so the
-    // first κ from the top that keeps the budget is the largest of the ladder that does.
-    let paper = at(0.0)?;
-    for j in 0..=BUDGET_HALVINGS {
-        let f = at(kappa * 2f64.powi(-j))?;
-        if f.total_cost <= budget * paper.total_cost {
+    // first κ from the top that keeps the budget is the largest of the ladder that does. The
+    // paper's fill and the top rung are found together.
+    let mut both = fills(&[0.0, kappa])?;
+    let top = both.pop().expect("two fills");
+    let paper = both.pop().expect("two fills");
+    let within = |f: &Fill| f.total_cost <= budget * paper.total_cost;
+    if within(&top) {
+        return Ok(top);
+    }
+    for j in 1..=BUDGET_HALVINGS {
+        let f = fills(&[kappa * 2f64.powi(-j)])?.remove(0);
+        if within(&f) {
             return Ok(f);
         }
     }
@@ -578,84 +599,10 @@ impl<'a> Graph<'a> {
         self.joined(self.runs().into_iter().map(|r| self.run(r).dijkstra_run()))
     }
 
-    /// The exact dynamic programme (module docs) on every run at once; `None` without a path.
-    /// Round j advances layer j of every run still going: the free layers of all runs are
-    /// computed in one pass over the table's columns, so each column is read once per round
-    /// however many runs use it.
+    /// The exact dynamic programme (module docs) on every run; `None` without a path.
+    #[cfg(test)]
     fn dp(&self) -> Option<Vec<usize>> {
-        let n = self.table.n;
-        let runs: Vec<Graph<'a>> = self.runs().into_iter().map(|r| self.run(r)).collect();
-        // D_k(s) of every layer of every run, row-major: the backtrack recovers the
-        // predecessors.
-        let mut dist: Vec<Vec<f64>> = runs
-            .iter()
-            .map(|g| {
-                let mut d = vec![f64::INFINITY; n * g.bars];
-                for (s, v) in d[..n].iter_mut().enumerate() {
-                    if g.allowed(0, s) {
-                        *v = g.node(0, s);
-                    }
-                }
-                d
-            })
-            .collect();
-        let rounds = runs.iter().map(|g| g.bars).max().unwrap_or(1) - 1;
-        let mut free = Vec::new();
-        let mut block = Vec::new();
-        for k in 0..rounds {
-            free.clear();
-            for (r, g) in runs.iter().enumerate() {
-                if k + 1 >= g.bars {
-                    continue;
-                }
-                let (done, rest) = dist[r].split_at_mut((k + 1) * n);
-                let d = &done[k * n..];
-                let next = &mut rest[..n];
-                match (g.pin[k], g.pin[k + 1]) {
-                    (_, Some(b)) => next[b] = g.column_min(k, d, b) + g.node(k + 1, b),
-                    (Some(a), None) => {
-                        let row = self.table.row(a);
-                        for (b, nb) in next.iter_mut().enumerate() {
-                            if g.edge(k, a, b) {
-                                *nb = d[a] + f64::from(row[b]) + g.node(k + 1, b);
-                            }
-                        }
-                    }
-                    (None, None) => free.push(r),
-                }
-            }
-            if free.is_empty() {
-                continue;
-            }
-            // The free layers: column b of every such run side by side in `block`.
-            let m = free.len();
-            block.clear();
-            block.resize(n * m, f64::INFINITY);
-            {
-                use rayon::prelude::*;
-                let (runs, dist, free) = (&runs, &dist, &free);
-                block
-                    .par_chunks_mut(DP_COLUMNS * m)
-                    .enumerate()
-                    .for_each(|(c, out)| {
-                        for (j, o) in out.chunks_exact_mut(m).enumerate() {
-                            let b = c * DP_COLUMNS + j;
-                            for (o, &r) in o.iter_mut().zip(free) {
-                                let g = &runs[r];
-                                *o = g.column_min(k, &dist[r][k * n..(k + 1) * n], b)
-                                    + g.node(k + 1, b);
-                            }
-                        }
-                    });
-            }
-            for (i, &r) in free.iter().enumerate() {
-                let next = &mut dist[r][(k + 1) * n..(k + 2) * n];
-                for (b, v) in next.iter_mut().enumerate() {
-                    *v = block[b * m + i];
-                }
-            }
-        }
-        self.joined(runs.iter().zip(&dist).map(|(g, d)| g.backtrack(d)))
+        dp_many(&[self]).pop().flatten()
     }
 
     /// The path of a run from its layers' D (row-major): the end of smallest total (smallest
@@ -698,6 +645,98 @@ impl<'a> Graph<'a> {
             min_plus(&d[..b], &col[..b]).min(min_plus(&d[b + 1..], &col[b + 1..]))
         }
     }
+}
+
+/// The exact dynamic programme on every run of every graph of `graphs` (on one table) at
+/// once, a path (or `None`) per graph. Round j advances layer j of every run still going:
+/// the free layers of all runs are computed in one pass over the table's columns, so each
+/// column is read once per round however many runs and graphs use it.
+fn dp_many<'a>(graphs: &[&Graph<'a>]) -> Vec<Option<Vec<usize>>> {
+    let Some(first) = graphs.first() else {
+        return vec![];
+    };
+    let n = first.table.n;
+    let owner: Vec<(usize, Graph<'a>)> = graphs
+        .iter()
+        .enumerate()
+        .flat_map(|(i, g)| g.runs().into_iter().map(move |r| (i, g.run(r))))
+        .collect();
+    let runs: Vec<&Graph<'a>> = owner.iter().map(|(_, g)| g).collect();
+    // D_k(s) of every layer of every run, row-major: the backtrack recovers the
+    // predecessors.
+    let mut dist: Vec<Vec<f64>> = runs
+        .iter()
+        .map(|g| {
+            let mut d = vec![f64::INFINITY; n * g.bars];
+            for (s, v) in d[..n].iter_mut().enumerate() {
+                if g.allowed(0, s) {
+                    *v = g.node(0, s);
+                }
+            }
+            d
+        })
+        .collect();
+    let rounds = runs.iter().map(|g| g.bars).max().unwrap_or(1) - 1;
+    let mut free = Vec::new();
+    let mut block = Vec::new();
+    for k in 0..rounds {
+        free.clear();
+        for (r, g) in runs.iter().enumerate() {
+            if k + 1 >= g.bars {
+                continue;
+            }
+            let (done, rest) = dist[r].split_at_mut((k + 1) * n);
+            let d = &done[k * n..];
+            let next = &mut rest[..n];
+            match (g.pin[k], g.pin[k + 1]) {
+                (_, Some(b)) => next[b] = g.column_min(k, d, b) + g.node(k + 1, b),
+                (Some(a), None) => {
+                    let row = first.table.row(a);
+                    for (b, nb) in next.iter_mut().enumerate() {
+                        if g.edge(k, a, b) {
+                            *nb = d[a] + f64::from(row[b]) + g.node(k + 1, b);
+                        }
+                    }
+                }
+                (None, None) => free.push(r),
+            }
+        }
+        if free.is_empty() {
+            continue;
+        }
+        // The free layers: column b of every such run side by side in `block`.
+        let m = free.len();
+        block.clear();
+        block.resize(n * m, f64::INFINITY);
+        {
+            use rayon::prelude::*;
+            let (runs, dist, free) = (&runs, &dist, &free);
+            block
+                .par_chunks_mut(DP_COLUMNS * m)
+                .enumerate()
+                .for_each(|(c, out)| {
+                    for (j, o) in out.chunks_exact_mut(m).enumerate() {
+                        let b = c * DP_COLUMNS + j;
+                        for (o, &r) in o.iter_mut().zip(free) {
+                            let g = &runs[r];
+                            *o =
+                                g.column_min(k, &dist[r][k * n..(k + 1) * n], b) + g.node(k + 1, b);
+                        }
+                    }
+                });
+        }
+        for (i, &r) in free.iter().enumerate() {
+            let next = &mut dist[r][(k + 1) * n..(k + 2) * n];
+            for (b, v) in next.iter_mut().enumerate() {
+                *v = block[b * m + i];
+            }
+        }
+    }
+    let mut paths: Vec<Vec<Option<Vec<usize>>>> = vec![vec![]; graphs.len()];
+    for ((i, g), d) in owner.iter().zip(&dist) {
+        paths[*i].push(g.backtrack(d));
+    }
+    graphs.iter().zip(paths).map(|(g, p)| g.joined(p)).collect()
 }
 
 /// Columns per rayon task of the DP (each a minimum over a whole column).
