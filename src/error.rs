@@ -26,12 +26,18 @@ pub enum Error {
     /// Building the human body (height, mass, joints).
     #[error(transparent)]
     Body(#[from] crate::humanoid::body::HumanError),
+    /// A DOF without a row in the strength table.
+    #[error(transparent)]
+    Strength(#[from] crate::humanoid::strength::NoStrength),
     /// An articulated-body model description.
     #[error(transparent)]
     Dynamics(#[from] crate::dynamics::ModelError),
     /// A joint-space inertia matrix that is not positive definite.
     #[error(transparent)]
     Inertia(#[from] crate::dynamics::crba::NotPositiveDefinite),
+    /// Balancing a body on the floor (its static equilibrium).
+    #[error(transparent)]
+    Equilibrium(#[from] crate::dynamics::equilibrium::EquilibriumError),
     /// Motor primitives: learning, playing, blending, connecting, files.
     #[error(transparent)]
     Primitive(#[from] crate::primitive::PrimitiveError),
@@ -44,6 +50,27 @@ pub enum Error {
     /// A motor-primitive experiment (high jump, jumping knee kick).
     #[error(transparent)]
     Experiment(#[from] crate::experiments::high_jump::PrimitiveExperimentError),
+    /// Making a physical character (primitives, strength, tissue, settings).
+    #[error(transparent)]
+    Character(#[from] crate::ecs::character::CharacterError),
+    /// An active character's run.
+    #[error(transparent)]
+    Active(#[from] crate::experiments::active::ActiveError),
+    /// Gene bounds that are not a box.
+    #[error(transparent)]
+    Bounds(#[from] crate::evolve::genome::BoundsError),
+    /// The GA: its settings, its evaluator or its checkpoints.
+    #[error(transparent)]
+    Evolve(#[from] crate::evolve::EvolveError),
+    /// One evaluation of a genome.
+    #[error(transparent)]
+    Evaluation(#[from] crate::evolve::EvaluationError),
+    /// The falling paper's GA problem (its ranges, bounds, gain bounds).
+    #[error(transparent)]
+    FallProblem(#[from] crate::experiments::evolve_fall::ProblemError),
+    /// Evolving falls: the GA, its checkpoints, replaying the best falls.
+    #[error(transparent)]
+    EvolveFall(#[from] crate::experiments::evolve_fall::EvolveFallError),
     /// Decoding or analysing a song.
     #[error(transparent)]
     Music(#[from] crate::choreo::music::MusicError),
@@ -68,6 +95,12 @@ pub enum Error {
     /// Assembling a dance from segments at a song's bars.
     #[error(transparent)]
     Dance(#[from] crate::choreo::dance::DanceError),
+    /// Generating a dance (fill, then assembly).
+    #[error(transparent)]
+    Generate(#[from] crate::experiments::dance::GenerateError),
+    /// The authored dance clips (their parameters).
+    #[error(transparent)]
+    Authored(#[from] crate::choreo::authored::AuthoredError),
     /// The dance-editing paper's Fig. 5 experiment.
     #[error(transparent)]
     DanceFill(#[from] crate::experiments::dance_fill::DanceFillError),
@@ -116,5 +149,26 @@ mod tests {
             m.to_string(),
             "unknown model 'robot': expected one of humanoid24, fall21"
         );
+    }
+
+    fn bounds_then_evaluation(lo: f64) -> Result<f64> {
+        crate::evolve::Bounds::new(vec![lo], vec![1.0])?;
+        let evaluation: crate::evolve::Evaluation =
+            Err(crate::evolve::EvaluationError::NotEvaluated);
+        let damage = evaluation?;
+        Ok(damage)
+    }
+
+    #[test]
+    fn the_ga_errors_convert_too() {
+        let e = bounds_then_evaluation(2.0).unwrap_err();
+        assert!(matches!(e, Error::Bounds(_)), "{e:?}");
+        assert_eq!(
+            e.to_string(),
+            "gene 0: bounds [2, 1] are not a finite interval with lo ≤ hi"
+        );
+        let e = bounds_then_evaluation(0.0).unwrap_err();
+        assert!(matches!(e, Error::Evaluation(_)), "{e:?}");
+        assert_eq!(e.to_string(), "not evaluated");
     }
 }

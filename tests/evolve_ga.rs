@@ -6,11 +6,14 @@
 
 use std::process::Command;
 
+use marionette::dynamics::StepError;
 use marionette::evolve::evaluator::{Evaluation, par_map};
 use marionette::evolve::{
-    Bounds, Evaluator, GaConfig, GaState, Genome, InProcess, JsonLines, checkpoint,
+    Bounds, EvaluationError, Evaluator, Failure, GaConfig, GaState, Genome, InProcess, JsonLines,
+    checkpoint,
 };
 use marionette::experiments::evolve_fall::{FallProblem, InProcessFalls};
+use marionette::experiments::fall::SimError;
 use marionette::humanoid::ranges::AgeGroup;
 
 /// The sphere function Σ (x_i − 1)², its minimum 0 at x = 1.
@@ -152,7 +155,7 @@ fn the_elite_check_keeps_resolution_artefacts_from_winning() {
     let rejected: Vec<_> = honest
         .failures
         .iter()
-        .filter(|(_, _, why)| why.starts_with("elite check"))
+        .filter(|(_, _, why)| why.is_elite_check())
         .collect();
     assert!(!rejected.is_empty(), "the basin was never entered");
     assert_eq!(
@@ -185,6 +188,24 @@ fn the_elite_check_keeps_resolution_artefacts_from_winning() {
 
 fn logbook_json(s: &GaState) -> String {
     serde_json::to_string(&s.logbook).unwrap()
+}
+
+/// The fall's own error behind a failure, if it is one.
+fn sim_error(why: &Failure) -> Option<&SimError> {
+    match why {
+        Failure::Evaluation(EvaluationError::Problem(p)) => p.downcast_ref::<SimError>(),
+        _ => None,
+    }
+}
+
+/// The time (s) at which a fall's step went non-finite or ran away, if that is why it failed.
+fn runaway_time(why: &Failure) -> Option<f64> {
+    match sim_error(why)? {
+        SimError::Step(
+            StepError::NonFinite { time_s, .. } | StepError::Exploding { time_s, .. },
+        ) => Some(*time_s),
+        _ => None,
+    }
 }
 
 fn small_fall_problem() -> FallProblem {
@@ -281,7 +302,7 @@ fn the_json_lines_worker_gives_the_in_process_fitness_bit_for_bit() {
     for (a, b) in got.iter().zip(&expected) {
         match (a, b) {
             (Ok(x), Ok(y)) => assert_eq!(x.to_bits(), y.to_bits(), "{x} vs {y}"),
-            (Err(x), Err(y)) => assert_eq!(x, y),
+            (Err(x), Err(y)) => assert_eq!(x.to_string(), y.to_string()),
             _ => panic!("{a:?} vs {b:?}"),
         }
     }
@@ -316,10 +337,13 @@ fn a_run_with_diverging_individuals_completes_and_logs_them() {
     let (g, i, why) = s
         .failures
         .iter()
-        .find(|f| !f.2.starts_with("elite check"))
+        .find(|f| !f.2.is_elite_check())
         .expect("no individual diverged");
     assert!(
-        why.contains("stability") || why.contains("exploding") || why.contains("non-finite"),
+        matches!(
+            sim_error(why),
+            Some(SimError::Unstable { .. } | SimError::Step(_))
+        ),
         "generation {g}, individual {i}: {why}"
     );
     assert_eq!(
@@ -380,10 +404,10 @@ fn a_run_whose_individual_blows_up_mid_fall_completes_with_it_worst_and_logged()
     };
     let s = run_to_end(GaState::initial(cfg, bounds, &mut e).unwrap(), &mut e);
     assert_eq!(s.generation, 1);
-    let blown: Vec<&(u64, usize, String)> = s
+    let blown: Vec<(&Failure, f64)> = s
         .failures
         .iter()
-        .filter(|(_, _, why)| why.contains("exploding") || why.contains("non-finite"))
+        .filter_map(|(_, _, why)| Some((why, runaway_time(why)?)))
         .collect();
     assert!(
         !blown.is_empty(),
@@ -394,22 +418,13 @@ fn a_run_whose_individual_blows_up_mid_fall_completes_with_it_worst_and_logged()
     assert!(
         s.failures
             .iter()
-            .all(|(_, _, why)| !why.contains("stability")),
+            .all(|(_, _, why)| !matches!(sim_error(why), Some(SimError::Unstable { .. }))),
         "refused up front: {:?}",
         s.failures
     );
     // Mid-fall: after the push and the reaction began.
-    for (_, _, why) in &blown {
-        let t: f64 = why
-            .split("t = ")
-            .nth(1)
-            .unwrap()
-            .split(' ')
-            .next()
-            .unwrap()
-            .parse()
-            .unwrap();
-        assert!(t > p.fall.control_start_s, "{why}");
+    for (why, t) in &blown {
+        assert!(*t > p.fall.control_start_s, "{why}");
     }
     // The last generation's runaways rank below every fall that completed.
     let last: Vec<usize> = s
@@ -450,7 +465,7 @@ fn the_standing_start_kept_across_generations_gives_the_bits_of_settling_each_fa
         .map(|g| {
             marionette::experiments::fall::simulate_fall(&p.config(g))
                 .map(|r| r.damage)
-                .map_err(|e| e.to_string())
+                .map_err(|e| EvaluationError::Problem(std::sync::Arc::new(e).into()))
         })
         .collect();
     assert!(first.iter().all(|r| r.is_ok()), "{first:?}");
@@ -463,7 +478,7 @@ fn the_standing_start_kept_across_generations_gives_the_bits_of_settling_each_fa
             c.dt_s *= 0.5;
             marionette::experiments::fall::simulate_fall(&c)
                 .map(|r| r.damage)
-                .map_err(|e| e.to_string())
+                .map_err(|e| EvaluationError::Problem(std::sync::Arc::new(e).into()))
         })
         .collect();
     assert_eq!(half, half_each);
@@ -770,7 +785,10 @@ fn a_checkpoint_whose_lists_disagree_or_whose_state_is_impossible_is_refused_say
         ("outside its bounds", |s| s.population[2][1] = 1e308),
         ("generation", |s| s.generation = 1),
         ("best", |s| s.best.as_mut().unwrap().1 = -3.0),
-        ("failures", |s| s.failures.push((9, 0, "later".into()))),
+        ("failures", |s| {
+            s.failures
+                .push((9, 0, EvaluationError::Reported("later".into()).into()))
+        }),
     ];
     for (what, edit) in edits {
         let mut bad = s.clone();
@@ -811,7 +829,12 @@ fn a_logbook_holding_infinity_reads_back_from_its_checkpoint() {
 
 #[test]
 fn a_generation_of_failed_evaluations_stops_the_ga_naming_the_first_failures() {
-    let fails = |x: &[f64]| -> Evaluation { Err(format!("diverged at x0 = {}", x[0])) };
+    let fails = |x: &[f64]| -> Evaluation {
+        Err(EvaluationError::Reported(format!(
+            "diverged at x0 = {}",
+            x[0]
+        )))
+    };
     let mut e = InProcess {
         batch: |g: &[Genome], _refine: u32| par_map(g, fails),
     };
@@ -847,7 +870,9 @@ fn a_generation_of_failed_evaluations_stops_the_ga_naming_the_first_failures() {
             .all(|f| *f >= 0.0 && f.is_finite())
     );
     assert!(
-        s.failures.iter().any(|f| f.2.contains("negative")),
+        s.failures
+            .iter()
+            .any(|f| matches!(f.2, Failure::Evaluation(EvaluationError::NegativeDamage(_)))),
         "{:?}",
         s.failures
     );
@@ -929,7 +954,7 @@ impl Evaluator for FailingAfterStart {
             .iter()
             .map(|x| match generation {
                 0 => sphere(x),
-                g => Err(format!("generation {g} fails")),
+                g => Err(EvaluationError::Reported(format!("generation {g} fails"))),
             })
             .collect())
     }

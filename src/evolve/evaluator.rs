@@ -25,6 +25,7 @@ use std::time::{Duration, Instant};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use super::failure::EvaluationError;
 use super::genome::Genome;
 
 /// The protocol's name and version.
@@ -62,8 +63,8 @@ pub enum EvolveError {
     Stopped(String),
 }
 
-/// The result of one evaluation: the damage (lower is fitter) or why the simulation failed.
-pub type Evaluation = Result<f64, String>;
+/// The result of one evaluation: the damage (lower is fitter) or why it failed.
+pub type Evaluation = Result<f64, EvaluationError>;
 
 /// Computes the fitness of a generation's genomes, in order.
 pub trait Evaluator {
@@ -468,7 +469,7 @@ impl Evaluator for JsonLines {
                     )));
                 }
                 Reply::Damage(d) => (d.index, Ok(d.value)),
-                Reply::Error(e) => (e.index, Err(e.message)),
+                Reply::Error(e) => (e.index, Err(EvaluationError::from_message(&e.message))),
             };
             match out.get_mut(index) {
                 Some(slot @ None) => *slot = Some(r),
@@ -732,16 +733,19 @@ where
     let mut text = String::new();
     for ((index, _, _), r) in batch.iter().zip(results) {
         let index = *index;
-        let r = r.unwrap_or_else(|| Err("not evaluated".into()));
+        let r = r.unwrap_or(Err(EvaluationError::NotEvaluated));
         let reply = match r {
             Ok(value) if value.is_finite() && value >= 0.0 => {
                 Reply::Damage(DamageLine { index, value })
             }
             Ok(value) => Reply::Error(ErrorLine {
                 index,
-                message: format!("damage {value} is negative or not finite"),
+                message: EvaluationError::InvalidDamage(value).to_string(),
             }),
-            Err(message) => Reply::Error(ErrorLine { index, message }),
+            Err(e) => Reply::Error(ErrorLine {
+                index,
+                message: e.to_string(),
+            }),
         };
         text.push_str(&serde_json::to_string(&reply).map_err(|e| err(e.to_string()))?);
         text.push('\n');

@@ -15,6 +15,7 @@ use serde::{Deserialize, Serialize};
 
 use super::checkpoint::Consistent;
 use super::evaluator::{Evaluation, Evaluator, EvolveError};
+use super::failure::{EvaluationError, Failure};
 use super::genome::{Bounds, Genome};
 use super::logbook::GenerationRecord;
 use super::operators::{better, polynomial_mutation, sbx, tournament};
@@ -191,8 +192,9 @@ pub struct GaState {
     pub generation_checks: u64,
     /// One record per generation so far.
     pub logbook: Vec<GenerationRecord>,
-    /// Failed evaluations: (generation, index, why).
-    pub failures: Vec<(u64, usize, String)>,
+    /// Failed evaluations and rejected elite checks: (generation, index, why); in a
+    /// checkpoint, why is its message.
+    pub failures: Vec<(u64, usize, Failure)>,
     /// Why the GA stopped: a generation in which more than [`GaConfig::max_failed_share`] of
     /// the evaluations failed (the generation is closed; every later step refuses with this).
     #[serde(default)]
@@ -594,19 +596,11 @@ impl GaState {
             let r = results
                 .next()
                 .ok_or_else(|| EvolveError::Evaluator("fewer results than genomes".into()))?;
-            let f = match r {
-                Ok(d) if d.is_finite() && d >= 0.0 => Some(d),
-                Ok(d) => {
-                    let why = if d.is_finite() {
-                        format!("damage {d} is negative")
-                    } else {
-                        format!("damage {d} is not finite")
-                    };
-                    self.failures.push((self.generation, offset + k, why));
-                    None
-                }
+            let f = match r.and_then(|d| EvaluationError::of_damage(d).map_or(Ok(d), Err)) {
+                Ok(d) => Some(d),
                 Err(why) => {
-                    self.failures.push((self.generation, offset + k, why));
+                    self.failures
+                        .push((self.generation, offset + k, why.into()));
                     None
                 }
             };
@@ -626,7 +620,7 @@ impl GaState {
     /// Stops the GA ([`Self::stopped`]) if more than [`GaConfig::max_failed_share`] of this
     /// generation's `children` evaluations failed, naming the first three failures.
     fn stop_if_too_many_failed(&mut self, children: usize) {
-        let failed: Vec<&(u64, usize, String)> = self
+        let failed: Vec<&(u64, usize, Failure)> = self
             .failures
             .iter()
             .rev()
@@ -692,13 +686,12 @@ impl GaState {
                 continue;
             }
             let why = match r {
-                Ok(fine) => format!(
-                    "{ELITE_CHECK}: damage {d} at the problem's resolution, {fine} at \
-                     {ELITE_CHECK_REFINE}× it ({:+.1} %, tolerance {:.1} %)",
-                    100.0 * (fine - d) / d,
-                    100.0 * tol
-                ),
-                Err(e) => format!("{ELITE_CHECK}: at {ELITE_CHECK_REFINE}× the resolution: {e}"),
+                Ok(fine) => Failure::EliteCheckMoved {
+                    damage: d,
+                    fine,
+                    tolerance: tol,
+                },
+                Err(e) => Failure::EliteCheckFailed(e),
             };
             self.fitness[i] = None;
             self.failures.push((self.generation, i, why));

@@ -147,7 +147,7 @@ pub fn run_active_knee_kick(
         damage_weights: scene.damage_weights.clone(),
         record_hz: 60.0,
     };
-    let o = run_active(&config, &kk.sequence()).map_err(|e| SceneError::Invalid(e.to_string()))?;
+    let o = run_active(&config, &kk.sequence())?;
     write_bvh(&out.join("active_knee_kick.bvh"), &o.motion)?;
     let motions = draw(
         &[

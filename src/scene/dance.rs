@@ -142,32 +142,20 @@ pub fn validate_dance(s: &DanceScene) -> Result<(), SceneError> {
         let by_index = p.segment.is_some();
         let by_clip = p.clip.is_some() || p.clip_bar.is_some();
         if by_index == by_clip || (by_clip && (p.clip.is_none() || p.clip_bar.is_none())) {
-            return Err(SceneError::Invalid(format!(
-                "pins[{k}] (bar {}): give either segment: N, or clip: \"name\" with clip_bar: N",
-                p.bar
-            )));
+            return Err(SceneError::PinChoice { pin: k, bar: p.bar });
         }
         if let Some(j) = seen.insert(p.bar, k) {
-            return Err(SceneError::Invalid(format!(
-                "pins[{k}]: bar {} is pinned already by pins[{j}]",
-                p.bar
-            )));
+            return Err(SceneError::PinTwice {
+                pin: k,
+                bar: p.bar,
+                first: j,
+            });
         }
     }
     if s.bars == Some(0) {
-        return Err(SceneError::Invalid(
-            "bars is 0: expected at least one bar to dance (or leave it out for the whole song)"
-                .into(),
-        ));
+        return Err(SceneError::NoBars);
     }
-    let fps = s.render.gif_fps;
-    if s.render.gif && !(fps.is_finite() && fps > 0.0 && fps <= crate::render::MAX_GIF_FPS) {
-        return Err(SceneError::Invalid(format!(
-            "render.gif_fps is {fps}, expected more than 0 and at most {}",
-            crate::render::MAX_GIF_FPS
-        )));
-    }
-    Ok(())
+    super::check_gif_fps(s.render.gif, s.render.gif_fps)
 }
 
 /// The song: mono samples, rate, and the synthesized track's ground truth when there is one.
@@ -260,10 +248,7 @@ fn load_song(src: &SongSource, base: &Path) -> Result<Song, SceneError> {
                 })
             }
             #[cfg(not(feature = "audio"))]
-            Err(SceneError::Invalid(format!(
-                "{}: decoding songs needs the `audio` feature",
-                path.display()
-            )))
+            Err(SceneError::NoAudio(path.to_path_buf()))
         }
     }
 }
@@ -385,23 +370,25 @@ fn resolve_pins(pins: &[Pin], db: &Database) -> Result<Pins, SceneError> {
             (Some(i), _, _) => i,
             (None, Some(clip), Some(bar)) => {
                 let names: Vec<String> = db.sources.iter().map(|s| clip_name(&s.file)).collect();
-                let c = names.iter().position(|n| n == clip).ok_or_else(|| {
-                    SceneError::Invalid(format!(
-                        "pins[{k}] (bar {}): no clip '{clip}' in the database; its clips: {}",
-                        p.bar,
-                        names.join(", ")
-                    ))
-                })?;
+                let c =
+                    names
+                        .iter()
+                        .position(|n| n == clip)
+                        .ok_or_else(|| SceneError::PinClip {
+                            pin: k,
+                            bar: p.bar,
+                            clip: clip.clone(),
+                            clips: names.clone(),
+                        })?;
                 db.segments
                     .iter()
                     .position(|s| s.clip == c && s.bar == bar)
-                    .ok_or_else(|| {
-                        SceneError::Invalid(format!(
-                            "pins[{k}] (bar {}): clip '{clip}' has {} bars (0 to {}), not bar {bar}",
-                            p.bar,
-                            db.sources[c].segments,
-                            db.sources[c].segments.saturating_sub(1)
-                        ))
+                    .ok_or_else(|| SceneError::PinClipBar {
+                        pin: k,
+                        bar: p.bar,
+                        clip: clip.clone(),
+                        bars: db.sources[c].segments,
+                        clip_bar: bar,
                     })?
             }
             _ => unreachable!("validate_dance checks each pin names its segment"),
@@ -459,7 +446,7 @@ fn write_dance(
     write_output(&out.join("motion.bvh"), bvh.as_bytes())?;
     if matches!(scene.song, SongSource::Synth(_)) {
         let wav = crate::choreo::music::wav::wav_bytes(samples, 1, *sample_rate)
-            .ok_or_else(|| SceneError::Invalid("the song is too long for a WAV file".into()))?;
+            .ok_or(SceneError::SongTooLong)?;
         write_output(&out.join("song.wav"), &wav)?;
     }
 

@@ -116,15 +116,11 @@ pub struct EvolveFallScene {
     pub render: PrimitiveRender,
 }
 
-fn invalid(m: String) -> SceneError {
-    SceneError::Invalid(m)
-}
-
 impl EvolveFallScene {
     /// The experiment's configuration.
     pub fn config(&self) -> Result<EvolveConfig, SceneError> {
         if self.groups.is_empty() || self.seeds.is_empty() {
-            return Err(invalid("groups and seeds must not be empty".into()));
+            return Err(SceneError::NoRuns);
         }
         // A checkpoint holds one run per group and seed (checkpoint::Consistent).
         for (name, dup) in [
@@ -138,43 +134,45 @@ impl EvolveFallScene {
             ),
         ] {
             if dup {
-                return Err(invalid(format!(
-                    "{name} must not repeat an entry, found groups {:?}, seeds {:?}",
-                    self.groups, self.seeds
-                )));
+                return Err(SceneError::Repeated {
+                    field: name,
+                    groups: self.groups.clone(),
+                    seeds: self.seeds.clone(),
+                });
             }
         }
         if !(self.kp_max_scale.is_finite() && self.kp_max_scale > 0.0 && self.kp_max_scale <= 100.0)
         {
-            return Err(invalid(format!(
-                "kp_max_scale must be in (0, 100], found {}",
-                self.kp_max_scale
-            )));
+            return Err(SceneError::NotInRange {
+                field: "kp_max_scale",
+                range: "(0, 100]",
+                value: self.kp_max_scale,
+            });
         }
         if !(self.worker_timeout_s.is_finite()
             && self.worker_timeout_s > 0.0
             && self.worker_timeout_s <= 7.0 * 86_400.0)
         {
-            return Err(invalid(format!(
-                "worker_timeout_s must be in (0, 604800] seconds, found {}",
-                self.worker_timeout_s
-            )));
+            return Err(SceneError::NotInRange {
+                field: "worker_timeout_s",
+                range: "(0, 604800] seconds",
+                value: self.worker_timeout_s,
+            });
         }
         if !(self.step_margin.is_finite() && self.step_margin > 0.0 && self.step_margin <= 1.0) {
-            return Err(invalid(format!(
-                "step_margin must be in (0, 1], found {}",
-                self.step_margin
-            )));
+            return Err(SceneError::NotInRange {
+                field: "step_margin",
+                range: "(0, 1]",
+                value: self.step_margin,
+            });
         }
-        self.ga.validate().map_err(|e| invalid(e.to_string()))?;
+        self.ga.validate()?;
         let falls = self.groups.len() as u64
             * self.seeds.len() as u64
             * self.ga.population as u64
             * (self.ga.generations + 1);
         if falls > 100_000_000 {
-            return Err(invalid(format!(
-                "{falls} falls to simulate is past the limit of 100 000 000"
-            )));
+            return Err(SceneError::TooManyFalls(falls));
         }
         let problems = self
             .groups
@@ -188,7 +186,7 @@ impl EvolveFallScene {
                     p.fall.torque_limits_nm = Some(crate::humanoid::strength::torque_limits(g));
                     p.fall.stop_at_rest = true;
                 }
-                p.bounds().map_err(|e| invalid(e.to_string()))?;
+                p.bounds()?;
                 Ok(p)
             })
             .collect::<Result<Vec<_>, SceneError>>()?;
@@ -207,18 +205,12 @@ impl EvolveFallScene {
                 match &self.evaluator {
                     EvaluatorChoice::InProcess => Ok(Box::new(InProcessFalls::new(p.clone()))),
                     EvaluatorChoice::Command(argv) => {
-                        let (prog, args) = argv
-                            .split_first()
-                            .ok_or_else(|| invalid("evaluator: Command needs a program".into()))?;
+                        let (prog, args) = argv.split_first().ok_or(SceneError::NoProgram)?;
                         let mut c = Command::new(prog);
                         c.args(args);
-                        Ok(Box::new(
-                            JsonLines::start(c, p)
-                                .map_err(|e| invalid(e.to_string()))?
-                                .with_timeout(std::time::Duration::from_secs_f64(
-                                    self.worker_timeout_s,
-                                )),
-                        ))
+                        Ok(Box::new(JsonLines::start(c, p)?.with_timeout(
+                            std::time::Duration::from_secs_f64(self.worker_timeout_s),
+                        )))
                     }
                 }
             })
@@ -283,7 +275,7 @@ fn controller_ron(problem: &FallProblem, genes: &[f64]) -> Result<String, SceneE
         evolved_for: Some(problem.age_group),
     };
     let text = ron::ser::to_string_pretty(&controller, ron::ser::PrettyConfig::default())
-        .map_err(|e| invalid(format!("controller file: {e}")))?;
+        .map_err(SceneError::ControllerFile)?;
     Ok(format!(
         "// The evolved key pose and stiffness, for a Fall scene's controller_file. Evolved at \
          dt = {dt} s (dt_s), the step a Fall scene replays it at, with the floor's damping \
@@ -468,14 +460,11 @@ pub fn run_evolve(
     };
     let resumed: Option<Vec<EvolutionRun>> = match &scene.resume {
         Some(_) => {
-            let mut runs: Vec<EvolutionRun> =
-                checkpoint::load(&ck_dir).map_err(|e| invalid(e.to_string()))?;
-            halted(&runs).map_err(|e| invalid(e.to_string()))?;
-            resumable(&runs, &config).map_err(|why| {
-                invalid(format!(
-                    "resume: the checkpoint in {} was made with other settings: {why}",
-                    ck_dir.display()
-                ))
+            let mut runs: Vec<EvolutionRun> = checkpoint::load(&ck_dir)?;
+            halted(&runs)?;
+            resumable(&runs, &config).map_err(|why| SceneError::ResumeSettings {
+                dir: ck_dir.clone(),
+                why,
             })?;
             for r in &mut runs {
                 r.state.config.generations = config.ga.generations;
@@ -499,7 +488,8 @@ pub fn run_evolve(
     })
     .map_err(|e| match e {
         EvolveFallError::Fall(e) => SceneError::from(e),
-        e => invalid(e.to_string()),
+        EvolveFallError::Evolve(e) => SceneError::from(e),
+        e => SceneError::from(e),
     })?;
     let mut page = write_evolution(scene, &outcome, out)?;
     page.headline = headline(&config, &outcome);

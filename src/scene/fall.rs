@@ -161,9 +161,11 @@ fn override_per_dof(
             }
         }
         if !hit {
-            return Err(SceneError::Invalid(format!(
-                "controller.{field}: '{key}' is not a fall21 DOF (e.g. knee, left_knee, neck_flexion)"
-            )));
+            return Err(SceneError::UnknownName {
+                field: format!("controller.{field}"),
+                name: key.clone(),
+                expected: "a fall21 DOF (e.g. knee, left_knee, neck_flexion)".into(),
+            });
         }
     }
     Ok(())
@@ -187,13 +189,7 @@ impl FallScene {
         };
         match (self.simulation.dt, controller) {
             (Some(dt), Some((evolved, from))) if dt != evolved => {
-                Err(SceneError::Invalid(format!(
-                    "simulation.dt = {dt} s, but {from} gives the step the controller was \
-                     evolved at, dt_s = {evolved} s (its damage holds at that step): leave \
-                     simulation.dt out to replay it, or set controller.dt_s to run it at \
-                     another step (e.g. --set controller.dt_s={} for half the step)",
-                    evolved / 2.0
-                )))
+                Err(SceneError::StepMismatch { dt, evolved, from })
             }
             (Some(dt), _) => Ok(dt),
             (None, Some((evolved, _))) => Ok(evolved),
@@ -258,14 +254,18 @@ impl FallScene {
         }
         for (link, w) in &self.damage_weights {
             if !c.damage_weights.contains_key(link) {
-                return Err(SceneError::Invalid(format!(
-                    "damage_weights: '{link}' is not a fall21 link ({})",
-                    c.damage_weights
-                        .keys()
-                        .cloned()
-                        .collect::<Vec<_>>()
-                        .join(", ")
-                )));
+                return Err(SceneError::UnknownName {
+                    field: "damage_weights".into(),
+                    name: link.clone(),
+                    expected: format!(
+                        "a fall21 link ({})",
+                        c.damage_weights
+                            .keys()
+                            .cloned()
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    ),
+                });
             }
             c.damage_weights.insert(link.clone(), *w);
         }

@@ -61,8 +61,8 @@ pub enum Scene {
 }
 
 /// Why a scene could not be read or run. Module errors keep their own type (and message), so a
-/// runner writes `?`; [`SceneError::Invalid`] is for a scene value that is out of range or
-/// inconsistent.
+/// runner writes `?`; the other variants say what in the scene is out of range, unknown or
+/// inconsistent, with the values concerned.
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
     /// A file could not be read or written.
@@ -87,9 +87,269 @@ pub enum SceneError {
         /// Why it does not fit.
         message: String,
     },
-    /// A value that is out of range or inconsistent.
-    #[error("{0}")]
-    Invalid(String),
+    /// A number out of its range: the field, its value and what it should be.
+    #[error("{field} is {value}, expected {expected}")]
+    OutOfRange {
+        /// The field.
+        field: String,
+        /// Its value.
+        value: f64,
+        /// What it should be.
+        expected: String,
+    },
+    /// A number outside its interval: the field, the interval and the value.
+    #[error("{field} must be in {range}, found {value}")]
+    NotInRange {
+        /// The field.
+        field: &'static str,
+        /// The interval (with its unit).
+        range: &'static str,
+        /// Its value.
+        value: f64,
+    },
+    /// A filmstrip frame count outside 1 to [`MAX_FILMSTRIP_FRAMES`].
+    #[error("render.filmstrip_frames is {}, expected 1 to {}", .0, MAX_FILMSTRIP_FRAMES)]
+    FilmstripFrames(usize),
+    /// A name the field does not know: the field, the name and what it should be (with the
+    /// names it knows).
+    #[error("{field}: '{name}' is not {expected}")]
+    UnknownName {
+        /// The field.
+        field: String,
+        /// The name given.
+        name: String,
+        /// What it should be.
+        expected: String,
+    },
+    /// A pushed link that is not a humanoid24 link.
+    #[error("push.link '{link}' is not a humanoid24 link; links: {}", .links.join(", "))]
+    UnknownPushLink {
+        /// The link given.
+        link: String,
+        /// The humanoid24 links.
+        links: Vec<String>,
+    },
+    /// A DOF a plotted trajectory does not have.
+    #[error("no DOF '{0}'")]
+    NoDof(String),
+    /// A scene name that is not a plain folder name.
+    #[error(
+        "name {:?}: expected a plain folder name (letters, digits, '_', '-', '.'; not \
+         starting with '.'; at most {} characters): it names the output folder out/<name>/",
+        .0,
+        MAX_NAME_LEN
+    )]
+    Name(String),
+    /// A value of the scene file itself (no `--set` names it) that did not survive its trip
+    /// through JSON, e.g. a NaN or infinite number.
+    #[error(
+        "field `{field}` of the scene itself (no --set names it): {message}{}",
+        if .message.contains("null") {
+            "; a NaN or infinite number in the scene file reads as null here: write a finite \
+             number"
+        } else {
+            ""
+        }
+    )]
+    SceneValue {
+        /// The field's path.
+        field: String,
+        /// The reader's message.
+        message: String,
+    },
+    /// A motion file that is neither a BVH file nor a keyframed clip.
+    #[error("{}: expected a .bvh motion file or a .ron keyframed clip", .0.display())]
+    MotionFormat(PathBuf),
+    /// A BVH file's motion that is not a clip.
+    #[error("{}: {source}", .path.display())]
+    BvhClip {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        source: crate::skeleton::ClipError,
+    },
+    /// A BVH clip's window that could not be cut.
+    #[error("{}: clip window: {source}", .path.display())]
+    ClipWindow {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        source: crate::skeleton::ClipError,
+    },
+    /// A keyframed clip's window that is empty or reaches outside the clip.
+    #[error(
+        "{}: clip window {start_s}..{end_s} s is empty or reaches outside the clip, which spans \
+         0..{span_s:.3} s",
+        .path.display()
+    )]
+    KeyframeWindow {
+        /// The file.
+        path: PathBuf,
+        /// Window start (s).
+        start_s: f64,
+        /// Window end (s).
+        end_s: f64,
+        /// The clip's span (s).
+        span_s: f64,
+    },
+    /// A keyframed clip on another model than the scene's.
+    #[error("the keyframed clip is on model {clip}, not {model}")]
+    ClipModel {
+        /// The clip's model.
+        clip: String,
+        /// The scene's model.
+        model: String,
+    },
+    /// A song file to decode in a build without the `audio` feature.
+    #[error("{}: decoding songs needs the `audio` feature", .0.display())]
+    NoAudio(PathBuf),
+    /// A song too long for a WAV file.
+    #[error("the song is too long for a WAV file")]
+    SongTooLong,
+    /// An output path that does not end in a folder name.
+    #[error("output folder {}: expected a path ending in a folder name", .0.display())]
+    OutputName(PathBuf),
+    /// An output folder that is a file.
+    #[error("output folder {} is a file", .0.display())]
+    OutputIsFile(PathBuf),
+    /// An output folder that holds files but no `report.json`.
+    #[error(
+        "output folder {} holds files but no report.json, so it is not a scene's output: \
+         choose another --out (a run replaces its folder whole)",
+        .0.display()
+    )]
+    NotSceneOutput(PathBuf),
+    /// A body that could not be built.
+    #[error(transparent)]
+    Body(#[from] crate::humanoid::body::HumanError),
+    /// The fall's body, for its picture.
+    #[error("the fall's body: {0}")]
+    FallBody(#[source] crate::humanoid::body::HumanError),
+    /// A fall's body without one contact box per joint.
+    #[error("the fall's body has {boxes} contact boxes for {joints} joints")]
+    BoxCount {
+        /// Contact boxes.
+        boxes: usize,
+        /// Joints.
+        joints: usize,
+    },
+    /// A checked character without its recorder.
+    #[error("no recorder")]
+    NoRecorder,
+    /// A fall's step given beside a controller evolved at another one.
+    #[error(
+        "simulation.dt = {dt} s, but {from} gives the step the controller was evolved at, \
+         dt_s = {evolved} s (its damage holds at that step): leave simulation.dt out to replay \
+         it, or set controller.dt_s to run it at another step (e.g. --set controller.dt_s={} \
+         for half the step)",
+        .evolved / 2.0
+    )]
+    StepMismatch {
+        /// `simulation.dt` (s).
+        dt: f64,
+        /// The controller's step (s).
+        evolved: f64,
+        /// Where the controller's step comes from.
+        from: String,
+    },
+    /// An active character's run.
+    #[error(transparent)]
+    Active(#[from] crate::experiments::active::ActiveError),
+    /// An evolution with no group or no seed.
+    #[error("groups and seeds must not be empty")]
+    NoRuns,
+    /// Groups or seeds given twice.
+    #[error("{field} must not repeat an entry, found groups {groups:?}, seeds {seeds:?}")]
+    Repeated {
+        /// `groups` or `seeds`.
+        field: &'static str,
+        /// The groups.
+        groups: Vec<crate::humanoid::ranges::AgeGroup>,
+        /// The seeds.
+        seeds: Vec<u64>,
+    },
+    /// More falls than an evolution may simulate.
+    #[error("{0} falls to simulate is past the limit of 100 000 000")]
+    TooManyFalls(u64),
+    /// A worker command without a program.
+    #[error("evaluator: Command needs a program")]
+    NoProgram,
+    /// The GA: its settings, its worker or its checkpoint.
+    #[error(transparent)]
+    Evolve(#[from] crate::evolve::EvolveError),
+    /// A fall's GA problem.
+    #[error(transparent)]
+    FallProblem(#[from] crate::experiments::evolve_fall::ProblemError),
+    /// Evolving the falls.
+    #[error(transparent)]
+    EvolveFall(#[from] crate::experiments::evolve_fall::EvolveFallError),
+    /// Writing an evolved controller file.
+    #[error("controller file: {0}")]
+    ControllerFile(#[source] ron::Error),
+    /// A checkpoint to resume that was made with other settings.
+    #[error(
+        "resume: the checkpoint in {} was made with other settings: {why}",
+        .dir.display()
+    )]
+    ResumeSettings {
+        /// The checkpoint's folder.
+        dir: PathBuf,
+        /// What differs.
+        why: String,
+    },
+    /// A pin that gives both or neither of a segment and a clip's bar.
+    #[error("pins[{pin}] (bar {bar}): give either segment: N, or clip: \"name\" with clip_bar: N")]
+    PinChoice {
+        /// The pin's index.
+        pin: usize,
+        /// Its bar.
+        bar: usize,
+    },
+    /// A bar pinned twice.
+    #[error("pins[{pin}]: bar {bar} is pinned already by pins[{first}]")]
+    PinTwice {
+        /// The pin's index.
+        pin: usize,
+        /// Its bar.
+        bar: usize,
+        /// The pin that took the bar first.
+        first: usize,
+    },
+    /// A pin's clip that is not in the database.
+    #[error(
+        "pins[{pin}] (bar {bar}): no clip '{clip}' in the database; its clips: {}",
+        .clips.join(", ")
+    )]
+    PinClip {
+        /// The pin's index.
+        pin: usize,
+        /// Its bar.
+        bar: usize,
+        /// The clip named.
+        clip: String,
+        /// The database's clips.
+        clips: Vec<String>,
+    },
+    /// A pin's clip bar past the clip's bars.
+    #[error(
+        "pins[{pin}] (bar {bar}): clip '{clip}' has {bars} bars (0 to {}), not bar {clip_bar}",
+        .bars.saturating_sub(1)
+    )]
+    PinClipBar {
+        /// The pin's index.
+        pin: usize,
+        /// Its bar.
+        bar: usize,
+        /// The clip named.
+        clip: String,
+        /// The clip's bars.
+        bars: usize,
+        /// The bar asked for.
+        clip_bar: usize,
+    },
+    /// A dance of no bars.
+    #[error("bars is 0: expected at least one bar to dance (or leave it out for the whole song)")]
+    NoBars,
     /// Converting a scene to or from its JSON form.
     #[error(transparent)]
     Json(#[from] serde_json::Error),
@@ -308,15 +568,10 @@ fn overridden_field_error(
         },
         // Not a field any --set touched: the scene's own value, which survives its trip
         // through JSON only when it is finite.
-        None => SceneError::Invalid(format!(
-            "field `{field}` of the scene itself (no --set names it): {message}{}",
-            if message.contains("null") {
-                "; a NaN or infinite number in the scene file reads as null here: \
-                 write a finite number"
-            } else {
-                ""
-            }
-        )),
+        None => SceneError::SceneValue {
+            field: field.to_string(),
+            message,
+        },
     }
 }
 
@@ -372,11 +627,7 @@ pub fn validate(scene: &Scene) -> Result<(), SceneError> {
         .chars()
         .all(|c| c.is_alphanumeric() || matches!(c, '_' | '-' | '.'));
     if name.is_empty() || name.starts_with('.') || !plain || name.chars().count() > MAX_NAME_LEN {
-        return Err(SceneError::Invalid(format!(
-            "name {name:?}: expected a plain folder name (letters, digits, '_', '-', '.'; not \
-             starting with '.'; at most {MAX_NAME_LEN} characters): it names the output folder \
-             out/<name>/"
-        )));
+        return Err(SceneError::Name(name.to_string()));
     }
     match scene {
         Scene::Show(s) => validate_show(s)?,
@@ -402,15 +653,20 @@ pub fn validate(scene: &Scene) -> Result<(), SceneError> {
 /// frames, and with a GIF a frame rate above 0 and at most [`crate::render::MAX_GIF_FPS`].
 fn check_pictures(frames: usize, gif: bool, fps: f64) -> Result<(), SceneError> {
     if !(1..=MAX_FILMSTRIP_FRAMES).contains(&frames) {
-        return Err(SceneError::Invalid(format!(
-            "render.filmstrip_frames is {frames}, expected 1 to {MAX_FILMSTRIP_FRAMES}"
-        )));
+        return Err(SceneError::FilmstripFrames(frames));
     }
+    check_gif_fps(gif, fps)
+}
+
+/// Errors unless, with a GIF, its frame rate is above 0 and at most
+/// [`crate::render::MAX_GIF_FPS`].
+fn check_gif_fps(gif: bool, fps: f64) -> Result<(), SceneError> {
     if gif && !(fps.is_finite() && fps > 0.0 && fps <= crate::render::MAX_GIF_FPS) {
-        return Err(SceneError::Invalid(format!(
-            "render.gif_fps is {fps}, expected more than 0 and at most {}",
-            crate::render::MAX_GIF_FPS
-        )));
+        return Err(SceneError::OutOfRange {
+            field: "render.gif_fps".into(),
+            value: fps,
+            expected: format!("more than 0 and at most {}", crate::render::MAX_GIF_FPS),
+        });
     }
     Ok(())
 }
@@ -423,11 +679,15 @@ fn validate_show(s: &ShowScene) -> Result<(), SceneError> {
         let model = crate::humanoid::Model::by_name(name)?;
         for d in &s.render.plot {
             if model.dof_index(d).is_none() {
-                return Err(SceneError::Invalid(format!(
-                    "render.plot: '{d}' is not a DOF of {}; its DOFs: {}",
-                    model.name,
-                    model.dof_names().join(", ")
-                )));
+                return Err(SceneError::UnknownName {
+                    field: "render.plot".into(),
+                    name: d.clone(),
+                    expected: format!(
+                        "a DOF of {}; its DOFs: {}",
+                        model.name,
+                        model.dof_names().join(", ")
+                    ),
+                });
             }
         }
     }
@@ -442,9 +702,11 @@ fn validate_active_knee_kick(s: &ActiveKneeKickScene) -> Result<(), SceneError> 
         if x.is_finite() && x > 0.0 {
             Ok(())
         } else {
-            Err(SceneError::Invalid(format!(
-                "{field} is {x}, expected a positive number"
-            )))
+            Err(SceneError::OutOfRange {
+                field: field.into(),
+                value: x,
+                expected: "a positive number".into(),
+            })
         }
     };
     positive("dt_s", s.dt_s)?;
@@ -452,33 +714,34 @@ fn validate_active_knee_kick(s: &ActiveKneeKickScene) -> Result<(), SceneError> 
     positive("character.joint_omega", s.character.joint_omega)?;
     positive("character.assist_omega", s.character.assist_omega)?;
     if !(0.0..=1.0).contains(&s.character.assist) {
-        return Err(SceneError::Invalid(format!(
-            "character.assist is {}, expected 0 (none) to 1 (full)",
-            s.character.assist
-        )));
+        return Err(SceneError::OutOfRange {
+            field: "character.assist".into(),
+            value: s.character.assist,
+            expected: "0 (none) to 1 (full)".into(),
+        });
     }
     if let Some(d) = s.release_delay_s
         && !(d.is_finite() && d >= 0.0)
     {
-        return Err(SceneError::Invalid(format!(
-            "release_delay_s is {d}, expected ≥ 0 or None"
-        )));
+        return Err(SceneError::OutOfRange {
+            field: "release_delay_s".into(),
+            value: d,
+            expected: "≥ 0 or None".into(),
+        });
     }
     if !(s.push.start_s.is_finite() && s.push.start_s >= 0.0 && s.push.start_s < s.duration_s) {
-        return Err(SceneError::Invalid(format!(
-            "push.start_s is {}, expected inside the run [0, {})",
-            s.push.start_s, s.duration_s
-        )));
+        return Err(SceneError::OutOfRange {
+            field: "push.start_s".into(),
+            value: s.push.start_s,
+            expected: format!("inside the run [0, {})", s.duration_s),
+        });
     }
-    let links = crate::humanoid::body::humanoid24_body(1.70, 65.0, 9.81)
-        .map_err(|e| SceneError::Invalid(e.to_string()))?
-        .link_names;
+    let links = crate::humanoid::body::humanoid24_body(1.70, 65.0, 9.81)?.link_names;
     if !links.contains(&s.push.link) {
-        return Err(SceneError::Invalid(format!(
-            "push.link '{}' is not a humanoid24 link; links: {}",
-            s.push.link,
-            links.join(", ")
-        )));
+        return Err(SceneError::UnknownPushLink {
+            link: s.push.link.clone(),
+            links,
+        });
     }
     Ok(())
 }
@@ -663,6 +926,117 @@ mod tests {
                 .unwrap_err()
                 .to_string()
                 .contains("newer")
+        );
+    }
+
+    /// The typed errors carry their values, and show the text the scene's checks wrote
+    /// before they were typed (the old `format!` calls, copied here), byte for byte.
+    #[test]
+    fn scene_errors_carry_their_values_and_keep_their_messages() {
+        let e = check_pictures(0, false, 10.0).unwrap_err();
+        assert!(matches!(e, SceneError::FilmstripFrames(0)), "{e:?}");
+        assert_eq!(
+            e.to_string(),
+            format!("render.filmstrip_frames is 0, expected 1 to {MAX_FILMSTRIP_FRAMES}")
+        );
+        let e = check_pictures(8, true, 60.0).unwrap_err();
+        let SceneError::OutOfRange { field, value, .. } = &e else {
+            panic!("{e:?}")
+        };
+        assert_eq!((field.as_str(), *value), ("render.gif_fps", 60.0));
+        assert_eq!(
+            e.to_string(),
+            format!(
+                "render.gif_fps is {}, expected more than 0 and at most {}",
+                60.0,
+                crate::render::MAX_GIF_FPS
+            )
+        );
+        let e = validate(&Scene::parse(&SCENE.replace("\"t\"", "\"../t\""), "t.ron").unwrap())
+            .unwrap_err();
+        assert!(matches!(&e, SceneError::Name(n) if n == "../t"), "{e:?}");
+        let name = "../t";
+        assert_eq!(
+            e.to_string(),
+            format!(
+                "name {name:?}: expected a plain folder name (letters, digits, '_', '-', '.'; \
+                 not starting with '.'; at most {MAX_NAME_LEN} characters): it names the \
+                 output folder out/<name>/"
+            )
+        );
+        let (dt, evolved, from) = (0.001, 0.0007, "controller.dt_s".to_string());
+        assert_eq!(
+            SceneError::StepMismatch {
+                dt,
+                evolved,
+                from: from.clone()
+            }
+            .to_string(),
+            format!(
+                "simulation.dt = {dt} s, but {from} gives the step the controller was \
+                 evolved at, dt_s = {evolved} s (its damage holds at that step): leave \
+                 simulation.dt out to replay it, or set controller.dt_s to run it at \
+                 another step (e.g. --set controller.dt_s={} for half the step)",
+                evolved / 2.0
+            )
+        );
+        for message in ["invalid type: null, expected f64", "invalid value: 3"] {
+            let e = SceneError::SceneValue {
+                field: "render.gif_fps".into(),
+                message: message.into(),
+            };
+            assert_eq!(
+                e.to_string(),
+                format!(
+                    "field `render.gif_fps` of the scene itself (no --set names it): {message}{}",
+                    if message.contains("null") {
+                        "; a NaN or infinite number in the scene file reads as null here: \
+                         write a finite number"
+                    } else {
+                        ""
+                    }
+                )
+            );
+        }
+        let path = Path::new("clips/x.ron");
+        let (a, b, span) = (1.5, 0.5, 2.25);
+        assert_eq!(
+            SceneError::KeyframeWindow {
+                path: path.into(),
+                start_s: a,
+                end_s: b,
+                span_s: span
+            }
+            .to_string(),
+            format!(
+                "{}: clip window {a}..{b} s is empty or reaches outside the clip, which \
+                 spans 0..{span:.3} s",
+                path.display()
+            )
+        );
+        assert_eq!(
+            SceneError::NotSceneOutput(path.into()).to_string(),
+            format!(
+                "output folder {} holds files but no report.json, so it is not a scene's \
+                 output: choose another --out (a run replaces its folder whole)",
+                path.display()
+            )
+        );
+        let (k, bar, clip, bars, clip_bar) = (2, 5, "c", 4, 9);
+        assert_eq!(
+            SceneError::PinClipBar {
+                pin: k,
+                bar,
+                clip: clip.into(),
+                bars,
+                clip_bar
+            }
+            .to_string(),
+            format!(
+                "pins[{k}] (bar {bar}): clip '{clip}' has {bars} bars (0 to {}), not bar \
+                 {clip_bar}",
+                bars - 1
+            )
         );
     }
 }

@@ -36,12 +36,7 @@ impl Staging {
     pub fn begin(target: &Path) -> Result<Staging, SceneError> {
         let name = target
             .file_name()
-            .ok_or_else(|| {
-                SceneError::Invalid(format!(
-                    "output folder {}: expected a path ending in a folder name",
-                    target.display()
-                ))
-            })?
+            .ok_or_else(|| SceneError::OutputName(target.to_path_buf()))?
             .to_string_lossy()
             .to_string();
         let parent = match target.parent() {
@@ -50,18 +45,11 @@ impl Staging {
         };
         if target.exists() {
             if !target.is_dir() {
-                return Err(SceneError::Invalid(format!(
-                    "output folder {} is a file",
-                    target.display()
-                )));
+                return Err(SceneError::OutputIsFile(target.to_path_buf()));
             }
             let mut entries = std::fs::read_dir(target).map_err(|e| io_error(target, e))?;
             if entries.next().is_some() && !target.join("report.json").is_file() {
-                return Err(SceneError::Invalid(format!(
-                    "output folder {} holds files but no report.json, so it is not a scene's \
-                     output: choose another --out (a run replaces its folder whole)",
-                    target.display()
-                )));
+                return Err(SceneError::NotSceneOutput(target.to_path_buf()));
             }
         }
         std::fs::create_dir_all(&parent).map_err(|e| io_error(&parent, e))?;

@@ -18,15 +18,15 @@ pub const PAGE_FILE: &str = "index.html";
 pub fn fall_motion(label: &str, r: &FallResult) -> Result<PageMotion, SceneError> {
     let clip = r.to_model_clip().to_clip();
     // The boxes' sizes follow the height only; the mass sets inertias, which are not drawn.
-    let body = crate::humanoid::body::fall21_body(r.height_m, 65.0, 9.81)
-        .map_err(|e| SceneError::Invalid(format!("the fall's body: {e}")))?;
+    let body =
+        crate::humanoid::body::fall21_body(r.height_m, 65.0, 9.81).map_err(SceneError::FallBody)?;
     let figure = crate::render::Figure::of(&clip.skeleton);
     let joints = clip.joint_count();
     if body.boxes.len() != joints {
-        return Err(SceneError::Invalid(format!(
-            "the fall's body has {} contact boxes for {joints} joints",
-            body.boxes.len()
-        )));
+        return Err(SceneError::BoxCount {
+            boxes: body.boxes.len(),
+            joints,
+        });
     }
     let boxes = contact_boxes(&clip, &body);
     let mut events = touchdowns(r, &body);

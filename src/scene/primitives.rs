@@ -167,7 +167,7 @@ fn dof_series(
 ) -> Result<Series, SceneError> {
     let j = traj
         .index_of(dof)
-        .ok_or_else(|| SceneError::Invalid(format!("no DOF '{dof}'")))?;
+        .ok_or_else(|| SceneError::NoDof(dof.to_string()))?;
     Ok(Series {
         name: label.into(),
         points: traj
@@ -353,7 +353,7 @@ fn play_in_world(
     run_ticks(&mut world, &mut kinematic_schedule(), frames - 1);
     let recorded = &world
         .get::<Recorder>(e)
-        .ok_or_else(|| SceneError::Invalid("no recorder".into()))?
+        .ok_or(SceneError::NoRecorder)?
         .frames;
     let kernel = expected.to_clip().point_frames();
     Ok(recorded

@@ -195,12 +195,14 @@ fn plotted_angles(
     let mut series = vec![];
     let mut peaks = serde_json::Map::new();
     for name in names {
-        let d = m.model.dof_index(name).ok_or_else(|| {
-            SceneError::Invalid(format!(
-                "render.plot: '{name}' is not a DOF of {}",
-                m.model.name
-            ))
-        })?;
+        let d = m
+            .model
+            .dof_index(name)
+            .ok_or_else(|| SceneError::UnknownName {
+                field: "render.plot".into(),
+                name: name.to_string(),
+                expected: format!("a DOF of {}", m.model.name),
+            })?;
         let s = m.dof_series(d);
         let max = s.iter().copied().fold(f64::MIN, f64::max).to_degrees();
         let min = s.iter().copied().fold(f64::MAX, f64::min).to_degrees();

@@ -85,10 +85,10 @@ impl LoadedMotion {
                 Ok(retarget(clip, &Mapping::detect(&clip.skeleton)?, model)?)
             }
             LoadedMotion::Keyframed(m) if m.model.name == model.name => Ok(m.clone()),
-            LoadedMotion::Keyframed(m) => Err(SceneError::Invalid(format!(
-                "the keyframed clip is on model {}, not {}",
-                m.model.name, model.name
-            ))),
+            LoadedMotion::Keyframed(m) => Err(SceneError::ClipModel {
+                clip: m.model.name.clone(),
+                model: model.name.clone(),
+            }),
         }
     }
 }
@@ -109,12 +109,16 @@ pub fn load_motion(src: &ClipSource, base: &Path) -> Result<LoadedMotion, SceneE
             for w in warnings {
                 eprintln!("warning: {}:{}: {}", path.display(), w.line, w.message);
             }
-            let mut clip = Clip::from_bvh(&bvh, src.unit_scale)
-                .map_err(|e| SceneError::Invalid(format!("{}: {e}", path.display())))?;
+            let mut clip =
+                Clip::from_bvh(&bvh, src.unit_scale).map_err(|source| SceneError::BvhClip {
+                    path: path.to_path_buf(),
+                    source,
+                })?;
             if src.start_s.is_some() || src.end_s.is_some() {
                 let (a, b) = window(clip.duration());
-                clip = clip.window(a, b).map_err(|e| {
-                    SceneError::Invalid(format!("{}: clip window: {e}", path.display()))
+                clip = clip.window(a, b).map_err(|source| SceneError::ClipWindow {
+                    path: path.to_path_buf(),
+                    source,
                 })?;
             }
             let mapping = match &src.mapping {
@@ -139,19 +143,15 @@ pub fn load_motion(src: &ClipSource, base: &Path) -> Result<LoadedMotion, SceneE
                     && a < b
                     && b <= span + 0.5 * m.frame_time;
                 let windowed = if inside { m.window(a, b) } else { None };
-                m = windowed.ok_or_else(|| {
-                    SceneError::Invalid(format!(
-                        "{}: clip window {a}..{b} s is empty or reaches outside the clip, which \
-                         spans 0..{span:.3} s",
-                        path.display()
-                    ))
+                m = windowed.ok_or_else(|| SceneError::KeyframeWindow {
+                    path: path.to_path_buf(),
+                    start_s: a,
+                    end_s: b,
+                    span_s: span,
                 })?;
             }
             Ok(LoadedMotion::Keyframed(m))
         }
-        _ => Err(SceneError::Invalid(format!(
-            "{}: expected a .bvh motion file or a .ron keyframed clip",
-            path.display()
-        ))),
+        _ => Err(SceneError::MotionFormat(path.to_path_buf())),
     }
 }

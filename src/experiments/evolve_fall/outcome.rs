@@ -11,7 +11,7 @@ use super::{
     Checkpointing, EvolutionRun, EvolveConfig, GroupOutcome, advance, outcomes, problem_index,
     replay, start,
 };
-use crate::evolve::ga::ELITE_CHECK;
+use crate::evolve::Failure;
 use crate::evolve::{Evaluator, EvolveError};
 use crate::experiments::fall::{FallConfig, FallResult, SimError, simulate_fall};
 use crate::humanoid::ranges::AgeGroup;
@@ -170,9 +170,7 @@ impl EvolveOutcome {
 
     /// Failed evaluations, elite checks aside.
     pub fn failed_evaluations(&self) -> usize {
-        self.failures()
-            .filter(|f| !f.starts_with(ELITE_CHECK))
-            .count()
+        self.failures().filter(|f| !f.is_elite_check()).count()
     }
 
     /// Elite re-simulations at half the step.
@@ -182,13 +180,11 @@ impl EvolveOutcome {
 
     /// Elites rejected by their check.
     pub fn rejected_elites(&self) -> usize {
-        self.failures()
-            .filter(|f| f.starts_with(ELITE_CHECK))
-            .count()
+        self.failures().filter(|f| f.is_elite_check()).count()
     }
 
     /// Why each failure failed.
-    fn failures(&self) -> impl Iterator<Item = &String> {
+    fn failures(&self) -> impl Iterator<Item = &Failure> {
         self.runs
             .iter()
             .flat_map(|r| &r.state.failures)

@@ -14,7 +14,7 @@ use std::sync::atomic::AtomicBool;
 use serde::{Deserialize, Serialize};
 
 use crate::evolve::genome::BoundsError;
-use crate::evolve::{Bounds, Evaluation, Genome};
+use crate::evolve::{Bounds, Evaluation, EvaluationError, Genome};
 use crate::experiments::fall::ecs::{ReactionStart, run_parallel_until};
 use crate::experiments::fall::{FallConfig, Ranges, SettledStart, SimError};
 use crate::humanoid::fall21;
@@ -268,13 +268,16 @@ impl FallProblem {
             .iter()
             .map(|g| {
                 if g.len() != genes {
-                    return Err(format!("a genome has {genes} genes, found {}", g.len()));
+                    return Err(EvaluationError::GenomeLength {
+                        expected: genes,
+                        found: g.len(),
+                    });
                 }
                 match ran.next() {
                     Some(r) => r
                         .map(|f| f.damage)
-                        .map_err(|e: Arc<SimError>| e.to_string()),
-                    None => Err("not evaluated".into()),
+                        .map_err(|e: Arc<SimError>| EvaluationError::Problem(e.into())),
+                    None => Err(EvaluationError::NotEvaluated),
                 }
             })
             .collect();
