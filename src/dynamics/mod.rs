@@ -14,6 +14,8 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod aba;
+#[cfg(test)]
+mod aba_book;
 pub mod aba_lanes;
 pub mod axis_rotation;
 pub mod crba;
