@@ -216,6 +216,9 @@ impl M3 {
     /// Zero in every lane.
     pub const ZERO: Self = Self::splat(&DMat3::ZERO);
 
+    /// The identity in every lane.
+    pub const IDENTITY: Self = Self::splat(&DMat3::IDENTITY);
+
     /// From columns.
     #[inline(always)]
     pub const fn from_cols(x_axis: V3, y_axis: V3, z_axis: V3) -> Self {

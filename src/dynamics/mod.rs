@@ -33,6 +33,7 @@ pub mod rnea;
 pub mod spatial;
 pub mod stability;
 pub mod trig;
+mod width;
 
 pub use aba::{aba, aba_passes};
 pub use crba::{crba, forward_dynamics_crba};
