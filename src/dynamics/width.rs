@@ -59,6 +59,8 @@ pub trait Vec3Ops<S>:
 
 /// The operations of a 3×3 matrix of numbers `S`.
 pub trait Mat3Ops<S: Real>: Copy {
+    /// Zero.
+    const ZERO: Self;
     /// The identity.
     const IDENTITY: Self;
     /// From columns.
@@ -73,6 +75,10 @@ pub trait Mat3Ops<S: Real>: Copy {
     fn inverse(&self) -> Self;
     /// `A v`.
     fn mul_vec3(&self, v: S::V3) -> S::V3;
+    /// `A B` (glam's: each column of `B` through [`Mat3Ops::mul_vec3`]).
+    fn mul_mat3(&self, b: &Self) -> Self;
+    /// `Aᵀ`.
+    fn transpose(&self) -> Self;
 }
 
 /// The operations of a motion vector.
@@ -140,6 +146,7 @@ pub trait ColumnsOps<S: Real> {
 macro_rules! forward_ops {
     ($s:ty, $v3:ty, $m3:ty, $motion:ty, $force:ty, $inertia:ty, $transform:ty, $rotation:ty) => {
         impl Mat3Ops<$s> for $m3 {
+            const ZERO: Self = <$m3>::ZERO;
             const IDENTITY: Self = <$m3>::IDENTITY;
             #[inline(always)]
             fn from_cols(x: $v3, y: $v3, z: $v3) -> Self {
@@ -164,6 +171,14 @@ macro_rules! forward_ops {
             #[inline(always)]
             fn mul_vec3(&self, v: $v3) -> $v3 {
                 <$m3>::mul_vec3(self, v)
+            }
+            #[inline(always)]
+            fn mul_mat3(&self, b: &Self) -> Self {
+                <$m3>::mul_mat3(self, b)
+            }
+            #[inline(always)]
+            fn transpose(&self) -> Self {
+                <$m3>::transpose(self)
             }
         }
 
