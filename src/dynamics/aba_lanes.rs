@@ -1,11 +1,12 @@
 //! The articulated-body algorithm for [`LANES`] bodies of one model at once: passes 2 and 3 of
 //! [`aba_passes`] (Featherstone 2008, §7.3) with every quantity a lane of [`super::lanes`], so
-//! one vector instruction advances every body. Each lane's `q̈` has the bits of
-//! [`aba_passes`] on that body alone: the same operations in the same order, the branches
-//! taken on the model's structure (joint types and axes), which every lane shares.
+//! one vector instruction advances every body. Passes 2 and 3 are the one source of
+//! [`super::aba`] at the width [`F4`]; this file gathers the lanes' kinematics (pass 1) and
+//! holds the lane buffers. Each lane's `q̈` has the bits of [`aba_passes`] on that body alone:
+//! the same operations in the same order, the branches taken on the model's structure (joint
+//! types and axes), which every lane shares.
 
-use super::aba::aba_passes;
-use super::axis_rotation::{CoordAxis, JointAxes};
+use super::aba::{Bodies, aba_passes, pass2_articulated_inertias, pass3_accelerations};
 use super::data::Data;
 use super::joint::JointType;
 use super::kinematics::base_acceleration;
@@ -182,38 +183,25 @@ fn passes(
         return;
     }
     pass1_bias_forces(model, lanes, &data, f_ext);
-    pass2_articulated_inertias(model, lanes, &tau, &armature);
-    pass3_accelerations(model, lanes, data, &tau);
-}
-
-/// The joint forces and armature of one body's joint in every lane, whose first DOF is `iv`.
-#[derive(Clone, Copy)]
-struct JointInputs<'a> {
-    tau: &'a [&'a [f64]; LANES],
-    armature: &'a [Option<&'a [f64]>; LANES],
-    iv: usize,
-}
-
-impl JointInputs<'_> {
-    /// `τ` of the joint's DOF `k`.
-    #[inline(always)]
-    fn tau(&self, k: usize) -> F4 {
-        F4::from_fn(|l| self.tau[l][self.iv + k])
-    }
-
-    /// The armature of the joint's DOF `k` (0 without armature).
-    #[inline(always)]
-    fn arm(&self, k: usize) -> F4 {
-        F4::from_fn(|l| self.armature[l].map_or(0.0, |a| a[self.iv + k]))
-    }
-}
-
-/// Where pass 2 leaves one body's `U`, `D⁻¹` and `u` for pass 3 (only the joint's DOFs are
-/// written).
-struct JointSlots<'a> {
-    u: &'a mut [Force4; 3],
-    dinv: &'a mut M3,
-    uu: &'a mut V3,
+    let n = model.nbodies();
+    let mut bodies = Bodies::<F4> {
+        xup: &lanes.xup[..n],
+        rotation: &lanes.rotation[..n],
+        s: &lanes.s[..n],
+        c: &lanes.c[..n],
+        a: &mut lanes.a[..n],
+        ia: &mut lanes.ia[..n],
+        pa: &mut lanes.pa[..n],
+        u: &mut lanes.u[..n],
+        dinv: &mut lanes.dinv[..n],
+        uu: &mut lanes.uu[..n],
+    };
+    let forces = (&tau, &armature);
+    pass2_articulated_inertias(model, &mut bodies, &forces);
+    let a0 = base_acceleration(model);
+    let a0 = Motion4::new(V3::splat(a0.ang), V3::splat(a0.lin));
+    let mut qdd = data.map(|d| &mut d.qdd[..]);
+    pass3_accelerations(model, &mut bodies, &forces, a0, &mut qdd);
 }
 
 /// Gathers each body's joint rotation from the lanes; false if the lanes' rotations differ
@@ -257,287 +245,4 @@ fn pass1_bias_forces(
         pas[i] = vi.cross_force(rigid_apply(&body.inertia, vi)) - Force4::from_fn(|l| f_ext[l][i]);
         ias[i] = Inertia4::splat(&model.inertia_blocks[i]);
     }
-}
-
-/// Pass 2 (leaves → root): each joint's `U = I^A S`, `D = Sᵀ U` (+ armature) and
-/// `u = τ − Sᵀ p^A`; a body with a parent passes on `I^a = I^A − U D⁻¹ Uᵀ` and
-/// `p^a = p^A + I^a c + U D⁻¹ u`, accumulated into the parent as `Xupᵀ I^a Xup` and
-/// `Xupᵀ p^a` (Featherstone 2008, Table 7.1).
-#[inline(always)]
-fn pass2_articulated_inertias(
-    model: &Model,
-    lanes: &mut LaneBuffers,
-    tau: &[&[f64]; LANES],
-    armature: &[Option<&[f64]>; LANES],
-) {
-    let n = model.nbodies();
-    let (xups, rots) = (&lanes.xup[..n], &lanes.rotation[..n]);
-    let (ss, cs) = (&lanes.s[..n], &lanes.c[..n]);
-    let (ias, pas) = (&mut lanes.ia[..n], &mut lanes.pa[..n]);
-    let (us, dinvs, uus) = (&mut lanes.u[..n], &mut lanes.dinv[..n], &mut lanes.uu[..n]);
-    for i in (0..n).rev() {
-        let body = &model.bodies[i];
-        let joint = JointInputs {
-            tau,
-            armature,
-            iv: model.v_idx[i],
-        };
-        let (ia_head, ia_tail) = ias.split_at_mut(i);
-        let ia = &mut ia_tail[0];
-        let pa = pas[i];
-        let out = JointSlots {
-            u: &mut us[i],
-            dinv: &mut dinvs[i],
-            uu: &mut uus[i],
-        };
-        let has_parent = body.parent.is_some();
-        let pa_a = match (&body.joint, model.joint_axes[i]) {
-            (JointType::Pin { .. }, axes) => {
-                pin_pass2(ia, pa, (&ss[i], axes), joint, out, has_parent)
-            }
-            (JointType::Universal { .. }, JointAxes::Two(_, a2)) => {
-                universal_pass2(ia, pa, (&ss[i], a2), joint, out, has_parent)
-            }
-            (JointType::Universal { .. } | JointType::Ball { .. }, _) => {
-                rotational_pass2(ia, pa, (&ss[i], body.joint.nv()), joint, out, has_parent)
-            }
-            (JointType::Fixed, _) => pa,
-            (JointType::Free, _) => continue,
-        };
-        if let Some(p) = body.parent {
-            let pa_a = pa_a + ia.apply(cs[i]);
-            let x = &xups[i];
-            ia_head[p] += ia.transform_to_parent_with(x, &rots[i]);
-            pas[p] += x.inv_apply_force(pa_a);
-        }
-    }
-}
-
-/// Pass 2 for a revolute joint (`D` is 1×1): with a parent, `I^a = I^A − U D⁻¹ Uᵀ` in place
-/// and returns `p^A + U D⁻¹ u` (a root's `p^A` as it is).
-#[inline(always)]
-fn pin_pass2(
-    ia: &mut Inertia4,
-    pa: Force4,
-    (s, axes): (&[V3; 3], JointAxes),
-    joint: JointInputs,
-    out: JointSlots,
-    has_parent: bool,
-) -> Force4 {
-    let (u, d, uu) = match axes {
-        JointAxes::One(ax) => coordinate_column(ia, ax.k, ax.sign, joint.tau(0), pa),
-        _ => {
-            let a = s[0];
-            let u = ia.apply_angular(a);
-            (u, a.dot(u.ang), joint.tau(0) - a.dot(pa.ang))
-        }
-    };
-    let d = d + joint.arm(0);
-    let dinv = F4::splat(1.0) / d;
-    out.u[0] = u;
-    out.dinv.x_axis.x = dinv;
-    out.uu.x = uu;
-    if !has_parent {
-        return pa;
-    }
-    ia.sub_outer(u, dinv);
-    pa + u * (dinv * uu)
-}
-
-/// Pass 2 for a universal joint whose second axis `a2` is a coordinate axis (`D` is 2×2,
-/// inverted in closed form): as [`pin_pass2`].
-#[inline(always)]
-fn universal_pass2(
-    ia: &mut Inertia4,
-    pa: Force4,
-    (s, a2): (&[V3; 3], CoordAxis),
-    joint: JointInputs,
-    out: JointSlots,
-    has_parent: bool,
-) -> Force4 {
-    let b = s[0];
-    let u0 = ia.apply_angular(b);
-    let (u1, d11, uu1) = coordinate_column(ia, a2.k, a2.sign, joint.tau(1), pa);
-    let d00 = b.dot(u0.ang) + joint.arm(0);
-    let d11 = d11 + joint.arm(1);
-    let (d01, d10) = (b.dot(u1.ang), u0.ang.get(a2.k) * a2.sign);
-    let uu0 = joint.tau(0) - b.dot(pa.ang);
-    let inv_det = F4::splat(1.0) / (d00 * d11 - d01 * d10);
-    let dinv = M3::from_cols(
-        V3::new(d11 * inv_det, -d10 * inv_det, F4::ZERO),
-        V3::new(-d01 * inv_det, d00 * inv_det, F4::ZERO),
-        V3::new(F4::ZERO, F4::ZERO, F4::splat(1.0)),
-    );
-    let u = [u0, u1];
-    out.u[0] = u0;
-    out.u[1] = u1;
-    *out.dinv = dinv;
-    *out.uu = V3::new(uu0, uu1, F4::ZERO);
-    if !has_parent {
-        return pa;
-    }
-    let w = [
-        u0 * dinv.x_axis.x + u1 * dinv.x_axis.y,
-        u0 * dinv.y_axis.x + u1 * dinv.y_axis.y,
-    ];
-    ia.sub_products(&w, &u);
-    pa + u0 * (dinv.x_axis.x * uu0 + dinv.y_axis.x * uu1)
-        + u1 * (dinv.x_axis.y * uu0 + dinv.y_axis.y * uu1)
-}
-
-/// Pass 2 for a joint of `nv` rotational DOFs about general axes (ball, universal): `D`
-/// (`nv`×`nv`) inverted as a 3×3 with ones beyond `nv`; as [`pin_pass2`].
-#[inline(always)]
-fn rotational_pass2(
-    ia: &mut Inertia4,
-    pa: Force4,
-    (s, nv): (&[V3; 3], usize),
-    joint: JointInputs,
-    out: JointSlots,
-    has_parent: bool,
-) -> Force4 {
-    let mut u = [Force4::ZERO; 3];
-    let mut d = M3::splat(&glam::DMat3::IDENTITY);
-    let mut uu = V3::ZERO;
-    for k in 0..nv {
-        let a = s[k];
-        u[k] = ia.apply_angular(a);
-        uu.set(k, joint.tau(k) - a.dot(pa.ang));
-    }
-    for r in 0..nv {
-        for k in 0..nv {
-            let mut e = s[r].dot(u[k].ang);
-            if r == k {
-                e += joint.arm(k);
-            }
-            d.col_mut(k).set(r, e);
-        }
-    }
-    let dinv = d.inverse();
-    *out.u = u;
-    *out.dinv = dinv;
-    *out.uu = uu;
-    if !has_parent {
-        return pa;
-    }
-    if nv == 2 {
-        ia.sub_u_dinv_ut(&[u[0], u[1]], &dinv);
-    } else {
-        ia.sub_u_dinv_ut(&u, &dinv);
-    }
-    let w = dinv.mul_vec3(uu);
-    let mut pa_a = pa;
-    for k in 0..nv {
-        pa_a += u[k] * w.get(k);
-    }
-    pa_a
-}
-
-/// Pass 3 (root → leaves): `a' = Xup a_λ + c`, `q̈ = D⁻¹(u − Uᵀ a')`, `a = a' + S q̈`
-/// (Featherstone 2008, Table 7.1); a free root's `a = (I^A)⁻¹(τ − p^A)` (`FDfb`). Writes each
-/// lane's `q̈` into its `data`.
-#[inline(always)]
-fn pass3_accelerations(
-    model: &Model,
-    lanes: &mut LaneBuffers,
-    data: [&mut Data; LANES],
-    tau: &[&[f64]; LANES],
-) {
-    let n = model.nbodies();
-    let (xups, ss, cs) = (&lanes.xup[..n], &lanes.s[..n], &lanes.c[..n]);
-    let (accs, ias, pas) = (&mut lanes.a[..n], &lanes.ia[..n], &lanes.pa[..n]);
-    let (us, dinvs, uus) = (&lanes.u[..n], &lanes.dinv[..n], &lanes.uu[..n]);
-    let tau_of = |k: usize| F4::from_fn(|l| tau[l][k]);
-    let a0 = base_acceleration(model);
-    let a0 = Motion4::new(V3::splat(a0.ang), V3::splat(a0.lin));
-    let mut qdds = data.map(|d| &mut d.qdd[..]);
-    let mut put = |k: usize, x: F4| {
-        for (q, x) in qdds.iter_mut().zip(x.0) {
-            q[k] = x;
-        }
-    };
-    for i in 0..n {
-        let body = &model.bodies[i];
-        let iv = model.v_idx[i];
-        let a_parent = match body.parent {
-            Some(p) => accs[p],
-            None => a0,
-        };
-        let a_prime = xups[i].apply_motion(a_parent) + cs[i];
-        match body.joint {
-            JointType::Pin { .. } => {
-                let qdd = dinvs[i].x_axis.x * (uus[i].x - a_prime.dot(us[i][0]));
-                put(iv, qdd);
-                let mut a = a_prime;
-                a.ang += ss[i][0] * qdd;
-                accs[i] = a;
-            }
-            JointType::Universal { .. } => {
-                accs[i] = multi_dof_acceleration::<2>(
-                    (&us[i], &dinvs[i], uus[i], &ss[i]),
-                    a_prime,
-                    iv,
-                    &mut put,
-                )
-            }
-            JointType::Ball { .. } => {
-                accs[i] = multi_dof_acceleration::<3>(
-                    (&us[i], &dinvs[i], uus[i], &ss[i]),
-                    a_prime,
-                    iv,
-                    &mut put,
-                )
-            }
-            JointType::Fixed => accs[i] = a_prime,
-            JointType::Free => {
-                let f = Force4::new(
-                    V3::new(tau_of(iv), tau_of(iv + 1), tau_of(iv + 2)),
-                    V3::new(tau_of(iv + 3), tau_of(iv + 4), tau_of(iv + 5)),
-                ) - pas[i];
-                let a = ias[i].solve(f);
-                let qdd = a - a_prime;
-                for (k, x) in [
-                    qdd.ang.x, qdd.ang.y, qdd.ang.z, qdd.lin.x, qdd.lin.y, qdd.lin.z,
-                ]
-                .into_iter()
-                .enumerate()
-                {
-                    put(iv + k, x);
-                }
-                accs[i] = a;
-            }
-        }
-    }
-}
-
-/// The column of a DOF about coordinate axis `k` with sign `sign`: `U = I^A S`, `Sᵀ U` and
-/// `τ − Sᵀ p^A` (the scalar `coordinate_column`).
-#[inline(always)]
-fn coordinate_column(ia: &Inertia4, k: usize, sign: f64, tau: F4, pa: Force4) -> (Force4, F4, F4) {
-    (
-        Force4::new(ia.m.col(k) * sign, ia.h.row(k) * sign),
-        ia.m.col(k).get(k),
-        tau - pa.ang.get(k) * sign,
-    )
-}
-
-/// Pass 3 for a joint of `N` rotational DOFs: `q̈ = D⁻¹(u − Uᵀ a')`, `a = a' + S q̈`.
-#[inline(always)]
-fn multi_dof_acceleration<const N: usize>(
-    (u, dinv, uu, s): (&[Force4; 3], &M3, V3, &[V3; 3]),
-    a_prime: Motion4,
-    iv: usize,
-    put: &mut impl FnMut(usize, F4),
-) -> Motion4 {
-    let mut r = V3::ZERO;
-    for k in 0..N {
-        r.set(k, uu.get(k) - a_prime.dot(u[k]));
-    }
-    let qdd = dinv.mul_vec3(r);
-    let mut a = a_prime;
-    for k in 0..N {
-        put(iv + k, qdd.get(k));
-        a.ang += s[k] * qdd.get(k);
-    }
-    a
 }

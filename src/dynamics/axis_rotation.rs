@@ -5,6 +5,7 @@
 //! products: `R A Rᵀ` costs 24 multiplications instead of 54, `A R` 12 instead of 27, `R v` 4
 //! instead of 9.
 
+use super::width::{Mat3Ops, Real, Vec3Ops};
 use glam::{DMat3, DVec3};
 
 /// A signed coordinate axis `sign · e_k` (`k` = 0, 1, 2 for x, y, z; `sign` = ±1).
@@ -42,15 +43,16 @@ pub enum JointAxes {
 
 /// The rotation by angle `φ` about coordinate axis `k` (`c = cos φ`, `s = sin φ`): with
 /// `(i, j)` the next two coordinates in cyclic order, `R e_i = c e_i + s e_j`,
-/// `R e_j = −s e_i + c e_j`, `R e_k = e_k`.
+/// `R e_j = −s e_i + c e_j`, `R e_k = e_k`. `S` is the number type: `f64` for one body, or
+/// [`F4`](super::lanes::F4) for the bodies of the lanes, which share the axis.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct AxisRotation {
+pub struct AxisRotation<S = f64> {
     /// The axis' coordinate index.
     pub k: usize,
     /// `cos φ`.
-    pub c: f64,
+    pub c: S,
     /// `sin φ`.
-    pub s: f64,
+    pub s: S,
 }
 
 impl AxisRotation {
@@ -87,9 +89,9 @@ impl AxisRotation {
     #[inline]
     pub fn apply(&self, v: DVec3) -> DVec3 {
         match self.k {
-            0 => rot::<1, 2>(self.c, self.s, v),
-            1 => rot::<2, 0>(self.c, self.s, v),
-            _ => rot::<0, 1>(self.c, self.s, v),
+            0 => rot::<f64, 1, 2>(self.c, self.s, v),
+            1 => rot::<f64, 2, 0>(self.c, self.s, v),
+            _ => rot::<f64, 0, 1>(self.c, self.s, v),
         }
     }
 
@@ -107,57 +109,71 @@ impl AxisRotation {
     #[inline]
     pub fn mul_right(&self, a: &DMat3) -> DMat3 {
         match self.k {
-            0 => mix_cols::<1, 2>(self.c, -self.s, a),
-            1 => mix_cols::<2, 0>(self.c, -self.s, a),
-            _ => mix_cols::<0, 1>(self.c, -self.s, a),
+            0 => mix_cols::<f64, 1, 2>(self.c, -self.s, a),
+            1 => mix_cols::<f64, 2, 0>(self.c, -self.s, a),
+            _ => mix_cols::<f64, 0, 1>(self.c, -self.s, a),
         }
     }
+}
 
+impl<S: Real> AxisRotation<S> {
     /// `R A Rᵀ`: `A Rᵀ` mixes columns `i` and `j`, then `R` rows `i` and `j`.
     #[inline(always)]
-    pub fn conjugate(&self, a: &DMat3) -> DMat3 {
+    pub fn conjugate(&self, a: &S::M3) -> S::M3 {
         match self.k {
-            0 => conjugate::<1, 2>(self.c, self.s, a),
-            1 => conjugate::<2, 0>(self.c, self.s, a),
-            _ => conjugate::<0, 1>(self.c, self.s, a),
+            0 => conjugate::<S, 1, 2>(self.c, self.s, a),
+            1 => conjugate::<S, 2, 0>(self.c, self.s, a),
+            _ => conjugate::<S, 0, 1>(self.c, self.s, a),
         }
     }
 
     /// `R A Rᵀ` for a symmetric `A`, of which only the upper triangle is read: the six
     /// distinct entries (18 multiplications instead of 24), the result exactly symmetric.
     #[inline(always)]
-    pub fn conjugate_symmetric(&self, a: &DMat3) -> DMat3 {
+    pub fn conjugate_symmetric(&self, a: &S::M3) -> S::M3 {
         match self.k {
-            0 => conjugate_symmetric::<0, 1, 2>(self.c, self.s, a),
-            1 => conjugate_symmetric::<1, 2, 0>(self.c, self.s, a),
-            _ => conjugate_symmetric::<2, 0, 1>(self.c, self.s, a),
+            0 => conjugate_symmetric::<S, 0, 1, 2>(self.c, self.s, a),
+            1 => conjugate_symmetric::<S, 1, 2, 0>(self.c, self.s, a),
+            _ => conjugate_symmetric::<S, 2, 0, 1>(self.c, self.s, a),
         }
     }
 }
 
 /// Entry `(r, c)` of a symmetric `A` read from its upper triangle.
 #[inline(always)]
-fn upper(a: &DMat3, r: usize, c: usize) -> f64 {
-    if r <= c { a.col(c)[r] } else { a.col(r)[c] }
+fn upper<S: Real>(a: &S::M3, r: usize, c: usize) -> S {
+    if r <= c {
+        a.col(c).get(r)
+    } else {
+        a.col(r).get(c)
+    }
 }
 
 /// `R A Rᵀ` for a symmetric `A` and the rotation `(c, s)` about axis `K` in the `I`–`J` plane,
 /// with the products of [`conjugate`] for one entry of each mirrored pair.
 #[inline(always)]
-fn conjugate_symmetric<const K: usize, const I: usize, const J: usize>(
-    c: f64,
-    s: f64,
-    a: &DMat3,
-) -> DMat3 {
-    let (aii, ajj, aij) = (upper(a, I, I), upper(a, J, J), upper(a, I, J));
-    let (aki, akj, akk) = (upper(a, K, I), upper(a, K, J), upper(a, K, K));
+fn conjugate_symmetric<S: Real, const K: usize, const I: usize, const J: usize>(
+    c: S,
+    s: S,
+    a: &S::M3,
+) -> S::M3 {
+    let (aii, ajj, aij) = (
+        upper::<S>(a, I, I),
+        upper::<S>(a, J, J),
+        upper::<S>(a, I, J),
+    );
+    let (aki, akj, akk) = (
+        upper::<S>(a, K, I),
+        upper::<S>(a, K, J),
+        upper::<S>(a, K, K),
+    );
     // `B = A Rᵀ` (its `I`, `J` block), then `R B`.
     let (bii, bji) = (c * aii - s * aij, c * aij - s * ajj);
     let (bij, bjj) = (s * aii + c * aij, s * aij + c * ajj);
-    let mut m = DMat3::ZERO;
-    let mut set = |r: usize, col: usize, v: f64| {
-        m.col_mut(col)[r] = v;
-        m.col_mut(r)[col] = v;
+    let mut m = S::M3::ZERO;
+    let mut set = |r: usize, col: usize, v: S| {
+        m.col_mut(col).set(r, v);
+        m.col_mut(r).set(col, v);
     };
     set(K, K, akk);
     set(K, I, c * aki - s * akj);
@@ -170,17 +186,17 @@ fn conjugate_symmetric<const K: usize, const I: usize, const J: usize>(
 
 /// `v` with components `I`, `J` rotated: `(c v_I − s v_J, s v_I + c v_J)`.
 #[inline(always)]
-fn rot<const I: usize, const J: usize>(c: f64, s: f64, v: DVec3) -> DVec3 {
+fn rot<S: Real, const I: usize, const J: usize>(c: S, s: S, v: S::V3) -> S::V3 {
     let mut r = v;
-    r[I] = c * v[I] - s * v[J];
-    r[J] = s * v[I] + c * v[J];
+    r.set(I, c * v.get(I) - s * v.get(J));
+    r.set(J, s * v.get(I) + c * v.get(J));
     r
 }
 
 /// `A` with columns `I`, `J` mixed as `(c a_I − s a_J, s a_I + c a_J)`: `A Rᵀ` for the rotation
 /// `(c, s)`, `A R` for `(c, −s)`.
 #[inline(always)]
-fn mix_cols<const I: usize, const J: usize>(c: f64, s: f64, a: &DMat3) -> DMat3 {
+fn mix_cols<S: Real, const I: usize, const J: usize>(c: S, s: S, a: &S::M3) -> S::M3 {
     let mut m = *a;
     let (ai, aj) = (a.col(I), a.col(J));
     *m.col_mut(I) = ai * c - aj * s;
@@ -190,34 +206,35 @@ fn mix_cols<const I: usize, const J: usize>(c: f64, s: f64, a: &DMat3) -> DMat3 
 
 /// `R A Rᵀ` for the rotation `(c, s)` in the `I`–`J` plane.
 #[inline(always)]
-fn conjugate<const I: usize, const J: usize>(c: f64, s: f64, a: &DMat3) -> DMat3 {
-    let b = mix_cols::<I, J>(c, s, a);
-    DMat3::from_cols(
-        rot::<I, J>(c, s, b.x_axis),
-        rot::<I, J>(c, s, b.y_axis),
-        rot::<I, J>(c, s, b.z_axis),
+fn conjugate<S: Real, const I: usize, const J: usize>(c: S, s: S, a: &S::M3) -> S::M3 {
+    let b = mix_cols::<S, I, J>(c, s, a);
+    S::M3::from_cols(
+        rot::<S, I, J>(c, s, b.col(0)),
+        rot::<S, I, J>(c, s, b.col(1)),
+        rot::<S, I, J>(c, s, b.col(2)),
     )
 }
 
 /// A body's joint rotation `R` (child → parent) at the current configuration, in the form
 /// [`JointAxes`] allows: `E = Rᵀ` is the rotation of the body's `Xup`.
+/// `S` is the number type, as in [`AxisRotation`] (the lanes share the variant and the axes).
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
-pub enum JointRotation {
+pub enum JointRotation<S = f64> {
     /// Only the matrix in `Xup` is known.
     #[default]
     General,
     /// `R = R₁`.
-    One(AxisRotation),
+    One(AxisRotation<S>),
     /// `R = R₁ R₂`.
-    Two(AxisRotation, AxisRotation),
+    Two(AxisRotation<S>, AxisRotation<S>),
 }
 
-impl JointRotation {
+impl<S: Real> JointRotation<S> {
     /// `Eᵀ A E` for the rotation `e` (= `Rᵀ`) of `Xup`: `R A Rᵀ`, through the factors when known.
     #[inline(always)]
-    pub fn conjugate(&self, e: &DMat3, a: &DMat3) -> DMat3 {
+    pub fn conjugate(&self, e: &S::M3, a: &S::M3) -> S::M3 {
         match self {
-            JointRotation::General => e.transpose() * *a * *e,
+            JointRotation::General => e.transpose().mul_mat3(a).mul_mat3(e),
             JointRotation::One(r) => r.conjugate(a),
             JointRotation::Two(r1, r2) => r1.conjugate(&r2.conjugate(a)),
         }
@@ -226,9 +243,9 @@ impl JointRotation {
     /// [`JointRotation::conjugate`] of a symmetric `A` (through the factors only its upper
     /// triangle is read and the result is exactly symmetric).
     #[inline(always)]
-    pub fn conjugate_symmetric(&self, e: &DMat3, a: &DMat3) -> DMat3 {
+    pub fn conjugate_symmetric(&self, e: &S::M3, a: &S::M3) -> S::M3 {
         match self {
-            JointRotation::General => e.transpose() * *a * *e,
+            JointRotation::General => e.transpose().mul_mat3(a).mul_mat3(e),
             JointRotation::One(r) => r.conjugate_symmetric(a),
             JointRotation::Two(r1, r2) => r1.conjugate_symmetric(&r2.conjugate_symmetric(a)),
         }
@@ -282,7 +299,7 @@ mod tests {
             let two = JointRotation::Two(r, r2).conjugate(&(g * g2).transpose(), &a());
             assert!(close(two, g * g2 * a() * (g * g2).transpose()));
             assert!(close(
-                JointRotation::General.conjugate(&e, &a()),
+                JointRotation::<f64>::General.conjugate(&e, &a()),
                 g * a() * g.transpose()
             ));
         }

@@ -216,6 +216,9 @@ impl M3 {
     /// Zero in every lane.
     pub const ZERO: Self = Self::splat(&DMat3::ZERO);
 
+    /// The identity in every lane.
+    pub const IDENTITY: Self = Self::splat(&DMat3::IDENTITY);
+
     /// From columns.
     #[inline(always)]
     pub const fn from_cols(x_axis: V3, y_axis: V3, z_axis: V3) -> Self {
@@ -676,118 +679,11 @@ fn symmetric(entry: impl Fn(usize, usize) -> F4) -> M3 {
     )
 }
 
-/// A rotation about coordinate axis `k` per lane ([`AxisRotation`]; `k` is the model's, the
-/// same in every lane).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct AxisRotation4 {
-    /// Axis index.
-    pub k: usize,
-    /// `cos φ` per lane.
-    pub c: F4,
-    /// `± sin φ` per lane.
-    pub s: F4,
-}
+/// A joint's rotation per lane ([`JointRotation`] of [`F4`]; the variant and the axes are the
+/// model's, the same in every lane).
+pub type Rotation4 = JointRotation<F4>;
 
-impl AxisRotation4 {
-    #[inline(always)]
-    fn gather(r: [&AxisRotation; LANES]) -> Self {
-        Self {
-            k: r[0].k,
-            c: F4::from_fn(|l| r[l].c),
-            s: F4::from_fn(|l| r[l].s),
-        }
-    }
-
-    /// `Rᵀ A R` ([`AxisRotation::conjugate`]).
-    #[inline(always)]
-    pub fn conjugate(&self, a: &M3) -> M3 {
-        match self.k {
-            0 => conjugate::<1, 2>(self.c, self.s, a),
-            1 => conjugate::<2, 0>(self.c, self.s, a),
-            _ => conjugate::<0, 1>(self.c, self.s, a),
-        }
-    }
-
-    /// [`AxisRotation::conjugate_symmetric`].
-    #[inline(always)]
-    pub fn conjugate_symmetric(&self, a: &M3) -> M3 {
-        match self.k {
-            0 => conjugate_symmetric::<0, 1, 2>(self.c, self.s, a),
-            1 => conjugate_symmetric::<1, 2, 0>(self.c, self.s, a),
-            _ => conjugate_symmetric::<2, 0, 1>(self.c, self.s, a),
-        }
-    }
-}
-
-#[inline(always)]
-fn upper(a: &M3, r: usize, c: usize) -> F4 {
-    if r <= c {
-        a.col(c).get(r)
-    } else {
-        a.col(r).get(c)
-    }
-}
-
-#[inline(always)]
-fn conjugate_symmetric<const K: usize, const I: usize, const J: usize>(c: F4, s: F4, a: &M3) -> M3 {
-    let (aii, ajj, aij) = (upper(a, I, I), upper(a, J, J), upper(a, I, J));
-    let (aki, akj, akk) = (upper(a, K, I), upper(a, K, J), upper(a, K, K));
-    let (bii, bji) = (c * aii - s * aij, c * aij - s * ajj);
-    let (bij, bjj) = (s * aii + c * aij, s * aij + c * ajj);
-    let mut m = M3::ZERO;
-    let mut set = |r: usize, col: usize, v: F4| {
-        m.col_mut(col).set(r, v);
-        m.col_mut(r).set(col, v);
-    };
-    set(K, K, akk);
-    set(K, I, c * aki - s * akj);
-    set(K, J, s * aki + c * akj);
-    set(I, I, c * bii - s * bji);
-    set(J, J, s * bij + c * bjj);
-    set(I, J, c * bij - s * bjj);
-    m
-}
-
-#[inline(always)]
-fn rot<const I: usize, const J: usize>(c: F4, s: F4, v: V3) -> V3 {
-    let mut r = v;
-    r.set(I, c * v.get(I) - s * v.get(J));
-    r.set(J, s * v.get(I) + c * v.get(J));
-    r
-}
-
-#[inline(always)]
-fn mix_cols<const I: usize, const J: usize>(c: F4, s: F4, a: &M3) -> M3 {
-    let mut m = *a;
-    let (ai, aj) = (a.col(I), a.col(J));
-    *m.col_mut(I) = ai * c - aj * s;
-    *m.col_mut(J) = ai * s + aj * c;
-    m
-}
-
-#[inline(always)]
-fn conjugate<const I: usize, const J: usize>(c: F4, s: F4, a: &M3) -> M3 {
-    let b = mix_cols::<I, J>(c, s, a);
-    M3::from_cols(
-        rot::<I, J>(c, s, b.x_axis),
-        rot::<I, J>(c, s, b.y_axis),
-        rot::<I, J>(c, s, b.z_axis),
-    )
-}
-
-/// A joint's rotation per lane ([`JointRotation`]; the variant is the model's, the same in
-/// every lane).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Rotation4 {
-    /// General: `E` itself.
-    General,
-    /// One coordinate-axis rotation.
-    One(AxisRotation4),
-    /// Two.
-    Two(AxisRotation4, AxisRotation4),
-}
-
-impl Rotation4 {
+impl JointRotation<F4> {
     /// Lane `k` is `r[k]`; `None` unless every lane has the variant and axes of lane 0.
     #[inline(always)]
     pub fn gather(r: [&JointRotation; LANES]) -> Option<Self> {
@@ -797,7 +693,7 @@ impl Rotation4 {
                 if !r.iter().all(|x| matches!(x, JointRotation::General)) {
                     return None;
                 }
-                Rotation4::General
+                JointRotation::General
             }
             JointRotation::One(a0) => {
                 let mut lanes = [a0; LANES];
@@ -807,7 +703,7 @@ impl Rotation4 {
                         _ => return None,
                     }
                 }
-                Rotation4::One(AxisRotation4::gather(lanes))
+                JointRotation::One(gather_axis(lanes))
             }
             JointRotation::Two(a0, b0) => {
                 let mut firsts = [a0; LANES];
@@ -821,31 +717,18 @@ impl Rotation4 {
                         _ => return None,
                     }
                 }
-                Rotation4::Two(
-                    AxisRotation4::gather(firsts),
-                    AxisRotation4::gather(seconds),
-                )
+                JointRotation::Two(gather_axis(firsts), gather_axis(seconds))
             }
         })
     }
+}
 
-    /// [`JointRotation::conjugate`].
-    #[inline(always)]
-    pub fn conjugate(&self, e: &M3, a: &M3) -> M3 {
-        match self {
-            Rotation4::General => e.transpose().mul_mat3(a).mul_mat3(e),
-            Rotation4::One(r) => r.conjugate(a),
-            Rotation4::Two(r1, r2) => r1.conjugate(&r2.conjugate(a)),
-        }
-    }
-
-    /// [`JointRotation::conjugate_symmetric`].
-    #[inline(always)]
-    pub fn conjugate_symmetric(&self, e: &M3, a: &M3) -> M3 {
-        match self {
-            Rotation4::General => e.transpose().mul_mat3(a).mul_mat3(e),
-            Rotation4::One(r) => r.conjugate_symmetric(a),
-            Rotation4::Two(r1, r2) => r1.conjugate_symmetric(&r2.conjugate_symmetric(a)),
-        }
+/// The lanes' rotations about one axis (that of lane 0).
+#[inline(always)]
+fn gather_axis(r: [&AxisRotation; LANES]) -> AxisRotation<F4> {
+    AxisRotation {
+        k: r[0].k,
+        c: F4::from_fn(|l| r[l].c),
+        s: F4::from_fn(|l| r[l].s),
     }
 }

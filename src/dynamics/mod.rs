@@ -14,6 +14,8 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod aba;
+#[cfg(test)]
+mod aba_book;
 pub mod aba_lanes;
 pub mod axis_rotation;
 pub mod crba;
@@ -31,6 +33,7 @@ pub mod rnea;
 pub mod spatial;
 pub mod stability;
 pub mod trig;
+mod width;
 
 pub use aba::{aba, aba_passes};
 pub use crba::{crba, forward_dynamics_crba};
