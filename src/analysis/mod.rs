@@ -1,7 +1,9 @@
-//! Measurements on motions: ground contact and flight phases.
+//! Measurements on motions: ground contact and flight phases, and the plain signal helpers
+//! they and the systems share ([`signal`]).
 
 mod contact;
 mod feet;
+pub mod signal;
 
 pub use contact::{
     ContactConfig, ContactReference, Contacts, Span, ground_contacts, ground_contacts_against,

@@ -25,6 +25,7 @@ use serde::{Deserialize, Serialize};
 
 use super::eros::{Pca, pca};
 use super::features::{joint_speeds, mean_motion_intensity, pose_rows};
+use crate::analysis::signal::{gaussian_smooth, median};
 use crate::humanoid::ModelClip;
 
 /// Counts (beats) per segment: one bar of 4/4.
@@ -208,25 +209,16 @@ pub fn speed_curve(positions: &[Vec<DVec3>], fps: f64) -> Vec<f64> {
 /// The speed curve made steady for the beat search (module docs): each value clipped to
 /// median + [`GLITCH_MADS`] × 1.4826 MAD (not at all when the MAD is 0), then its trend taken off, the Gaussian-weighted mean
 /// m(f) = Σ_g w(f − g) v(g) / Σ_g w(f − g) with σ one bar of [`BEATS_PER_BAR`] counts at
-/// [`MIN_BPM`] (6 s; the weights cut at ±3σ and at the curve's ends): it takes off drifts
+/// [`MIN_BPM`] (6 s; [`gaussian_smooth`]: the weights cut at ±4σ and renormalised at the curve's
+/// ends): it takes off drifts
 /// slower than about 30 s (half power at 0.03 Hz) and leaves every beat of the search range
 /// whole. Units as `speed`.
 pub fn steady_speed(speed: &[f64], fps: f64) -> Vec<f64> {
-    let n = speed.len();
-    if n == 0 {
+    if speed.is_empty() {
         return vec![];
     }
-    let median = |v: &mut Vec<f64>| {
-        v.sort_by(f64::total_cmp);
-        let m = v.len() / 2;
-        if v.len() % 2 == 1 {
-            v[m]
-        } else {
-            0.5 * (v[m - 1] + v[m])
-        }
-    };
-    let med = median(&mut speed.to_vec());
-    let mad = median(&mut speed.iter().map(|v| (v - med).abs()).collect());
+    let med = median(speed);
+    let mad = median(&speed.iter().map(|v| (v - med).abs()).collect::<Vec<_>>());
     // More than half the frames at one speed (a keyframed clip holding its poses): no spread to
     // tell a glitch from a move by, so nothing is clipped.
     let ceiling = if mad > 0.0 {
@@ -236,22 +228,8 @@ pub fn steady_speed(speed: &[f64], fps: f64) -> Vec<f64> {
     };
     let clipped: Vec<f64> = speed.iter().map(|&v| v.min(ceiling)).collect();
     let sigma = BEATS_PER_BAR as f64 * 60.0 / MIN_BPM * fps;
-    let reach = (3.0 * sigma).ceil() as usize;
-    let w: Vec<f64> = (0..=reach)
-        .map(|d| (-0.5 * (d as f64 / sigma).powi(2)).exp())
-        .collect();
-    (0..n)
-        .map(|f| {
-            let (lo, hi) = (f.saturating_sub(reach), (f + reach).min(n - 1));
-            let (mut sum, mut weight) = (0.0, 0.0);
-            for (g, &v) in clipped.iter().enumerate().take(hi + 1).skip(lo) {
-                let k = w[f.abs_diff(g)];
-                sum += k * v;
-                weight += k;
-            }
-            clipped[f] - sum / weight
-        })
-        .collect()
+    let trend = gaussian_smooth(&clipped, sigma);
+    clipped.iter().zip(&trend).map(|(v, m)| v - m).collect()
 }
 
 /// The period of a steady speed curve ([`steady_speed`]) sampled at `fps`, in BPM: the
@@ -758,7 +736,7 @@ mod tests {
         let t = kinematic_tempo(&s, fps, None).unwrap();
         assert!((t / bpm - 1.0).abs() < 0.01, "{t}");
         // Taking off a linear drift leaves the beat whole: in the middle third, the steady curve
-        // (more than 3σ from either end) is the beat less its mean to within 1 % of its swing.
+        // (more than 4σ from either end) is the beat less its mean to within 1 % of its swing.
         let beat = beat_curve(bpm, 0.0, fps, 80.0);
         let mean = beat.iter().sum::<f64>() / beat.len() as f64;
         let drifting: Vec<f64> = (0..beat.len()).map(|f| beat[f] + 0.01 * f as f64).collect();
