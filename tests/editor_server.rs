@@ -6,7 +6,7 @@
 mod editor_fixture;
 
 use std::collections::BTreeSet;
-use std::io::Write;
+use std::io::{Read, Write};
 use std::net::{SocketAddr, TcpStream};
 use std::time::Duration;
 
@@ -419,6 +419,21 @@ fn bad_requests_get_clear_refusals_and_the_server_keeps_serving() {
         refused(a, "POST", "/api/like", Some(r#"{"bar": 2, "segment": 0}"#)).0,
         409
     );
+    // HTTP/2, by its version or by its connection preface (as `curl --http2-prior-knowledge`
+    // opens): refused at once with 505, never left hanging.
+    for req in [
+        &b"GET /api/state HTTP/2.0\r\nHost: 127.0.0.1\r\n\r\n"[..],
+        b"PRI * HTTP/2.0\r\n\r\nSM\r\n\r\n\x00\x00\x00\x04\x00\x00\x00\x00\x00",
+    ] {
+        let mut s = TcpStream::connect(a).unwrap();
+        s.set_read_timeout(Some(Duration::from_secs(10))).unwrap();
+        // The client does not close its side: the answer must come anyway.
+        s.write_all(req).unwrap();
+        let mut out = vec![];
+        let _ = s.read_to_end(&mut out);
+        let text = String::from_utf8_lossy(&out);
+        assert!(text.starts_with("HTTP/1.1 505 "), "{text}");
+    }
     // Garbage that is not HTTP at all, then a correct answer.
     let _ = raw(a, b"\x00\xff\xfe garbage\r\n\r\n");
     let _ = raw(a, b"GET");
@@ -496,7 +511,7 @@ fn clients_that_stall_hold_no_one_else_up() {
     let (ed, _) = start("stalled");
     let a = ed.addr();
     // Clients that stop mid-request and never close: bodies shorter than their Content-Length
-    // (over and under the 1,024 bytes tiny_http reads ahead), a chunked body cut off, an
+    // (over and under the 1,024 bytes a server may read ahead), a chunked body cut off, an
     // `Expect: 100-continue` never followed by its body, headers cut off.
     let cut: [&[u8]; 5] = [
         b"POST /api/set HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Length: 2000\r\n\r\n{\"bar\": 1,",

@@ -6,10 +6,12 @@
 //!   saves — the same file `marionette run` reads;
 //! - [`session`]: what the server holds — the edit, the song, the transition table, the fill;
 //! - [`api`]: the JSON API, one route per action, as a pure function over the session;
-//! - [`server`]: the HTTP server (tiny_http) on 127.0.0.1 — Host check against DNS
+//! - `http`: HTTP/1.1 connections — request heads (httparse), bodies, deadlines, refusals;
+//! - [`server`]: the HTTP server on 127.0.0.1 — Host check against DNS
 //!   rebinding, embedded files only, body limit, the session behind a `Mutex`.
 
 pub mod api;
+mod http;
 pub mod scene;
 pub mod server;
 pub mod session;

@@ -1,30 +1,30 @@
-//! The editor's HTTP server: tiny_http on 127.0.0.1 only, one [`Session`] behind a `Mutex`
-//! (one action at a time, so several tabs never interleave inside an action).
+//! The editor's HTTP server on 127.0.0.1 only: one [`Session`] behind a `Mutex` (one action at
+//! a time, so several tabs never interleave inside an action).
 //!
-//! Every request is answered on its own thread, at most [`MAX_IN_FLIGHT`] at once: a client
-//! that sends part of a body and never closes (tiny_http 0.12 has no read timeout, and drains an
-//! unread body when a request is dropped), or never reads a long answer, holds only its own
-//! thread — as tiny_http already gives every connection's headers their own thread — never the
-//! one that takes requests, so every other client is answered. Only when [`MAX_IN_FLIGHT`]
-//! requests are all stuck does the next one wait for a thread.
+//! Every connection is served on its own thread, at most [`MAX_CONNECTIONS`] at once (the next
+//! waits in the listening queue), by the editor's HTTP/1.1 layer (`editor::http`): a client that
+//! sends part of a request and stalls, or never reads a long answer, holds only its own thread,
+//! and only until its deadline (20 s to send a request or take an answer once begun, 30 s idle
+//! between requests); every other client is answered meanwhile. An HTTP/2 client gets 505 at
+//! once. (tiny_http 0.12, used before, had no read deadlines, and hung for ever on a request of
+//! version 2.0: its 505 waited on the writer of the very request it refused.)
 //!
-//! The listening socket has `TCP_NODELAY`, which the accepted connections inherit (Linux,
-//! the BSDs): an answer's last partial segment goes out at once instead of waiting for the
-//! client's delayed acknowledgement of the one before (Nagle's algorithm), a stall of about
-//! 40 ms on a kept-alive connection. Every answer says in a `Server-Timing` header how long the
-//! server took over it (`app;dur=` milliseconds, from the request's arrival at its thread to
-//! the answer ready), so a client can tell the server's time from the rest.
+//! Accepted connections get `TCP_NODELAY`: an answer's last partial segment goes out at once
+//! instead of waiting for the client's delayed acknowledgement of the one before (Nagle's
+//! algorithm), a stall of about 40 ms on a kept-alive connection. Every answer says in a
+//! `Server-Timing` header how long the server took over it (`app;dur=` milliseconds, from the
+//! request's arrival, body read, to the answer ready), so a client can tell the server's time
+//! from the rest.
 //!
 //! Every request is checked before it reaches the session: a `Host` that is not loopback
 //! (`127.0.0.1`, `localhost`, `[::1]`, any port) gets 403 (a DNS-rebinding page cannot talk to
 //! it), and so does an `Origin` other than the editor's own (another site's page cannot post to
 //! it); a path that is not exactly one of the embedded files or an API route gets 404 (no path
 //! from a request reaches the file system, so `..`, encoded slashes and absolute paths are
-//! simply unknown); a body over [`MAX_BODY`] bytes gets 413. Nothing in the request path
-//! unwraps request data; a poisoned lock (which only a bug could cause) is taken over rather
-//! than spreading.
+//! simply unknown); a body over [`MAX_BODY`] bytes gets 413 before it is read. Nothing in the
+//! request path unwraps request data; a poisoned lock (which only a bug could cause) is taken
+//! over rather than spreading.
 
-use std::io::Read;
 use std::net::SocketAddr;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Condvar, Mutex};
@@ -33,6 +33,7 @@ use std::time::Duration;
 
 use super::EditorError;
 use super::api::{Reply, handle};
+use super::http;
 use super::session::{Session, Song};
 
 /// The default port of `marionette edit`.
@@ -41,8 +42,8 @@ pub const DEFAULT_PORT: u16 = 8765;
 /// Largest request body accepted (bytes); the API's bodies are a few dozen bytes.
 pub const MAX_BODY: usize = 16 * 1024;
 
-/// Requests answered at once, each on its own thread; the next waits for one to finish.
-pub const MAX_IN_FLIGHT: usize = 256;
+/// Connections served at once, each on its own thread; the next waits for one to close.
+pub const MAX_CONNECTIONS: usize = 1024;
 
 /// The page's files, embedded in the binary: (path, content type, bytes).
 const ASSETS: [(&str, &str, &[u8]); 5] = [
@@ -85,21 +86,21 @@ struct SongPieces {
     bars: Vec<(f64, f64)>,
 }
 
-/// How many requests are being answered, and a signal when one is done.
+/// A count of connections or of requests being answered, and a signal when one ends.
 #[derive(Default)]
 struct InFlight {
     count: Mutex<usize>,
     done: Condvar,
 }
 
-/// One request's place among the [`MAX_IN_FLIGHT`]; given back when dropped.
+/// One connection's place among the [`MAX_CONNECTIONS`]; given back when dropped.
 struct Slot(Arc<InFlight>);
 
 impl InFlight {
-    /// Waits for a free place (or for `stop`).
-    fn acquire(self: &Arc<Self>, stop: &AtomicBool) -> Option<Slot> {
+    /// Waits for a place among `limit` (or for `stop`).
+    fn acquire(self: &Arc<Self>, limit: usize, stop: &AtomicBool) -> Option<Slot> {
         let mut n = self.count.lock().unwrap_or_else(|e| e.into_inner());
-        while *n >= MAX_IN_FLIGHT {
+        while *n >= limit {
             if stop.load(Ordering::Relaxed) {
                 return None;
             }
@@ -112,22 +113,31 @@ impl InFlight {
         *n += 1;
         Some(Slot(self.clone()))
     }
+
+    /// One more.
+    fn begin(&self) {
+        *self.count.lock().unwrap_or_else(|e| e.into_inner()) += 1;
+    }
+
+    /// One less, and a signal.
+    fn end(&self) {
+        let mut n = self.count.lock().unwrap_or_else(|e| e.into_inner());
+        *n = n.saturating_sub(1);
+        self.done.notify_all();
+    }
 }
 
 impl Drop for Slot {
     fn drop(&mut self) {
-        let mut n = self.0.count.lock().unwrap_or_else(|e| e.into_inner());
-        *n -= 1;
-        self.0.done.notify_one();
+        self.0.end();
     }
 }
 
 /// A running editor server.
 pub struct Editor {
-    server: Arc<tiny_http::Server>,
     addr: SocketAddr,
     stop: Arc<AtomicBool>,
-    dispatcher: JoinHandle<()>,
+    acceptor: JoinHandle<()>,
     session: Arc<Mutex<Session>>,
     in_flight: Arc<InFlight>,
 }
@@ -140,17 +150,8 @@ impl Editor {
             addr: want.to_string(),
             message,
         };
-        let listener = listen(want).map_err(|e| bind_err(e.to_string()))?;
-        let server = tiny_http::Server::from_listener(listener, None)
-            .map_err(|e| bind_err(e.to_string()))?;
-        let addr = server
-            .server_addr()
-            .to_ip()
-            .ok_or_else(|| EditorError::Bind {
-                addr: want.to_string(),
-                message: "not an IP socket".into(),
-            })?;
-        let server = Arc::new(server);
+        let listener = std::net::TcpListener::bind(want).map_err(|e| bind_err(e.to_string()))?;
+        let addr = listener.local_addr().map_err(|e| bind_err(e.to_string()))?;
         let song = Arc::new(SongPieces {
             song: session.shared_song(),
             bars: session
@@ -163,38 +164,54 @@ impl Editor {
         let session = Arc::new(Mutex::new(session));
         let stop = Arc::new(AtomicBool::new(false));
         let in_flight = Arc::new(InFlight::default());
-        let dispatcher = {
-            let (server, stop, session, in_flight) = (
-                server.clone(),
-                stop.clone(),
-                session.clone(),
-                in_flight.clone(),
-            );
+        let connections = Arc::new(InFlight::default());
+        let acceptor = {
+            let (stop, session, in_flight) = (stop.clone(), session.clone(), in_flight.clone());
             std::thread::spawn(move || {
-                while !stop.load(Ordering::Relaxed) {
-                    let Ok(Some(rq)) = server.recv_timeout(Duration::from_millis(100)) else {
+                for stream in listener.incoming() {
+                    if stop.load(Ordering::Relaxed) {
+                        break;
+                    }
+                    let Ok(stream) = stream else {
+                        // Out of descriptors, say: wait for connections to close rather than
+                        // spin on the queued ones.
+                        std::thread::sleep(Duration::from_millis(50));
                         continue;
                     };
-                    let Some(slot) = in_flight.acquire(&stop) else {
+                    // Answers go out whole at once (module docs).
+                    let _ = stream.set_nodelay(true);
+                    let Some(slot) = connections.acquire(MAX_CONNECTIONS, &stop) else {
                         break;
                     };
-                    let (session, song) = (session.clone(), song.clone());
-                    // Should the system refuse a thread, the request is dropped (tiny_http
-                    // answers 500).
+                    let (session, song, stop, in_flight) = (
+                        session.clone(),
+                        song.clone(),
+                        stop.clone(),
+                        in_flight.clone(),
+                    );
+                    // Should the system refuse a thread, the connection is closed unanswered.
                     let _ = std::thread::Builder::new()
-                        .name("editor-request".into())
+                        .name("editor-connection".into())
                         .spawn(move || {
                             let _slot = slot;
-                            serve(rq, &session, &song, addr.port());
+                            let handle =
+                                |rq: http::Request| serve(&rq, &session, &song, addr.port());
+                            http::serve_connection(
+                                stream,
+                                MAX_BODY,
+                                &stop,
+                                &handle,
+                                &|| in_flight.begin(),
+                                &|| in_flight.end(),
+                            );
                         });
                 }
             })
         };
         Ok(Editor {
-            server,
             addr,
             stop,
-            dispatcher,
+            acceptor,
             session,
             in_flight,
         })
@@ -212,23 +229,29 @@ impl Editor {
 
     /// Serves until the process ends.
     pub fn wait(self) {
-        let _ = self.dispatcher.join();
+        let _ = self.acceptor.join();
     }
 
-    /// Stops taking requests (those being answered finish on their own threads).
+    /// Stops taking connections and requests; kept-alive connections close, and requests being
+    /// answered finish on their own threads.
     pub fn stop(self) {
+        self.stop_accepting();
+        let _ = self.acceptor.join();
+    }
+
+    fn stop_accepting(&self) {
         self.stop.store(true, Ordering::Relaxed);
-        let _ = self.dispatcher.join();
-        drop(self.server);
+        // The acceptor waits in `accept`: one more connection wakes it to see the flag.
+        let _ = std::net::TcpStream::connect(self.addr);
     }
 
     /// Stops taking requests and waits for those being answered: up to `grace` for every one
-    /// to end (a client stalled mid-body may never end), then for the session, so that an
-    /// action holding it — a Save writing the scene — is finished before this returns. Returns
-    /// how many requests were still waiting for their clients.
+    /// to end (a client stalled mid-body may take until its deadline, [`http::TRANSFER`]), then
+    /// for the session, so that an action holding it — a Save writing the scene — is finished
+    /// before this returns. Returns how many requests were still waiting for their clients.
     pub fn shutdown(self, grace: Duration) -> usize {
-        self.stop.store(true, Ordering::Relaxed);
-        let _ = self.dispatcher.join();
+        self.stop_accepting();
+        let _ = self.acceptor.join();
         let until = std::time::Instant::now() + grace;
         let mut n = self
             .in_flight
@@ -250,7 +273,6 @@ impl Editor {
         let stuck = *n;
         drop(n);
         drop(self.session.lock().unwrap_or_else(|e| e.into_inner()));
-        drop(self.server);
         stuck
     }
 }
@@ -292,64 +314,31 @@ pub fn own_origin(origin: &str, port: u16) -> bool {
     loopback_host(host) && given == Some(port)
 }
 
-/// The values of every header `name` of `rq`.
-fn header_values<'a>(rq: &'a tiny_http::Request, name: &'static str) -> Vec<&'a str> {
-    rq.headers()
-        .iter()
-        .filter(|h| h.field.equiv(name))
-        .map(|h| h.value.as_str())
-        .collect()
-}
-
-fn answer(
-    rq: &mut tiny_http::Request,
-    session: &Mutex<Session>,
-    song: &SongPieces,
-    port: u16,
-) -> Reply {
-    let hosts = header_values(rq, "Host");
+fn answer(rq: &http::Request, session: &Mutex<Session>, song: &SongPieces, port: u16) -> Reply {
+    let hosts = rq.header_values("Host");
     if hosts.len() != 1 || !loopback_host(hosts[0]) {
         return Reply::error(
             403,
             "the editor answers only requests to 127.0.0.1 or localhost",
         );
     }
-    if header_values(rq, "Origin")
+    if rq
+        .header_values("Origin")
         .iter()
         .any(|o| !own_origin(o, port))
     {
         return Reply::error(403, "the editor answers only its own page (Origin)");
     }
-    let method = rq.method().as_str().to_string();
-    let url = rq.url().to_string();
-    let (path, query) = url.split_once('?').unwrap_or((&url, ""));
-    if path == "/api/audio.wav"
-        && method == "GET"
-        && rq.body_length().unwrap_or(0) == 0
-        && header_values(rq, "Transfer-Encoding").is_empty()
-    {
+    let method = rq.method.as_str();
+    let (path, query) = rq.target.split_once('?').unwrap_or((&rq.target, ""));
+    if path == "/api/audio.wav" && method == "GET" && rq.body.is_empty() {
         return match super::api::audio(&song.song, &song.bars, query) {
             Ok(r) | Err(r) => r,
         };
     }
     if path.starts_with("/api/") {
-        if rq.body_length().is_some_and(|n| n > MAX_BODY) {
-            return Reply::error(413, &format!("request body over {MAX_BODY} bytes"));
-        }
-        let mut body = Vec::new();
-        if rq
-            .as_reader()
-            .take(MAX_BODY as u64 + 1)
-            .read_to_end(&mut body)
-            .is_err()
-        {
-            return Reply::error(400, "request body: could not be read");
-        }
-        if body.len() > MAX_BODY {
-            return Reply::error(413, &format!("request body over {MAX_BODY} bytes"));
-        }
         let mut s = session.lock().unwrap_or_else(|e| e.into_inner());
-        return handle(&mut s, &method, path, query, &body);
+        return handle(&mut s, method, path, query, &rq.body);
     }
     match ASSETS.iter().find(|a| a.0 == path) {
         Some(&(_, content_type, bytes)) if method == "GET" || method == "HEAD" => Reply {
@@ -363,59 +352,45 @@ fn answer(
     }
 }
 
-/// A listening socket on `addr` with `TCP_NODELAY`, which its connections inherit (module
-/// docs).
-fn listen(addr: SocketAddr) -> std::io::Result<std::net::TcpListener> {
-    let listener = std::net::TcpListener::bind(addr)?;
-    socket2::SockRef::from(&listener).set_tcp_nodelay(true)?;
-    Ok(listener)
-}
-
-fn header(name: &str, value: &str) -> Option<tiny_http::Header> {
-    tiny_http::Header::from_bytes(name.as_bytes(), value.as_bytes()).ok()
-}
-
-fn serve(mut rq: tiny_http::Request, session: &Mutex<Session>, song: &SongPieces, port: u16) {
+/// The answer to `rq`, with the headers every answer carries.
+fn serve(
+    rq: &http::Request,
+    session: &Mutex<Session>,
+    song: &SongPieces,
+    port: u16,
+) -> http::Response {
     let t0 = std::time::Instant::now();
-    let r = answer(&mut rq, session, song, port);
+    let r = answer(rq, session, song, port);
     let server_ms = t0.elapsed().as_secs_f64() * 1e3;
-    let mut resp = tiny_http::Response::from_data(r.body).with_status_code(r.status);
-    let headers = [
-        header("Content-Type", r.content_type),
-        header("Cache-Control", "no-store"),
-        header("Server-Timing", &format!("app;dur={server_ms:.2}")),
-        header("X-Content-Type-Options", "nosniff"),
-        header(
+    let mut headers: Vec<(String, String)> = [
+        ("Content-Type", r.content_type.to_string()),
+        ("Cache-Control", "no-store".into()),
+        ("Server-Timing", format!("app;dur={server_ms:.2}")),
+        ("X-Content-Type-Options", "nosniff".into()),
+        (
             "Content-Security-Policy",
-            "default-src 'self'; media-src 'self' blob:; img-src 'self' data: blob:",
+            "default-src 'self'; media-src 'self' blob:; img-src 'self' data: blob:".into(),
         ),
-        r.download.and_then(|f| {
-            header(
-                "Content-Disposition",
-                &format!("attachment; filename=\"{f}\""),
-            )
-        }),
-    ];
-    for h in headers.into_iter().flatten() {
-        resp.add_header(h);
+    ]
+    .into_iter()
+    .map(|(n, v)| (n.to_string(), v))
+    .collect();
+    if let Some(f) = r.download {
+        headers.push((
+            "Content-Disposition".into(),
+            format!("attachment; filename=\"{f}\""),
+        ));
     }
-    // A client that went away is not the server's failure.
-    let _ = rq.respond(resp);
+    http::Response {
+        status: r.status,
+        headers,
+        body: r.body,
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// An answer's last partial segment must not wait for the client's delayed ACK (about
-    /// 40 ms per kept-alive request): the connections the server accepts have `TCP_NODELAY`.
-    #[test]
-    fn accepted_connections_do_not_wait_for_acks() {
-        let listener = listen(SocketAddr::from(([127, 0, 0, 1], 0))).unwrap();
-        let _client = std::net::TcpStream::connect(listener.local_addr().unwrap()).unwrap();
-        let (accepted, _) = listener.accept().unwrap();
-        assert!(accepted.nodelay().unwrap());
-    }
 
     #[test]
     fn loopback_hosts() {
