@@ -106,6 +106,26 @@ fn bench(c: &mut Criterion) {
     g.bench_function("fill_dijkstra_with_table_64x2000", |bch| {
         bch.iter(|| black_box(fill_dijkstra_with_table(&db, &table, &music, &pins, &p).unwrap()))
     });
+    // The two halves of Generate after the fill, apart.
+    let f = fill_with_table(&db, &table, &music, &pins, &p).unwrap();
+    g.bench_function("assemble_64", |bch| {
+        bch.iter(|| {
+            black_box(assemble(
+                &db,
+                &f.segments,
+                &bars,
+                &beats,
+                &DanceParams::default(),
+            ))
+        })
+    });
+    let d = assemble(&db, &f.segments, &bars, &beats, &DanceParams::default()).unwrap();
+    g.bench_function("plant_feet_64", |bch| {
+        bch.iter(|| {
+            let mut clip = d.clip.clone();
+            black_box(plant_feet(&mut clip, &PlantParams::default()))
+        })
+    });
     for (name, params) in [
         ("fill_assemble_64x2000", &p),
         ("fill_assemble_64x2000_fixed_kappa", &fixed),

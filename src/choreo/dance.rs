@@ -260,33 +260,48 @@ pub fn assemble(
     let bar_frames = bar_frames(bars, p, frames, dt)?;
     let w = p.seam_frames;
 
+    // Each segment's beats (phases of counts 2, 3, 4), found once per segment, and each bar's
+    // warp and samples: independent, so found in parallel.
+    use rayon::prelude::*;
+    let beats_of: std::collections::BTreeMap<usize, Vec<Option<f64>>> = if p.beat_warp {
+        let unique: std::collections::BTreeSet<usize> = segments.iter().copied().collect();
+        let unique: Vec<usize> = unique.into_iter().collect();
+        unique
+            .par_iter()
+            .map(|&s| (s, segment_beats(&db.segments[s], &model)))
+            .collect::<Vec<_>>()
+            .into_iter()
+            .collect()
+    } else {
+        Default::default()
+    };
+    let parts: Vec<(usize, ModelClip)> = segments
+        .par_iter()
+        .zip(bars)
+        .enumerate()
+        .map(|(k, (&s, bar))| {
+            let seg = &db.segments[s];
+            let m = seg.frame_count();
+            let (first, stop) = bar_frames[k];
+            let length = bar.end_s - bar.start_s;
+            let warp = match beats_of.get(&s) {
+                Some(own) => bar_warp(bar, beats_s, own),
+                None => Warp::identity(),
+            };
+            let x = |f: usize| warp.at((f as f64 * dt - (bar.start_s - start_s)) / length);
+            let part = sample(seg, dofs, (first..stop).map(|f| x(f) * m as f64));
+            (warp.knots().len() - 2, part)
+        })
+        .collect();
+
     let mut clip = ModelClip::with_capacity(model.clone(), dt, frames);
     // The carry-on of the previous bar: its rotation about Y and horizontal offset, and where
     // its segment ends (extrapolated to phase 1) in the dance.
     let mut end: Option<(DVec3, f64)> = None;
-    // Each segment's beats (phases of counts 2, 3, 4), found once per segment.
-    let mut beats_of: std::collections::BTreeMap<usize, Vec<Option<f64>>> = Default::default();
     let mut warped_beats = Vec::with_capacity(bars.len());
-    for (k, (&s, bar)) in segments.iter().zip(bars).enumerate() {
+    for (k, (&s, (warped, part))) in segments.iter().zip(parts).enumerate() {
         let seg = &db.segments[s];
-        let m = seg.frame_count();
-        let (first, stop) = bar_frames[k];
-        let length = bar.end_s - bar.start_s;
-        let warp = if p.beat_warp {
-            let own = beats_of
-                .entry(s)
-                .or_insert_with(|| segment_beats(seg, &model));
-            bar_warp(bar, beats_s, own)
-        } else {
-            Warp::identity()
-        };
-        warped_beats.push(warp.knots().len() - 2);
-        let part = sample(
-            seg,
-            dofs,
-            (first..stop)
-                .map(|f| warp.at((f as f64 * dt - (bar.start_s - start_s)) / length) * m as f64),
-        );
+        warped_beats.push(warped);
         let (turn, offset) = carry_on(seg, end);
         for (t, q) in part.root_translation.iter().zip(&part.root_rotation) {
             clip.root_translation.push(turn * *t + offset);

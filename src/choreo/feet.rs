@@ -38,7 +38,7 @@ use crate::analysis::{
     ContactConfig, ContactReference, Contacts, PointRef, foot_points, ground_contacts_against,
 };
 use crate::humanoid::ModelClip;
-use crate::humanoid::leg_ik::{Leg, frame_globals, reach};
+use crate::humanoid::leg_ik::{Leg, chain_globals, frame_globals, reach, with_ancestors};
 use crate::skeleton::{Skeleton, Transform};
 
 /// Most rounds of IK per frame and leg: the target corrected by the foot's residual each round
@@ -193,14 +193,21 @@ pub fn plant_feet(clip: &mut ModelClip, p: &PlantParams) -> Planting {
     if !p.enabled || n < 2 || feet.iter().any(Vec::is_empty) || legs.iter().any(Option::is_none) {
         return report;
     }
+    let joints: Vec<usize> = feet.iter().flatten().map(|p| p.0).collect();
     let model = Feet {
         rest: rest_sole_heights(clip),
+        chain: with_ancestors(&clip.model, &joints),
         skeleton,
         points: feet,
     };
     let rest = &model.rest;
-    let mut g = vec![];
-    let before: Vec<[Vec<DVec3>; 2]> = (0..n).map(|f| model.positions(clip, f, &mut g)).collect();
+    let before: Vec<[Vec<DVec3>; 2]> = {
+        use rayon::prelude::*;
+        (0..n)
+            .into_par_iter()
+            .map_init(Vec::new, |g, f| model.positions(clip, f, g))
+            .collect()
+    };
     let config = ContactConfig::default();
     let contacts = floor_contacts(clip, &before, rest, &config);
     let blend = (p.blend_s / clip.frame_time).round().max(1.0) as usize;
@@ -234,23 +241,32 @@ pub fn plant_feet(clip: &mut ModelClip, p: &PlantParams) -> Planting {
 }
 
 /// The model's feet: its skeleton, each foot's points ([`foot_points`]) and their rest sole
-/// heights ([`rest_sole_heights`]), `[left, right]`.
+/// heights ([`rest_sole_heights`]), `[left, right]`, and the joints that place them (the foot
+/// points' joints and their ancestors).
 struct Feet {
     skeleton: Skeleton,
     points: [Vec<PointRef>; 2],
     rest: [Vec<f64>; 2],
+    chain: Vec<usize>,
 }
 
 impl Feet {
     /// The foot points of both feet at frame `f` of `clip`, world space.
     fn positions(&self, clip: &ModelClip, f: usize, g: &mut Vec<Transform>) -> [Vec<DVec3>; 2] {
-        frame_globals(
-            &clip.model,
-            clip.root_translation[f],
-            clip.root_rotation[f],
-            clip.frame_angles(f),
-            g,
-        );
+        let (t, q) = (clip.root_translation[f], clip.root_rotation[f]);
+        self.positions_at(&clip.model, t, q, clip.frame_angles(f), g)
+    }
+
+    /// The foot points of both feet with the root at `t`, `q` and the DOF `angles` of one frame.
+    fn positions_at(
+        &self,
+        model: &crate::humanoid::Model,
+        t: DVec3,
+        q: glam::DQuat,
+        angles: &[f64],
+        g: &mut Vec<Transform>,
+    ) -> [Vec<DVec3>; 2] {
+        chain_globals(model, &self.chain, t, q, angles, g);
         [0, 1].map(|s| {
             self.points[s]
                 .iter()
@@ -506,55 +522,58 @@ fn reach_targets(
     targets: &[Vec<Option<(DVec3, usize)>>; 2],
     report: &mut Planting,
 ) {
+    use rayon::prelude::*;
     let d = clip.dof_count();
     let rest = &model.rest;
-    let mut g = vec![];
-    for f in 0..clip.frame_count() {
-        for side in 0..2 {
-            let Some((c, k)) = targets[side][f] else {
-                continue;
-            };
-            if c.length() < 1e-6 {
-                continue;
-            }
-            report.leg_frames += 1;
-            let leg = legs[side].expect("checked above");
-            // Where the foot's points should go: each moved by c.
-            let want: Vec<DVec3> = before[f][side].iter().map(|x| *x + c).collect();
-            let want_sole = sole_height(&want, &rest[side]);
-            let mut ankle_target = g_ankle(clip, f, leg, &mut g) + c;
-            let mut residual = 0.0;
-            for _ in 0..IK_ROUNDS {
-                let (t, q) = (clip.root_translation[f], clip.root_rotation[f]);
-                let angles = &mut clip.angles[f * d..(f + 1) * d];
-                reach(&clip.model, leg, t, q, angles, ankle_target);
-                let now = model.positions(clip, f, &mut g)[side].clone();
-                // The residual of the foot: its sole height, and its key point's horizontal
-                // place.
-                let dy = want_sole - sole_height(&now, &rest[side]);
-                let dxz = (want[k] - now[k]) * DVec3::new(1.0, 0.0, 1.0);
-                let r = dxz + DVec3::Y * dy;
-                residual = r.length();
-                if residual < 1e-4 {
-                    break;
+    let (roots, rotations) = (&clip.root_translation, &clip.root_rotation);
+    let skeleton = &clip.model;
+    // Frames are independent: each moves only its own angles. Per frame: legs moved and the
+    // largest residual.
+    let moved: Vec<(usize, f64)> = clip
+        .angles
+        .par_chunks_mut(d)
+        .enumerate()
+        .map_init(Vec::new, |g, (f, angles)| {
+            let (t, q) = (roots[f], rotations[f]);
+            let mut out = (0, 0.0f64);
+            for side in 0..2 {
+                let Some((c, k)) = targets[side][f] else {
+                    continue;
+                };
+                if c.length() < 1e-6 {
+                    continue;
                 }
-                ankle_target += r;
+                out.0 += 1;
+                let leg = legs[side].expect("checked above");
+                // Where the foot's points should go: each moved by c.
+                let want: Vec<DVec3> = before[f][side].iter().map(|x| *x + c).collect();
+                let want_sole = sole_height(&want, &rest[side]);
+                chain_globals(skeleton, &model.chain, t, q, angles, g);
+                let mut ankle_target = g[leg.ankle].translation + c;
+                let mut residual = 0.0;
+                for _ in 0..IK_ROUNDS {
+                    reach(skeleton, leg, t, q, angles, ankle_target);
+                    let now = &model.positions_at(skeleton, t, q, angles, g)[side];
+                    // The residual of the foot: its sole height, and its key point's
+                    // horizontal place.
+                    let dy = want_sole - sole_height(now, &rest[side]);
+                    let dxz = (want[k] - now[k]) * DVec3::new(1.0, 0.0, 1.0);
+                    let r = dxz + DVec3::Y * dy;
+                    residual = r.length();
+                    if residual < 1e-4 {
+                        break;
+                    }
+                    ankle_target += r;
+                }
+                out.1 = out.1.max(residual);
             }
-            report.max_residual_m = report.max_residual_m.max(residual);
-        }
+            out
+        })
+        .collect();
+    for (legs_moved, residual) in moved {
+        report.leg_frames += legs_moved;
+        report.max_residual_m = report.max_residual_m.max(residual);
     }
-}
-
-/// The ankle of `leg` at frame `f` of `clip`.
-fn g_ankle(clip: &ModelClip, f: usize, leg: Leg, g: &mut Vec<Transform>) -> DVec3 {
-    frame_globals(
-        &clip.model,
-        clip.root_translation[f],
-        clip.root_rotation[f],
-        clip.frame_angles(f),
-        g,
-    );
-    g[leg.ankle].translation
 }
 
 #[cfg(test)]

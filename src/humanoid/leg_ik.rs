@@ -99,6 +99,44 @@ pub fn frame_globals(
     }
 }
 
+/// `joints` with every ancestor of each, in model order (parents before children): the joints
+/// whose global transforms [`chain_globals`] needs to place `joints`.
+pub fn with_ancestors(model: &Model, joints: &[usize]) -> Vec<usize> {
+    let mut inside = vec![false; model.joints.len()];
+    for &j in joints {
+        let mut at = Some(j);
+        while let Some(i) = at.filter(|&i| !inside[i]) {
+            inside[i] = true;
+            at = model.joints[i].parent;
+        }
+    }
+    (0..inside.len()).filter(|&i| inside[i]).collect()
+}
+
+/// [`frame_globals`] of the joints `chain` only (closed under parents and in model order, as
+/// [`with_ancestors`] gives): the same transforms, bit for bit, at the cost of the chain; the
+/// other entries of `out` are left as they were.
+pub fn chain_globals(
+    model: &Model,
+    chain: &[usize],
+    root_t: DVec3,
+    root_q: DQuat,
+    angles: &[f64],
+    out: &mut Vec<Transform>,
+) {
+    out.resize(model.joints.len(), Transform::IDENTITY);
+    for &j in chain {
+        let joint = &model.joints[j];
+        out[j] = match joint.parent {
+            Some(p) => out[p].compose(model.local_rotation_of(j, angles), joint.offset),
+            None => Transform {
+                rotation: root_q,
+                translation: root_t,
+            },
+        };
+    }
+}
+
 /// Moves the ankle of `leg` towards the global point `target` (module docs): rewrites the hip's
 /// and knee's DOF angles in `angles` (one frame, radians, model order), the root at `root_t`,
 /// `root_q`. Returns the distance left between the ankle and the target, metres (0 up to
@@ -112,7 +150,8 @@ pub fn reach(
     target: DVec3,
 ) -> f64 {
     let mut g = Vec::new();
-    frame_globals(model, root_t, root_q, angles, &mut g);
+    let chain = with_ancestors(model, &[leg.ankle]);
+    chain_globals(model, &chain, root_t, root_q, angles, &mut g);
     let hip_pos = g[leg.hip].translation;
     let k = model.joints[leg.knee].offset;
     let e = model.joints[leg.ankle].offset;
@@ -164,7 +203,7 @@ pub fn reach(
             &mut angles[first..first + m],
         );
     }
-    frame_globals(model, root_t, root_q, angles, &mut g);
+    chain_globals(model, &chain, root_t, root_q, angles, &mut g);
     (g[leg.ankle].translation - target).length()
 }
 

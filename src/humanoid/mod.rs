@@ -204,15 +204,21 @@ impl Model {
     /// Local rotations of every joint (root's is identity) for the DOF angles `angles`
     /// (radians, model order); writes into `out` (one per joint).
     pub fn local_rotations(&self, angles: &[f64], out: &mut [DQuat]) {
-        for (j, joint) in self.joints.iter().enumerate() {
-            let n = joint.dofs.len();
-            let mut axes = [DVec3::ZERO; 3];
-            let mut a = [0.0; 3];
-            for (k, &d) in joint.dofs.iter().enumerate() {
-                axes[k] = self.dofs[d].axis;
-                a[k] = angles[d];
-            }
-            out[j] = local_rotation(joint.kind, &axes[..n], &a[..n]);
+        for (j, o) in out.iter_mut().enumerate().take(self.joints.len()) {
+            *o = self.local_rotation_of(j, angles);
         }
+    }
+
+    /// The local rotation of joint `j` for the DOF angles `angles` (radians, model order).
+    pub fn local_rotation_of(&self, j: usize, angles: &[f64]) -> DQuat {
+        let joint = &self.joints[j];
+        let n = joint.dofs.len();
+        let mut axes = [DVec3::ZERO; 3];
+        let mut a = [0.0; 3];
+        for (k, &d) in joint.dofs.iter().enumerate() {
+            axes[k] = self.dofs[d].axis;
+            a[k] = angles[d];
+        }
+        local_rotation(joint.kind, &axes[..n], &a[..n])
     }
 }
