@@ -7,8 +7,9 @@
 //! - [`tempo`]: the tempo (autocorrelation of the envelope weighted by a log-normal tempo prior);
 //! - [`beats`]: beat placement by dynamic programming on the envelope (Ellis 2007);
 //! - [`chroma`]: the harmony between beats (pitch-class profiles) and where it changes;
-//! - [`bars`]: bars of 4 beats from downbeats tracked on the bass, the onsets and the chord
-//!   changes (a shorter bar where the song inserts one), or from a given first downbeat;
+//! - [`bars`]: bars of 4 beats from downbeats tracked on the bass onsets, the onsets, the chord
+//!   changes and the bass line's changes (a shorter bar where the song inserts one), or from a
+//!   given first downbeat;
 //! - [`eval`]: the standard beat, continuity, tempo and downbeat scores against annotations;
 //! - [`intensity`]: each bar's RMS and its level in dB;
 //! - [`synth`]: a drum track with exact ground truth (tempo, beats, bar loudness) for tests and
@@ -146,6 +147,9 @@ pub struct MusicParams {
     pub beats: BeatParams,
     /// The chroma of the harmony between beats (the beat level's check and the downbeats).
     pub chroma: ChromaParams,
+    /// The chroma of the bass register in each beat, whose change is downbeat evidence
+    /// ([`ChromaParams::bass`]; [`bars`]).
+    pub bass: ChromaParams,
     /// Beats per bar (4 for 4/4).
     pub beats_per_bar: usize,
     /// Index of the first downbeat among the beats (0 .. beats_per_bar); every bar then has
@@ -168,6 +172,7 @@ impl Default for MusicParams {
             prior: TempoPrior::default(),
             beats: BeatParams::default(),
             chroma: ChromaParams::default(),
+            bass: ChromaParams::bass(),
             beats_per_bar: 4,
             downbeat: None,
             rephase_sd: 8.0,
@@ -308,7 +313,14 @@ pub fn analyze(
             let halves = halves
                 .unwrap_or_else(|| tonal_halves(samples, sample_rate, &beats_s, &params.chroma));
             let harmony = harmonic_change(&chroma::beat_chroma(&halves), 2);
-            let z = downbeat_evidence(&env, &beat_frames, &harmony);
+            // The bass line's change, in a song with tonality (halves not empty).
+            let bass = if halves.is_empty() {
+                vec![]
+            } else {
+                let c = chroma::beat_interval_chroma(samples, sample_rate, &beats_s, &params.bass);
+                harmonic_change(&c, 2)
+            };
+            let z = downbeat_evidence(&env, &beat_frames, &[&harmony, &bass]);
             (track_downbeats(&z, bpb, params.rephase_sd), false)
         }
     };
