@@ -5,17 +5,20 @@
 //! the low band (bass and kick drum come in on the downbeat), plus half that of its full-band
 //! onset strength, plus that of the harmonic change at the beat (chords change most often on
 //! the bar's first beat; [`super::chroma::harmonic_change`] over two beats each side), plus
-//! that of the bass line's harmonic change at the beat (the bass takes a new note most often on
-//! the bar's first beat; the same change over two beats each side, of the bass register's
-//! chroma of each beat, [`super::chroma::beat_interval_chroma`]):
-//! e_i = r(low_i) + ½ r(full_i) + r(h_i) + r(b_i), each rank r in (0, 1); z_i is e_i
-//! standardised over the song. A song without tonality has neither harmonic term. The downbeats are the bar positions (0 .. B − 1, B = beats per
-//! bar) that maximise Σ_{i: position 0} z_i by dynamic programming (Viterbi) over the beats:
-//! the position advances by one each beat and wraps from B − 1 to 0, and a bar may end early
-//! (a bar of fewer beats, as when a song inserts a 2/4 bar) at a cost of `rephase_sd` (in
-//! units of z: the downbeat evidence of the bars after it must make up for it). The first beat
-//! may sit anywhere in its bar (a pickup). With a given downbeat, or an infinite cost, every
-//! bar has B beats.
+//! that of the bass line's harmonic change at the beat (the bass takes a new note most often
+//! on the bar's first beat, also where the chords above it change on every second beat; the
+//! same change over two beats each side, of the bass register's chroma,
+//! [`super::chroma::half_beat_chroma_and_bass`], a beat's being its first half's):
+//!
+//! e_i = r(low_i) + ½ r(full_i) + r(h_i) + r(b_i), each rank r in (0, 1),
+//!
+//! and z_i is e_i standardised over the song. A song without tonality has neither harmonic
+//! term. The downbeats are the bar positions (0 .. B − 1, B = beats per bar) that maximise
+//! Σ_{i: position 0} z_i by dynamic programming (Viterbi) over the beats: the position advances
+//! by one each beat and wraps from B − 1 to 0, and a bar may end early (a bar of fewer beats,
+//! as when a song inserts a 2/4 bar) at a cost of `rephase_sd` (in units of z: the downbeat
+//! evidence of the bars after it must make up for it). The first beat may sit anywhere in its
+//! bar (a pickup). With a given downbeat, or an infinite cost, every bar has B beats.
 //!
 //! A bar spans from its downbeat to the next; the last bar, whose closing downbeat was not
 //! tracked, ends one bar's fitted length after its start if the song lasts that long.
@@ -190,7 +193,7 @@ mod tests {
     #[test]
     fn the_bass_line_s_change_marks_the_bar_where_the_chords_change_every_two_beats() {
         use crate::choreo::music::chroma::{
-            ChromaParams, beat_chroma, beat_interval_chroma, half_beat_chroma, harmonic_change,
+            ChromaParams, beat_chroma, half_beat_chroma_and_bass, harmonic_change,
         };
         use crate::choreo::music::{OnsetParams, onset_envelope};
         // Beats every 0.5 s from 0.25 s; one beat of pickup, then bars from beat 1. Every beat
@@ -217,7 +220,9 @@ mod tests {
             }
         }
         let beats: Vec<f64> = (0..n).map(|b| 0.25 + beat_s * b as f64).collect();
-        let bass_chroma = beat_interval_chroma(&x, sr, &beats, &ChromaParams::bass());
+        let (halves, bass_halves) =
+            half_beat_chroma_and_bass(&x, sr, &beats, &ChromaParams::default());
+        let bass_chroma = beat_chroma(&bass_halves);
         // Each beat's bass chroma peaks on its root's class, under the chords above 260 Hz.
         for (b, c) in bass_chroma.iter().enumerate() {
             let class = c
@@ -239,7 +244,6 @@ mod tests {
         };
         assert!(mean(0) > 3.0 * mean(2), "{} vs {}", mean(0), mean(2));
         // With the onsets and the chords' change, the downbeats are the bar's first beats.
-        let halves = half_beat_chroma(&x, sr, &beats, &ChromaParams::default());
         let chords_change = harmonic_change(&beat_chroma(&halves), 2);
         let env = onset_envelope(&x, sr, &OnsetParams::default()).unwrap();
         let frames: Vec<f64> = beats.iter().map(|t| t * env.frame_rate()).collect();
