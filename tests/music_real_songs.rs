@@ -75,8 +75,8 @@ fn held_out_songs_beats_tempo_and_bars_beside_librosa() {
     eprintln!("{}", pop909::line("marionette, 16 held out", &ours_held));
     eprintln!("{}", pop909::line("librosa, 16 held out", &theirs_held));
     // Issue 35's aims on the held-out songs: F ≥ librosa's + 0.03 and Acc1 ≥ 80 %, met; downbeat
-    // F ≥ 0.8, not met (0.769 when written, with the chord changes: see docs/choreography.md),
-    // held here at 0.74.
+    // F ≥ 0.8, not met (0.782 when written, with the chord and bass-line changes: see
+    // docs/choreography.md), held here at 0.76.
     let [f, _, aml_t, acc1, acc2, downbeat_f] = pop909::means(&ours_held);
     let [f_librosa, ..] = pop909::means(&theirs_held);
     assert!(
@@ -88,7 +88,7 @@ fn held_out_songs_beats_tempo_and_bars_beside_librosa() {
         acc2 >= 0.9 && aml_t >= 0.85,
         "Acc2 {acc2:.3} AMLt {aml_t:.3}"
     );
-    assert!(downbeat_f >= 0.74, "held-out downbeat F {downbeat_f:.3}");
+    assert!(downbeat_f >= 0.76, "held-out downbeat F {downbeat_f:.3}");
     let [f_dev, _, _, acc1_dev, _, downbeat_dev] = pop909::means(&dev);
     assert!(
         f_dev >= 0.9 && acc1_dev >= 0.85 && downbeat_dev >= 0.69,

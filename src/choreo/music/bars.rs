@@ -4,14 +4,21 @@
 //! Each beat i gets a downbeat evidence e_i: the rank among the beats of its onset strength in
 //! the low band (bass and kick drum come in on the downbeat), plus half that of its full-band
 //! onset strength, plus that of the harmonic change at the beat (chords change most often on
-//! the bar's first beat; [`super::chroma::harmonic_change`] over two beats each side); z_i is
-//! e_i standardised over the song. The downbeats are the bar positions (0 .. B − 1, B = beats per
-//! bar) that maximise Σ_{i: position 0} z_i by dynamic programming (Viterbi) over the beats:
-//! the position advances by one each beat and wraps from B − 1 to 0, and a bar may end early
-//! (a bar of fewer beats, as when a song inserts a 2/4 bar) at a cost of `rephase_sd` (in
-//! units of z: the downbeat evidence of the bars after it must make up for it). The first beat
-//! may sit anywhere in its bar (a pickup). With a given downbeat, or an infinite cost, every
-//! bar has B beats.
+//! the bar's first beat; [`super::chroma::harmonic_change`] over two beats each side), plus
+//! that of the bass line's harmonic change at the beat (the bass takes a new note most often
+//! on the bar's first beat, also where the chords above it change on every second beat; the
+//! same change over two beats each side, of the bass register's chroma,
+//! [`super::chroma::half_beat_chroma_and_bass`], a beat's being its first half's):
+//!
+//! e_i = r(low_i) + ½ r(full_i) + r(h_i) + r(b_i), each rank r in (0, 1),
+//!
+//! and z_i is e_i standardised over the song. A song without tonality has neither harmonic
+//! term. The downbeats are the bar positions (0 .. B − 1, B = beats per bar) that maximise
+//! Σ_{i: position 0} z_i by dynamic programming (Viterbi) over the beats: the position advances
+//! by one each beat and wraps from B − 1 to 0, and a bar may end early (a bar of fewer beats,
+//! as when a song inserts a 2/4 bar) at a cost of `rephase_sd` (in units of z: the downbeat
+//! evidence of the bars after it must make up for it). The first beat may sit anywhere in its
+//! bar (a pickup). With a given downbeat, or an infinite cost, every bar has B beats.
 //!
 //! A bar spans from its downbeat to the next; the last bar, whose closing downbeat was not
 //! tracked, ends one bar's fitted length after its start if the song lasts that long.
@@ -43,17 +50,18 @@ pub(super) fn at(x: &[f64], f: f64) -> f64 {
 }
 
 /// The standardised downbeat evidence z_i of each beat (module docs) from the onsets at each
-/// beat and the harmonic change at each beat (`harmony`, one per beat; a slice of any other
-/// length, as the empty one of a song without tonality, leaves it out): each feature enters as its rank among the beats (0 to 1), so that one outlier, as the
-/// first onset of a song, does not outweigh the rest.
-pub fn downbeat_evidence(env: &OnsetEnvelope, beat_frames: &[f64], harmony: &[f64]) -> Vec<f64> {
+/// beat and the harmonic changes at each beat (`harmony`: the chords' and the bass line's, each
+/// one per beat and of weight 1; one of any other length, as the empty one of a song without
+/// tonality, is left out): each feature enters as its rank among the beats (0 to 1), so that
+/// one outlier, as the first onset of a song, does not outweigh the rest.
+pub fn downbeat_evidence(env: &OnsetEnvelope, beat_frames: &[f64], harmony: &[&[f64]]) -> Vec<f64> {
     let n = beat_frames.len();
     let mut e = vec![0.0; n];
     let low: Vec<f64> = beat_frames.iter().map(|&f| at(&env.low, f)).collect();
     let full: Vec<f64> = beat_frames.iter().map(|&f| at(&env.values, f)).collect();
     let mut features = vec![(low, 1.0), (full, 0.5)];
-    if harmony.len() == n {
-        features.push((harmony.to_vec(), 1.0));
+    for h in harmony.iter().filter(|h| h.len() == n) {
+        features.push((h.to_vec(), 1.0));
     }
     for (s, weight) in features {
         let mut order: Vec<usize> = (0..n).collect();
@@ -180,6 +188,68 @@ mod tests {
         };
         let z = downbeat_evidence(&env, &frames, &[]);
         assert_eq!(track_downbeats(&z, 4, f64::INFINITY)[0], 3);
+    }
+
+    #[test]
+    fn the_bass_line_s_change_marks_the_bar_where_the_chords_change_every_two_beats() {
+        use crate::choreo::music::chroma::{
+            ChromaParams, beat_chroma, half_beat_chroma_and_bass, harmonic_change,
+        };
+        use crate::choreo::music::{OnsetParams, onset_envelope};
+        // Beats every 0.5 s from 0.25 s; one beat of pickup, then bars from beat 1. Every beat
+        // strikes the same chord and bass note loudness; the chord changes on beats 1 and 3 of
+        // each bar (C major, then F major), the bass note only on beat 1 (C2, A1, F1, G1, …).
+        let (sr, beat_s, n) = (22_050u32, 0.5, 33usize);
+        let chords = [[261.63, 329.63, 392.0], [349.23, 440.0, 523.25]];
+        let roots = [65.41, 55.0, 43.65, 49.0];
+        let mut x = vec![0f32; (sr as f64 * (0.25 + beat_s * n as f64 + 0.5)) as usize];
+        for b in 0..n {
+            let (bar, pos) = (b.div_ceil(4), (b + 3) % 4);
+            let chord = chords[pos / 2];
+            let root = roots[bar % 4];
+            let start = (sr as f64 * (0.25 + beat_s * b as f64)) as usize;
+            for k in 0..(sr as f64 * beat_s) as usize {
+                let t = k as f64 / sr as f64;
+                let decay = (-3.0 * t).exp();
+                let upper: f64 = chord
+                    .iter()
+                    .map(|f| (std::f64::consts::TAU * f * t).sin())
+                    .sum();
+                let bass = 2.0 * (std::f64::consts::TAU * root * t).sin();
+                x[start + k] += (0.1 * decay * (upper + bass)) as f32;
+            }
+        }
+        let beats: Vec<f64> = (0..n).map(|b| 0.25 + beat_s * b as f64).collect();
+        let (halves, bass_halves) =
+            half_beat_chroma_and_bass(&x, sr, &beats, &ChromaParams::default());
+        let bass_chroma = beat_chroma(&bass_halves);
+        // Each beat's bass chroma peaks on its root's class, under the chords above 260 Hz.
+        for (b, c) in bass_chroma.iter().enumerate() {
+            let class = c
+                .iter()
+                .enumerate()
+                .fold((0, 0.0), |m, (i, &v)| if v > m.1 { (i, v) } else { m })
+                .0;
+            let expected = [0, 9, 5, 7][b.div_ceil(4) % 4];
+            assert_eq!(class, expected, "beat {b}: {c:?}");
+        }
+        // The bass line changes on each bar's first beat, hardly on its third.
+        let bass = harmonic_change(&bass_chroma, 2);
+        let mean = |pos: usize| {
+            let v: Vec<f64> = (4..n - 2)
+                .filter(|b| (b + 3) % 4 == pos)
+                .map(|b| bass[b])
+                .collect();
+            v.iter().sum::<f64>() / v.len() as f64
+        };
+        assert!(mean(0) > 3.0 * mean(2), "{} vs {}", mean(0), mean(2));
+        // With the onsets and the chords' change, the downbeats are the bar's first beats.
+        let chords_change = harmonic_change(&beat_chroma(&halves), 2);
+        let env = onset_envelope(&x, sr, &OnsetParams::default()).unwrap();
+        let frames: Vec<f64> = beats.iter().map(|t| t * env.frame_rate()).collect();
+        let z = downbeat_evidence(&env, &frames, &[&chords_change, &bass]);
+        let downbeats = track_downbeats(&z, 4, f64::INFINITY);
+        assert_eq!(downbeats[..3], [1, 5, 9], "{z:?}");
     }
 
     #[test]

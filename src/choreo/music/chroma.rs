@@ -13,6 +13,15 @@
 //! In songs with chords, chords change on beats, and most often on the bar's first beat (Goto
 //! 2001, "An audio-based real-time beat tracking system for music with or without drum-sounds").
 //!
+//! The bass line is followed apart: from the same spectrum, the bins from `bass_low_hz` to
+//! `bass_high_hz` (30 to 260 Hz, below middle C, where the bass instruments and the pianist's
+//! left hand play) are folded, compressed (with P_max the loudest class of this register) and
+//! scaled the same way into a second chroma, the bass's ([`register_chroma`]), whose harmonic
+//! change is measured likewise. The bass takes a new note most often on the bar's first beat,
+//! and it says so apart from the upper voices, whose chroma a melody and passing notes blur.
+//! The default window (0.37 s at 22.05 or 44.1 kHz) has bins 2.7 Hz apart, finer than a
+//! semitone from about G1 (49 Hz) up; below that the bass's harmonics carry its pitch class.
+//!
 //! Harmony means something only where there is pitch: the tonality of a song is the mean over
 //! its intervals of the cosine distance of their chroma from the flat profile (1/√12 each),
 //! near 0 for noise and drums (0.01 to 0.05 for five synthesized drum tracks of 68 to 150 BPM)
@@ -36,6 +45,10 @@ pub struct ChromaParams {
     pub low_hz: f64,
     /// Highest frequency folded onto the pitch classes (Hz).
     pub high_hz: f64,
+    /// Lowest frequency of the bass register (Hz; module docs).
+    pub bass_low_hz: f64,
+    /// Highest frequency of the bass register (Hz).
+    pub bass_high_hz: f64,
     /// γ of the log compression, as 10 log₁₀ γ (dB).
     pub compression_db: f64,
     /// Least tonality (module docs) at which the harmony is used.
@@ -48,6 +61,8 @@ impl Default for ChromaParams {
             window_s: 0.186,
             low_hz: 100.0,
             high_hz: 2000.0,
+            bass_low_hz: 30.0,
+            bass_high_hz: 260.0,
             compression_db: 30.0,
             min_tonality: 0.1,
         }
@@ -58,32 +73,51 @@ impl Default for ChromaParams {
 pub type Chroma = [f64; 12];
 
 /// The chroma of each interval between successive `times_s` (one fewer than the times; see the
-/// module docs), of mono `samples` at `sample_rate` Hz. Intervals run in parallel, each with its
-/// own buffers, so the result does not depend on the threads.
+/// module docs), of mono `samples` at `sample_rate` Hz, over `low_hz` to `high_hz`.
 pub fn interval_chroma(
     samples: &[f32],
     sample_rate: u32,
     times_s: &[f64],
     params: &ChromaParams,
 ) -> Vec<Chroma> {
+    let register = [(params.low_hz, params.high_hz)];
+    register_chroma(samples, sample_rate, times_s, params, &register)
+        .pop()
+        .unwrap_or_default()
+}
+
+/// The chroma of each interval between successive `times_s` in each register (lowest, highest
+/// frequency in Hz) of `registers`, all from one spectrum per interval (module docs): one list
+/// of chroma per register. Intervals run in parallel, each with its own buffers, so the result
+/// does not depend on the threads.
+pub fn register_chroma(
+    samples: &[f32],
+    sample_rate: u32,
+    times_s: &[f64],
+    params: &ChromaParams,
+    registers: &[(f64, f64)],
+) -> Vec<Vec<Chroma>> {
     let sr = sample_rate as f64;
     let n_fft = ((params.window_s * sr).ceil() as usize)
         .next_power_of_two()
         .max(16);
     let window = super::onsets::hann(n_fft);
     let bin_hz = sr / n_fft as f64;
-    let bins: Vec<(usize, usize)> = (1..n_fft / 2)
-        .filter_map(|k| {
+    // (bin, register, pitch class) of every bin folded.
+    let bins: Vec<(usize, usize, usize)> = (1..n_fft / 2)
+        .flat_map(|k| {
             let f = k as f64 * bin_hz;
-            let midi = 69.0 + 12.0 * (f / 440.0).log2();
-            (params.low_hz..=params.high_hz)
-                .contains(&f)
-                .then(|| (k, (midi.round() as i64).rem_euclid(12) as usize))
+            let class = ((69.0 + 12.0 * (f / 440.0).log2()).round() as i64).rem_euclid(12);
+            registers
+                .iter()
+                .enumerate()
+                .filter(move |(_, (lo, hi))| (*lo..=*hi).contains(&f))
+                .map(move |(r, _)| (k, r, class as usize))
         })
         .collect();
     let fft: Arc<dyn RealToComplex<f32>> = RealFftPlanner::<f32>::new().plan_fft_forward(n_fft);
     let half = (n_fft / 2) as f64;
-    let power: Vec<[f64; 12]> = times_s
+    let power: Vec<Vec<[f64; 12]>> = times_s
         .par_windows(2)
         .map_init(
             || {
@@ -104,18 +138,25 @@ pub fn interval_chroma(
                 }
                 // The lengths come from the same plan, so processing cannot fail.
                 let _ = fft.process_with_scratch(input, spectrum, scratch);
-                let mut p = [0.0; 12];
-                for &(k, class) in &bins {
-                    p[class] += spectrum[k].norm_sqr() as f64;
+                let mut p = vec![[0.0; 12]; registers.len()];
+                for &(k, r, class) in &bins {
+                    p[r][class] += spectrum[k].norm_sqr() as f64;
                 }
                 p
             },
         )
         .collect();
-    let max = power.iter().flatten().fold(0f64, |m, &p| m.max(p));
-    let gamma = 10f64.powf(params.compression_db / 10.0) / max.max(f64::MIN_POSITIVE);
+    (0..registers.len())
+        .map(|r| compress(power.iter().map(|p| p[r]), params.compression_db))
+        .collect()
+}
+
+/// Chroma from pitch-class powers: c(p) = ln(1 + γ P(p) / P_max) with P_max the largest power
+/// of all, each scaled to unit length (module docs).
+fn compress(power: impl Iterator<Item = [f64; 12]> + Clone, compression_db: f64) -> Vec<Chroma> {
+    let max = power.clone().flatten().fold(0f64, |m, p| m.max(p));
+    let gamma = 10f64.powf(compression_db / 10.0) / max.max(f64::MIN_POSITIVE);
     power
-        .iter()
         .map(|p| {
             let mut c = p.map(|v| (gamma * v).ln_1p());
             let norm = c.iter().map(|v| v * v).sum::<f64>().sqrt();
@@ -178,6 +219,35 @@ pub fn half_beat_chroma(
     beats_s: &[f64],
     params: &ChromaParams,
 ) -> Vec<Chroma> {
+    interval_chroma(samples, sample_rate, &half_beat_times(beats_s), params)
+}
+
+/// The chroma of each half beat of `beats_s` as [`half_beat_chroma`], and from the same
+/// spectra the bass's (`bass_low_hz` to `bass_high_hz`, module docs): (chords, bass).
+pub fn half_beat_chroma_and_bass(
+    samples: &[f32],
+    sample_rate: u32,
+    beats_s: &[f64],
+    params: &ChromaParams,
+) -> (Vec<Chroma>, Vec<Chroma>) {
+    let registers = [
+        (params.low_hz, params.high_hz),
+        (params.bass_low_hz, params.bass_high_hz),
+    ];
+    let mut c = register_chroma(
+        samples,
+        sample_rate,
+        &half_beat_times(beats_s),
+        params,
+        &registers,
+    );
+    let bass = c.pop().unwrap_or_default();
+    (c.pop().unwrap_or_default(), bass)
+}
+
+/// The bounds of every half beat of `beats_s`, the last beat one fitted period long; none for
+/// fewer than two beats.
+fn half_beat_times(beats_s: &[f64]) -> Vec<f64> {
     if beats_s.len() < 2 {
         return vec![];
     }
@@ -192,7 +262,7 @@ pub fn half_beat_chroma(
         .flat_map(|w| [w[0], 0.5 * (w[0] + w[1])])
         .collect();
     halves.extend(beats.last());
-    interval_chroma(samples, sample_rate, &halves, params)
+    halves
 }
 
 /// The chroma of each beat from those of its halves ([`half_beat_chroma`]): that of its first

@@ -6,9 +6,11 @@
 //! - [`onsets`]: the onset-strength envelope (spectral flux on a log-magnitude spectrogram);
 //! - [`tempo`]: the tempo (autocorrelation of the envelope weighted by a log-normal tempo prior);
 //! - [`beats`]: beat placement by dynamic programming on the envelope (Ellis 2007);
-//! - [`chroma`]: the harmony between beats (pitch-class profiles) and where it changes;
-//! - [`bars`]: bars of 4 beats from downbeats tracked on the bass, the onsets and the chord
-//!   changes (a shorter bar where the song inserts one), or from a given first downbeat;
+//! - [`chroma`]: the harmony between beats and the bass line (pitch-class profiles) and where
+//!   they change;
+//! - [`bars`]: bars of 4 beats from downbeats tracked on the bass onsets, the onsets, the chord
+//!   changes and the bass line's changes (a shorter bar where the song inserts one), or from a
+//!   given first downbeat;
 //! - [`eval`]: the standard beat, continuity, tempo and downbeat scores against annotations;
 //! - [`intensity`]: each bar's RMS and its level in dB;
 //! - [`synth`]: a drum track with exact ground truth (tempo, beats, bar loudness) for tests and
@@ -305,10 +307,11 @@ pub fn analyze(
     let (downbeats, downbeat_given) = match params.downbeat {
         Some(d) => (bars::regular_downbeats(d, bpb, beats_s.len()), true),
         None => {
-            let halves = halves
+            let (halves, bass_halves) = halves
                 .unwrap_or_else(|| tonal_halves(samples, sample_rate, &beats_s, &params.chroma));
             let harmony = harmonic_change(&chroma::beat_chroma(&halves), 2);
-            let z = downbeat_evidence(&env, &beat_frames, &harmony);
+            let bass = harmonic_change(&chroma::beat_chroma(&bass_halves), 2);
+            let z = downbeat_evidence(&env, &beat_frames, &[&harmony, &bass]);
             (track_downbeats(&z, bpb, params.rephase_sd), false)
         }
     };
@@ -398,14 +401,16 @@ fn audible_envelope(
 
 /// The beats at the comb's level, or tracked again twice as fast when that level's midpoints
 /// are as strong as its beats (a backbeat) or its chords change between its beats (every second
-/// beat, or off the beat); with the half-beat chroma of the returned beats when it was taken.
+/// beat, or off the beat); with the half-beat chroma and bass chroma of the returned beats when
+/// they were taken.
+#[allow(clippy::type_complexity)]
 fn beat_level(
     samples: &[f32],
     sample_rate: u32,
     env: &OnsetEnvelope,
     tempo: &TempoEstimate,
     params: &MusicParams,
-) -> Result<(Vec<f64>, Option<Vec<Chroma>>), MusicError> {
+) -> Result<(Vec<f64>, Option<(Vec<Chroma>, Vec<Chroma>)>), MusicError> {
     let beat_frames = track_beats(env, tempo.period_frames, &params.beats)?;
     let fastest = 60.0 * env.frame_rate() / params.prior.max_bpm;
     if tempo.period_frames / 2.0 < fastest {
@@ -417,7 +422,7 @@ fn beat_level(
     }
     let times = times_of(env, &beat_frames);
     let halves = tonal_halves(samples, sample_rate, &times, &params.chroma);
-    if chroma::midpoint_harmony_ratio(&halves) >= params.beats.midpoint_harmony {
+    if chroma::midpoint_harmony_ratio(&halves.0) >= params.beats.midpoint_harmony {
         return Ok((faster()?, None));
     }
     Ok((beat_frames, Some(halves)))
@@ -428,17 +433,18 @@ fn times_of(env: &OnsetEnvelope, frames: &[f64]) -> Vec<f64> {
     frames.iter().map(|&f| env.time_of(f)).collect()
 }
 
-/// The chroma of each half beat of `beats_s` ([`chroma::half_beat_chroma`]); empty for a song
-/// less tonal than `p.min_tonality` (drums, noise), whose harmony is not used.
+/// The chroma and the bass chroma of each half beat of `beats_s`
+/// ([`chroma::half_beat_chroma_and_bass`]); both empty for a song less tonal than
+/// `p.min_tonality` (drums, noise), whose harmony is not used.
 fn tonal_halves(
     samples: &[f32],
     sample_rate: u32,
     beats_s: &[f64],
     p: &ChromaParams,
-) -> Vec<Chroma> {
-    let halves = chroma::half_beat_chroma(samples, sample_rate, beats_s, p);
+) -> (Vec<Chroma>, Vec<Chroma>) {
+    let (halves, bass) = chroma::half_beat_chroma_and_bass(samples, sample_rate, beats_s, p);
     if chroma::tonality(&halves) < p.min_tonality {
-        return vec![];
+        return (vec![], vec![]);
     }
-    halves
+    (halves, bass)
 }
