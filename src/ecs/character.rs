@@ -3,7 +3,8 @@
 //! channels) as for a kinematic character; in [`MotionSet::Control`] the pose becomes the PD
 //! targets of the simulated joints ([`ControlSet::Targets`]), pushes release the assistance or
 //! switch to a key pose ([`ControlSet::Reactions`]), and a root assistance ("hand of god") pulls
-//! the pelvis toward the animated root ([`ControlSet::Assist`]); the body steps in
+//! the pelvis toward the animated root ([`ControlSet::Assist`]: its wrench joins the
+//! character's [`ExternalForces`], which the step reads); the body steps in
 //! [`MotionSet::Physics`] through the one pipeline (limits, contact and dynamics are its stages,
 //! evaluated at every integrator stage, so they are not separate systems); its pose reaches the
 //! joint state in [`MotionSet::Pose`] and the [`CharacterLog`] in [`MotionSet::Record`].
@@ -56,7 +57,8 @@ pub enum ControlSet {
     Targets,
     /// Pushes release the assistance or switch the controller ([`react_to_pushes`]).
     Reactions,
-    /// The root assistance's force and torque for this tick ([`root_assist`]).
+    /// The root assistance's force and torque for this tick, written into the character's
+    /// [`ExternalForces`] ([`root_assist`]).
     Assist,
 }
 
@@ -687,6 +689,7 @@ pub fn react_to_pushes(mut q: Query<ReactionQuery>) {
         let t = state.time_s;
         if reaction.pushed_at_s.is_none() {
             reaction.pushed_at_s = forces
+                .pushes()
                 .iter()
                 .filter(|f| f.start_s <= t)
                 .map(|f| f.start_s)
@@ -709,34 +712,52 @@ pub fn react_to_pushes(mut q: Query<ReactionQuery>) {
     }
 }
 
+/// What [`root_assist`] reads and writes.
+type AssistQuery<'a> = (
+    &'a BodyState,
+    &'a ModelBinding,
+    &'a DofPose,
+    &'a mut RootAssist,
+    Option<&'a mut ExternalForces>,
+);
+
 /// The root assistance's force and torque for this tick from the body's pelvis at the tick
-/// start and the animated root (see the module doc).
-pub fn root_assist(mut q: Query<(&BodyState, &ModelBinding, &DofPose, &mut RootAssist)>) {
-    for (state, binding, pose, mut a) in &mut q {
-        if a.released || a.strength == 0.0 {
-            a.force = DVec3::ZERO;
-            a.torque = DVec3::ZERO;
-            continue;
+/// start and the animated root (see the module doc), written into the character's
+/// [`ExternalForces`] ([`ExternalForces::set_assist`]; none when zero) for the step to apply.
+pub fn root_assist(mut q: Query<AssistQuery>) {
+    for (state, binding, pose, mut a, external) in &mut q {
+        assist_wrench(state, binding, pose, &mut a);
+        if let Some(mut external) = external {
+            external.set_assist(a.external());
         }
-        let r = binding.root_columns();
-        let th = |k: usize| pose.theta[r[k]];
-        let rate = |k: usize| pose.theta_dot[r[k]];
-        let qs = &state.q;
-        let p = DVec3::new(qs[0], qs[1], qs[2]);
-        let rot = DQuat::from_xyzw(qs[3], qs[4], qs[5], qs[6]);
-        let v = &state.v;
-        let w_world = rot * DVec3::new(v[0], v[1], v[2]);
-        let v_world = rot * DVec3::new(v[3], v[4], v[5]);
-        let (om, z, s) = (a.omega, a.zeta, a.strength);
-        let (kp, kd) = (om * om, 2.0 * z * om);
-        let p_d = DVec3::new(th(0), th(1), th(2));
-        let v_d = DVec3::new(rate(0), rate(1), rate(2));
-        a.force = s * (a.feedforward_force + a.mass_kg * (kp * (p_d - p) + kd * (v_d - v_world)));
-        let rot_d = DQuat::from_scaled_axis(DVec3::new(th(3), th(4), th(5)));
-        let e = quat_log(rot_d * rot.inverse());
-        let w_d = DVec3::new(rate(3), rate(4), rate(5));
-        a.torque = s * (a.feedforward_torque + a.inertia_kg_m2 * (kp * e + kd * (w_d - w_world)));
     }
+}
+
+/// Sets `a.force` and `a.torque` for this tick (zero once released or at strength 0).
+fn assist_wrench(state: &BodyState, binding: &ModelBinding, pose: &DofPose, a: &mut RootAssist) {
+    if a.released || a.strength == 0.0 {
+        a.force = DVec3::ZERO;
+        a.torque = DVec3::ZERO;
+        return;
+    }
+    let r = binding.root_columns();
+    let th = |k: usize| pose.theta[r[k]];
+    let rate = |k: usize| pose.theta_dot[r[k]];
+    let qs = &state.q;
+    let p = DVec3::new(qs[0], qs[1], qs[2]);
+    let rot = DQuat::from_xyzw(qs[3], qs[4], qs[5], qs[6]);
+    let v = &state.v;
+    let w_world = rot * DVec3::new(v[0], v[1], v[2]);
+    let v_world = rot * DVec3::new(v[3], v[4], v[5]);
+    let (om, z, s) = (a.omega, a.zeta, a.strength);
+    let (kp, kd) = (om * om, 2.0 * z * om);
+    let p_d = DVec3::new(th(0), th(1), th(2));
+    let v_d = DVec3::new(rate(0), rate(1), rate(2));
+    a.force = s * (a.feedforward_force + a.mass_kg * (kp * (p_d - p) + kd * (v_d - v_world)));
+    let rot_d = DQuat::from_scaled_axis(DVec3::new(th(3), th(4), th(5)));
+    let e = quat_log(rot_d * rot.inverse());
+    let w_d = DVec3::new(rate(3), rate(4), rate(5));
+    a.torque = s * (a.feedforward_torque + a.inertia_kg_m2 * (kp * e + kd * (w_d - w_world)));
 }
 
 /// Logs every physical character after its step (see [`CharacterLog`]).
