@@ -29,12 +29,12 @@ use bevy_ecs::prelude::*;
 use glam::{DMat3, DQuat, DVec3};
 
 use super::clock::Clock;
-use super::dof_pose::ModelBinding;
+use super::dof_pose::{DofPose, ModelBinding};
 use super::physics::{
     BodyState, ExternalForces, FloorContact, JointLimits, PdController, PhysicsBody, PhysicsBundle,
     PhysicsMonitor, PhysicsStatus, drawn_body,
 };
-use super::primitive::{DofPose, PrimitivePlayer};
+use super::primitive::PrimitivePlayer;
 use super::sets::{MotionSet, configure_motion_sets};
 use crate::dynamics::control::{
     ComputedTorque, RootAssistGains, RootTarget, Wrench, inertia_scaled_gains, root_assist_wrench,
