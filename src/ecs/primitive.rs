@@ -2,10 +2,10 @@
 //!
 //! - [`PrimitivePlayer`] plays a sequence of primitives, connected: each starts from the state the
 //!   previous one ended in and takes over without a step in acceleration (as
-//!   [`super::connect()`], with its [`HandOver`]); after the last one the DMP keeps running and
-//!   settles on its goal.
+//!   [`crate::primitive::connect()`], with its [`HandOver`]); after the last one the DMP keeps
+//!   running and settles on its goal.
 //! - [`BlendPlayer`] plays two primitives placed on a time line and mixes them live with γ(t′)
-//!   (step 3 of the paper's blending, as [`super::blend()`] without re-learning).
+//!   (step 3 of the paper's blending, as [`crate::primitive::blend()`] without re-learning).
 //! - Both write the character's [`DofPose`] (θ and θ̇ per DOF) for the systems downstream
 //!   (forward kinematics, rendering).
 //! - The World's [`Clock`] gives the step (one tick); [`PrimitiveSet`] orders the systems inside
@@ -163,7 +163,8 @@ pub struct BlendPlayer {
 }
 
 impl BlendPlayer {
-    /// A live blend (the same checks as [`super::blend()`]: same DOFs, a valid arrangement, a valid γ).
+    /// A live blend (the same checks as [`crate::primitive::blend()`]: same DOFs, a valid
+    /// arrangement, a valid γ).
     pub fn new(
         a: &Primitive,
         b: &Primitive,
