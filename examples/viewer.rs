@@ -481,7 +481,7 @@ fn status_text(
         }
         match r.released_at_s {
             Some(t) if a.released => line.push_str(&format!(", assistance released at {t:.2} s")),
-            _ => line.push_str(&format!(", assistance {:.2}", a.strength)),
+            _ => line.push_str(&format!(", assistance {:.2}", a.gains.strength)),
         }
         if let Some(last) = log.samples.last() {
             line.push_str(&format!(

@@ -32,9 +32,9 @@ pub use crate::ecs::physics::{
     BodyState, ExternalForces, FloorContact, JointLimits, PdController, PhysicsBundle,
     add_physics_systems,
 };
-pub use crate::ecs::primitive::{BlendPlayer, DofPose, PrimitivePlayer, add_primitive_systems};
+pub use crate::ecs::primitive::{BlendPlayer, PrimitivePlayer, add_primitive_systems};
 pub use crate::ecs::{
-    Clock, MotionSet, Recorder, WorldPool, add_core_systems, add_motion_systems,
+    Clock, DofPose, MotionSet, Recorder, WorldPool, add_core_systems, add_motion_systems,
     spawn_clip_character, spawn_primitive_character,
 };
 pub use crate::experiments::fall::ecs::{add_fall_systems, build_fall_world, run_fall_world};

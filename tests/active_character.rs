@@ -348,8 +348,8 @@ fn fully_assisted_tracking_of_both_jumps_under_adult_strength() {
 #[test]
 fn the_release_switches_the_pd_to_the_key_pose() {
     use marionette::dynamics::forces::pd::PdTargets;
+    use marionette::ecs::DofPose;
     use marionette::ecs::physics::PdController;
-    use marionette::ecs::primitive::DofPose;
     let jump = Arc::new(primitive("normal_jump.ron"));
     let body = Arc::new(humanoid24_body(1.70, 65.0, 9.81).unwrap());
     let n = body.dof_v.len();

@@ -138,7 +138,7 @@ fn stepped_damage(cfg: &FallConfig, integrator: Integrator, dt: f64) -> Result<f
         ch.controller.apply(state.time_s, &mut pd);
         let forces = Forces {
             pd: Some(&pd),
-            external: &ch.external.0,
+            external: ch.external.all(),
             ..passive(&ch)
         };
         pipeline::step(

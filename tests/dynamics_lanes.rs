@@ -29,7 +29,7 @@ fn fall_steps() -> Vec<String> {
         pd: Some(&ch.pd.0),
         limits: Some(&ch.limits.0),
         contact: Some(&*ch.contact.0),
-        external: &ch.external.0,
+        external: ch.external.all(),
     };
     let settings = StepSettings {
         integrator: ch.physics.body.integrator,
@@ -129,7 +129,7 @@ fn bodies_stepped_in_lanes_have_the_bits_of_bodies_stepped_alone() {
         pd: Some(pd),
         limits: Some(&ch.limits.0),
         contact: Some(&*ch.contact.0),
-        external: &ch.external.0,
+        external: ch.external.all(),
     };
     for implicit_damping in [true, false] {
         let settings = StepSettings {

@@ -4,7 +4,8 @@
 use std::sync::Arc;
 
 use bevy_ecs::prelude::*;
-use marionette::ecs::primitive::{BlendPlayer, DofPose, PrimitivePlayer, add_primitive_systems};
+use marionette::ecs::DofPose;
+use marionette::ecs::primitive::{BlendPlayer, PrimitivePlayer, add_primitive_systems};
 use marionette::primitive::synthetic::smooth_humanoid24;
 use marionette::primitive::{
     BlendPlacement, Gamma, LearnConfig, Primitive, Relearn, Trajectory, blend, connect,

@@ -17,11 +17,12 @@ use bevy_app::{App, FixedMain, FixedUpdate, Plugin, RunFixedMainLoop, RunFixedMa
 use bevy_ecs::prelude::*;
 use bevy_transform::components::Transform;
 
+use crate::ecs::DofPose;
 use crate::ecs::character::{
     CharacterLog, Feedforward, Reaction, RootAssist, TrackPose, add_all_character_systems,
 };
 use crate::ecs::physics::{BodyState, ExternalForces, PdController, PhysicsBody};
-use crate::ecs::primitive::{DofPose, PrimitivePlayer};
+use crate::ecs::primitive::PrimitivePlayer;
 use crate::ecs::{Clock, JointState, MotionSet};
 
 /// The plugin: the clock, the components, the engine's systems on [`FixedUpdate`].

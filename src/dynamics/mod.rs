@@ -1,7 +1,8 @@
 //! The rigid-body kernel: spatial algebra, the kinematic tree, the articulated-body algorithm
 //! (checked against RNEA and CRBA), integrators on the configuration manifold, the forces a
-//! body feels ([`forces`]: PD, joint model, floor contact, external) and the step as a pipeline
-//! of named stages ([`pipeline`]). Nothing here knows humans, experiments or the ECS.
+//! body feels ([`forces`]: PD, joint model, floor contact, external), the control laws that set
+//! them ([`control`]: gains, feedforward, root assistance) and the step as a pipeline of named
+//! stages ([`pipeline`]). Nothing here knows humans, experiments or the ECS.
 //!
 //! Layout (after Featherstone's spatial_v2 and Pinocchio): an immutable [`Model`] (parents,
 //! joint types, `Xtree`, inertias; `nq ≠ nv`) apart from a scratch [`Data`]; one algorithm per
@@ -18,6 +19,7 @@ pub mod aba;
 mod aba_book;
 pub mod aba_lanes;
 pub mod axis_rotation;
+pub mod control;
 pub mod crba;
 pub mod data;
 pub mod equilibrium;

@@ -3,22 +3,24 @@
 //! channels) as for a kinematic character; in [`MotionSet::Control`] the pose becomes the PD
 //! targets of the simulated joints ([`ControlSet::Targets`]), pushes release the assistance or
 //! switch to a key pose ([`ControlSet::Reactions`]), and a root assistance ("hand of god") pulls
-//! the pelvis toward the animated root ([`ControlSet::Assist`]); the body steps in
+//! the pelvis toward the animated root ([`ControlSet::Assist`]: its wrench joins the
+//! character's [`ExternalForces`], which the step reads); the body steps in
 //! [`MotionSet::Physics`] through the one pipeline (limits, contact and dynamics are its stages,
 //! evaluated at every integrator stage, so they are not separate systems); its pose reaches the
 //! joint state in [`MotionSet::Pose`] and the [`CharacterLog`] in [`MotionSet::Record`].
 //!
-//! Root assistance, a PD on the pelvis's pose with strength `s ∈ [0, 1]` (1 = fully assisted,
-//! 0 = not at all): `F = s M (ω_a² (p_d − p) + 2ζ_a ω_a (ṗ_d − ṗ))` at the pelvis origin and
-//! `T = s I (ω_a² log(R_d Rᵀ) + 2ζ_a ω_a (ω_d − ω))`, world frame, with `M` the body's mass and
-//! `I` the mean of its composite rotational inertia about the pelvis (CRBA's root block at the
-//! start pose). `ω_d` is taken as the rate of the animated rotation vector (exact about a fixed
-//! axis, a first-order approximation otherwise).
+//! The control laws are kernel functions ([`crate::dynamics::control`]); the systems here only
+//! feed them the components. Root assistance ([`root_assist_wrench`]): a PD on the pelvis's pose
+//! toward the animated root, with `M` the body's mass and `I` the mean of its composite
+//! rotational inertia about the pelvis (CRBA's root block at the start pose); `ω_d` is taken
+//! as the rate of the animated rotation vector (exact about a fixed axis, a first-order
+//! approximation otherwise).
 //!
 //! Joint torques are PD plus the computed-torque feedforward of the animated motion
-//! ([`Feedforward`]). Joint PD gains come from the body itself: `k_p = ω_j² H_kk`, `k_v = 2ζ_j ω_j H_kk` with `H_kk`
-//! the joint-space inertia (CRBA diagonal) of DOF `k` at the start pose, so every DOF tracks
-//! with the same bandwidth `ω_j`; the torques are clamped to the DOF's strength
+//! ([`Feedforward`], [`ComputedTorque`]). Joint PD gains come from the body itself
+//! ([`inertia_scaled_gains`]: `k_p = ω_j² H_kk`, `k_v = 2ζ_j ω_j H_kk` with `H_kk` the
+//! joint-space inertia of DOF `k` at the start pose), so every DOF tracks with the same
+//! bandwidth `ω_j`; the torques are clamped to the DOF's strength
 //! ([`crate::humanoid::strength`]).
 
 use std::sync::Arc;
@@ -27,20 +29,23 @@ use bevy_ecs::prelude::*;
 use glam::{DMat3, DQuat, DVec3};
 
 use super::clock::Clock;
-use super::dof_pose::ModelBinding;
+use super::dof_pose::{DofPose, ModelBinding};
 use super::physics::{
     BodyState, ExternalForces, FloorContact, JointLimits, PdController, PhysicsBody, PhysicsBundle,
     PhysicsMonitor, PhysicsStatus, drawn_body,
 };
-use super::primitive::{DofPose, PrimitivePlayer};
+use super::primitive::PrimitivePlayer;
 use super::sets::{MotionSet, configure_motion_sets};
+use crate::dynamics::control::{
+    ComputedTorque, RootAssistGains, RootTarget, Wrench, inertia_scaled_gains, root_assist_wrench,
+    root_rotational_inertia, root_share,
+};
 use crate::dynamics::data::Data;
 use crate::dynamics::forces::contact::{ContactModel, ContactParams};
 use crate::dynamics::forces::external::{ExternalForce, Push};
 use crate::dynamics::forces::limits::{JointLimitParams, JointRanges};
 use crate::dynamics::forces::pd::PdTargets;
 use crate::dynamics::integrator::Integrator;
-use crate::dynamics::joint::quat_log;
 use crate::dynamics::kinematics::kinematics;
 use crate::dynamics::model::Model;
 use crate::humanoid::body::HumanBody;
@@ -56,7 +61,8 @@ pub enum ControlSet {
     Targets,
     /// Pushes release the assistance or switch the controller ([`react_to_pushes`]).
     Reactions,
-    /// The root assistance's force and torque for this tick ([`root_assist`]).
+    /// The root assistance's force and torque for this tick, written into the character's
+    /// [`ExternalForces`] ([`root_assist`]).
     Assist,
 }
 
@@ -64,41 +70,31 @@ pub enum ControlSet {
 #[derive(Component, Clone, Copy, Debug, Default)]
 pub struct TrackPose;
 
-/// The root assistance ("hand of god"): a PD pulling the pelvis toward the animated root pose.
+/// The root assistance ("hand of god"): a PD pulling the pelvis toward the animated root pose
+/// ([`root_assist_wrench`]).
 #[derive(Component, Clone, Debug, PartialEq)]
 pub struct RootAssist {
-    /// Strength `s` (1 fully assisted, 0 not at all; values in between partly).
-    pub strength: f64,
-    /// Natural frequency `ω_a` (rad/s).
-    pub omega: f64,
-    /// Damping ratio `ζ_a`.
-    pub zeta: f64,
-    /// Body mass `M` (kg).
-    pub mass_kg: f64,
-    /// Rotational inertia scale `I` (kg·m²).
-    pub inertia_kg_m2: f64,
-    /// True once released: the force is zero from then on.
+    /// Strength, bandwidth, damping, mass and inertia scale.
+    pub gains: RootAssistGains,
+    /// True once released: the wrench is zero from then on.
     pub released: bool,
-    /// The root's share of the animated motion's inverse dynamics (world, N, at the pelvis
-    /// origin): the force the pelvis needs for the whole body to move as animated with no
-    /// other support; set by [`pd_targets_from_pose`] with a [`Feedforward`], else zero.
-    pub feedforward_force: DVec3,
-    /// The same torque (world, N·m, about the pelvis origin).
-    pub feedforward_torque: DVec3,
-    /// The force (N, world) at the pelvis origin for this tick.
-    pub force: DVec3,
-    /// The torque (N·m, world) for this tick.
-    pub torque: DVec3,
+    /// The root's share of the animated motion's inverse dynamics (world, N and N·m, about the
+    /// pelvis origin): the wrench the pelvis needs for the whole body to move as animated with
+    /// no other support; set by [`pd_targets_from_pose`] with a [`Feedforward`], else zero.
+    pub feedforward: Wrench,
+    /// The wrench (world, N and N·m, about the pelvis origin) for this tick.
+    pub wrench: Wrench,
 }
 
 impl RootAssist {
     /// The assistance as the external force the step applies (none when zero).
     pub fn external(&self) -> Option<ExternalForce> {
-        (self.force != DVec3::ZERO || self.torque != DVec3::ZERO).then_some(ExternalForce {
+        let Wrench { force, torque } = self.wrench;
+        (force != DVec3::ZERO || torque != DVec3::ZERO).then_some(ExternalForce {
             body: 0,
             point: DVec3::ZERO,
-            force: self.force,
-            torque: self.torque,
+            force,
+            torque,
             start_s: 0.0,
             duration_s: f64::INFINITY,
         })
@@ -154,7 +150,7 @@ pub struct CharacterLog {
     /// the animated motion asks of the joint (its inverse dynamics with the root carried).
     pub demand_nm: Vec<(f64, f64)>,
     /// The largest downward whole-body external force the animated motion needs before the
-    /// first push (N, ≥ 0): of its root feedforward ([`RootAssist::feedforward_force`]) the
+    /// first push (N, ≥ 0): of its root feedforward ([`RootAssist::feedforward`]) the
     /// component against gravity, where negative. A floor can only push up, so a motion that
     /// needs to be pulled down (e.g. a flight whose centre of mass falls faster than gravity)
     /// is not one a body can make; the assistance supplies it and the joints feel it.
@@ -282,7 +278,7 @@ pub struct PhysicalSettings {
     /// Add the computed-torque feedforward ([`Feedforward`]) to the PD.
     pub feedforward: bool,
     /// With `feedforward`, the root assistance also carries the root's share of the animated
-    /// motion's inverse dynamics ([`RootAssist::feedforward_force`]): the whole-body weight and
+    /// motion's inverse dynamics ([`RootAssist::feedforward`]): the whole-body weight and
     /// root wrench, so the joints only move the limbs, and the floor is placed for the weight
     /// the assistance does not carry.
     pub assist_feedforward: bool,
@@ -529,19 +525,16 @@ fn floor_contact(
     })
 }
 
-/// PD gains holding `targets` from the joint-space inertia `h` (nv×nv) at the start pose:
-/// `kp = ω² H_kk`, `kv = 2ζω H_kk`, with the strength's torque limits.
+/// PD gains holding `targets` from the joint-space inertia `h` (nv×nv) at the start pose
+/// ([`inertia_scaled_gains`]), with the strength's torque limits.
 fn pd_targets(
     body: &HumanBody,
     settings: &PhysicalSettings,
     h: &[f64],
     targets: Vec<f64>,
 ) -> Result<PdTargets, CharacterError> {
-    let nv = body.model.nv;
-    let hkk: Vec<f64> = body.dof_v.iter().map(|&k| h[k * nv + k]).collect();
     let (w, z) = (settings.joint_omega, settings.joint_zeta);
-    let kp: Vec<f64> = hkk.iter().map(|i| w * w * i).collect();
-    let kv: Vec<f64> = hkk.iter().map(|i| 2.0 * z * w * i).collect();
+    let (kp, kv) = inertia_scaled_gains(h, body.model.nv, &body.dof_v, w, z);
     let limits = match settings.strength {
         Some(g) => torque_limits_for(&body.figure, g)?,
         None => Vec::new(),
@@ -578,18 +571,17 @@ fn joint_limits(
 /// The root assistance of the settings, its rotational inertia the mean of the free root's
 /// diagonal of `h` (nv×nv).
 fn new_root_assist(settings: &PhysicalSettings, model: &Model, h: &[f64]) -> RootAssist {
-    let nv = model.nv;
     RootAssist {
-        strength: settings.assist,
-        omega: settings.assist_omega,
-        zeta: settings.assist_zeta,
-        mass_kg: model.total_mass(),
-        inertia_kg_m2: (h[0] + h[nv + 1] + h[2 * nv + 2]) / 3.0,
+        gains: RootAssistGains {
+            strength: settings.assist,
+            omega: settings.assist_omega,
+            zeta: settings.assist_zeta,
+            mass_kg: model.total_mass(),
+            inertia_kg_m2: root_rotational_inertia(h, model.nv),
+        },
         released: false,
-        feedforward_force: DVec3::ZERO,
-        feedforward_torque: DVec3::ZERO,
-        force: DVec3::ZERO,
-        torque: DVec3::ZERO,
+        feedforward: Wrench::ZERO,
+        wrench: Wrench::ZERO,
     }
 }
 
@@ -614,16 +606,13 @@ pub fn push_now(world: &mut World, entity: Entity, push: &Push) -> bool {
     true
 }
 
-/// Computed-torque feedforward of a tracking character: `τ_ff = RNEA(q_d, q̇_d, q̈_d)` on the
-/// animated motion (no contact; the root's share is left to the assistance), `q̈_d` the
-/// backward difference of `q̇_d` over one tick.
+/// Computed-torque feedforward of a tracking character ([`ComputedTorque`] on the animated
+/// motion, one sample a tick: no contact; the root's share is left to the assistance).
 #[derive(Component, Clone, Debug, Default)]
 pub struct Feedforward {
     /// Also hand the root's share to the [`RootAssist`].
     pub root: bool,
-    previous_velocity: Option<Vec<f64>>,
-    acceleration: Vec<f64>,
-    data: Option<Data>,
+    law: ComputedTorque,
 }
 
 /// What [`pd_targets_from_pose`] reads and writes.
@@ -659,24 +648,12 @@ pub fn pd_targets_from_pose(clock: Res<Clock>, mut q: Query<TargetQuery, With<Tr
         }
         let Some(mut ff) = ff else { continue };
         let ff = &mut *ff;
-        ff.acceleration.resize(v_d.len(), 0.0);
-        if let Some(prev) = &ff.previous_velocity {
-            for ((a, v), p) in ff.acceleration.iter_mut().zip(&v_d).zip(prev) {
-                *a = (v - p) / clock.tick_s;
-            }
-        }
-        let data = ff.data.get_or_insert_with(|| Data::new(&b.model));
-        let f_ext = vec![crate::dynamics::spatial::ForceVec::ZERO; b.model.nbodies()];
-        let tau = crate::dynamics::rnea(&b.model, data, &q_d, &v_d, &ff.acceleration, &f_ext);
+        let tau = ff.law.torques(&b.model, &q_d, v_d, clock.tick_s);
         pd.feedforward.clear();
         pd.feedforward.extend(b.dof_v.iter().map(|&k| tau[k]));
         if let Some(mut a) = assist.filter(|_| ff.root) {
-            // The free root's entry is [n; f] in pelvis coordinates about its origin.
-            let rot = DQuat::from_xyzw(q_d[3], q_d[4], q_d[5], q_d[6]);
-            a.feedforward_torque = rot * DVec3::new(tau[0], tau[1], tau[2]);
-            a.feedforward_force = rot * DVec3::new(tau[3], tau[4], tau[5]);
+            a.feedforward = root_share(&q_d, tau);
         }
-        ff.previous_velocity = Some(v_d);
     }
 }
 
@@ -687,6 +664,7 @@ pub fn react_to_pushes(mut q: Query<ReactionQuery>) {
         let t = state.time_s;
         if reaction.pushed_at_s.is_none() {
             reaction.pushed_at_s = forces
+                .pushes()
                 .iter()
                 .filter(|f| f.start_s <= t)
                 .map(|f| f.start_s)
@@ -709,34 +687,44 @@ pub fn react_to_pushes(mut q: Query<ReactionQuery>) {
     }
 }
 
+/// What [`root_assist`] reads and writes.
+type AssistQuery<'a> = (
+    &'a BodyState,
+    &'a ModelBinding,
+    &'a DofPose,
+    &'a mut RootAssist,
+    Option<&'a mut ExternalForces>,
+);
+
 /// The root assistance's force and torque for this tick from the body's pelvis at the tick
-/// start and the animated root (see the module doc).
-pub fn root_assist(mut q: Query<(&BodyState, &ModelBinding, &DofPose, &mut RootAssist)>) {
-    for (state, binding, pose, mut a) in &mut q {
-        if a.released || a.strength == 0.0 {
-            a.force = DVec3::ZERO;
-            a.torque = DVec3::ZERO;
-            continue;
+/// start and the animated root (see the module doc), written into the character's
+/// [`ExternalForces`] ([`ExternalForces::set_assist`]; none when zero) for the step to apply.
+pub fn root_assist(mut q: Query<AssistQuery>) {
+    for (state, binding, pose, mut a, external) in &mut q {
+        assist_wrench(state, binding, pose, &mut a);
+        if let Some(mut external) = external {
+            external.set_assist(a.external());
         }
-        let r = binding.root_columns();
-        let th = |k: usize| pose.theta[r[k]];
-        let rate = |k: usize| pose.theta_dot[r[k]];
-        let qs = &state.q;
-        let p = DVec3::new(qs[0], qs[1], qs[2]);
-        let rot = DQuat::from_xyzw(qs[3], qs[4], qs[5], qs[6]);
-        let v = &state.v;
-        let w_world = rot * DVec3::new(v[0], v[1], v[2]);
-        let v_world = rot * DVec3::new(v[3], v[4], v[5]);
-        let (om, z, s) = (a.omega, a.zeta, a.strength);
-        let (kp, kd) = (om * om, 2.0 * z * om);
-        let p_d = DVec3::new(th(0), th(1), th(2));
-        let v_d = DVec3::new(rate(0), rate(1), rate(2));
-        a.force = s * (a.feedforward_force + a.mass_kg * (kp * (p_d - p) + kd * (v_d - v_world)));
-        let rot_d = DQuat::from_scaled_axis(DVec3::new(th(3), th(4), th(5)));
-        let e = quat_log(rot_d * rot.inverse());
-        let w_d = DVec3::new(rate(3), rate(4), rate(5));
-        a.torque = s * (a.feedforward_torque + a.inertia_kg_m2 * (kp * e + kd * (w_d - w_world)));
     }
+}
+
+/// Sets `a.wrench` for this tick ([`root_assist_wrench`]; zero once released) toward the
+/// animated root of `pose`, its angular velocity the rate of the animated rotation vector.
+fn assist_wrench(state: &BodyState, binding: &ModelBinding, pose: &DofPose, a: &mut RootAssist) {
+    if a.released {
+        a.wrench = Wrench::ZERO;
+        return;
+    }
+    let r = binding.root_columns();
+    let th = |k: usize| pose.theta[r[k]];
+    let rate = |k: usize| pose.theta_dot[r[k]];
+    let target = RootTarget {
+        position: DVec3::new(th(0), th(1), th(2)),
+        velocity: DVec3::new(rate(0), rate(1), rate(2)),
+        rotation: DQuat::from_scaled_axis(DVec3::new(th(3), th(4), th(5))),
+        angular_velocity: DVec3::new(rate(3), rate(4), rate(5)),
+    };
+    a.wrench = root_assist_wrench(&a.gains, a.feedforward, &state.q, &state.v, &target);
 }
 
 /// Logs every physical character after its step (see [`CharacterLog`]).
@@ -787,7 +775,7 @@ pub fn log_characters(
         if before_push {
             log.tracked_ticks += 1;
             let up = -b.model.gravity.normalize_or_zero();
-            let pull = assist.map_or(0.0, |a| -a.feedforward_force.dot(up));
+            let pull = assist.map_or(0.0, |a| -a.feedforward.force.dot(up));
             if pull > log.max_pull_n {
                 log.max_pull_n = pull;
                 log.max_pull_time_s = state.time_s;

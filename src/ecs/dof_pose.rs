@@ -1,17 +1,39 @@
-//! Wiring of the motor primitives into the base ECS: a character whose DOF pose comes from
-//! primitive players gets its joint state from its model, then goes through forward kinematics
-//! and recording like any other character.
+//! A character's pose as DOF values ([`DofPose`]: θ and θ̇ per DOF and root channel, written by
+//! the primitive players or any other source) and its binding to a model ([`ModelBinding`]):
+//! [`pose_from_dofs`] turns it into the joint state, which then goes through forward kinematics
+//! and recording like any other character's.
 
 use std::sync::Arc;
 
 use bevy_ecs::prelude::*;
 use glam::{DQuat, DVec3};
 
-use super::motion::{Character, JointState, Recorder, SkeletonRef};
+use super::motion::JointState;
 use super::physics::PhysicsBody;
-use super::primitive::{DofPose, PrimitivePlayer};
 use crate::humanoid::{Model, ROOT_CHANNELS};
 use crate::primitive::{Primitive, PrimitiveError};
+
+/// A character's current DOF state, written by its motion source (e.g. a primitive player).
+#[derive(Component, Clone, Debug, PartialEq, Default)]
+pub struct DofPose {
+    /// DOF names (shared).
+    pub names: Arc<[String]>,
+    /// θ per DOF (rad, or m).
+    pub theta: Vec<f64>,
+    /// θ̇ per DOF (rad/s, or m/s).
+    pub theta_dot: Vec<f64>,
+}
+
+impl DofPose {
+    /// A pose for the DOFs of `p`, at its demonstrated start, at rest.
+    pub fn for_primitive(p: &Primitive) -> DofPose {
+        DofPose {
+            names: p.names().into(),
+            theta: p.dofs.iter().map(|d| d.start).collect(),
+            theta_dot: vec![0.0; p.dofs.len()],
+        }
+    }
+}
 
 /// Which entries of a character's [`DofPose`] are its model's DOFs and its six root channels
 /// (`root_tx, root_ty, root_tz` in metres, `root_rx, root_ry, root_rz` a rotation vector).
@@ -80,29 +102,4 @@ pub fn pose_from_dofs(
         st.translations[0] = DVec3::new(r(0), r(1), r(2));
         st.rotations[0] = DQuat::from_scaled_axis(DVec3::new(r(3), r(4), r(5)));
     }
-}
-
-/// Spawns a character on `model` that plays `sequence` (connected) and records its points.
-pub fn spawn_primitive_character(
-    world: &mut World,
-    name: &str,
-    model: Arc<Model>,
-    sequence: Vec<Arc<Primitive>>,
-) -> Result<Entity, PrimitiveError> {
-    let player = PrimitivePlayer::new(sequence)?;
-    let pose = player.pose();
-    let binding = ModelBinding::new(model.clone(), &pose.names)?;
-    let skeleton = Arc::new(model.skeleton());
-    let n = skeleton.joints.len();
-    Ok(world
-        .spawn((
-            Character { name: name.into() },
-            SkeletonRef(skeleton),
-            JointState::new(n),
-            Recorder::default(),
-            pose,
-            player,
-            binding,
-        ))
-        .id())
 }

@@ -5,7 +5,7 @@
 //!   drawable points; forward kinematics and recording treat all alike;
 //! - kinematic motion: a [`ClipPlayback`], or primitive players
 //!   ([`primitive::PrimitivePlayer`], [`primitive::BlendPlayer`]) writing a
-//!   [`primitive::DofPose`] that a [`ModelBinding`] turns into the joint state;
+//!   [`DofPose`] that a [`ModelBinding`] turns into the joint state;
 //! - physics: a [`physics::PhysicsBundle`] and the force components the step reads
 //!   ([`physics::PdController`], [`physics::JointLimits`], [`physics::FloorContact`],
 //!   [`physics::ExternalForces`]); its pose reaches the same joint state;
@@ -31,8 +31,9 @@ mod systems;
 pub mod worlds;
 
 pub use clock::{Clock, advance_clock};
-pub use dof_pose::{ModelBinding, pose_from_dofs, spawn_primitive_character};
+pub use dof_pose::{DofPose, ModelBinding, pose_from_dofs};
 pub use motion::{Character, ClipPlayback, JointState, Recorder, SkeletonRef};
+pub use primitive::spawn_primitive_character;
 pub use sets::{MotionSet, add_core_systems, configure_motion_sets};
 pub use systems::{add_motion_systems, forward_kinematics_system, record_frames, sample_clips};
 pub use worlds::{WorldPool, WorldRng, WorldSeed, world_seed};

@@ -15,7 +15,6 @@ use std::sync::Arc;
 use bevy_ecs::prelude::*;
 use glam::{DQuat, DVec3};
 
-use super::character::RootAssist;
 use super::clock::Clock;
 use super::motion::{Character, JointState, Recorder, SkeletonRef};
 use super::sets::{MotionSet, configure_motion_sets};
@@ -75,10 +74,58 @@ wrapper!(JointLimits, JointRanges);
 #[derive(Component, Clone, Debug)]
 pub struct FloorContact(pub Arc<ContactModel>);
 
-/// Forces applied to the body (pushes), each with its time window.
+/// Forces applied to the body, in the order the step applies them: the pushes (each with its
+/// time window) as they were added, then the root assistance's wrench for the tick when a
+/// system has set one ([`ExternalForces::set_assist`]). Removing the component removes them all.
 #[derive(Component, Clone, Debug, PartialEq, Default)]
-pub struct ExternalForces(pub Vec<ExternalForce>);
-wrapper!(ExternalForces, Vec<ExternalForce>);
+pub struct ExternalForces {
+    /// The pushes, then the assistance when `assisted`.
+    forces: Vec<ExternalForce>,
+    /// Whether the last entry of `forces` is the assistance.
+    assisted: bool,
+}
+
+impl ExternalForces {
+    /// The forces `pushes` (world frame, each with its time window), no assistance.
+    pub fn new(pushes: Vec<ExternalForce>) -> Self {
+        Self {
+            forces: pushes,
+            assisted: false,
+        }
+    }
+
+    /// Adds `force` after the pushes already there (and before the assistance).
+    pub fn push(&mut self, force: ExternalForce) {
+        let at = self.pushes().len();
+        self.forces.insert(at, force);
+    }
+
+    /// The pushes, in the order they were added.
+    pub fn pushes(&self) -> &[ExternalForce] {
+        &self.forces[..self.forces.len() - usize::from(self.assisted)]
+    }
+
+    /// The root assistance's wrench for this tick (world-frame force at the pelvis origin and
+    /// torque), if one is set.
+    pub fn assist(&self) -> Option<&ExternalForce> {
+        self.forces.last().filter(|_| self.assisted)
+    }
+
+    /// Sets the root assistance's wrench the step applies after the pushes this tick, or with
+    /// `None` removes it (a system in [`MotionSet::Control`] writes it every tick).
+    pub fn set_assist(&mut self, force: Option<ExternalForce>) {
+        if self.assisted {
+            self.forces.pop();
+        }
+        self.assisted = force.is_some();
+        self.forces.extend(force);
+    }
+
+    /// Every force the step applies: the pushes, then the assistance.
+    pub fn all(&self) -> &[ExternalForce] {
+        &self.forces
+    }
+}
 
 /// The pipeline's buffers.
 #[derive(Component, Clone, Debug)]
@@ -163,38 +210,31 @@ type StepQuery<'a> = (
     &'a mut PhysicsWorkspace,
     &'a mut PhysicsMonitor,
     &'a mut PhysicsStatus,
-    Option<&'a RootAssist>,
 );
 
 /// Steps every running body by the clock's substeps of `tick / substeps` seconds; an error
 /// stops that body (recorded in its [`PhysicsStatus`]) and no other.
 ///
-/// A character's [`RootAssist`] joins its external forces for the tick. Bodies of one model
-/// integrated by semi-implicit Euler step together through [`pipeline::step_lanes`] (their
-/// articulated-body algorithm [`LANES`](crate::dynamics::lanes::LANES) at a time in vector
-/// lanes), each to the bits it has stepped alone.
+/// Bodies of one model integrated by semi-implicit Euler step together through
+/// [`pipeline::step_lanes`] (their articulated-body algorithm
+/// [`LANES`](crate::dynamics::lanes::LANES) at a time in vector lanes), each to the bits it has
+/// stepped alone.
 pub fn step_bodies(
     clock: Res<Clock>,
-    mut scratch: Local<Vec<ExternalForce>>,
     mut lanes: Local<Vec<(Arc<HumanBody>, LaneData)>>,
     mut q: Query<StepQuery>,
 ) {
     let dt = clock.physics_dt();
     let mut together = Vec::new();
-    for item in &mut q {
-        let (body, state, pd, limits, contact, external, ws, monitor, status, assist) = item;
-        if !status.running() {
+    for one in &mut q {
+        if !one.8.running() {
             continue;
         }
-        let assisted = assist.and_then(RootAssist::external);
-        let one = (
-            body, state, pd, limits, contact, external, ws, monitor, status,
-        );
-        if assisted.is_none() && matches!(body.integrator, Integrator::SemiImplicitEuler { .. }) {
+        if matches!(one.0.integrator, Integrator::SemiImplicitEuler { .. }) {
             together.push(one);
             continue;
         }
-        step_alone(one, assisted, &mut scratch, dt, clock.substeps);
+        step_alone(one, dt, clock.substeps);
     }
     // The bodies of one model and scheme, in query order.
     while let Some(first) = together.first() {
@@ -227,8 +267,7 @@ pub fn step_bodies(
     }
 }
 
-/// One running body's components as the step takes them (its [`StepQuery`] without the
-/// assistance).
+/// One running body's components as the step takes them (its [`StepQuery`] item).
 type StepItem<'w> = (
     &'w PhysicsBody,
     Mut<'w, BodyState>,
@@ -241,23 +280,10 @@ type StepItem<'w> = (
     Mut<'w, PhysicsStatus>,
 );
 
-/// Steps one body alone by `substeps` steps of `dt`, the assistance's force `assisted` (if
-/// any) joining its external forces; an error stops it.
-fn step_alone(
-    item: StepItem,
-    assisted: Option<ExternalForce>,
-    scratch: &mut Vec<ExternalForce>,
-    dt: f64,
-    substeps: u32,
-) {
+/// Steps one body alone by `substeps` steps of `dt`; an error stops it.
+fn step_alone(item: StepItem, dt: f64, substeps: u32) {
     let (body, mut state, pd, limits, contact, external, mut ws, mut monitor, mut status) = item;
-    let mut external = external.map_or(&[][..], |e| &e.0[..]);
-    if let Some(f) = assisted {
-        scratch.clear();
-        scratch.extend_from_slice(external);
-        scratch.push(f);
-        external = &scratch[..];
-    }
+    let external = external.map_or(&[][..], |e| e.all());
     let forces = Forces {
         dofs: &body.body.dof_v,
         pd: pd.map(|p| &p.0),
@@ -304,7 +330,7 @@ fn step_together(
                         pd: pd.map(|p| &p.0),
                         limits: limits.map(|l| &l.0),
                         contact: contact.map(|c| &*c.0),
-                        external: external.map_or(&[][..], |e| &e.0[..]),
+                        external: external.map_or(&[][..], |e| e.all()),
                     },
                     state: &mut state.0,
                     ws: &mut ws.0,
@@ -362,4 +388,35 @@ pub fn add_physics_systems(schedule: &mut Schedule) {
         step_bodies.in_set(MotionSet::Physics),
         publish_body_pose.in_set(MotionSet::Pose),
     ));
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn force(body: usize) -> ExternalForce {
+        ExternalForce {
+            body,
+            point: DVec3::ZERO,
+            force: DVec3::X,
+            torque: DVec3::ZERO,
+            start_s: 0.0,
+            duration_s: 0.1,
+        }
+    }
+
+    #[test]
+    fn the_assistance_stays_after_the_pushes() {
+        let mut f = ExternalForces::new(vec![force(1)]);
+        f.set_assist(Some(force(0)));
+        f.push(force(2));
+        assert_eq!(f.pushes(), &[force(1), force(2)]);
+        assert_eq!(f.assist(), Some(&force(0)));
+        assert_eq!(f.all(), &[force(1), force(2), force(0)]);
+        f.set_assist(Some(force(3)));
+        assert_eq!(f.all(), &[force(1), force(2), force(3)]);
+        f.set_assist(None);
+        assert_eq!(f.all(), f.pushes());
+        assert_eq!(f.assist(), None);
+    }
 }

@@ -2,10 +2,10 @@
 //!
 //! - [`PrimitivePlayer`] plays a sequence of primitives, connected: each starts from the state the
 //!   previous one ended in and takes over without a step in acceleration (as
-//!   [`super::connect()`], with its [`HandOver`]); after the last one the DMP keeps running and
-//!   settles on its goal.
+//!   [`crate::primitive::connect()`], with its [`HandOver`]); after the last one the DMP keeps
+//!   running and settles on its goal.
 //! - [`BlendPlayer`] plays two primitives placed on a time line and mixes them live with γ(t′)
-//!   (step 3 of the paper's blending, as [`super::blend()`] without re-learning).
+//!   (step 3 of the paper's blending, as [`crate::primitive::blend()`] without re-learning).
 //! - Both write the character's [`DofPose`] (θ and θ̇ per DOF) for the systems downstream
 //!   (forward kinematics, rendering).
 //! - The World's [`Clock`] gives the step (one tick); [`PrimitiveSet`] orders the systems inside
@@ -18,36 +18,16 @@ use std::sync::Arc;
 use bevy_ecs::prelude::*;
 
 use super::clock::Clock;
-use super::dof_pose::pose_from_dofs;
+use super::dof_pose::{DofPose, ModelBinding, pose_from_dofs};
+use super::motion::{Character, JointState, Recorder, SkeletonRef};
 use super::sets::{MotionSet, configure_motion_sets};
+use crate::humanoid::Model;
 
 use crate::primitive::blend::{BlendPlacement, Gamma};
 use crate::primitive::connect::HandOver;
 use crate::primitive::error::{PrimitiveError, Result};
 use crate::primitive::primitive::Primitive;
 use crate::primitive::rollout::Rollout;
-
-/// A character's current DOF state, written by the primitive systems.
-#[derive(Component, Clone, Debug, PartialEq, Default)]
-pub struct DofPose {
-    /// DOF names (shared).
-    pub names: Arc<[String]>,
-    /// θ per DOF (rad, or m).
-    pub theta: Vec<f64>,
-    /// θ̇ per DOF (rad/s, or m/s).
-    pub theta_dot: Vec<f64>,
-}
-
-impl DofPose {
-    /// A pose for the DOFs of `p`, at its demonstrated start, at rest.
-    pub fn for_primitive(p: &Primitive) -> DofPose {
-        DofPose {
-            names: p.names().into(),
-            theta: p.dofs.iter().map(|d| d.start).collect(),
-            theta_dot: vec![0.0; p.dofs.len()],
-        }
-    }
-}
 
 /// Plays a connected sequence of primitives.
 #[derive(Component, Clone, Debug)]
@@ -183,7 +163,8 @@ pub struct BlendPlayer {
 }
 
 impl BlendPlayer {
-    /// A live blend (the same checks as [`super::blend()`]: same DOFs, a valid arrangement, a valid γ).
+    /// A live blend (the same checks as [`crate::primitive::blend()`]: same DOFs, a valid
+    /// arrangement, a valid γ).
     pub fn new(
         a: &Primitive,
         b: &Primitive,
@@ -299,8 +280,8 @@ pub fn step_blend_players(clock: Res<Clock>, mut q: Query<(&mut BlendPlayer, &mu
 
 /// Adds the primitive systems to `schedule`: [`PrimitiveSet::Players`] then
 /// [`PrimitiveSet::Blends`] inside [`MotionSet::Animate`], and [`pose_from_dofs`] in
-/// [`MotionSet::Pose`] (characters with a [`ModelBinding`](super::ModelBinding) get their joint
-/// state from their DOF pose).
+/// [`MotionSet::Pose`] (characters with a [`ModelBinding`] get their joint state from their DOF
+/// pose).
 pub fn add_primitive_systems(schedule: &mut Schedule) {
     configure_motion_sets(schedule);
     schedule.configure_sets(
@@ -313,4 +294,29 @@ pub fn add_primitive_systems(schedule: &mut Schedule) {
         step_blend_players.in_set(PrimitiveSet::Blends),
         pose_from_dofs.in_set(MotionSet::Pose),
     ));
+}
+
+/// Spawns a character on `model` that plays `sequence` (connected) and records its points.
+pub fn spawn_primitive_character(
+    world: &mut World,
+    name: &str,
+    model: Arc<Model>,
+    sequence: Vec<Arc<Primitive>>,
+) -> Result<Entity> {
+    let player = PrimitivePlayer::new(sequence)?;
+    let pose = player.pose();
+    let binding = ModelBinding::new(model.clone(), &pose.names)?;
+    let skeleton = Arc::new(model.skeleton());
+    let n = skeleton.joints.len();
+    Ok(world
+        .spawn((
+            Character { name: name.into() },
+            SkeletonRef(skeleton),
+            JointState::new(n),
+            Recorder::default(),
+            pose,
+            player,
+            binding,
+        ))
+        .id())
 }

@@ -581,7 +581,7 @@ fn assemble(cfg: &FallConfig) -> Result<FallCharacter, SimError> {
             limit_gains,
         }),
         contact: FloorContact(Arc::new(contact)),
-        external: ExternalForces(vec![cfg.push.to_force(push_link)]),
+        external: ExternalForces::new(vec![cfg.push.to_force(push_link)]),
         controller: FallController {
             stance,
             key,
@@ -767,7 +767,7 @@ pub fn simulate_fall(config: &FallConfig) -> Result<FallResult, SimError> {
             pd: Some(&pd.0),
             limits: Some(&limits.0),
             contact: Some(&contact.0),
-            external: &external.0,
+            external: external.all(),
         };
         pipeline::step(&body.model, settings, &forces, state, ws, monitor)?;
         recorder.record(body, state, ws.kinematics_of(&body.model, state), monitor);
