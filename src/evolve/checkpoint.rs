@@ -19,7 +19,7 @@ use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 use serde_json::value::RawValue;
 
-use super::evaluator::EvolveError;
+use super::error::{CheckpointError, EvolveError};
 
 /// The checkpoint file inside a run's folder.
 pub const FILE: &str = "checkpoint.json";
@@ -64,34 +64,27 @@ struct Envelope<'a> {
 }
 
 /// The content of a checkpoint file's text, its version, checksum and consistency checked.
-pub fn decode<T: DeserializeOwned + Consistent>(text: &str) -> Result<T, String> {
+pub fn decode<T: DeserializeOwned + Consistent>(text: &str) -> Result<T, CheckpointError> {
     let envelope: Envelope = serde_json::from_str(text).map_err(|e| {
         if text.trim_start().starts_with('[') {
-            format!(
-                "a checkpoint of format version 1 (no version, no checksum); this marionette \
-                 reads version {FORMAT_VERSION}: run the scene again without --resume"
-            )
+            CheckpointError::Version1
         } else {
-            format!("not a checkpoint: {e}")
+            CheckpointError::NotACheckpoint(e)
         }
     })?;
     if envelope.format_version != FORMAT_VERSION {
-        return Err(format!(
-            "format version {}, this marionette reads version {FORMAT_VERSION}",
-            envelope.format_version
-        ));
+        return Err(CheckpointError::FormatVersion(envelope.format_version));
     }
     let content = envelope.content.get();
-    let sum = checksum(content.as_bytes());
-    if sum != envelope.checksum {
-        return Err(format!(
-            "the checksum of the content is {sum}, the file says {}: the file was changed or \
-             cut after it was written",
-            envelope.checksum
-        ));
+    let computed = checksum(content.as_bytes());
+    if computed != envelope.checksum {
+        return Err(CheckpointError::Checksum {
+            computed,
+            stated: envelope.checksum,
+        });
     }
-    let state: T = serde_json::from_str(content).map_err(|e| format!("content: {e}"))?;
-    state.consistency()?;
+    let state: T = serde_json::from_str(content).map_err(CheckpointError::Content)?;
+    state.consistency().map_err(CheckpointError::Inconsistent)?;
     Ok(state)
 }
 
@@ -104,34 +97,35 @@ where
     T::Owned: Serialize + DeserializeOwned + Consistent,
 {
     let path = dir.join(FILE);
-    let err = |message: String| EvolveError::Checkpoint {
-        path: path.display().to_string(),
-        message,
-    };
+    written(dir, states).map_err(|why| EvolveError::Checkpoint { path, why })
+}
+
+/// [`save`], its error without the path.
+fn written<T>(dir: &Path, states: &T) -> Result<(), CheckpointError>
+where
+    T: Serialize + Consistent + ToOwned + ?Sized,
+    T::Owned: Serialize + DeserializeOwned + Consistent,
+{
     states
         .consistency()
-        .map_err(|m| err(format!("not written, the state is inconsistent: {m}")))?;
-    let text = encode(states).map_err(err)?;
-    let back: T::Owned = decode(&text).map_err(|m| err(format!("not written: {m}")))?;
-    if encode(&back).map_err(err)? != text {
-        return Err(err(
-            "not written: a number in it would not read back bit for bit".into(),
-        ));
+        .map_err(CheckpointError::InconsistentState)?;
+    let text = encode(states).map_err(CheckpointError::Encode)?;
+    let back: T::Owned = decode(&text).map_err(|e| CheckpointError::Unreadable(Box::new(e)))?;
+    if encode(&back).map_err(CheckpointError::Encode)? != text {
+        return Err(CheckpointError::NotBitExact);
     }
-    std::fs::create_dir_all(dir).map_err(|e| err(e.to_string()))?;
-    crate::io::write_atomic(&path, text.as_bytes()).map_err(|e| err(e.to_string()))
+    std::fs::create_dir_all(dir).map_err(CheckpointError::Io)?;
+    crate::io::write_atomic(&dir.join(FILE), text.as_bytes()).map_err(CheckpointError::Io)
 }
 
 /// Reads the states saved in `dir`: refused, naming the file and what is wrong, unless the
 /// format version and checksum match and the states are consistent.
 pub fn load<T: DeserializeOwned + Consistent>(dir: &Path) -> Result<T, EvolveError> {
     let path = dir.join(FILE);
-    let err = |message: String| EvolveError::Checkpoint {
-        path: path.display().to_string(),
-        message,
-    };
-    let text = std::fs::read_to_string(&path).map_err(|e| err(e.to_string()))?;
-    decode(&text).map_err(err)
+    std::fs::read_to_string(&path)
+        .map_err(CheckpointError::Io)
+        .and_then(|text| decode(&text))
+        .map_err(|why| EvolveError::Checkpoint { path, why })
 }
 
 #[cfg(test)]
@@ -164,12 +158,18 @@ mod tests {
         );
         // A number changed by hand: the checksum no longer holds.
         let edited = good.replace("2.5", "2.4");
-        assert!(decode::<Rising>(&edited).unwrap_err().contains("checksum"));
+        assert!(
+            decode::<Rising>(&edited)
+                .unwrap_err()
+                .to_string()
+                .contains("checksum")
+        );
         // Cut short.
         let cut = &good[..good.len() - 3];
         assert!(
             decode::<Rising>(cut)
                 .unwrap_err()
+                .to_string()
                 .contains("not a checkpoint")
         );
         // Another format version, and the bare state of version 1.
@@ -177,18 +177,20 @@ mod tests {
         assert!(
             decode::<Rising>(&v3)
                 .unwrap_err()
+                .to_string()
                 .contains("format version 3")
         );
         let v1 = serde_json::to_string(&vec![Rising(vec![1.0])]).unwrap();
         assert!(
             decode::<Rising>(&v1)
                 .unwrap_err()
+                .to_string()
                 .contains("format version 1")
         );
         // Sealed right but inconsistent: refused by what disagrees; never written.
         let falling = encode(&Rising(vec![3.0, 1.0])).unwrap();
         assert_eq!(
-            decode::<Rising>(&falling).unwrap_err(),
+            decode::<Rising>(&falling).unwrap_err().to_string(),
             "entry 1 does not rise"
         );
         let dir = std::env::temp_dir().join(format!("marionette-ck-unit-{}", std::process::id()));

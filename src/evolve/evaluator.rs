@@ -25,6 +25,8 @@ use std::time::{Duration, Instant};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+pub use super::error::EvolveError;
+use super::error::{EvaluatorError, LastWords, LineError, WorkerFailure, WorkerFault};
 use super::failure::EvaluationError;
 use super::genome::Genome;
 
@@ -34,34 +36,6 @@ use super::genome::Genome;
 /// Version 3 tagged each message by its key and refuses unknown fields (a version-2 line is
 /// refused as an unknown message).
 pub const PROTOCOL: &str = "marionette-eval/3";
-
-/// Why a run could not go on.
-#[derive(Debug, thiserror::Error)]
-pub enum EvolveError {
-    /// A setting is invalid.
-    #[error("ga.{field}: {message}")]
-    Config {
-        /// Field.
-        field: String,
-        /// What is wrong.
-        message: String,
-    },
-    /// The evaluator broke (worker died, protocol violated).
-    #[error("evaluator: {0}")]
-    Evaluator(String),
-    /// A checkpoint could not be read or written.
-    #[error("checkpoint {path}: {message}")]
-    Checkpoint {
-        /// The file.
-        path: String,
-        /// What went wrong.
-        message: String,
-    },
-    /// Too many evaluations of a generation failed ([`super::GaConfig::max_failed_share`]):
-    /// the run, the generation and the first failures.
-    #[error("the GA stopped: {0}")]
-    Stopped(String),
-}
 
 /// The result of one evaluation: the damage (lower is fitter) or why it failed.
 pub type Evaluation = Result<f64, EvaluationError>;
@@ -190,26 +164,30 @@ enum Reply {
     Done(BatchEnd),
 }
 
-/// Parses `text`, line `line` of a protocol stream (`what`: "request", "reply"), as `T`: an
+/// Parses `text`, line `line` of a protocol stream (`side`: "request", "reply"), as `T`: an
 /// error names the line, the column, the field and what was expected.
 fn parse_line<T: serde::de::DeserializeOwned>(
     text: &str,
-    what: &str,
+    side: &'static str,
     line: usize,
-) -> Result<T, String> {
+) -> Result<T, LineError> {
     let located = |path: &str, e: &serde_json::Error| {
         let message = e.to_string();
         let suffix = format!(" at line {} column {}", e.line(), e.column());
-        let message = message.strip_suffix(&suffix).unwrap_or(&message);
-        let field = match path {
-            "" | "." => String::new(),
-            p => format!(", field `{p}`"),
-        };
-        format!(
-            "{what} line {line}, column {}{field}: {message} (in {})",
-            e.column(),
-            shorten(text)
-        )
+        LineError {
+            side,
+            line,
+            column: e.column(),
+            field: match path {
+                "" | "." => None,
+                p => Some(p.to_string()),
+            },
+            expected: message
+                .strip_suffix(&suffix)
+                .unwrap_or(&message)
+                .to_string(),
+            text: shorten(text),
+        }
     };
     let mut de = serde_json::Deserializer::from_str(text);
     let value: T = serde_path_to_error::deserialize(&mut de).map_err(|e| {
@@ -218,6 +196,11 @@ fn parse_line<T: serde::de::DeserializeOwned>(
     })?;
     de.end().map_err(|e| located("", &e))?;
     Ok(value)
+}
+
+/// A request line the worker does not understand.
+fn bad_request(e: LineError) -> EvaluatorError {
+    EvaluatorError::BadRequest(Box::new(e))
 }
 
 /// `text` cut to 120 characters, for messages.
@@ -236,35 +219,6 @@ pub const DEFAULT_BATCH_TIMEOUT_S: f64 = 600.0;
 /// Longest wait between two progress lines while a worker is silent.
 const PROGRESS_EVERY: Duration = Duration::from_secs(10);
 
-/// The last line a worker wrote on each of its outputs, and why its input broke.
-#[derive(Default)]
-struct LastSaid {
-    stdout: Option<String>,
-    stderr: Option<String>,
-    stdin_error: Option<String>,
-}
-
-impl LastSaid {
-    fn describe(&self) -> String {
-        let mut parts = Vec::new();
-        if let Some(s) = &self.stdout {
-            parts.push(format!("on stdout {s:?}"));
-        }
-        if let Some(s) = &self.stderr {
-            parts.push(format!("on stderr {s:?}"));
-        }
-        let said = if parts.is_empty() {
-            "it said nothing".to_string()
-        } else {
-            format!("it last said {}", parts.join(" and "))
-        };
-        match &self.stdin_error {
-            Some(e) => format!("{said}; its input broke: {e}"),
-            None => said,
-        }
-    }
-}
-
 /// Drives a worker process over the JSON-lines protocol. A batch that the worker does not
 /// answer in full within the timeout ([`Self::with_timeout`], default
 /// [`DEFAULT_BATCH_TIMEOUT_S`]) stops the worker and fails, naming the worker and what it last
@@ -275,17 +229,16 @@ pub struct JsonLines {
     name: String,
     to_worker: Option<mpsc::Sender<Vec<u8>>>,
     from_worker: mpsc::Receiver<Option<String>>,
-    last: Arc<Mutex<LastSaid>>,
+    last: Arc<Mutex<LastWords>>,
     timeout: Duration,
     lines_read: usize,
-    broken: Option<String>,
+    broken: Option<Box<WorkerFailure>>,
 }
 
 impl JsonLines {
     /// Starts `command` (e.g. `marionette eval --stdin`, or `python3 tools/ray_eval.py`) and
     /// sends it `problem`.
     pub fn start(mut command: Command, problem: &impl Serialize) -> Result<Self, EvolveError> {
-        let err = |m: String| EvolveError::Evaluator(m);
         let name = std::iter::once(command.get_program())
             .chain(command.get_args())
             .map(|a| a.to_string_lossy().into_owned())
@@ -296,13 +249,16 @@ impl JsonLines {
             .stdout(Stdio::piped())
             .stderr(Stdio::piped())
             .spawn()
-            .map_err(|e| err(format!("cannot start the worker `{name}`: {e}")))?;
+            .map_err(|source| EvaluatorError::Start {
+                worker: name.clone(),
+                source,
+            })?;
         let (stdin, stdout, stderr) =
             match (child.stdin.take(), child.stdout.take(), child.stderr.take()) {
                 (Some(i), Some(o), Some(e)) => (i, o, e),
-                _ => return Err(err(format!("the worker `{name}` has no pipes"))),
+                _ => return Err(EvaluatorError::NoPipes { worker: name }.into()),
             };
-        let last = Arc::new(Mutex::new(LastSaid::default()));
+        let last = Arc::new(Mutex::new(LastWords::default()));
         let to_worker = spawn_writer(stdin, noter(&last));
         let from_worker = spawn_reader(stdout, noter(&last));
         spawn_stderr_echo(stderr, noter(&last));
@@ -318,9 +274,9 @@ impl JsonLines {
         };
         let header = Header {
             protocol: PROTOCOL.into(),
-            problem: serde_json::to_value(problem).map_err(|e| err(e.to_string()))?,
+            problem: serde_json::to_value(problem).map_err(EvaluatorError::Encode)?,
         };
-        let mut line = serde_json::to_string(&header).map_err(|e| err(e.to_string()))?;
+        let mut line = serde_json::to_string(&header).map_err(EvaluatorError::Encode)?;
         line.push('\n');
         me.send(line);
         Ok(me)
@@ -333,51 +289,52 @@ impl JsonLines {
     }
 
     /// Hands `text` to the writing thread (a write that fails is found by the reply that then
-    /// never comes, and named by [`LastSaid`]).
+    /// never comes, and named by [`LastWords`]).
     fn send(&mut self, text: String) {
         if let Some(t) = &self.to_worker {
             let _ = t.send(text.into_bytes());
         }
     }
 
-    /// Stops the worker after `why` and remembers that it failed.
-    fn fail(&mut self, why: String) -> EvolveError {
+    /// Stops the worker after `fault` and remembers that it failed.
+    fn fail(&mut self, fault: WorkerFault) -> EvolveError {
         let _ = self.child.kill();
         // The threads see the pipes close; give the last words a moment to arrive.
         std::thread::sleep(Duration::from_millis(50));
-        let said = self
-            .last
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .describe();
-        let message = format!("the worker `{}` {why}; {said}", self.name);
-        self.broken = Some(message.clone());
-        EvolveError::Evaluator(message)
+        let said = self.last.lock().unwrap_or_else(|e| e.into_inner()).clone();
+        let failure = WorkerFailure {
+            worker: self.name.clone(),
+            fault,
+            said,
+        };
+        self.broken = Some(Box::new(failure.clone()));
+        EvaluatorError::Worker(Box::new(failure)).into()
     }
 
-    /// The worker's exit status once it has ended (waiting up to a second), for messages.
-    fn exit_status(&mut self) -> String {
+    /// The worker's exit status once it has ended (waiting up to a second); `None` if it is
+    /// still running.
+    fn exit_status(&mut self) -> Option<std::process::ExitStatus> {
         for _ in 0..20 {
             if let Ok(Some(s)) = self.child.try_wait() {
-                return format!("it ended with {s}");
+                return Some(s);
             }
             std::thread::sleep(Duration::from_millis(50));
         }
-        "it is still running".into()
+        None
     }
 }
 
 /// A handle through which a pipe's thread notes in `last` what the worker said.
-fn noter(last: &Arc<Mutex<LastSaid>>) -> impl Fn(&dyn Fn(&mut LastSaid)) + Send + 'static {
+fn noter(last: &Arc<Mutex<LastWords>>) -> impl Fn(&dyn Fn(&mut LastWords)) + Send + 'static {
     let l = last.clone();
-    move |f: &dyn Fn(&mut LastSaid)| f(&mut l.lock().unwrap_or_else(|e| e.into_inner()))
+    move |f: &dyn Fn(&mut LastWords)| f(&mut l.lock().unwrap_or_else(|e| e.into_inner()))
 }
 
 /// Writes to the worker's input on a thread of its own: a worker that stops reading blocks
 /// it, not the GA. A write that fails is noted and ends the thread.
 fn spawn_writer(
     mut stdin: ChildStdin,
-    note: impl Fn(&dyn Fn(&mut LastSaid)) + Send + 'static,
+    note: impl Fn(&dyn Fn(&mut LastWords)) + Send + 'static,
 ) -> mpsc::Sender<Vec<u8>> {
     let (to_worker, inbox) = mpsc::channel::<Vec<u8>>();
     std::thread::spawn(move || {
@@ -396,7 +353,7 @@ fn spawn_writer(
 /// `None` once the output ends.
 fn spawn_reader(
     stdout: ChildStdout,
-    note: impl Fn(&dyn Fn(&mut LastSaid)) + Send + 'static,
+    note: impl Fn(&dyn Fn(&mut LastWords)) + Send + 'static,
 ) -> mpsc::Receiver<Option<String>> {
     let (outbox, from_worker) = mpsc::channel::<Option<String>>();
     std::thread::spawn(move || {
@@ -422,7 +379,7 @@ fn spawn_reader(
 }
 
 /// Passes the worker's standard error through to this process's, noting its last line.
-fn spawn_stderr_echo(stderr: ChildStderr, note: impl Fn(&dyn Fn(&mut LastSaid)) + Send + 'static) {
+fn spawn_stderr_echo(stderr: ChildStderr, note: impl Fn(&dyn Fn(&mut LastWords)) + Send + 'static) {
     std::thread::spawn(move || {
         for line in BufReader::new(stderr).lines() {
             let Ok(line) = line else { return };
@@ -443,7 +400,7 @@ impl Evaluator for JsonLines {
         refine: u32,
     ) -> Result<Vec<Evaluation>, EvolveError> {
         if let Some(why) = &self.broken {
-            return Err(EvolveError::Evaluator(format!("failed before: {why}")));
+            return Err(EvaluatorError::FailedBefore(why.clone()).into());
         }
         self.send(batch_text(genomes, refine)?);
         let n = genomes.len();
@@ -458,15 +415,17 @@ impl Evaluator for JsonLines {
             }
             let reply: Reply = match parse_line(line.trim_end(), "reply", self.lines_read) {
                 Ok(r) => r,
-                Err(e) => return Err(self.fail(format!("sent a bad {e}"))),
+                Err(e) => return Err(self.fail(WorkerFault::BadReply(e))),
             };
             let (index, r) = match reply {
                 Reply::Done(BatchEnd { count }) if count == n && got == n => break,
                 Reply::Done(BatchEnd { count }) => {
-                    return Err(self.fail(format!(
-                        "ended generation {generation} with {{\"done\": {{\"count\": {count}}}}} \
-                         after {got} of its {n} replies"
-                    )));
+                    return Err(self.fail(WorkerFault::EarlyDone {
+                        generation,
+                        count,
+                        got,
+                        n,
+                    }));
                 }
                 Reply::Damage(d) => (d.index, Ok(d.value)),
                 Reply::Error(e) => (e.index, Err(EvaluationError::from_message(&e.message))),
@@ -474,14 +433,14 @@ impl Evaluator for JsonLines {
             match out.get_mut(index) {
                 Some(slot @ None) => *slot = Some(r),
                 Some(Some(_)) => {
-                    return Err(self.fail(format!(
-                        "replied twice for genome {index} of generation {generation}"
-                    )));
+                    return Err(self.fail(WorkerFault::RepliedTwice { index, generation }));
                 }
                 None => {
-                    return Err(self.fail(format!(
-                        "replied for genome {index}, past the {n} of generation {generation}"
-                    )));
+                    return Err(self.fail(WorkerFault::IndexPastBatch {
+                        index,
+                        n,
+                        generation,
+                    }));
                 }
             }
             got += 1;
@@ -492,7 +451,6 @@ impl Evaluator for JsonLines {
 
 /// The request lines of a batch: one genome line each, then the batch end.
 fn batch_text(genomes: &[Genome], refine: u32) -> Result<String, EvolveError> {
-    let err = |m: String| EvolveError::Evaluator(m);
     let mut text = String::new();
     for (index, g) in genomes.iter().enumerate() {
         let line = Request::Genome(GenomeLine {
@@ -500,13 +458,13 @@ fn batch_text(genomes: &[Genome], refine: u32) -> Result<String, EvolveError> {
             genes: g.clone(),
             refine,
         });
-        text.push_str(&serde_json::to_string(&line).map_err(|e| err(e.to_string()))?);
+        text.push_str(&serde_json::to_string(&line).map_err(EvaluatorError::Encode)?);
         text.push('\n');
     }
     let end = Request::Evaluate(BatchEnd {
         count: genomes.len(),
     });
-    text.push_str(&serde_json::to_string(&end).map_err(|e| err(e.to_string()))?);
+    text.push_str(&serde_json::to_string(&end).map_err(EvaluatorError::Encode)?);
     text.push('\n');
     Ok(text)
 }
@@ -545,11 +503,13 @@ impl JsonLines {
             let now = Instant::now();
             let deadline = clock.started + self.timeout;
             if now >= deadline {
-                return Err(self.fail(format!(
-                    "answered {got} of the {n} genomes of generation {generation} in {:.1} s, \
-                     the batch timeout, and was stopped",
-                    self.timeout.as_secs_f64()
-                )));
+                let seconds = self.timeout.as_secs_f64();
+                return Err(self.fail(WorkerFault::Timeout {
+                    got,
+                    n,
+                    generation,
+                    seconds,
+                }));
             }
             match self
                 .from_worker
@@ -558,10 +518,12 @@ impl JsonLines {
                 Ok(Some(line)) => return Ok(line),
                 Ok(None) | Err(mpsc::RecvTimeoutError::Disconnected) => {
                     let status = self.exit_status();
-                    return Err(self.fail(format!(
-                        "closed its output after {got} of the {n} replies of generation \
-                         {generation} ({status})"
-                    )));
+                    return Err(self.fail(WorkerFault::Closed {
+                        got,
+                        n,
+                        generation,
+                        status,
+                    }));
                 }
                 Err(mpsc::RecvTimeoutError::Timeout) => {
                     if Instant::now() >= clock.next_note {
@@ -614,34 +576,32 @@ where
     W: Write,
     E: Fn(&[Genome], u32) -> Vec<Evaluation>,
 {
-    let err = |m: String| EvolveError::Evaluator(m);
     let mut lines = input.lines();
     let first = lines
         .next()
-        .ok_or_else(|| err("no header line".into()))?
-        .map_err(|e| err(e.to_string()))?;
+        .ok_or(EvaluatorError::NoHeader)?
+        .map_err(|source| EvaluatorError::Read { line: 1, source })?;
     let eval = read_problem(&first, make)?;
     let mut batch: Vec<(usize, Genome, u32)> = Vec::new();
     for (k, line) in lines.enumerate() {
         let at = k + 2;
-        let line = line.map_err(|e| err(format!("request line {at}: {e}")))?;
+        let line = line.map_err(|source| EvaluatorError::Read { line: at, source })?;
         if line.len() > MAX_LINE {
-            return Err(err(format!(
-                "request line {at} longer than {MAX_LINE} bytes"
-            )));
+            return Err(EvaluatorError::LineTooLong(at).into());
         }
         if line.trim().is_empty() {
             continue;
         }
-        match parse_line::<Request>(&line, "request", at).map_err(err)? {
+        match parse_line::<Request>(&line, "request", at).map_err(bad_request)? {
             Request::Genome(g) => add_genome(&mut batch, g, at)?,
             Request::Evaluate(BatchEnd { count }) => {
                 if count != batch.len() {
-                    return Err(err(format!(
-                        "request line {at}, field `evaluate.count`: the batch holds {} \
-                         genomes, found {count}",
-                        batch.len()
-                    )));
+                    return Err(EvaluatorError::BatchCount {
+                        line: at,
+                        held: batch.len(),
+                        count,
+                    }
+                    .into());
                 }
                 answer_batch(&eval, &batch, &mut output)?;
                 batch.clear();
@@ -649,10 +609,7 @@ where
         }
     }
     if !batch.is_empty() {
-        return Err(err(format!(
-            "the input ended inside a batch of {} genomes (no {{\"evaluate\": …}} line)",
-            batch.len()
-        )));
+        return Err(EvaluatorError::UnendedBatch(batch.len()).into());
     }
     Ok(())
 }
@@ -666,18 +623,14 @@ fn read_problem<P, E>(
 where
     P: serde::de::DeserializeOwned,
 {
-    let err = |m: String| EvolveError::Evaluator(m);
-    let header: Header = parse_line(first, "request", 1).map_err(err)?;
+    let header: Header = parse_line(first, "request", 1).map_err(bad_request)?;
     if header.protocol != PROTOCOL {
-        return Err(err(format!(
-            "protocol '{}' is not '{PROTOCOL}'",
-            header.protocol
-        )));
+        return Err(EvaluatorError::Protocol(header.protocol).into());
     }
     serde_json::from_value(header.problem)
         .map_err(|e| e.to_string())
         .and_then(make)
-        .map_err(|e| err(format!("problem: {e}")))
+        .map_err(|e| EvaluatorError::Problem(e).into())
 }
 
 /// Adds the genome of request line `at` to the batch: its refinement in range, its index new.
@@ -690,18 +643,11 @@ fn add_genome(
     }: GenomeLine,
     at: usize,
 ) -> Result<(), EvolveError> {
-    let err = |m: String| EvolveError::Evaluator(m);
     if !(1..=MAX_REFINE).contains(&refine) {
-        return Err(err(format!(
-            "request line {at}, field `genome.refine`: must be 1..={MAX_REFINE}, \
-             found {refine}"
-        )));
+        return Err(EvaluatorError::Refine { line: at, refine }.into());
     }
     if batch.iter().any(|b| b.0 == index) {
-        return Err(err(format!(
-            "request line {at}, field `genome.index`: genome {index} given twice \
-             in a batch"
-        )));
+        return Err(EvaluatorError::RepeatedIndex { line: at, index }.into());
     }
     batch.push((index, genes, refine));
     Ok(())
@@ -718,7 +664,6 @@ where
     W: Write,
     E: Fn(&[Genome], u32) -> Vec<Evaluation>,
 {
-    let err = |m: String| EvolveError::Evaluator(m);
     let mut results: Vec<Option<Evaluation>> = vec![None; batch.len()];
     let mut levels: Vec<u32> = batch.iter().map(|b| b.2).collect();
     levels.sort_unstable();
@@ -747,16 +692,16 @@ where
                 message: e.to_string(),
             }),
         };
-        text.push_str(&serde_json::to_string(&reply).map_err(|e| err(e.to_string()))?);
+        text.push_str(&serde_json::to_string(&reply).map_err(EvaluatorError::Encode)?);
         text.push('\n');
     }
     let done = Reply::Done(BatchEnd { count: batch.len() });
-    text.push_str(&serde_json::to_string(&done).map_err(|e| err(e.to_string()))?);
+    text.push_str(&serde_json::to_string(&done).map_err(EvaluatorError::Encode)?);
     text.push('\n');
     output
         .write_all(text.as_bytes())
         .and_then(|_| output.flush())
-        .map_err(|e| err(e.to_string()))
+        .map_err(|e| EvaluatorError::Write(e).into())
 }
 
 #[cfg(test)]

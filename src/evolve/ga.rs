@@ -14,6 +14,7 @@ use rand_pcg::Pcg64;
 use serde::{Deserialize, Serialize};
 
 use super::checkpoint::Consistent;
+use super::error::{EvaluatorError, StopCause};
 use super::evaluator::{Evaluation, Evaluator, EvolveError};
 use super::failure::{EvaluationError, Failure};
 use super::genome::{Bounds, Genome};
@@ -258,10 +259,10 @@ impl GaState {
     /// `Err(EvolveError::Stopped)` with the cause if the GA has stopped ([`Self::stopped`]).
     pub fn halted(&self) -> Result<(), EvolveError> {
         match &self.stopped {
-            Some(why) => Err(EvolveError::Stopped(format!(
-                "seed {}, {why}",
-                self.config.seed
-            ))),
+            Some(why) => Err(EvolveError::Stopped {
+                run: format!("seed {}", self.config.seed),
+                cause: StopCause::from_message(why),
+            }),
             None => Ok(()),
         }
     }
@@ -568,12 +569,7 @@ impl GaState {
     pub fn receive(&mut self, brood: Brood, results: Vec<Evaluation>) -> Result<(), EvolveError> {
         let copies = brood.copies();
         let expected = brood.children.len() - copies;
-        if results.len() != expected {
-            return Err(EvolveError::Evaluator(format!(
-                "{} results for {expected} genomes",
-                results.len(),
-            )));
-        }
+        result_count(expected, &results)?;
         self.generation = brood.generation;
         self.evaluations += expected as u64;
         self.inherited += copies as u64;
@@ -593,9 +589,8 @@ impl GaState {
                 checked.push(was_checked);
                 continue;
             }
-            let r = results
-                .next()
-                .ok_or_else(|| EvolveError::Evaluator("fewer results than genomes".into()))?;
+            // The count was checked: a result is always there.
+            let r = results.next().unwrap_or(Err(EvaluationError::NotEvaluated));
             let f = match r.and_then(|d| EvaluationError::of_damage(d).map_or(Ok(d), Err)) {
                 Ok(d) => Some(d),
                 Err(why) => {
@@ -627,20 +622,19 @@ impl GaState {
             .take_while(|f| f.0 == self.generation)
             .collect();
         if failed.len() as f64 > self.config.max_failed_share * children as f64 {
-            let first: Vec<String> = failed
-                .iter()
-                .rev()
-                .take(3)
-                .map(|(_, i, why)| format!("individual {i}: {why}"))
-                .collect();
-            self.stopped = Some(format!(
-                "generation {}: {} of {children} evaluations failed, more than \
-                 ga.max_failed_share = {} of them; the first: {}",
-                self.generation,
-                failed.len(),
-                self.config.max_failed_share,
-                first.join("; ")
-            ));
+            let cause = StopCause::TooManyFailed {
+                generation: self.generation,
+                failed: failed.len(),
+                evaluations: children,
+                limit: self.config.max_failed_share,
+                first: failed
+                    .iter()
+                    .rev()
+                    .take(3)
+                    .map(|(_, i, why)| (*i, why.clone()))
+                    .collect(),
+            };
+            self.stopped = Some(cause.to_string());
         }
     }
 
@@ -669,13 +663,7 @@ impl GaState {
         todo: &[usize],
         results: Vec<Evaluation>,
     ) -> Result<(), EvolveError> {
-        if results.len() != todo.len() {
-            return Err(EvolveError::Evaluator(format!(
-                "{} results for {} genomes",
-                results.len(),
-                todo.len()
-            )));
-        }
+        result_count(todo.len(), &results)?;
         let tol = self.config.elite_check_tolerance.unwrap_or(f64::INFINITY);
         self.check_evaluations += todo.len() as u64;
         self.generation_checks += todo.len() as u64;
@@ -737,6 +725,20 @@ impl Consistent for GaState {
 
 /// Whether an elite check holds: the re-evaluation `r` of an individual of damage `d` is finite
 /// and within `|D_fine − D| ≤ tol · |D|`.
+/// `Ok` if an evaluator gave one result for each of the `expected` genomes, else
+/// [`EvaluatorError::ResultCount`].
+pub fn result_count(expected: usize, results: &[Evaluation]) -> Result<(), EvolveError> {
+    if results.len() == expected {
+        Ok(())
+    } else {
+        Err(EvaluatorError::ResultCount {
+            expected,
+            found: results.len(),
+        }
+        .into())
+    }
+}
+
 fn check_holds(d: f64, r: &Evaluation, tol: f64) -> bool {
     matches!(r, Ok(fine) if fine.is_finite() && *fine >= 0.0 && (fine - d).abs() <= tol * d.abs())
 }

@@ -1,12 +1,13 @@
 //! Evolution: a genetic algorithm as a kernel over plain data, knowing no problem in particular
 //! (no World inside): a real-coded [`genome`] in [`Bounds`], the textbook [`operators`]
 //! (tournament, SBX, polynomial mutation, elitism), the generational loop [`ga`], its
-//! [`logbook`] and [`checkpoint`]s, why an individual has no fitness ([`failure`]), and who computes fitness ([`evaluator`]: the [`Evaluator`]
+//! [`logbook`] and [`checkpoint`]s, why an individual has no fitness ([`failure`]), why a run cannot go on ([`error`]), and who computes fitness ([`evaluator`]: the [`Evaluator`]
 //! trait, an in-process rayon backend, or a JSON-lines worker a Ray cluster can run, generic over
 //! a serialisable problem). The falling paper's problem lives with its experiment
 //! (`experiments::evolve_fall`).
 
 pub mod checkpoint;
+pub mod error;
 pub mod evaluator;
 pub mod failure;
 pub mod ga;
@@ -14,6 +15,7 @@ pub mod genome;
 pub mod logbook;
 pub mod operators;
 
+pub use error::{CheckpointError, EvaluatorError, StopCause, WorkerFailure, WorkerFault};
 pub use evaluator::{Evaluation, Evaluator, EvolveError, InProcess, JsonLines};
 pub use failure::{EvaluationError, Failure, ProblemFailure};
 pub use ga::{GaConfig, GaState};

@@ -21,7 +21,9 @@ use std::path::PathBuf;
 use serde::{Deserialize, Serialize};
 
 use crate::evolve::ga::{Brood, ELITE_CHECK_REFINE};
-use crate::evolve::{Evaluation, Evaluator, EvolveError, GaConfig, GaState, Genome, checkpoint};
+use crate::evolve::{
+    Evaluation, Evaluator, EvolveError, GaConfig, GaState, Genome, StopCause, checkpoint,
+};
 use crate::experiments::fall::{FallConfig, FallResult, SimError, simulate_fall};
 use crate::humanoid::ranges::AgeGroup;
 
@@ -92,11 +94,10 @@ impl checkpoint::Consistent for Vec<EvolutionRun> {
 /// why.
 pub fn halted(runs: &[EvolutionRun]) -> Result<(), EvolveError> {
     match runs.iter().find(|r| r.state.stopped.is_some()) {
-        Some(r) => Err(EvolveError::Stopped(format!(
-            "{}, {}",
-            r.name(),
-            r.state.stopped.as_deref().unwrap_or_default()
-        ))),
+        Some(r) => Err(EvolveError::Stopped {
+            run: r.name(),
+            cause: StopCause::from_message(r.state.stopped.as_deref().unwrap_or_default()),
+        }),
         None => Ok(()),
     }
 }
@@ -345,13 +346,7 @@ fn evaluate_by_owner(
                 )?
             }
         };
-        if results.len() != genomes.len() {
-            return Err(EvolveError::Evaluator(format!(
-                "{} results for {} genomes",
-                results.len(),
-                genomes.len()
-            )));
-        }
+        crate::evolve::ga::result_count(genomes.len(), &results)?;
         let mut all = results.into_iter();
         for k in mine {
             out[k] = all.by_ref().take(parts[k].1.len()).collect();
