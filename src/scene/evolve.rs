@@ -308,7 +308,7 @@ pub fn default_checkpoint_dir(scene: &EvolveFallScene, out_dir: &Path) -> PathBu
 /// groups and seeds in the same order, the same problem for each group and every GA setting
 /// the same but `generations`, which may grow (not below the generation the checkpoint is at);
 /// else which setting differs and how.
-fn resumable(runs: &[EvolutionRun], config: &EvolveConfig) -> Result<(), String> {
+fn resumable(runs: &[EvolutionRun], config: &EvolveConfig) -> Result<(), ResumeMismatch> {
     let distinct = |items: Vec<serde_json::Value>| {
         let mut out: Vec<serde_json::Value> = Vec::new();
         for i in items {
@@ -330,9 +330,7 @@ fn resumable(runs: &[EvolutionRun], config: &EvolveConfig) -> Result<(), String>
     let seeds = to_json(&config.seeds);
     for (name, had, asked) in [("groups", had_groups, groups), ("seeds", had_seeds, seeds)] {
         if had != asked {
-            return Err(format!(
-                "{name}: the checkpoint has {had}, the scene asks {asked}"
-            ));
+            return Err(SettingMismatch::new(name, &had, &asked).into());
         }
     }
     let wanted: Vec<String> = config
@@ -347,11 +345,12 @@ fn resumable(runs: &[EvolutionRun], config: &EvolveConfig) -> Result<(), String>
         .collect();
     let held: Vec<String> = runs.iter().map(EvolutionRun::name).collect();
     if held != wanted {
-        return Err(format!(
-            "runs: the checkpoint holds [{}], the scene asks [{}]",
-            held.join(", "),
-            wanted.join(", ")
-        ));
+        return Err(SettingMismatch::new(
+            "runs",
+            format!("[{}]", held.join(", ")),
+            format!("[{}]", wanted.join(", ")),
+        )
+        .into());
     }
     for r in runs {
         let Some(p) = config
@@ -369,7 +368,11 @@ fn resumable(runs: &[EvolutionRun], config: &EvolveConfig) -> Result<(), String>
 /// Errors unless run `r` of the checkpoint has the scene's problem `p` and GA settings (its
 /// seed and generations aside), and has not gone past the scene's generations: the first few
 /// differences.
-fn same_settings(r: &EvolutionRun, p: &FallProblem, config: &EvolveConfig) -> Result<(), String> {
+fn same_settings(
+    r: &EvolutionRun,
+    p: &FallProblem,
+    config: &EvolveConfig,
+) -> Result<(), ResumeMismatch> {
     let mut diff = Vec::new();
     differences(
         &format!("{}, problem", r.name()),
@@ -386,18 +389,13 @@ fn same_settings(r: &EvolutionRun, p: &FallProblem, config: &EvolveConfig) -> Re
     if !diff.is_empty() {
         let more = diff.len().saturating_sub(3);
         diff.truncate(3);
-        let mut why = diff.join("; ");
-        if more > 0 {
-            why.push_str(&format!("; and {more} more"));
-        }
-        return Err(why);
+        return Err(ResumeMismatch::Settings { differ: diff, more });
     }
     if r.state.generation > config.ga.generations {
-        return Err(format!(
-            "ga.generations: the checkpoint is already at generation {}, the scene asks {} \
-             (ga.generations may grow, not fall below the checkpoint's generation)",
-            r.state.generation, config.ga.generations
-        ));
+        return Err(ResumeMismatch::PastGenerations {
+            at: r.state.generation,
+            asked: config.ga.generations,
+        });
     }
     Ok(())
 }
@@ -407,13 +405,12 @@ fn to_json<T: Serialize + ?Sized>(v: &T) -> serde_json::Value {
     serde_json::to_value(v).unwrap_or(serde_json::Value::Null)
 }
 
-/// Each leaf where `had` (the checkpoint's) and `asked` (the scene's) differ, as
-/// `path: the checkpoint has …, the scene asks …`.
+/// Each leaf where `had` (the checkpoint's) and `asked` (the scene's) differ.
 fn differences(
     path: &str,
     had: &serde_json::Value,
     asked: &serde_json::Value,
-    out: &mut Vec<String>,
+    out: &mut Vec<SettingMismatch>,
 ) {
     use serde_json::Value;
     match (had, asked) {
@@ -436,11 +433,69 @@ fn differences(
             }
         }
         _ if had != asked => {
-            out.push(format!(
-                "{path}: the checkpoint has {had}, the scene asks {asked}"
-            ));
+            out.push(SettingMismatch::new(path, had, asked));
         }
         _ => {}
+    }
+}
+
+/// How a checkpoint to resume differs from the runs the scene asks for.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum ResumeMismatch {
+    /// Settings that differ: the first three, and how many more.
+    #[error(
+        "{}{}",
+        .differ.iter().map(ToString::to_string).collect::<Vec<_>>().join("; "),
+        if *.more > 0 { format!("; and {} more", .more) } else { String::new() }
+    )]
+    Settings {
+        /// The first settings that differ.
+        differ: Vec<SettingMismatch>,
+        /// How many more differ.
+        more: usize,
+    },
+    /// The checkpoint is already past the generations the scene asks for.
+    #[error(
+        "ga.generations: the checkpoint is already at generation {at}, the scene asks {asked} \
+         (ga.generations may grow, not fall below the checkpoint's generation)"
+    )]
+    PastGenerations {
+        /// The checkpoint's generation.
+        at: u64,
+        /// The scene's `ga.generations`.
+        asked: u64,
+    },
+}
+
+/// A setting whose value in the checkpoint is not the scene's.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("{setting}: the checkpoint has {checkpoint}, the scene asks {asked}")]
+pub struct SettingMismatch {
+    /// The setting, e.g. `seeds` or `ga.population`.
+    pub setting: String,
+    /// Its value in the checkpoint.
+    pub checkpoint: String,
+    /// The scene's value.
+    pub asked: String,
+}
+
+impl SettingMismatch {
+    /// `setting` differs: `checkpoint` in the checkpoint, `asked` in the scene.
+    fn new(setting: &str, checkpoint: impl ToString, asked: impl ToString) -> Self {
+        Self {
+            setting: setting.to_string(),
+            checkpoint: checkpoint.to_string(),
+            asked: asked.to_string(),
+        }
+    }
+}
+
+impl From<SettingMismatch> for ResumeMismatch {
+    fn from(m: SettingMismatch) -> Self {
+        Self::Settings {
+            differ: vec![m],
+            more: 0,
+        }
     }
 }
 

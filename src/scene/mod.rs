@@ -22,7 +22,7 @@ pub use dance::{
     DanceInputs, DanceRender, DanceScene, DatabaseSource, Pin, SongSource, load_dance, run_dance,
     scene_pins, song_timed_bvh, validate_dance,
 };
-pub use evolve::{EvaluatorChoice, EvolveFallScene, run_evolve};
+pub use evolve::{EvaluatorChoice, EvolveFallScene, ResumeMismatch, SettingMismatch, run_evolve};
 pub use fall::{Body, Controller, FallScene, Simulation, fall_report, run_fall};
 pub use page::{PAGE_FILE, RunPage, write_run_index};
 pub use primitives::{
@@ -295,7 +295,7 @@ pub enum SceneError {
         /// The checkpoint's folder.
         dir: PathBuf,
         /// What differs.
-        why: String,
+        why: ResumeMismatch,
     },
     /// A pin that gives both or neither of a segment and a clip's bar.
     #[error("pins[{pin}] (bar {bar}): give either segment: N, or clip: \"name\" with clip_bar: N")]
