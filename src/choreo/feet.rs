@@ -38,7 +38,7 @@ use crate::analysis::{
     ContactConfig, ContactReference, Contacts, PointRef, foot_points, ground_contacts_against,
 };
 use crate::humanoid::ModelClip;
-use crate::humanoid::leg_ik::{Leg, chain_globals, frame_globals, reach, with_ancestors};
+use crate::humanoid::leg_ik::{Leg, chain_globals, frame_globals, reach_along, with_ancestors};
 use crate::skeleton::{Skeleton, Transform};
 
 /// Most rounds of IK per frame and leg: the target corrected by the foot's residual each round
@@ -552,7 +552,7 @@ fn reach_targets(
                 let mut ankle_target = g[leg.ankle].translation + c;
                 let mut residual = 0.0;
                 for _ in 0..IK_ROUNDS {
-                    reach(skeleton, leg, t, q, angles, ankle_target);
+                    reach_along(skeleton, leg, &model.chain, g, (t, q), angles, ankle_target);
                     let now = &model.positions_at(skeleton, t, q, angles, g)[side];
                     // The residual of the foot: its sole height, and its key point's
                     // horizontal place.

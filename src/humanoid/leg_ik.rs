@@ -149,9 +149,31 @@ pub fn reach(
     angles: &mut [f64],
     target: DVec3,
 ) -> f64 {
-    let mut g = Vec::new();
     let chain = with_ancestors(model, &[leg.ankle]);
-    chain_globals(model, &chain, root_t, root_q, angles, &mut g);
+    reach_along(
+        model,
+        leg,
+        &chain,
+        &mut Vec::new(),
+        (root_t, root_q),
+        angles,
+        target,
+    )
+}
+
+/// [`reach`] placing the joints `chain` (the ankle's and its ancestors at least, in model order
+/// as [`with_ancestors`] gives) in the scratch `g`: the same angles, bit for bit, without an
+/// allocation per call, for legs moved frame after frame.
+pub fn reach_along(
+    model: &Model,
+    leg: Leg,
+    chain: &[usize],
+    g: &mut Vec<Transform>,
+    (root_t, root_q): (DVec3, DQuat),
+    angles: &mut [f64],
+    target: DVec3,
+) -> f64 {
+    chain_globals(model, chain, root_t, root_q, angles, g);
     let hip_pos = g[leg.hip].translation;
     let k = model.joints[leg.knee].offset;
     let e = model.joints[leg.ankle].offset;
@@ -203,7 +225,7 @@ pub fn reach(
             &mut angles[first..first + m],
         );
     }
-    chain_globals(model, &chain, root_t, root_q, angles, &mut g);
+    chain_globals(model, chain, root_t, root_q, angles, g);
     (g[leg.ankle].translation - target).length()
 }
 
