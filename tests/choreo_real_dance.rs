@@ -69,6 +69,10 @@ fn check(what: &str, r: &serde_json::Value, paper: &serde_json::Value, folder: &
         "{what}: beats off the music"
     );
     assert!(f(&m["intensity_spearman"]) >= 0.6, "{what}: intensity");
+    assert!(
+        f(&pen["contact_within_1cm_fraction"]) >= f(&src["contact_within_1cm_fraction"]),
+        "{what}: feet in contact hover more than their sources'"
+    );
     let (cost, cost_paper) = (
         f(&m["transition_cost"]),
         f(&paper["metrics"]["transition_cost"]),

@@ -13,9 +13,13 @@
 //! - **Contact.** A foot is in contact in the frames where [`ground_contacts_against`] finds it
 //!   contact against the floor y = 0 and the model's rest heights: some point within
 //!   [`ContactConfig::threshold_m`] of its rest height (debounced).
-//! - **Lift.** Wherever the sole is under the floor the foot is lifted onto it: c_y(f) =
-//!   max(0, −s(f)). Nothing is pulled down: a foot that hovers stays where its segment puts it,
-//!   so no swinging foot is made to touch the floor (and skate on it).
+//! - **Ground.** A contact span that is not held (below) is moved by one height, so that its
+//!   lowest sole touches the floor: c_y(f) = −min_{span} s (with [`PlantParams::ground`]). A
+//!   foot the analysis calls in contact is within [`ContactConfig::threshold_m`] of the floor,
+//!   so this moves it a few centimetres, and the foot keeps its own motion within the span.
+//! - **Lift.** Wherever else the sole is under the floor the foot is lifted onto it: c_y(f) ≥
+//!   −s(f). Outside the spans and their fades nothing is pulled down: a swinging foot is not made
+//!   to touch the floor (and skate on it).
 //! - **Lock.** A contact span whose contact point (the foot point lowest relative to its rest
 //!   height on average over the span) slides, its mean horizontal speed over the span above
 //!   [`ContactConfig::rest_speed_mps`] (the speed under which the contact analysis calls a
@@ -55,6 +59,10 @@ pub struct PlantParams {
     /// Hold a planted foot's contact point still over its contact span (false: only heights
     /// are corrected).
     pub lock: bool,
+    /// Put a standing foot on the floor: each contact span that is not held moved by one
+    /// height, down as well as up, so its lowest sole is at y = 0 (false: a foot is only lifted
+    /// out of the floor, and one in contact may hover).
+    pub ground: bool,
     /// Time over which a correction fades in and out around a contact span, seconds.
     pub blend_s: f64,
     /// σ of the Gaussian the corrections are smoothed with over time, seconds (0: none): the
@@ -69,6 +77,7 @@ impl Default for PlantParams {
         PlantParams {
             enabled: true,
             lock: true,
+            ground: true,
             blend_s: 0.2,
             smooth_s: 0.05,
         }
@@ -368,6 +377,17 @@ fn hold_spans(
         if slides && p.lock {
             report.locked += 1;
         }
+        // On the floor: a span that is not held (the foot stands, or slides unlocked) lowered
+        // or raised by one height, the sole's lowest over the span, so the foot keeps its own
+        // small motion and touches down. A held span is not also lowered: with the pull to
+        // its anchor, that would straighten the knee at once.
+        let down = if p.ground && !(p.lock && slides) {
+            -(a..b)
+                .map(|f| sole_height(foot.points(f), foot.rest))
+                .fold(f64::INFINITY, f64::min)
+        } else {
+            0.0
+        };
         for f in a..b {
             key[f] = k;
             let pt = foot.at(f, k);
@@ -376,7 +396,7 @@ fn hold_spans(
             } else {
                 DVec3::ZERO
             };
-            corr[f] = Some(horizontal);
+            corr[f] = Some(horizontal + DVec3::Y * down);
         }
     }
     (corr, key)
@@ -488,12 +508,14 @@ fn smooth_and_floor(
 ) -> Vec<Option<(DVec3, usize)>> {
     let n = corr.len();
     let mut corr = corr.to_vec();
-    let lift: Vec<f64> = (0..n)
-        .map(|f| (-sole_height(foot.points(f), foot.rest)).max(0.0))
+    // The least vertical correction that keeps the sole out of the floor: −s(f).
+    let floor: Vec<f64> = (0..n)
+        .map(|f| -sole_height(foot.points(f), foot.rest))
         .collect();
     for f in 0..n {
-        if lift[f] > 0.0 {
-            corr[f] = Some(corr[f].unwrap_or_default() + DVec3::Y * lift[f]);
+        let c = corr[f].unwrap_or_default();
+        if floor[f] > c.y {
+            corr[f] = Some(DVec3::new(c.x, floor[f], c.z));
         }
     }
     let raw: Vec<DVec3> = corr.iter().map(|c| c.unwrap_or_default()).collect();
@@ -504,8 +526,8 @@ fn smooth_and_floor(
             continue;
         }
         let mut c = smooth[f];
-        // No sole under the floor: the vertical correction only lifts.
-        c.y = c.y.max(lift[f]);
+        // No sole under the floor.
+        c.y = c.y.max(floor[f]);
         report.max_correction_m = report.max_correction_m.max(c.length());
         targets[f] = Some((c, key[f]));
     }
@@ -657,6 +679,34 @@ mod tests {
             sunk.root_translation,
             stance(0.5, -0.04, 0.0, 120).root_translation
         );
+    }
+
+    #[test]
+    fn a_standing_foot_that_hovers_is_put_down_on_the_floor() {
+        // Standing 2 cm above the floor (in contact: within the analysis's 3 cm): the soles go
+        // down onto it, the pelvis stays, and without `ground` the figure is left alone.
+        let lowest = |clip: &ModelClip| {
+            let rest = rest_sole_heights(clip);
+            let tracks = foot_tracks(clip);
+            (0..2)
+                .flat_map(|s| tracks[s].iter().map(move |pts| (s, pts)))
+                .map(|(s, pts)| sole_height(pts, &rest[s]))
+                .fold(f64::INFINITY, f64::min)
+        };
+        let mut hover = stance(0.5, 0.02, 0.0, 120);
+        let r = plant_feet(&mut hover, &PlantParams::default());
+        assert!(lowest(&hover).abs() < 1e-3, "{} m: {r:?}", lowest(&hover));
+        assert_eq!(
+            hover.root_translation,
+            stance(0.5, 0.02, 0.0, 120).root_translation
+        );
+        let mut left = stance(0.5, 0.02, 0.0, 120);
+        let only_lift = PlantParams {
+            ground: false,
+            ..PlantParams::default()
+        };
+        plant_feet(&mut left, &only_lift);
+        assert!((lowest(&left) - 0.02).abs() < 1e-9, "{}", lowest(&left));
     }
 
     #[test]
