@@ -215,9 +215,23 @@ fn band_power(samples: &[f32], n_fft: usize, hop: usize, edges: &[usize]) -> Vec
             let mut scratch = fft.make_scratch_vec();
             for (j, row) in rows.chunks_mut(bands).enumerate() {
                 let centre = (c * CHUNK + j) * hop;
-                for (i, (x, w)) in input.iter_mut().zip(&window).enumerate() {
-                    let s = (centre + i).checked_sub(half).and_then(|k| samples.get(k));
-                    *x = s.map_or(0.0, |s| s * w);
+                match centre
+                    .checked_sub(half)
+                    .and_then(|a| samples.get(a..a + n_fft))
+                {
+                    // A frame inside the song: one straight pass the compiler vectorises.
+                    Some(frame) => {
+                        for ((x, s), w) in input.iter_mut().zip(frame).zip(&window) {
+                            *x = s * w;
+                        }
+                    }
+                    // A frame over either end: the samples outside the song are 0.
+                    None => {
+                        for (i, (x, w)) in input.iter_mut().zip(&window).enumerate() {
+                            let s = (centre + i).checked_sub(half).and_then(|k| samples.get(k));
+                            *x = s.map_or(0.0, |s| s * w);
+                        }
+                    }
                 }
                 // The lengths come from the same plan, so processing cannot fail.
                 let _ = fft.process_with_scratch(&mut input, &mut spectrum, &mut scratch);
