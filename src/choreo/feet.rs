@@ -33,7 +33,7 @@
 //!   rolls: a kink the knee would follow), then the lift is applied again as a floor.
 //! - **Reach.** The ankle is sent to its own position plus c(f) by the leg's IK, and the
 //!   foot's residual (the foot turns a little with the shin, since humanoid24 has no ankle DOF)
-//!   is added to the target again, [`IK_ROUNDS`] times.
+//!   is added to the target again, [`IK_ROUNDS`] times at most.
 
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
@@ -276,6 +276,11 @@ impl Feet {
         g: &mut Vec<Transform>,
     ) -> [Vec<DVec3>; 2] {
         chain_globals(model, &self.chain, t, q, angles, g);
+        self.points_in(g)
+    }
+
+    /// The foot points of both feet where the chain's global transforms `g` place them.
+    fn points_in(&self, g: &[Transform]) -> [Vec<DVec3>; 2] {
         [0, 1].map(|s| {
             self.points[s]
                 .iter()
@@ -573,14 +578,15 @@ fn reach_targets(
                 chain_globals(skeleton, &model.chain, t, q, angles, g);
                 let mut ankle_target = g[leg.ankle].translation + c;
                 let mut residual = 0.0;
+                // The foot's place to reach: its key point's horizontal place and its sole
+                // height.
+                let wanted = DVec3::new(want[k].x, want_sole, want[k].z);
                 for _ in 0..IK_ROUNDS {
+                    // `g` holds the chain for `angles`, before and after the reach.
                     reach_along(skeleton, leg, &model.chain, g, (t, q), angles, ankle_target);
-                    let now = &model.positions_at(skeleton, t, q, angles, g)[side];
-                    // The residual of the foot: its sole height, and its key point's
-                    // horizontal place.
-                    let dy = want_sole - sole_height(now, &rest[side]);
-                    let dxz = (want[k] - now[k]) * DVec3::new(1.0, 0.0, 1.0);
-                    let r = dxz + DVec3::Y * dy;
+                    let now = &model.points_in(g)[side];
+                    let place = DVec3::new(now[k].x, sole_height(now, &rest[side]), now[k].z);
+                    let r = wanted - place;
                     residual = r.length();
                     if residual < 1e-4 {
                         break;

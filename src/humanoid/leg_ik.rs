@@ -150,20 +150,15 @@ pub fn reach(
     target: DVec3,
 ) -> f64 {
     let chain = with_ancestors(model, &[leg.ankle]);
-    reach_along(
-        model,
-        leg,
-        &chain,
-        &mut Vec::new(),
-        (root_t, root_q),
-        angles,
-        target,
-    )
+    let mut g = Vec::new();
+    chain_globals(model, &chain, root_t, root_q, angles, &mut g);
+    reach_along(model, leg, &chain, &mut g, (root_t, root_q), angles, target)
 }
 
-/// [`reach`] placing the joints `chain` (the ankle's and its ancestors at least, in model order
-/// as [`with_ancestors`] gives) in the scratch `g`: the same angles, bit for bit, without an
-/// allocation per call, for legs moved frame after frame.
+/// [`reach`] over the joints `chain` (the ankle's and its ancestors at least, in model order
+/// as [`with_ancestors`] gives), whose global transforms for `angles` the scratch `g` holds
+/// already ([`chain_globals`]), and leaves holding for the new angles: the same angles, bit for
+/// bit, without an allocation or a second placing per call, for legs moved round after round.
 pub fn reach_along(
     model: &Model,
     leg: Leg,
@@ -173,7 +168,6 @@ pub fn reach_along(
     angles: &mut [f64],
     target: DVec3,
 ) -> f64 {
-    chain_globals(model, chain, root_t, root_q, angles, g);
     let hip_pos = g[leg.hip].translation;
     let k = model.joints[leg.knee].offset;
     let e = model.joints[leg.ankle].offset;
