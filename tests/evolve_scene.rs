@@ -175,7 +175,7 @@ fn a_resumed_evolution_ends_where_an_uninterrupted_one_does() {
     // A scene step that contradicts the controller's is refused, naming the way out.
     let out = Command::new(env!("CARGO_BIN_EXE_marionette"))
         .args(["run", "scenes/fall.ron", "--out", &s(&replay)])
-        .args(["--set", &file, "--set", "simulation.dt=0.0005"])
+        .args(["--set", &file, "--set", "fall.dt_s=0.0005"])
         .current_dir(env!("CARGO_MANIFEST_DIR"))
         .output()
         .unwrap();

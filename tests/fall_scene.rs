@@ -74,16 +74,16 @@ fn pushed_from_the_front_the_figure_falls_backward_and_rests() {
 fn set_reaches_the_age_group_step_integrator_and_push() {
     let r = run_fall(&[
         "age_group=adult",
-        "simulation.dt=0.00025",
-        "push.force_n=1200",
+        "fall.dt_s=0.00025",
+        "fall.push.force_n=1200",
         "render.gif=false",
     ]);
     assert_eq!(r["age_group"], "adult");
     assert_eq!(r["dt_s"].as_f64().unwrap(), 0.00025);
     assert_eq!(r["steps"].as_u64().unwrap(), 12000);
     let rk4 = run_fall(&[
-        "simulation.integrator=Rk4",
-        "simulation.dt=0.00025",
+        "fall.integrator=Rk4",
+        "fall.dt_s=0.00025",
         "render.gif=false",
     ]);
     assert_eq!(rk4["came_to_rest"], serde_json::Value::Bool(true));
@@ -91,11 +91,12 @@ fn set_reaches_the_age_group_step_integrator_and_push() {
 
 #[test]
 fn set_reaches_a_single_field_of_every_block() {
-    // The contact, body and push blocks take one field without restating the others.
+    // The fall's contact and push blocks, and its single fields, take one field without
+    // restating the others.
     let r = run_fall(&[
-        "contact.stiffness_scale=1.2",
-        "body.mass_kg=70",
-        "push.start_s=0.12",
+        "fall.contact.stiffness_scale=1.2",
+        "fall.mass_kg=70",
+        "fall.push.start_s=0.12",
         "compare_with=null",
         "render.gif=false",
     ]);
@@ -104,7 +105,7 @@ fn set_reaches_a_single_field_of_every_block() {
     // The old per-kilogram contact field is named as unknown, with the fields there.
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes/fall.ron");
     let scene = Scene::load(&path).unwrap();
-    let e = apply_overrides(&scene, &["contact.stiffness_per_kg=1".to_string()])
+    let e = apply_overrides(&scene, &["fall.contact.stiffness_per_kg=1".to_string()])
         .unwrap_err()
         .to_string();
     assert!(e.contains("stiffness_scale"), "{e}");
@@ -116,11 +117,11 @@ fn impossible_runs_are_refused_up_front() {
     let scene = Scene::load(&path).unwrap();
     let out = std::env::temp_dir().join(format!("marionette-fall-refused-{}", std::process::id()));
     for (sets, expect) in [
-        (vec!["simulation.duration=1e9"], "duration_s"),
-        (vec!["simulation.dt=1e-9"], "duration_s"),
-        (vec!["push.start_s=5"], "push.start_s"),
+        (vec!["fall.duration_s=1e9"], "duration_s"),
+        (vec!["fall.dt_s=1e-9"], "duration_s"),
+        (vec!["fall.push.start_s=5"], "push.start_s"),
         (
-            vec!["controller.dt_s=0.0009", "simulation.dt=0.0005"],
+            vec!["controller.dt_s=0.0009", "fall.dt_s=0.0005"],
             "evolved at, dt_s = 0.0009 s",
         ),
     ] {
@@ -140,7 +141,8 @@ fn impossible_runs_are_refused_up_front() {
 #[test]
 fn the_report_follows_damage_weights_and_age_groups_under_set() {
     let r = run_fall(&[
-        r#"damage_weights={"head":3.0,"pelvis":0.5}"#,
+        "fall.damage_weights.head=3.0",
+        "fall.damage_weights.pelvis=0.5",
         "age_group=adult",
         "compare_with=elderly",
         "render.gif=false",
