@@ -3,7 +3,7 @@
 //! that releases the assistance makes it fall, one that does not leaves it standing; two
 //! characters in one World do not touch each other; Worlds give the same bits on 1 and 2 threads.
 
-mod common;
+use crate::common;
 
 use std::path::PathBuf;
 use std::sync::Arc;

@@ -4,8 +4,7 @@
 use glam::DVec3;
 use marionette::bvh::{self, Bvh, BvhError, Channel};
 
-mod common;
-use common::data_dir;
+use crate::common::data_dir;
 
 /// A small valid file; line numbers are referred to by the malformed-input tests.
 const BASE: &[&str] = &[

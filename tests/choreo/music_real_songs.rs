@@ -2,9 +2,8 @@
 //! FluidSynth, see `common/pop909.rs`), beside librosa in the same run, and the evaluation's own
 //! scores against `mir_eval`, the reference implementation of the MIREX beat metrics.
 
-mod common;
-#[path = "common/pop909.rs"]
-mod pop909;
+use crate::common;
+use crate::pop909;
 
 use std::io::Write;
 

@@ -2,7 +2,7 @@
 //! local Ray (actors each holding a `marionette eval --stdin` worker) and ends with the same
 //! bits as the in-process run.
 
-mod common;
+use crate::common;
 
 use std::path::PathBuf;
 use std::process::Command;

@@ -4,7 +4,7 @@
 //! only); the fill honours every pin and assembles into a dance that lasts exactly its bars
 //! with the pinned frames unchanged outside the seams.
 
-mod common;
+use crate::common;
 
 use marionette::choreo::dance::{DanceParams, assemble};
 use marionette::choreo::database::{BuildParams, Database, Manifest, OnRefusal};

@@ -10,7 +10,7 @@
 //! metre below its floor). Screenshots go to `target/results-page/`. Needs Chromium, Node and
 //! `tests/browser/node_modules`: ignored with that reason when absent (`cfg(tool_browser)`).
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 use std::process::Command;

@@ -9,8 +9,7 @@ use marionette::humanoid::Model;
 use marionette::mapping::{Mapping, Synonyms, effector_errors, retarget};
 use marionette::skeleton::Clip;
 
-mod common;
-use common::data_dir;
+use crate::common::data_dir;
 
 /// Every BVH file of the shared data.
 fn real_files() -> Option<Vec<std::path::PathBuf>> {
@@ -112,7 +111,7 @@ fn real_files_with_meaningless_joint_names_map_by_structure_within_the_same_boun
                 e.max_m * 1e3,
                 k.max_m * 1e3
             );
-            // The bounds of tests/mapping_real_data.rs.
+            // The bounds of tests/mapping/real_data.rs.
             let limit = match e.effector.as_str() {
                 "left_foot" | "right_foot" if name.contains("jumps") => 0.05,
                 "head" => 0.25,

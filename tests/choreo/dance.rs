@@ -3,7 +3,7 @@
 //! one clear error that leaves the output folder as it was; the salsa scene runs on the shared
 //! data when it is there.
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 

@@ -2,7 +2,7 @@
 //! loudness), decoding (WAV written here; the real OGG songs when the shared data is there),
 //! and its errors.
 
-mod common;
+use crate::common;
 
 use marionette::choreo::music::eval::f_measure;
 use marionette::choreo::music::synth::{SynthSong, synthesize};

@@ -19,7 +19,7 @@ use marionette::skeleton::{Clip, Joint, Skeleton, Transform};
 /// The motion every rig carries.
 fn motion() -> ModelClip {
     KeyframeClip::parse(
-        include_str!("../scenes/clips/knee_kick.ron"),
+        include_str!("../../scenes/clips/knee_kick.ron"),
         "knee_kick.ron",
     )
     .unwrap()

@@ -70,7 +70,9 @@ const CHILD: &str = "MARIONETTE_TEST_PRINT_STEPS";
 /// a child process of this test run portable, the same bits at every step.
 #[test]
 fn the_processor_specific_step_gives_the_portable_steps_bits() {
-    let name = "the_processor_specific_step_gives_the_portable_steps_bits";
+    // The test's full name in this binary: its module path without the crate.
+    let module = module_path!().split_once("::").map_or("", |(_, m)| m);
+    let name = format!("{module}::the_processor_specific_step_gives_the_portable_steps_bits");
     let here = fall_steps();
     if std::env::var_os(CHILD).is_some() {
         // A line of its own first: the test harness's "test NAME ... " is not ended by a
@@ -82,7 +84,7 @@ fn the_processor_specific_step_gives_the_portable_steps_bits() {
         return;
     }
     let out = Command::new(std::env::current_exe().unwrap())
-        .args([name, "--exact", "--nocapture", "--test-threads=1"])
+        .args([name.as_str(), "--exact", "--nocapture", "--test-threads=1"])
         .env(CHILD, "1")
         .env("MARIONETTE_PORTABLE", "1")
         .output()

@@ -8,8 +8,7 @@ use marionette::mapping::{Mapping, effector_errors, retarget};
 use marionette::render::Figure;
 use marionette::skeleton::Clip;
 
-mod common;
-use common::data_dir;
+use crate::common::data_dir;
 
 const FILES: [&str; 6] = [
     "cmu/cmu_01_01_forward_jumps.bvh",

@@ -12,13 +12,13 @@
 //! `tests/browser`: ignored with that reason when absent (`cfg(tool_browser)`, `build.rs`), a
 //! failure under CI.
 
-mod common;
-mod editor_fixture;
+use crate::common;
+use crate::fixture;
 
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command};
 
-use editor_fixture::{assert_bvh_lasts_the_bars, get, scene_on, start_editor};
+use crate::fixture::{assert_bvh_lasts_the_bars, get, scene_on, start_editor};
 use marionette::choreo::augment::augment;
 use marionette::choreo::database::{BuildParams, Database, Manifest, OnRefusal};
 use marionette::choreo::generated::generated_database;
@@ -273,7 +273,7 @@ fn playback_survives_every_action_seeks_loops_and_pauses_with_live_previews() {
         &chromium,
         &mut child,
     );
-    let whole = editor_fixture::request(addr, "GET", "/api/audio.wav", None)
+    let whole = fixture::request(addr, "GET", "/api/audio.wav", None)
         .body
         .len();
     let bvh = std::fs::read_to_string(seen["bvh"].as_str().unwrap()).unwrap();
@@ -302,7 +302,7 @@ fn a_200_bar_timeline_reads_at_scale_2_and_sounds_within_200_ms() {
     let Some(chromium) = common::browser() else {
         return;
     };
-    let path = editor_fixture::scene("long", 6, 10, 200);
+    let path = fixture::scene("long", 6, 10, 200);
     let (mut child, url, _, _) = start_editor(&path);
     let shots = shots();
     let seen = node(

@@ -8,9 +8,8 @@
 //! likes withheld, at the paper's τ_0 = 1 (printed) and at the stated τ_0 = 0.5 (asserted); on
 //! generated clips the likes change the second re-search's candidates.
 
-mod common;
-#[path = "common/dance_clips.rs"]
-mod dance_clips;
+use crate::common;
+use crate::dance_clips;
 
 use std::sync::Arc;
 

@@ -3,7 +3,7 @@
 //! known tempo, the shared dance clips (segments and tempo per clip), and one clear error per
 //! bad input.
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 

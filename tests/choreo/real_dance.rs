@@ -5,7 +5,7 @@
 //! paper's fill by more than 1.2×, every clip of the folder used or named as skipped, and beat
 //! alignment at least its sources'. The seam jerk is printed beside the paper's fill's.
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 

@@ -3,14 +3,12 @@
 //! embedded files only, body limit, one-line 400s — and that it keeps answering correctly, with
 //! the saved edit intact, after thousands of bad and concurrent requests.
 
-mod editor_fixture;
-
 use std::collections::BTreeSet;
 use std::io::{Read, Write};
 use std::net::{SocketAddr, TcpStream};
 use std::time::Duration;
 
-use editor_fixture::{assert_bvh_lasts_the_bars, get, post, raw, request, scene, start_editor};
+use crate::fixture::{assert_bvh_lasts_the_bars, get, post, raw, request, scene, start_editor};
 use marionette::editor::server::{Editor, MAX_BODY};
 use marionette::editor::session::Session;
 

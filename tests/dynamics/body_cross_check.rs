@@ -7,7 +7,7 @@
 //! when it is missing the tests are ignored with that reason (`cfg(tool_python)`, `build.rs`),
 //! and when it lacks a module they print a SKIPPED line; under CI both fail instead.
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 use std::process::Command;

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use marionette::scene::{Scene, apply_overrides, run};
 
-mod common;
+use crate::common;
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))

@@ -1,7 +1,7 @@
 //! The `marionette` command as a user runs it: outputs on good input, a non-zero exit and one
 //! clear line on bad input.
 
-mod common;
+use crate::common;
 
 use std::path::PathBuf;
 use std::process::Command;
