@@ -3,7 +3,8 @@
 
 Usage: mujoco_check.py BODY.xml FALL.json TOL_M
 
-FALL.json (written by tests/body_cross_check.rs) holds the engine's settled standing state, the
+FALL.json (written by tests/dynamics/body_cross_check.rs) holds the engine's settled standing
+state, the
 controller (stance PD held to its strength limits, the joint model), the push, the step, and the
 engine's head-height record up to the first touchdown of a link other than the feet. MuJoCo
 steps the same body with the same joint torques and push (applied as generalised forces, with

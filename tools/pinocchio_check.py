@@ -3,7 +3,8 @@
 
 Usage: pinocchio_check.py BODY.urdf STATES.json
 
-STATES.json (written by tests/body_cross_check.rs) holds random states of the engine's body with
+STATES.json (written by tests/dynamics/body_cross_check.rs) holds random states of the engine's
+body with
 the engine's inverse dynamics (RNEA) and forward dynamics (ABA) at each. The URDF is loaded with a
 free-flyer root and the engine's gravity (0, -g, 0). Velocity coordinates are matched by DOF
 name; the free root's engine order [angular; linear] is Pinocchio's [linear; angular]. The neck

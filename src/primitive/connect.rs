@@ -36,7 +36,7 @@ pub struct Junction {
 /// kick's landing, played from the kick's pose at Leap, then leaves it at a pace the physical
 /// character's clavicles and waist can follow (with 0.1 s the DMPs' accelerations still differed
 /// by 332 rad/s² at the CMU knee kick's junction, and it tracked at 2.15° under adult strength;
-/// `tests/active_character.rs`).
+/// `tests/fall/active_character.rs`).
 pub const HANDOVER_WINDOW_S: f64 = 0.25;
 
 /// The hand-over window at a junction into a primitive of `next_duration_s` seconds:

@@ -23,7 +23,7 @@ pub use dance::{
     scene_pins, song_timed_bvh, validate_dance,
 };
 pub use evolve::{EvaluatorChoice, EvolveFallScene, ResumeMismatch, SettingMismatch, run_evolve};
-pub use fall::{Body, Controller, FallScene, Simulation, fall_report, run_fall};
+pub use fall::{Controller, FallScene, SceneFall, fall_report, run_fall};
 pub use page::{PAGE_FILE, RunPage, write_run_index};
 pub use primitives::{
     HighJumpScene, JumpingKneeKickScene, PrimitiveRender, knee_kick_config, run_high_jump,
@@ -238,14 +238,14 @@ pub enum SceneError {
     NoRecorder,
     /// A fall's step given beside a controller evolved at another one.
     #[error(
-        "simulation.dt = {dt} s, but {from} gives the step the controller was evolved at, \
-         dt_s = {evolved} s (its damage holds at that step): leave simulation.dt out to replay \
+        "fall.dt_s = {dt} s, but {from} gives the step the controller was evolved at, \
+         dt_s = {evolved} s (its damage holds at that step): leave fall.dt_s out to replay \
          it, or set controller.dt_s to run it at another step (e.g. --set controller.dt_s={} \
          for half the step)",
         .evolved / 2.0
     )]
     StepMismatch {
-        /// `simulation.dt` (s).
+        /// `fall.dt_s` (s).
         dt: f64,
         /// The controller's step (s).
         evolved: f64,
@@ -973,9 +973,9 @@ mod tests {
             }
             .to_string(),
             format!(
-                "simulation.dt = {dt} s, but {from} gives the step the controller was \
+                "fall.dt_s = {dt} s, but {from} gives the step the controller was \
                  evolved at, dt_s = {evolved} s (its damage holds at that step): leave \
-                 simulation.dt out to replay it, or set controller.dt_s to run it at \
+                 fall.dt_s out to replay it, or set controller.dt_s to run it at \
                  another step (e.g. --set controller.dt_s={} for half the step)",
                 evolved / 2.0
             )

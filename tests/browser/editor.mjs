@@ -1,4 +1,4 @@
-// Drives the dance editor's page in headless Chromium (tests/editor_browser.rs runs it):
+// Drives the dance editor's page in headless Chromium (tests/editor/browser.rs runs it):
 // node editor.mjs URL SCREENSHOT_DIR
 // Prints one JSON line of what the page showed; exits non-zero on any failed check.
 import { launch } from './launch.mjs';

@@ -1,4 +1,4 @@
-// Latency of the dance editor as its page sees it (tests/editor_browser.rs runs it):
+// Latency of the dance editor as its page sees it (tests/editor/browser.rs runs it):
 // node latency.mjs URL
 // In headless Chromium, with performance.now() in the page: the first load (navigation start
 // to a usable page), Search rounds (the POST answered and its JSON read; and the Search

@@ -1,4 +1,4 @@
-// Playback and the timeline of the dance editor in headless Chromium (tests/editor_browser.rs
+// Playback and the timeline of the dance editor in headless Chromium (tests/editor/browser.rs
 // runs it): node playback.mjs URL SCREENSHOT_DIR MODE
 //
 // MODE "actions" (a short dance): Play from the selected bar; Set, Undo, Redo, Unpin and

@@ -1,5 +1,5 @@
 // Drives a results page (index.html of a scene, or `marionette view`'s page) in headless
-// Chromium from its file:// URL (tests/results_page.rs runs it):
+// Chromium from its file:// URL (tests/cli/results_page.rs runs it):
 // node results.mjs URL SCREENSHOT.png [AT]
 // Prints one JSON line of what the page showed; the Rust test asserts on it. Exits non-zero
 // only when the page cannot be driven at all.

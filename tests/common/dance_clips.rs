@@ -3,7 +3,7 @@
 //! move to the next and back over three bars at its own tempo, written as BVH and built into a
 //! database through a manifest (as a user's clips would be).
 //!
-//! Shared by `tests/choreo_search.rs` and `benches/choreo_search.rs` (through `#[path]`).
+//! Shared by `tests/choreo/search.rs` and `benches/choreo_search.rs` (through `#[path]`).
 
 #![allow(dead_code)] // each user takes some of these
 

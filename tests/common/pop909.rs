@@ -1,4 +1,4 @@
-//! The POP909 evaluation of the music analysis, shared by `tests/music_real_songs.rs` and
+//! The POP909 evaluation of the music analysis, shared by `tests/choreo/music_real_songs.rs` and
 //! `benches/music_real_songs.rs`: the 40 shared songs (`$MARIONETTE_DATA/pop909/NNN.mid` with
 //! `NNN.beats.txt`) rendered to audio with FluidSynth and the Fluid R3 GM soundfont (cached in
 //! `target/pop909-audio/`), scored against their annotated beats and downbeats, beside librosa's
