@@ -270,7 +270,13 @@ fn describe(moves: &[f64]) -> String {
 #[test]
 fn on_random_genomes_the_2_ms_damage_moves_less_than_the_explicit_steps_when_halved() {
     let mut all: Vec<(AgeGroup, Vec<f64>, Vec<f64>)> = Vec::new();
-    for (group, seed) in [(AgeGroup::Elderly, 1), (AgeGroup::Adult, 2)] {
+    // Seeds 1 and 2 are the genomes the step was examined on, 101 and 102 a check.
+    for (group, seed) in [
+        (AgeGroup::Elderly, 1),
+        (AgeGroup::Adult, 2),
+        (AgeGroup::Elderly, 101),
+        (AgeGroup::Adult, 102),
+    ] {
         let explicit = FallProblem::paper(group);
         let mut problem = FallProblem::paper(group);
         problem.fall.integrator = LINEARISED;
@@ -292,7 +298,8 @@ fn on_random_genomes_the_2_ms_damage_moves_less_than_the_explicit_steps_when_hal
         }
         stepped.sort_by(|a, b| a.abs().total_cmp(&b.abs()));
         println!(
-            "{group:?}, 32 random genomes, damage at h against h/2: linearised at 2 ms: {}; \
+            "{group:?}, seed {seed}, 32 random genomes, damage at h against h/2: linearised at \
+             2 ms: {}; \
              explicit at the GA's {} ms: {}; explicit at 2 ms past the check: {blew_up} blew \
              up, the others {}",
             describe(&moves),
@@ -306,10 +313,10 @@ fn on_random_genomes_the_2_ms_damage_moves_less_than_the_explicit_steps_when_hal
         );
         all.push((group, moves, stepped));
     }
-    // Measured (see the printed figures): the linearised step at 2 ms does not hold every
-    // random genome within 10 % (the issue's aim; 7 of the 32 adult genomes move more),
-    // but it holds the typical one within 5 % and never does worse than the explicit step at
-    // the same 2 ms past its check.
+    // Measured (see the printed figures; docs/falls.md): the linearised step at 2 ms does not
+    // hold every random adult genome within 10 % (the issue's aim), but it holds the typical
+    // one within 5 % and never does worse than the explicit step at the same 2 ms past its
+    // check.
     for (group, moves, stepped) in all {
         let beyond = |m: &[f64]| m.iter().filter(|x| x.abs() >= 0.1).count();
         let median = moves[moves.len() / 2].abs();
