@@ -535,28 +535,6 @@ fn floor_patch(p: &mut Pixmap, cam: &Camera, centre: DVec2) {
     }
 }
 
-/// The root when it is a ground proxy, not a part of the body (as Bandai's `joint_Root` on the
-/// floor under `Hips`): a root with one child, lower than a tenth of the figure's height above
-/// its lowest point and farther from that child than a quarter of the height. Its bone would
-/// be drawn as a third leg, so it is not drawn.
-pub(crate) fn ground_proxy(fig: &super::figure::Figure, pts: &[DVec3]) -> Option<usize> {
-    let root = fig.root();
-    let mut children = fig
-        .parents
-        .iter()
-        .enumerate()
-        .filter(|(_, par)| **par == Some(root));
-    let (child, _) = children.next()?;
-    if children.next().is_some() {
-        return None;
-    }
-    let lo = pts.iter().map(|q| q.y).fold(f64::INFINITY, f64::min);
-    let hi = pts.iter().map(|q| q.y).fold(f64::NEG_INFINITY, f64::max);
-    let h = hi - lo;
-    (h > 0.0 && pts[root].y - lo < 0.1 * h && (pts[child] - pts[root]).length() > 0.25 * h)
-        .then_some(root)
-}
-
 /// The floor's grid spacing over `span` metres: 0.5 m, doubled until at most 100 lines cross
 /// it (so a panel framed on a far-flung point draws a hundred lines, not billions).
 fn grid_step(span: f64) -> f64 {
@@ -971,35 +949,6 @@ mod tests {
             })
             .sum();
         assert!((area - 8.0).abs() < 1e-6, "{area}");
-    }
-
-    #[test]
-    fn a_root_on_the_floor_under_the_hips_is_a_ground_proxy_and_a_pelvis_root_is_not() {
-        // root (on the floor) → hips 0.9 m up → two legs down to the floor, a spine up.
-        let names = [
-            "root", "hips", "l_knee", "l_foot", "r_knee", "r_foot", "head",
-        ];
-        let fig = super::super::figure::Figure {
-            names: names.iter().map(|s| s.to_string()).collect(),
-            parents: vec![None, Some(0), Some(1), Some(2), Some(1), Some(4), Some(1)],
-        };
-        let y = |x: f64, y: f64| DVec3::new(x, y, 0.0);
-        let pts = [
-            y(0.0, 0.0),
-            y(0.0, 0.9),
-            y(0.1, 0.45),
-            y(0.1, 0.0),
-            y(-0.1, 0.45),
-            y(-0.1, 0.0),
-            y(0.0, 1.7),
-        ];
-        assert_eq!(ground_proxy(&fig, &pts), Some(0));
-        // The same body without the floor root: the hips are the root, with three children.
-        let body = super::super::figure::Figure {
-            names: fig.names[1..].to_vec(),
-            parents: vec![None, Some(0), Some(1), Some(0), Some(3), Some(0)],
-        };
-        assert_eq!(ground_proxy(&body, &pts[1..]), None);
     }
 
     #[test]

@@ -112,7 +112,7 @@ pub(crate) fn flight_apexes(track: &Track) -> Option<Vec<(f64, f64)>> {
     let proxy = track
         .frames
         .first()
-        .and_then(|f| super::canvas::ground_proxy(fig, f));
+        .and_then(|f| super::figure::ground_proxy(fig, f));
     let pick = |want: &dyn Fn(usize) -> bool| -> Vec<Vec<DVec3>> {
         let idx: Vec<usize> = (0..n).filter(|&i| want(i)).collect();
         track

@@ -22,7 +22,7 @@
 //!   - the rest of a limb: 0.17 ℓ, kept within 0.012 H – 0.045 H (a thigh of 0.245 H gets
 //!     0.042 H, a forearm of 0.146 H 0.025 H, fingers and toes 0.012 H).
 //!
-//!   A root that only stands in for the ground (see [`super::canvas::ground_proxy`]) gets none.
+//!   A root that only stands in for the ground (see [`super::figure::ground_proxy`]) gets none.
 //!
 //! Every volume carries the side of its point ([`super::Figure::sides`]) for its colour (but the
 //! head's).
@@ -210,7 +210,7 @@ impl Body {
             .fold(0.0, f64::max);
         let sides = fig.sides();
         let first = track.frames.first();
-        let proxy = first.and_then(|f| super::canvas::ground_proxy(fig, f));
+        let proxy = first.and_then(|f| super::figure::ground_proxy(fig, f));
         let len = |i: usize, p: usize| first.map_or(0.0, |f| (f[i] - f[p]).length());
         let named = |i: usize, w: &str| fig.names[i].to_lowercase().contains(w);
         // A limb's bone is its girdle when every bone above it in the limb is negligible.

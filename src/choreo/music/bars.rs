@@ -26,7 +26,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::OnsetEnvelope;
-use super::beats::fitted_period;
+use super::beats::{at, fitted_period};
 
 /// One bar: its span and its intensity (the RMS of the song's samples in it).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -39,14 +39,6 @@ pub struct Bar {
     pub rms: f64,
     /// The RMS in dB: 20 log₁₀ rms (0 dB = an RMS of 1, a full-scale square wave).
     pub rms_db: f64,
-}
-
-/// Strength of `x` at beat frame `f`: its maximum within ±2 frames.
-pub(super) fn at(x: &[f64], f: f64) -> f64 {
-    let c = f.round() as usize;
-    let lo = c.saturating_sub(2);
-    let hi = (c + 3).min(x.len());
-    x[lo.min(hi)..hi].iter().fold(0.0, |m, &v| m.max(v))
 }
 
 /// The standardised downbeat evidence z_i of each beat (module docs) from the onsets at each

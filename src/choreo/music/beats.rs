@@ -215,7 +215,7 @@ fn local_score(values: &[f64], period: f64) -> Vec<f64> {
 /// and the midpoints do not, near 1 or above when the midpoints are beats too. 0 for fewer than
 /// two beats.
 pub fn midpoint_ratio(env: &OnsetEnvelope, frames: &[f64]) -> f64 {
-    let at = |f: f64| super::bars::at(&env.values, f) + super::bars::at(&env.low, f);
+    let at = |f: f64| at(&env.values, f) + at(&env.low, f);
     if frames.len() < 2 {
         return 0.0;
     }
@@ -244,6 +244,14 @@ pub fn fitted_period(beats_s: &[f64]) -> f64 {
         sxx += di * di;
     }
     sxy / sxx
+}
+
+/// Strength of `x` at beat frame `f`: its maximum within ±2 frames.
+pub(super) fn at(x: &[f64], f: f64) -> f64 {
+    let c = f.round() as usize;
+    let lo = c.saturating_sub(2);
+    let hi = (c + 3).min(x.len());
+    x[lo.min(hi)..hi].iter().fold(0.0, |m, &v| m.max(v))
 }
 
 #[cfg(test)]
