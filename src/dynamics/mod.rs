@@ -44,6 +44,8 @@ pub use integrator::{Dynamics, Integrator, IntegratorWorkspace};
 pub use joint::JointType;
 pub use kinematics::kinematics;
 pub use model::{Body, Model, ModelError};
-pub use pipeline::{Forces, State, StepError, StepMonitor, StepSettings, StepWorkspace};
+pub use pipeline::{
+    Forces, State, StepError, StepMonitor, StepRefinement, StepSettings, StepWorkspace,
+};
 pub use rnea::rnea;
 pub use spatial::{ArticulatedInertia, ForceVec, Inertia, MotionVec, SpatialTransform};

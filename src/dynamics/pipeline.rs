@@ -295,6 +295,71 @@ unsafe fn step_avx2(
     step_stages(model, settings, forces, state, ws, monitor)
 }
 
+/// Finer steps over a stretch of time: every step whose start time (s) lies in
+/// `[from_s, until_s)` is taken as `substeps` sub-steps of `dt / substeps` seconds
+/// ([`step_refined`]), counted as one step of `dt`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StepRefinement {
+    /// Start of the stretch (s).
+    pub from_s: f64,
+    /// End of the stretch (s, excluded).
+    pub until_s: f64,
+    /// Sub-steps per step inside it (1 = none).
+    pub substeps: u32,
+}
+
+impl StepRefinement {
+    /// The sub-steps of a step that starts at `t` (s): [`Self::substeps`] inside the stretch
+    /// (at least 1), 1 outside.
+    pub fn substeps_at(&self, t: f64) -> u32 {
+        if t >= self.from_s && t < self.until_s {
+            self.substeps.max(1)
+        } else {
+            1
+        }
+    }
+}
+
+/// One step of `settings.dt` seconds taken as `substeps` sub-steps of `dt / substeps` by
+/// [`step`], each seeing the forces at its own start time and accounted for in `monitor`
+/// (peaks, impulses, saturation times of every sub-step); the state then counts one step
+/// (time `steps · dt`). With `substeps` ≤ 1 it is [`step`], to the bit. An error carries the
+/// end time (s) of the sub-step that failed.
+pub fn step_refined(
+    model: &Model,
+    settings: StepSettings,
+    substeps: u32,
+    forces: &Forces,
+    state: &mut State,
+    ws: &mut StepWorkspace,
+    monitor: &mut StepMonitor,
+) -> Result<(), StepError> {
+    if substeps <= 1 {
+        return step(model, settings, forces, state, ws, monitor);
+    }
+    let (steps, t0) = (state.steps, state.time_s);
+    let h = settings.dt / f64::from(substeps);
+    let sub = StepSettings { dt: h, ..settings };
+    for j in 0..substeps {
+        // Each sub-step starts from the step's count at its own time; the kinematics the
+        // previous sub-step left are those of this start.
+        state.steps = steps;
+        state.time_s = t0 + f64::from(j) * h;
+        if j > 0 {
+            ws.eval.kinematics_at_step = Some(steps);
+        }
+        step(model, sub, forces, state, ws, monitor).map_err(|mut e| {
+            let (StepError::NonFinite { time_s, .. } | StepError::Exploding { time_s, .. }) =
+                &mut e;
+            *time_s = t0 + f64::from(j + 1) * h;
+            e
+        })?;
+    }
+    // The last sub-step counted `steps + 1` (its kinematics tagged so); its time is the step's.
+    state.time_s = state.steps as f64 * settings.dt;
+    Ok(())
+}
+
 /// The five stages of [`step`].
 #[inline(always)]
 fn step_stages(

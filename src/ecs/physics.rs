@@ -26,7 +26,8 @@ use crate::dynamics::forces::pd::PdTargets;
 use crate::dynamics::integrator::Integrator;
 use crate::dynamics::model::Model;
 use crate::dynamics::pipeline::{
-    self, Forces, LaneBody, State, StepError, StepMonitor, StepSettings, StepWorkspace,
+    self, Forces, LaneBody, State, StepError, StepMonitor, StepRefinement, StepSettings,
+    StepWorkspace,
 };
 use crate::humanoid::body::HumanBody;
 
@@ -53,6 +54,9 @@ pub struct PhysicsBody {
     pub body: Arc<HumanBody>,
     /// Integration scheme.
     pub integrator: Integrator,
+    /// Finer steps over a stretch of time (`None`: every step whole); a body with one steps
+    /// alone ([`pipeline::step_refined`]), not in vector lanes.
+    pub refinement: Option<StepRefinement>,
 }
 
 /// The body's state `(q, v)`, friction anchors, time (s) and steps.
@@ -177,7 +181,11 @@ impl PhysicsBundle {
         let workspace = StepWorkspace::new(m);
         let monitor = StepMonitor::new(m.nbodies(), body.dof_v.len());
         Self {
-            body: PhysicsBody { body, integrator },
+            body: PhysicsBody {
+                body,
+                integrator,
+                refinement: None,
+            },
             state: BodyState(state),
             workspace: PhysicsWorkspace(workspace),
             monitor: PhysicsMonitor(monitor),
@@ -230,7 +238,9 @@ pub fn step_bodies(
         if !one.8.running() {
             continue;
         }
-        if matches!(one.0.integrator, Integrator::SemiImplicitEuler { .. }) {
+        if one.0.refinement.is_none()
+            && matches!(one.0.integrator, Integrator::SemiImplicitEuler { .. })
+        {
             together.push(one);
             continue;
         }
@@ -280,7 +290,8 @@ type StepItem<'w> = (
     Mut<'w, PhysicsStatus>,
 );
 
-/// Steps one body alone by `substeps` steps of `dt`; an error stops it.
+/// Steps one body alone by `substeps` steps of `dt` (each refined where its
+/// [`PhysicsBody::refinement`] says); an error stops it.
 fn step_alone(item: StepItem, dt: f64, substeps: u32) {
     let (body, mut state, pd, limits, contact, external, mut ws, mut monitor, mut status) = item;
     let external = external.map_or(&[][..], |e| e.all());
@@ -296,9 +307,11 @@ fn step_alone(item: StepItem, dt: f64, substeps: u32) {
         dt,
     };
     for _ in 0..substeps {
-        if let Err(e) = pipeline::step(
+        let refined = body.refinement.map_or(1, |r| r.substeps_at(state.0.time_s));
+        if let Err(e) = pipeline::step_refined(
             &body.body.model,
             settings,
+            refined,
             &forces,
             &mut state.0,
             &mut ws.0,

@@ -62,6 +62,15 @@ pub struct FallConfig {
     pub dt_s: f64,
     /// Integration scheme.
     pub integrator: Integrator,
+    /// Sub-steps per step over the first `reaction_window_s` of the reaction (from
+    /// `control_start_s`, where the key-pose PD takes over): each step of `dt_s` starting in
+    /// that stretch is taken as this many sub-steps of `dt_s / reaction_substeps`, the floor's
+    /// peaks seeing every one. 1 (the default) = none.
+    #[serde(skip_serializing_if = "is_one")]
+    pub reaction_substeps: u32,
+    /// Length of that stretch (s); 0 (the default) = none.
+    #[serde(skip_serializing_if = "is_zero")]
+    pub reaction_window_s: f64,
     /// Simulated time (s), counted from the end of the settling phase.
     pub duration_s: f64,
     /// Longest settling phase before the run (s): the standing body is relaxed to rest first.
@@ -80,6 +89,14 @@ pub struct FallConfig {
     /// End the run as soon as the body has rested for `rest_hold_s` (saves most of the time
     /// of a GA evaluation; peaks and damage are unchanged, impulses stop accumulating).
     pub stop_at_rest: bool,
+}
+
+fn is_one(n: &u32) -> bool {
+    *n == 1
+}
+
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
 }
 
 /// The natural frequency (Hz) every joint's range limit is tuned to in [`FallConfig::paper`],
@@ -173,6 +190,8 @@ impl FallConfig {
             integrator: Integrator::SemiImplicitEuler {
                 implicit_damping: true,
             },
+            reaction_substeps: 1,
+            reaction_window_s: 0.0,
             duration_s: 3.0,
             settle_max_s: 3.0,
             contact: ContactParams::default(),

@@ -34,7 +34,7 @@ use crate::dynamics::forces::contact::ContactModel;
 use crate::dynamics::forces::limits::{JointRanges, limit_gains};
 use crate::dynamics::forces::pd::PdTargets;
 use crate::dynamics::kinematics::kinematics;
-use crate::dynamics::pipeline::{self, Forces, StepSettings};
+use crate::dynamics::pipeline::{self, Forces, StepRefinement, StepSettings};
 use crate::dynamics::stability::{
     DofStiffness, StiffestMode, StiffnessBasis, inverse_joint_inertia, scheme_name,
 };
@@ -94,6 +94,7 @@ fn validate(cfg: &FallConfig) -> Result<Resolved, SimError> {
     )?;
     validate_reaction(cfg, n)?;
     positive("settle_max_s", cfg.settle_max_s)?;
+    check_refinement(cfg)?;
     check_run_size(cfg)?;
     check_contact_and_limits(cfg)?;
     let push_link = resolve_push(cfg, &body)?;
@@ -113,10 +114,36 @@ fn validate(cfg: &FallConfig) -> Result<Resolved, SimError> {
     })
 }
 
+/// The reaction's sub-steps (at least 1) and their window (finite, ≥ 0 s).
+fn check_refinement(cfg: &FallConfig) -> Result<(), SimError> {
+    if cfg.reaction_substeps < 1 {
+        return Err(cfg_err("reaction_substeps", "must be at least 1"));
+    }
+    let w = cfg.reaction_window_s;
+    if !(w.is_finite() && w >= 0.0) {
+        return Err(cfg_err(
+            "reaction_window_s",
+            format!("must be ≥ 0 s, found {w}"),
+        ));
+    }
+    Ok(())
+}
+
+/// The reaction's finer steps of `cfg` (see [`FallConfig::reaction_substeps`]), if any.
+fn reaction_refinement(cfg: &FallConfig) -> Option<StepRefinement> {
+    (cfg.reaction_substeps > 1 && cfg.reaction_window_s > 0.0).then_some(StepRefinement {
+        from_s: cfg.control_start_s,
+        until_s: cfg.control_start_s + cfg.reaction_window_s,
+        substeps: cfg.reaction_substeps,
+    })
+}
+
 /// The run's size (steps and recorded frames, checked before anything is allocated or run)
 /// and the push's start inside it.
 fn check_run_size(cfg: &FallConfig) -> Result<(), SimError> {
-    let steps = cfg.duration_s / cfg.dt_s;
+    let refined = cfg.reaction_window_s.min(cfg.duration_s) / cfg.dt_s;
+    let steps =
+        cfg.duration_s / cfg.dt_s + refined * (f64::from(cfg.reaction_substeps) - 1.0).max(0.0);
     if steps > MAX_STEPS as f64 {
         return Err(cfg_err(
             "duration_s",
@@ -494,6 +521,8 @@ fn settle_key(cfg: &FallConfig) -> FallConfig {
         rest_kinetic_energy_j: base.rest_kinetic_energy_j,
         rest_hold_s: base.rest_hold_s,
         stop_at_rest: base.stop_at_rest,
+        reaction_substeps: base.reaction_substeps,
+        reaction_window_s: base.reaction_window_s,
         ..reaction_key(cfg)
     }
 }
@@ -572,8 +601,10 @@ fn assemble(cfg: &FallConfig) -> Result<FallCharacter, SimError> {
         None => Vec::new(),
     };
     let nv = body.model.nv;
+    let mut physics = PhysicsBundle::new(body, cfg.integrator, q);
+    physics.body.refinement = reaction_refinement(cfg);
     Ok(FallCharacter {
-        physics: PhysicsBundle::new(body, cfg.integrator, q),
+        physics,
         pd: PdController(stance.clone()),
         limits: JointLimits(JointRanges {
             ranges,
@@ -759,6 +790,7 @@ pub fn simulate_fall(config: &FallConfig) -> Result<FallResult, SimError> {
         integrator: physics.body.integrator,
         dt: config.dt_s,
     };
+    let refinement = physics.body.refinement;
     recorder.record(body, state, ws.kinematics_of(&body.model, state), monitor);
     while !recorder.finished(state) {
         controller.apply(state.time_s, &mut pd.0);
@@ -769,7 +801,8 @@ pub fn simulate_fall(config: &FallConfig) -> Result<FallResult, SimError> {
             contact: Some(&contact.0),
             external: external.all(),
         };
-        pipeline::step(&body.model, settings, &forces, state, ws, monitor)?;
+        let substeps = refinement.map_or(1, |r| r.substeps_at(state.time_s));
+        pipeline::step_refined(&body.model, settings, substeps, &forces, state, ws, monitor)?;
         recorder.record(body, state, ws.kinematics_of(&body.model, state), monitor);
     }
     Ok(recorder.result(body, state, monitor))
