@@ -21,6 +21,7 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use super::eros::eros_weights;
+pub use super::error::Skipped;
 pub use super::segments::BuildParams;
 use super::segments::{
     Beat, Segment, SegmentError, TempoSource, check_tempo, cut_segments, kinematic_beat,
@@ -320,15 +321,6 @@ pub struct Source {
     pub beat: Beat,
     /// Segments cut from it.
     pub segments: usize,
-}
-
-/// A clip the database was not built from, and why.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct Skipped {
-    /// The clip file as given.
-    pub file: String,
-    /// Why it was refused (the error, naming the file).
-    pub reason: String,
 }
 
 /// What [`Database::build`] does with a clip it cannot use (unreadable, not mappable onto

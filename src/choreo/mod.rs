@@ -32,6 +32,7 @@ pub mod dance;
 pub mod database;
 pub mod edit;
 pub mod eros;
+mod error;
 pub mod features;
 pub mod feet;
 pub mod fill;
