@@ -229,6 +229,10 @@ pub fn plant_feet(clip: &mut ModelClip, p: &PlantParams) -> Planting {
             before: &before,
             side,
             rest: &rest[side],
+            sole: before
+                .iter()
+                .map(|b| sole_height(&b[side], &rest[side]))
+                .collect(),
             frame_time: clip.frame_time,
         };
         let on: Vec<bool> = (0..n)
@@ -263,19 +267,7 @@ impl Feet {
     /// The foot points of both feet at frame `f` of `clip`, world space.
     fn positions(&self, clip: &ModelClip, f: usize, g: &mut Vec<Transform>) -> [Vec<DVec3>; 2] {
         let (t, q) = (clip.root_translation[f], clip.root_rotation[f]);
-        self.positions_at(&clip.model, t, q, clip.frame_angles(f), g)
-    }
-
-    /// The foot points of both feet with the root at `t`, `q` and the DOF `angles` of one frame.
-    fn positions_at(
-        &self,
-        model: &crate::humanoid::Model,
-        t: DVec3,
-        q: glam::DQuat,
-        angles: &[f64],
-        g: &mut Vec<Transform>,
-    ) -> [Vec<DVec3>; 2] {
-        chain_globals(model, &self.chain, t, q, angles, g);
+        chain_globals(&clip.model, &self.chain, t, q, clip.frame_angles(f), g);
         self.points_in(g)
     }
 
@@ -323,6 +315,8 @@ struct FootTrack<'a> {
     side: usize,
     /// Rest sole height of each of this foot's points.
     rest: &'a [f64],
+    /// The foot's sole height at each frame ([`sole_height`]).
+    sole: Vec<f64>,
     /// Seconds per frame.
     frame_time: f64,
 }
@@ -331,11 +325,6 @@ impl FootTrack<'_> {
     /// Point `i` of the foot at frame `f`.
     fn at(&self, f: usize, i: usize) -> DVec3 {
         self.before[f][self.side][i]
-    }
-
-    /// The foot's points at frame `f`.
-    fn points(&self, f: usize) -> &[DVec3] {
-        &self.before[f][self.side]
     }
 
     /// The contact point of span `[a, b)`: the point lowest relative to its rest height on
@@ -387,8 +376,9 @@ fn hold_spans(
         // small motion and touches down. A held span is not also lowered: with the pull to
         // its anchor, that would straighten the knee at once.
         let down = if p.ground && !(p.lock && slides) {
-            -(a..b)
-                .map(|f| sole_height(foot.points(f), foot.rest))
+            -foot.sole[a..b]
+                .iter()
+                .copied()
                 .fold(f64::INFINITY, f64::min)
         } else {
             0.0
@@ -514,9 +504,7 @@ fn smooth_and_floor(
     let n = corr.len();
     let mut corr = corr.to_vec();
     // The least vertical correction that keeps the sole out of the floor: −s(f).
-    let floor: Vec<f64> = (0..n)
-        .map(|f| -sole_height(foot.points(f), foot.rest))
-        .collect();
+    let floor: Vec<f64> = foot.sole.iter().map(|s| -s).collect();
     for f in 0..n {
         let c = corr[f].unwrap_or_default();
         if floor[f] > c.y {
@@ -572,15 +560,18 @@ fn reach_targets(
                 }
                 out.0 += 1;
                 let leg = legs[side].expect("checked above");
-                // Where the foot's points should go: each moved by c.
-                let want: Vec<DVec3> = before[f][side].iter().map(|x| *x + c).collect();
-                let want_sole = sole_height(&want, &rest[side]);
+                // The foot's place to reach, its points each moved by c: its key point's
+                // horizontal place and its sole height.
+                let moved = before[f][side].iter().map(|x| *x + c);
+                let want_sole = moved
+                    .zip(&rest[side])
+                    .map(|(x, r)| x.y - r)
+                    .fold(f64::INFINITY, f64::min);
+                let key = before[f][side][k] + c;
+                let wanted = DVec3::new(key.x, want_sole, key.z);
                 chain_globals(skeleton, &model.chain, t, q, angles, g);
                 let mut ankle_target = g[leg.ankle].translation + c;
                 let mut residual = 0.0;
-                // The foot's place to reach: its key point's horizontal place and its sole
-                // height.
-                let wanted = DVec3::new(want[k].x, want_sole, want[k].z);
                 for _ in 0..IK_ROUNDS {
                     // `g` holds the chain for `angles`, before and after the reach.
                     reach_along(skeleton, leg, &model.chain, g, (t, q), angles, ankle_target);

@@ -129,13 +129,7 @@ pub fn register_chroma(
             },
             |(input, spectrum, scratch), w| {
                 let start = (0.5 * (w[0] + w[1]) * sr - half).round() as i64;
-                for (i, (x, win)) in input.iter_mut().zip(&window).enumerate() {
-                    let k = start + i as i64;
-                    *x = usize::try_from(k)
-                        .ok()
-                        .and_then(|k| samples.get(k))
-                        .map_or(0.0, |s| s * win);
-                }
+                super::onsets::windowed(samples, start, &window, input);
                 // The lengths come from the same plan, so processing cannot fail.
                 let _ = fft.process_with_scratch(input, spectrum, scratch);
                 let mut p = vec![[0.0; 12]; registers.len()];

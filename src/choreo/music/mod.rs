@@ -403,14 +403,13 @@ fn audible_envelope(
 /// are as strong as its beats (a backbeat) or its chords change between its beats (every second
 /// beat, or off the beat); with the half-beat chroma and bass chroma of the returned beats when
 /// they were taken.
-#[allow(clippy::type_complexity)]
 fn beat_level(
     samples: &[f32],
     sample_rate: u32,
     env: &OnsetEnvelope,
     tempo: &TempoEstimate,
     params: &MusicParams,
-) -> Result<(Vec<f64>, Option<(Vec<Chroma>, Vec<Chroma>)>), MusicError> {
+) -> Result<(Vec<f64>, Option<Halves>), MusicError> {
     let beat_frames = track_beats(env, tempo.period_frames, &params.beats)?;
     let fastest = 60.0 * env.frame_rate() / params.prior.max_bpm;
     if tempo.period_frames / 2.0 < fastest {
@@ -433,15 +432,13 @@ fn times_of(env: &OnsetEnvelope, frames: &[f64]) -> Vec<f64> {
     frames.iter().map(|&f| env.time_of(f)).collect()
 }
 
+/// The chroma and the bass chroma of each half beat of a song's beats.
+type Halves = (Vec<Chroma>, Vec<Chroma>);
+
 /// The chroma and the bass chroma of each half beat of `beats_s`
 /// ([`chroma::half_beat_chroma_and_bass`]); both empty for a song less tonal than
 /// `p.min_tonality` (drums, noise), whose harmony is not used.
-fn tonal_halves(
-    samples: &[f32],
-    sample_rate: u32,
-    beats_s: &[f64],
-    p: &ChromaParams,
-) -> (Vec<Chroma>, Vec<Chroma>) {
+fn tonal_halves(samples: &[f32], sample_rate: u32, beats_s: &[f64], p: &ChromaParams) -> Halves {
     let (halves, bass) = chroma::half_beat_chroma_and_bass(samples, sample_rate, beats_s, p);
     if chroma::tonality(&halves) < p.min_tonality {
         return (vec![], vec![]);

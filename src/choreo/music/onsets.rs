@@ -215,24 +215,7 @@ fn band_power(samples: &[f32], n_fft: usize, hop: usize, edges: &[usize]) -> Vec
             let mut scratch = fft.make_scratch_vec();
             for (j, row) in rows.chunks_mut(bands).enumerate() {
                 let centre = (c * CHUNK + j) * hop;
-                match centre
-                    .checked_sub(half)
-                    .and_then(|a| samples.get(a..a + n_fft))
-                {
-                    // A frame inside the song: one straight pass the compiler vectorises.
-                    Some(frame) => {
-                        for ((x, s), w) in input.iter_mut().zip(frame).zip(&window) {
-                            *x = s * w;
-                        }
-                    }
-                    // A frame over either end: the samples outside the song are 0.
-                    None => {
-                        for (i, (x, w)) in input.iter_mut().zip(&window).enumerate() {
-                            let s = (centre + i).checked_sub(half).and_then(|k| samples.get(k));
-                            *x = s.map_or(0.0, |s| s * w);
-                        }
-                    }
-                }
+                windowed(samples, centre as i64 - half as i64, &window, &mut input);
                 // The lengths come from the same plan, so processing cannot fail.
                 let _ = fft.process_with_scratch(&mut input, &mut spectrum, &mut scratch);
                 for (b, p) in row.iter_mut().enumerate() {
@@ -244,6 +227,31 @@ fn band_power(samples: &[f32], n_fft: usize, hop: usize, edges: &[usize]) -> Vec
             }
         });
     power
+}
+
+/// `out[i] = samples[start + i] · window[i]`, a sample outside the song being 0: the frame of
+/// `window.len()` samples from `start` (which may lie before the song's start), windowed.
+pub(crate) fn windowed(samples: &[f32], start: i64, window: &[f32], out: &mut [f32]) {
+    let inside = usize::try_from(start)
+        .ok()
+        .and_then(|a| samples.get(a..a + window.len()));
+    match inside {
+        // A frame inside the song: one straight pass the compiler vectorises.
+        Some(frame) => {
+            for ((x, s), w) in out.iter_mut().zip(frame).zip(window) {
+                *x = s * w;
+            }
+        }
+        // A frame over either end.
+        None => {
+            for (i, (x, w)) in out.iter_mut().zip(window).enumerate() {
+                let s = usize::try_from(start + i as i64)
+                    .ok()
+                    .and_then(|k| samples.get(k));
+                *x = s.map_or(0.0, |s| s * w);
+            }
+        }
+    }
 }
 
 /// A Hann window of `n` samples, sin²(π i / n).
