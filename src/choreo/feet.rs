@@ -1,6 +1,6 @@
 //! Feet on the floor: an assembled dance's planted feet put on the floor (y = 0) and held still,
-//! by two-bone leg inverse kinematics ([`crate::humanoid::leg_ik`]), the pelvis left where the
-//! dance puts it.
+//! by two-bone leg inverse kinematics ([`crate::humanoid::leg_ik`]), the pelvis lowered where
+//! the legs cannot reach the floor otherwise.
 //!
 //! Segments from different clips, time-resized to the song's bars and joined at seams, put the
 //! feet a little in or above the floor and let a planted foot slide where its sources did not.
@@ -13,10 +13,10 @@
 //! - **Contact.** A foot is in contact in the frames where [`ground_contacts_against`] finds it
 //!   contact against the floor y = 0 and the model's rest heights: some point within
 //!   [`ContactConfig::threshold_m`] of its rest height (debounced).
-//! - **Ground.** A contact span that is not held (below) is moved by one height, so that its
-//!   lowest sole touches the floor: c_y(f) = −min_{span} s (with [`PlantParams::ground`]). A
-//!   foot the analysis calls in contact is within [`ContactConfig::threshold_m`] of the floor,
-//!   so this moves it a few centimetres, and the foot keeps its own motion within the span.
+//! - **Ground.** Each contact span is moved by one height, so that its lowest sole touches
+//!   the floor: c_y(f) = −min_{span} s (with [`PlantParams::ground`]). A foot the analysis calls
+//!   in contact is within [`ContactConfig::threshold_m`] of the floor, so this moves it a few
+//!   centimetres, and the foot keeps its own motion within the span.
 //! - **Lift.** Wherever else the sole is under the floor the foot is lifted onto it: c_y(f) ≥
 //!   −s(f). Outside the spans and their fades nothing is pulled down: a swinging foot is not made
 //!   to touch the floor (and skate on it).
@@ -31,9 +31,19 @@
 //! - **Smoothing.** The corrections are smoothed over time by a Gaussian of σ =
 //!   [`PlantParams::smooth_s`] (the sole's height switches between toe and heel as the foot
 //!   rolls: a kink the knee would follow), then the lift is applied again as a floor.
-//! - **Reach.** The ankle is sent to its own position plus c(f) by the leg's IK, and the
-//!   foot's residual (the foot turns a little with the shin, since humanoid24 has no ankle DOF)
-//!   is added to the target again, [`IK_ROUNDS`] times at most.
+//! - **Cap.** A leg is never asked to stretch further than the dancer stretched it: the
+//!   hip–ankle distance of a target is at most the largest the leg had, as assembled, within
+//!   [`PlantParams::blend_s`] of the frame (a target beyond is raised to that distance). A
+//!   retargeted dancer whose pelvis is carried high for the new legs would otherwise have a
+//!   knee snap straight to put a foot down.
+//! - **Pelvis.** Where a foot in contact cannot reach its target within the cap, the pelvis is
+//!   lowered by what is missing (with [`PlantParams::pelvis`]): the most over both feet in
+//!   contact, held over ±`blend_s` and smoothed by a Gaussian of σ = `blend_s`/3, so it settles
+//!   and rises as smoothly as a correction fades. The corrections are then found again for the
+//!   lowered dance.
+//! - **Reach.** The ankle is sent to its own position plus c(f) (within the cap) by the leg's
+//!   IK, and the foot's residual (the foot turns a little with the shin, since humanoid24 has no
+//!   ankle DOF) is added to the target again, [`IK_ROUNDS`] times at most.
 
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
@@ -59,10 +69,14 @@ pub struct PlantParams {
     /// Hold a planted foot's contact point still over its contact span (false: only heights
     /// are corrected).
     pub lock: bool,
-    /// Put a standing foot on the floor: each contact span that is not held moved by one
-    /// height, down as well as up, so its lowest sole is at y = 0 (false: a foot is only lifted
-    /// out of the floor, and one in contact may hover).
+    /// Put a standing foot on the floor: each contact span moved by one height, down as well
+    /// as up, so its lowest sole is at y = 0 (false: a foot is only lifted out of the floor, and
+    /// one in contact may hover).
     pub ground: bool,
+    /// Lower the pelvis where a standing foot cannot reach the floor with its knee no
+    /// straighter than the dancer's own (module docs, "Pelvis"); false: the pelvis stays where
+    /// the dance puts it.
+    pub pelvis: bool,
     /// Time over which a correction fades in and out around a contact span, seconds.
     pub blend_s: f64,
     /// σ of the Gaussian the corrections are smoothed with over time, seconds (0: none): the
@@ -78,6 +92,7 @@ impl Default for PlantParams {
             enabled: true,
             lock: true,
             ground: true,
+            pelvis: true,
             blend_s: 0.2,
             smooth_s: 0.05,
         }
@@ -97,6 +112,8 @@ pub struct Planting {
     pub max_correction_m: f64,
     /// Largest distance left between a foot and its target (out of the leg's reach), metres.
     pub max_residual_m: f64,
+    /// Most the pelvis was lowered, metres (0 without [`PlantParams::pelvis`]).
+    pub pelvis_drop_max_m: f64,
 }
 
 /// Sole height of every foot point: its height in the rest pose of `clip.model` standing on the
@@ -209,24 +226,60 @@ pub fn plant_feet(clip: &mut ModelClip, p: &PlantParams) -> Planting {
         skeleton,
         points: feet,
     };
-    let rest = &model.rest;
-    let before: Vec<[Vec<DVec3>; 2]> = {
-        use rayon::prelude::*;
-        (0..n)
-            .into_par_iter()
-            .map_init(Vec::new, |g, f| model.positions(clip, f, g))
-            .collect()
-    };
-    let config = ContactConfig::default();
-    let contacts = floor_contacts(clip, &before, rest, &config);
+    let legs = legs.map(|l| l.expect("checked above"));
     let blend = (p.blend_s / clip.frame_time).round().max(1.0) as usize;
+    let (mut before, mut reach) = placed(clip, &legs, &model, blend);
+    let mut plan = self::plan(clip, &model, &before, p, blend, &mut report);
+    if p.pelvis {
+        let drop = pelvis_drop(&plan, &reach, blend);
+        let most = drop.iter().copied().fold(0.0, f64::max);
+        if most > 1e-6 {
+            // Lowering the root moves every joint by as much: the places are shifted, not
+            // placed again.
+            for (f, r) in drop.iter().enumerate() {
+                let down = DVec3::Y * *r;
+                clip.root_translation[f] -= down;
+                before[f].iter_mut().flatten().for_each(|x| *x -= down);
+                reach.hip[f].iter_mut().for_each(|x| *x -= down);
+                reach.ankle[f].iter_mut().for_each(|x| *x -= down);
+            }
+            report = Planting {
+                pelvis_drop_max_m: most,
+                ..Planting::default()
+            };
+            plan = self::plan(clip, &model, &before, p, blend, &mut report);
+        }
+    }
+    reach_targets(clip, &legs, &model, &before, &plan, &reach.cap, &mut report);
+    report
+}
 
-    // The correction of every frame of each foot (module docs).
-    // Per frame and foot: the correction and the foot point whose place it is measured on.
+/// Where each foot is to go: per foot and frame, the correction and the contact point it is
+/// measured on (`None`: nothing to do), and which frames the foot is in contact.
+struct Plan {
+    targets: [Vec<Option<(DVec3, usize)>>; 2],
+    on: [Vec<bool>; 2],
+}
+
+/// The [`Plan`] of `clip`, whose foot points are at `before` (module docs: contact, ground,
+/// lift, lock, smoothing).
+fn plan(
+    clip: &ModelClip,
+    model: &Feet,
+    before: &[[Vec<DVec3>; 2]],
+    p: &PlantParams,
+    blend: usize,
+    report: &mut Planting,
+) -> Plan {
+    let n = clip.frame_count();
+    let rest = &model.rest;
+    let config = ContactConfig::default();
+    let contacts = floor_contacts(clip, before, rest, &config);
     let mut targets: [Vec<Option<(DVec3, usize)>>; 2] = [vec![None; n], vec![None; n]];
+    let mut ons: [Vec<bool>; 2] = [vec![], vec![]];
     for (side, spans) in [&contacts.left, &contacts.right].into_iter().enumerate() {
         let foot = FootTrack {
-            before: &before,
+            before,
             side,
             rest: &rest[side],
             sole: before
@@ -245,12 +298,117 @@ pub fn plant_feet(clip: &mut ModelClip, p: &PlantParams) -> Planting {
             .collect();
         let planted = runs(&on);
         report.spans += planted.len();
-        let (mut corr, mut key) = hold_spans(&foot, &planted, p, &config, &mut report);
+        let (mut corr, mut key) = hold_spans(&foot, &planted, p, &config, report);
         fade_free_frames(&on, &planted, blend, &mut corr, &mut key);
-        targets[side] = smooth_and_floor(&foot, &corr, &key, p, &mut report);
+        targets[side] = smooth_and_floor(&foot, &corr, &key, p, report);
+        ons[side] = on;
     }
-    reach_targets(clip, &legs, &model, &before, &targets, &mut report);
-    report
+    Plan { targets, on: ons }
+}
+
+/// The legs as the dance puts them: per frame and leg, the hip's and ankle's places, and the
+/// cap on the hip–ankle distance (the leg's straightest within a blend of the frame, so that
+/// no foot is put down by a knee straighter than the dancer's own nearby).
+struct LegReach {
+    hip: Vec<[DVec3; 2]>,
+    ankle: Vec<[DVec3; 2]>,
+    cap: Vec<[f64; 2]>,
+}
+
+/// The foot points of `clip` at every frame ([`Feet::positions`]) and its [`LegReach`], the
+/// cap taken over ±`blend` frames.
+fn placed(
+    clip: &ModelClip,
+    legs: &[Leg; 2],
+    model: &Feet,
+    blend: usize,
+) -> (Vec<[Vec<DVec3>; 2]>, LegReach) {
+    use rayon::prelude::*;
+    let n = clip.frame_count();
+    type Placed = ([Vec<DVec3>; 2], ([DVec3; 2], [DVec3; 2]));
+    let placed: Vec<Placed> = (0..n)
+        .into_par_iter()
+        .map_init(Vec::new, |g, f| {
+            let feet = model.positions(clip, f, g);
+            let legs = (
+                legs.map(|l| g[l.hip].translation),
+                legs.map(|l| g[l.ankle].translation),
+            );
+            (feet, legs)
+        })
+        .collect();
+    let (before, legs): (Vec<_>, Vec<_>) = placed.into_iter().unzip();
+    let (hip, ankle): (Vec<_>, Vec<_>) = legs.into_iter().unzip();
+    let [left, right] = [0, 1].map(|s| {
+        let length: Vec<f64> = (0..n).map(|f| (ankle[f][s] - hip[f][s]).length()).collect();
+        window_max(&length, blend)
+    });
+    let cap = left.into_iter().zip(right).map(|(l, r)| [l, r]).collect();
+    (before, LegReach { hip, ankle, cap })
+}
+
+/// The largest of `x` over frames f − `w` ..= f + `w` (within the clip) at every frame f, by a
+/// monotone queue of the window's candidates: O(n) whatever `w`.
+fn window_max(x: &[f64], w: usize) -> Vec<f64> {
+    let n = x.len();
+    let mut out = Vec::with_capacity(n);
+    let mut queue = std::collections::VecDeque::new();
+    let mut next = 0;
+    for f in 0..n {
+        // Take in frames up to f + w, dropping the candidates they outdo.
+        while next < n && next <= f + w {
+            while queue.back().is_some_and(|&j: &usize| x[j] <= x[next]) {
+                queue.pop_back();
+            }
+            queue.push_back(next);
+            next += 1;
+        }
+        while queue.front().is_some_and(|&j| j + w < f) {
+            queue.pop_front();
+        }
+        out.push(x[*queue.front().expect("frame f is in its own window")]);
+    }
+    out
+}
+
+/// `target` (an ankle's place) raised, where the leg would have to reach further than `cap`
+/// from the hip at `hip`, to the lowest place at that distance straight above or below it.
+fn within_reach(target: DVec3, hip: DVec3, cap: f64) -> DVec3 {
+    let d = target - hip;
+    let across = d.x * d.x + d.z * d.z;
+    if d.length_squared() > cap * cap && cap * cap > across {
+        DVec3::new(target.x, hip.y - (cap * cap - across).sqrt(), target.z)
+    } else {
+        target
+    }
+}
+
+/// How far to lower the pelvis at each frame (module docs, "Pelvis"): the most a foot in
+/// contact must come down beyond its leg's cap, spread over ±`blend` frames and smoothed, so
+/// that the pelvis settles and rises as smoothly as a correction fades.
+fn pelvis_drop(plan: &Plan, reach: &LegReach, blend: usize) -> Vec<f64> {
+    let n = reach.cap.len();
+    let need: Vec<f64> = (0..n)
+        .map(|f| {
+            (0..2)
+                .filter(|&s| plan.on[s][f])
+                .filter_map(|s| {
+                    let (c, _) = plan.targets[s][f]?;
+                    let target = reach.ankle[f][s] + c;
+                    let reachable = within_reach(target, reach.hip[f][s], reach.cap[f][s]);
+                    Some(reachable.y - target.y)
+                })
+                .fold(0.0, f64::max)
+        })
+        .collect();
+    let held: Vec<DVec3> = window_max(&need, blend)
+        .into_iter()
+        .map(|most| DVec3::Y * most)
+        .collect();
+    gaussian(&held, blend as f64 / 3.0)
+        .into_iter()
+        .map(|c| c.y.max(0.0))
+        .collect()
 }
 
 /// The model's feet: its skeleton, each foot's points ([`foot_points`]) and their rest sole
@@ -371,11 +529,10 @@ fn hold_spans(
         if slides && p.lock {
             report.locked += 1;
         }
-        // On the floor: a span that is not held (the foot stands, or slides unlocked) lowered
-        // or raised by one height, the sole's lowest over the span, so the foot keeps its own
-        // small motion and touches down. A held span is not also lowered: with the pull to
-        // its anchor, that would straighten the knee at once.
-        let down = if p.ground && !(p.lock && slides) {
+        // On the floor: every span lowered or raised by one height, the sole's lowest over
+        // the span, so the foot keeps its own small motion and touches down (the leg's cap
+        // and the pelvis keep the knee from straightening to get there, module docs).
+        let down = if p.ground {
             -foot.sole[a..b]
                 .iter()
                 .copied()
@@ -406,12 +563,17 @@ fn fade_free_frames(
     corr: &mut [Option<DVec3>],
     key: &mut [usize],
 ) {
+    // The first span starting after f; a free frame's previous span is the one before it.
+    let mut after = 0;
     for f in 0..on.len() {
+        while after < planted.len() && planted[after].0 <= f {
+            after += 1;
+        }
         if on[f] {
             continue;
         }
-        let prev = planted.iter().rev().find(|s| s.1 <= f);
-        let next = planted.iter().find(|s| s.0 > f);
+        let prev = after.checked_sub(1).map(|i| &planted[i]);
+        let next = planted.get(after);
         key[f] = match (prev, next) {
             (Some(&(_, pe)), Some(&(ns, _))) => key[if f + 1 - pe <= ns - f { pe - 1 } else { ns }],
             (Some(&(_, pe)), None) => key[pe - 1],
@@ -531,10 +693,11 @@ fn smooth_and_floor(
 /// and the foot's residual added to the ankle's target, [`IK_ROUNDS`] times at most.
 fn reach_targets(
     clip: &mut ModelClip,
-    legs: &[Option<Leg>; 2],
+    legs: &[Leg; 2],
     model: &Feet,
     before: &[[Vec<DVec3>; 2]],
-    targets: &[Vec<Option<(DVec3, usize)>>; 2],
+    plan: &Plan,
+    cap: &[[f64; 2]],
     report: &mut Planting,
 ) {
     use rayon::prelude::*;
@@ -542,6 +705,7 @@ fn reach_targets(
     let rest = &model.rest;
     let (roots, rotations) = (&clip.root_translation, &clip.root_rotation);
     let skeleton = &clip.model;
+    let targets = &plan.targets;
     // Frames are independent: each moves only its own angles. Per frame: legs moved and the
     // largest residual.
     let moved: Vec<(usize, f64)> = clip
@@ -559,7 +723,7 @@ fn reach_targets(
                     continue;
                 }
                 out.0 += 1;
-                let leg = legs[side].expect("checked above");
+                let leg = legs[side];
                 // The foot's place to reach, its points each moved by c: its key point's
                 // horizontal place and its sole height.
                 let moved = before[f][side].iter().map(|x| *x + c);
@@ -570,7 +734,9 @@ fn reach_targets(
                 let key = before[f][side][k] + c;
                 let wanted = DVec3::new(key.x, want_sole, key.z);
                 chain_globals(skeleton, &model.chain, t, q, angles, g);
-                let mut ankle_target = g[leg.ankle].translation + c;
+                // Never further from the hip than the leg's cap.
+                let (hip, cap) = (g[leg.hip].translation, cap[f][side]);
+                let mut ankle_target = within_reach(g[leg.ankle].translation + c, hip, cap);
                 let mut residual = 0.0;
                 for _ in 0..IK_ROUNDS {
                     // `g` holds the chain for `angles`, before and after the reach.
@@ -582,7 +748,12 @@ fn reach_targets(
                     if residual < 1e-4 {
                         break;
                     }
-                    ankle_target += r;
+                    let next = within_reach(ankle_target + r, hip, cap);
+                    if (next - ankle_target).length_squared() < 1e-8 {
+                        // Capped: the leg can come no closer.
+                        break;
+                    }
+                    ankle_target = next;
                 }
                 out.1 = out.1.max(residual);
             }
@@ -680,8 +851,10 @@ mod tests {
 
     #[test]
     fn a_standing_foot_that_hovers_is_put_down_on_the_floor() {
-        // Standing 2 cm above the floor (in contact: within the analysis's 3 cm): the soles go
-        // down onto it, the pelvis stays, and without `ground` the figure is left alone.
+        // Standing 2 cm above the floor (in contact: within the analysis's 3 cm), knees as bent
+        // throughout: the legs may not stretch further, so the pelvis comes down 2 cm and the
+        // soles with it, the knees kept. Without `pelvis` the feet stay up (the legs are
+        // capped at their own stretch), and without `ground` the figure is left alone.
         let lowest = |clip: &ModelClip| {
             let rest = rest_sole_heights(clip);
             let tracks = foot_tracks(clip);
@@ -690,20 +863,51 @@ mod tests {
                 .map(|(s, pts)| sole_height(pts, &rest[s]))
                 .fold(f64::INFINITY, f64::min)
         };
-        let mut hover = stance(0.5, 0.02, 0.0, 120);
+        let original = stance(0.5, 0.02, 0.0, 120);
+        let knee = original.model.dof_index("left_knee").unwrap();
+        let mut hover = original.clone();
         let r = plant_feet(&mut hover, &PlantParams::default());
         assert!(lowest(&hover).abs() < 1e-3, "{} m: {r:?}", lowest(&hover));
-        assert_eq!(
-            hover.root_translation,
-            stance(0.5, 0.02, 0.0, 120).root_translation
+        assert!((r.pelvis_drop_max_m - 0.02).abs() < 1e-3, "{r:?}");
+        for f in 0..120 {
+            let dropped = original.root_translation[f].y - hover.root_translation[f].y;
+            assert!((dropped - 0.02).abs() < 1e-3, "frame {f}: {dropped} m");
+            let bend = hover.frame_angles(f)[knee] - original.frame_angles(f)[knee];
+            assert!(bend.abs() < 0.01, "frame {f}: knee moved {bend} rad");
+        }
+        let mut kept = original.clone();
+        plant_feet(
+            &mut kept,
+            &PlantParams {
+                pelvis: false,
+                ..PlantParams::default()
+            },
         );
-        let mut left = stance(0.5, 0.02, 0.0, 120);
+        assert_eq!(kept.root_translation, original.root_translation);
+        assert!((lowest(&kept) - 0.02).abs() < 1e-3, "{}", lowest(&kept));
+        let mut left = original.clone();
         let only_lift = PlantParams {
             ground: false,
             ..PlantParams::default()
         };
         plant_feet(&mut left, &only_lift);
         assert!((lowest(&left) - 0.02).abs() < 1e-9, "{}", lowest(&left));
+    }
+
+    #[test]
+    fn the_window_maximum_is_the_plain_one() {
+        let x: Vec<f64> = (0..200).map(|i| ((i * 37 % 101) as f64).sin()).collect();
+        for w in [0, 1, 5, 12, 300] {
+            let plain: Vec<f64> = (0..x.len())
+                .map(|f| {
+                    x[f.saturating_sub(w)..(f + w + 1).min(x.len())]
+                        .iter()
+                        .copied()
+                        .fold(f64::NEG_INFINITY, f64::max)
+                })
+                .collect();
+            assert_eq!(window_max(&x, w), plain, "w = {w}");
+        }
     }
 
     #[test]

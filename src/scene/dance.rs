@@ -707,6 +707,9 @@ fn feet_json(feet: &PlantParams, planting: &Planting) -> serde_json::Value {
     json!({
         "planted": feet.enabled,
         "locked": feet.lock,
+        "grounded": feet.ground,
+        "pelvis_lowered": feet.pelvis,
+        "pelvis_drop_max_m": planting.pelvis_drop_max_m,
         "contact_spans": planting.spans,
         "contact_spans_locked": planting.locked,
         "leg_frames_moved": planting.leg_frames,
