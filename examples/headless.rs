@@ -21,7 +21,8 @@ use marionette::dynamics::forces::external::Push;
 use marionette::ecs::character::{
     PhysicalSettings, Reaction, character_schedule, spawn_physical_character,
 };
-use marionette::ecs::physics::{BodyState, ExternalForces, PhysicsBody};
+use marionette::ecs::human::HumanFigure;
+use marionette::ecs::physics::{BodyState, ExternalForces};
 use marionette::ecs::{Clock, JointState, new_world, run_ticks};
 use marionette::humanoid::body::humanoid24_body;
 use marionette::primitive::{LearnConfig, Primitive};
@@ -168,7 +169,7 @@ fn report(world: &World, tick: u64) -> bool {
         }
     }
     println!("largest published-transform gap: {worst_t:e} m (f32 rounding)");
-    let body = &world.get::<PhysicsBody>(pair[1]).expect("body").body;
+    let body = &world.get::<HumanFigure>(pair[1]).expect("body").0;
     let standing = body.figure.joints[0].offset.y;
     let fell = pelvis(world, pair[1]).y < 0.5 * standing;
     let stood = pelvis(world, pair[0]).y > 0.7 * standing;

@@ -21,6 +21,7 @@ use crate::ecs::DofPose;
 use crate::ecs::character::{
     CharacterLog, Feedforward, Reaction, RootAssist, TrackPose, add_all_character_systems,
 };
+use crate::ecs::human::HumanFigure;
 use crate::ecs::physics::{BodyState, ExternalForces, PdController, PhysicsBody};
 use crate::ecs::primitive::PrimitivePlayer;
 use crate::ecs::{Clock, JointState, MotionSet};
@@ -48,6 +49,7 @@ impl Plugin for MarionettePlugin {
             .insert_resource(TicksPerUpdate(self.ticks_per_update));
         let w = app.world_mut();
         w.register_component::<PhysicsBody>();
+        w.register_component::<HumanFigure>();
         w.register_component::<BodyState>();
         w.register_component::<PdController>();
         w.register_component::<ExternalForces>();

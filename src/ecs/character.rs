@@ -30,9 +30,10 @@ use glam::{DMat3, DQuat, DVec3};
 
 use super::clock::Clock;
 use super::dof_pose::{DofPose, ModelBinding};
+use super::human::{HumanFigure, drawn_body, human_physics};
 use super::physics::{
-    BodyState, ExternalForces, FloorContact, JointLimits, PdController, PhysicsBody, PhysicsBundle,
-    PhysicsMonitor, PhysicsStatus, drawn_body,
+    BodyState, ExternalForces, FloorContact, JointLimits, PdController, PhysicsMonitor,
+    PhysicsStatus,
 };
 use super::primitive::PrimitivePlayer;
 use super::sets::{MotionSet, configure_motion_sets};
@@ -214,7 +215,7 @@ fn lowest_corner(contact: &ContactModel, data: &Data, link: usize) -> f64 {
 
 /// What [`check_feet`] reads and writes.
 type FeetQuery<'a> = (
-    &'a PhysicsBody,
+    &'a HumanFigure,
     &'a BodyState,
     &'a FloorContact,
     &'a ModelBinding,
@@ -225,11 +226,11 @@ type FeetQuery<'a> = (
 
 /// Updates every character's [`FeetOnFloor`] after its step, before its first push.
 pub fn check_feet(mut q: Query<FeetQuery>) {
-    for (body, state, contact, binding, pose, reaction, mut feet) in &mut q {
+    for (human, state, contact, binding, pose, reaction, mut feet) in &mut q {
         if reaction.pushed_at_s.is_some_and(|p| state.time_s > p) {
             continue;
         }
-        let b = &*body.body;
+        let b = &**human;
         let feet = &mut *feet;
         let (q_d, v_d) = pose_configuration(b, binding, pose);
         let anim = feet.animated.get_or_insert_with(|| Data::new(&b.model));
@@ -402,7 +403,7 @@ pub fn spawn_physical_character(
     let assist = new_root_assist(settings, model, &h);
     let ndofs = body.dof_v.len();
     let nlinks = model.nbodies();
-    let mut physics = PhysicsBundle::new(body.clone(), settings.integrator, q);
+    let (mut physics, human) = human_physics(body.clone(), settings.integrator, q);
     physics.state.v = v;
     let log = CharacterLog {
         dof_sq_error: vec![0.0; ndofs],
@@ -414,7 +415,7 @@ pub fn spawn_physical_character(
     };
     let mut entity = world.spawn((
         drawn_body(name, &body),
-        physics,
+        (physics, human),
         (pose, player, binding, TrackPose),
         (
             PdController(pd),
@@ -586,9 +587,10 @@ fn new_root_assist(settings: &PhysicalSettings, model: &Model, h: &[f64]) -> Roo
 }
 
 /// Pushes `entity` with `push` starting now (the body's time), e.g. from a game's input; the
-/// push's own `start_s` is replaced. Returns false when the entity is not a simulated body.
+/// push's own `start_s` is replaced. Returns false when the entity is not a simulated human
+/// body.
 pub fn push_now(world: &mut World, entity: Entity, push: &Push) -> bool {
-    let Some(body) = world.get::<PhysicsBody>(entity).map(|b| b.body.clone()) else {
+    let Some(body) = world.get::<HumanFigure>(entity).map(|h| h.0.clone()) else {
         return false;
     };
     let Some(link) = body.link_index(&push.link) else {
@@ -617,7 +619,7 @@ pub struct Feedforward {
 
 /// What [`pd_targets_from_pose`] reads and writes.
 type TargetQuery<'a> = (
-    &'a PhysicsBody,
+    &'a HumanFigure,
     &'a ModelBinding,
     &'a DofPose,
     &'a mut PdController,
@@ -638,9 +640,9 @@ type ReactionQuery<'a> = (
 /// velocity of the pose: [`pose_configuration`]) and,
 /// with a [`Feedforward`], the inverse dynamics of the animated motion into its feedforward.
 pub fn pd_targets_from_pose(clock: Res<Clock>, mut q: Query<TargetQuery, With<TrackPose>>) {
-    for (body, binding, pose, mut pd, ff, assist) in &mut q {
+    for (human, binding, pose, mut pd, ff, assist) in &mut q {
         let pd = &mut pd.0;
-        let b = &*body.body;
+        let b = &**human;
         let (q_d, v_d) = pose_configuration(b, binding, pose);
         for (d, &c) in binding.dof_columns().iter().enumerate() {
             pd.target[d] = pose.theta[c];
@@ -731,7 +733,7 @@ fn assist_wrench(state: &BodyState, binding: &ModelBinding, pose: &DofPose, a: &
 #[allow(clippy::type_complexity)]
 pub fn log_characters(
     mut q: Query<(
-        &PhysicsBody,
+        &HumanFigure,
         &BodyState,
         &PhysicsMonitor,
         &PdController,
@@ -742,8 +744,8 @@ pub fn log_characters(
         &mut CharacterLog,
     )>,
 ) {
-    for (body, state, monitor, pd, binding, pose, reaction, assist, mut log) in &mut q {
-        let b = &*body.body;
+    for (human, state, monitor, pd, binding, pose, reaction, assist, mut log) in &mut q {
+        let b = &**human;
         let log = &mut *log;
         log.angles.resize(b.model.nv, 0.0);
         log.reference.resize(b.model.nv, 0.0);

@@ -87,7 +87,7 @@ impl ModelBinding {
 /// Sets every bound kinematic character's joint state from its DOF pose: the root from the
 /// root channels, every other joint's rotation from its DOF angles (see
 /// [`Model::local_rotations`]). A simulated character's joint state comes from its body instead
-/// ([`publish_body_pose`](super::physics::publish_body_pose)); its DOF pose is the PD target.
+/// ([`publish_body_pose`](super::human::publish_body_pose)); its DOF pose is the PD target.
 pub fn pose_from_dofs(
     mut q: Query<(&ModelBinding, &DofPose, &mut JointState), Without<PhysicsBody>>,
 ) {

@@ -6,9 +6,10 @@
 //! - kinematic motion: a [`ClipPlayback`], or primitive players
 //!   ([`primitive::PrimitivePlayer`], [`primitive::BlendPlayer`]) writing a
 //!   [`DofPose`] that a [`ModelBinding`] turns into the joint state;
-//! - physics: a [`physics::PhysicsBundle`] and the force components the step reads
-//!   ([`physics::PdController`], [`physics::JointLimits`], [`physics::FloorContact`],
-//!   [`physics::ExternalForces`]); its pose reaches the same joint state;
+//! - physics: a [`physics::PhysicsBundle`] (the rigid-body model, nothing human) and the force
+//!   components the step reads ([`physics::PdController`], [`physics::JointLimits`],
+//!   [`physics::FloorContact`], [`physics::ExternalForces`]); a human body also carries a
+//!   [`human::HumanFigure`], through which its pose reaches the same joint state;
 //! - physical characters (active ragdolls, [`character`]): both at once, a primitive player
 //!   whose pose is the PD target of the simulated body, with root assistance and reactions to
 //!   pushes.
@@ -23,6 +24,7 @@
 pub mod character;
 mod clock;
 mod dof_pose;
+pub mod human;
 mod motion;
 pub mod physics;
 pub mod primitive;

@@ -1,22 +1,23 @@
-//! Simulated characters: every force a body feels comes from a component the step reads.
+//! Simulated bodies: every force a body feels comes from a component the step reads.
 //!
-//! A physical character carries a [`PhysicsBundle`] (the body, its state, workspace, monitor
-//! and status) and any of [`PdController`] (targets θ_d, θ̇_d and gains per DOF),
-//! [`JointLimits`] (ranges and the joint model), [`FloorContact`] and [`ExternalForces`].
-//! Removing one removes that force; a controller of the user's (a primitive player, a GA
-//! genome, a game's input) writes [`PdController`] in [`MotionSet::Control`].
-//! [`step_bodies`] takes the clock's substeps in [`MotionSet::Physics`] through
-//! [`pipeline::step`]; [`publish_body_pose`] hands the body's pose to the same joint state,
-//! forward kinematics and recorder as a kinematic character in [`MotionSet::Pose`].
+//! A physical body carries a [`PhysicsBundle`] (the rigid-body kernel's [`Model`] and its
+//! actuated DOFs, its state, workspace, monitor and status) and any of [`PdController`]
+//! (targets θ_d, θ̇_d and gains per DOF), [`JointLimits`] (ranges and the joint model),
+//! [`FloorContact`] (the link boxes' corners and gains) and [`ExternalForces`]. Removing one
+//! removes that force; a controller of the user's (a primitive player, a GA genome, a game's
+//! input) writes [`PdController`] in [`MotionSet::Control`]. [`step_bodies`] takes the clock's
+//! substeps in [`MotionSet::Physics`] through [`pipeline::step`]. Nothing here knows what the
+//! body is: a human's figure, DOF names and links are its
+//! [`HumanFigure`](super::human::HumanFigure), from which
+//! [`publish_body_pose`](super::human::publish_body_pose) hands the pose to the same joint
+//! state, forward kinematics and recorder as a kinematic character in [`MotionSet::Pose`].
 
 use std::ops::{Deref, DerefMut};
 use std::sync::Arc;
 
 use bevy_ecs::prelude::*;
-use glam::{DQuat, DVec3};
 
 use super::clock::Clock;
-use super::motion::{Character, JointState, Recorder, SkeletonRef};
 use super::sets::{MotionSet, configure_motion_sets};
 use crate::dynamics::aba_lanes::LaneData;
 use crate::dynamics::forces::contact::ContactModel;
@@ -29,7 +30,6 @@ use crate::dynamics::pipeline::{
     self, Forces, LaneBody, State, StepError, StepMonitor, StepRefinement, StepSettings,
     StepWorkspace,
 };
-use crate::humanoid::body::HumanBody;
 
 macro_rules! wrapper {
     ($name:ident, $inner:ty) => {
@@ -47,11 +47,16 @@ macro_rules! wrapper {
     };
 }
 
-/// The simulated body: the articulated human (immutable, shared) and its integration scheme.
+/// The simulated body: the rigid-body model (immutable, shared), the DOFs its per-DOF forces
+/// act on, and its integration scheme.
 #[derive(Component, Clone, Debug)]
 pub struct PhysicsBody {
-    /// The body (model, figure, DOF map, link names, contact boxes).
-    pub body: Arc<HumanBody>,
+    /// The articulated body (immutable); bodies sharing one model step together in vector
+    /// lanes ([`step_bodies`]).
+    pub model: Arc<Model>,
+    /// Velocity index (in `v`) of each actuated DOF: the order of the per-DOF entries of
+    /// [`PdController`], [`JointLimits`] and [`PhysicsMonitor`].
+    pub dofs: Arc<[usize]>,
     /// Integration scheme.
     pub integrator: Integrator,
     /// Finer steps over a stretch of time (`None`: every step whole); a body with one steps
@@ -74,7 +79,7 @@ wrapper!(PdController, PdTargets);
 pub struct JointLimits(pub JointRanges);
 wrapper!(JointLimits, JointRanges);
 
-/// Floor contact of the body's link boxes.
+/// Floor contact of the body's link boxes (their corners, bounds, masses and gains).
 #[derive(Component, Clone, Debug)]
 pub struct FloorContact(pub Arc<ContactModel>);
 
@@ -161,7 +166,7 @@ impl PhysicsStatus {
 /// The components every simulated body needs.
 #[derive(Bundle, Clone, Debug)]
 pub struct PhysicsBundle {
-    /// Body.
+    /// Model, actuated DOFs and scheme.
     pub body: PhysicsBody,
     /// State.
     pub state: BodyState,
@@ -174,15 +179,16 @@ pub struct PhysicsBundle {
 }
 
 impl PhysicsBundle {
-    /// `body` at configuration `q`, at rest, integrated with `integrator`.
-    pub fn new(body: Arc<HumanBody>, integrator: Integrator, q: Vec<f64>) -> Self {
-        let m = &body.model;
-        let state = State::new(q, vec![0.0; m.nv], m.nbodies());
-        let workspace = StepWorkspace::new(m);
-        let monitor = StepMonitor::new(m.nbodies(), body.dof_v.len());
+    /// A body of `model` actuated at the velocity indices `dofs`, at configuration `q`, at
+    /// rest, integrated with `integrator`.
+    pub fn new(model: Arc<Model>, dofs: Arc<[usize]>, integrator: Integrator, q: Vec<f64>) -> Self {
+        let state = State::new(q, vec![0.0; model.nv], model.nbodies());
+        let workspace = StepWorkspace::new(&model);
+        let monitor = StepMonitor::new(model.nbodies(), dofs.len());
         Self {
             body: PhysicsBody {
-                body,
+                model,
+                dofs,
                 integrator,
                 refinement: None,
             },
@@ -192,19 +198,6 @@ impl PhysicsBundle {
             status: PhysicsStatus::default(),
         }
     }
-}
-
-/// The drawable side of a simulated body: a character with the body's figure skeleton, so the
-/// motion systems draw and record it as any other character.
-pub fn drawn_body(name: &str, body: &HumanBody) -> impl Bundle {
-    let skeleton = Arc::new(body.figure.skeleton());
-    let n = skeleton.joints.len();
-    (
-        Character { name: name.into() },
-        SkeletonRef(skeleton),
-        JointState::new(n),
-        Recorder::default(),
-    )
 }
 
 /// The components of one body as the step reads them.
@@ -229,7 +222,7 @@ type StepQuery<'a> = (
 /// stepped alone.
 pub fn step_bodies(
     clock: Res<Clock>,
-    mut lanes: Local<Vec<(Arc<HumanBody>, LaneData)>>,
+    mut lanes: Local<Vec<(Arc<Model>, LaneData)>>,
     mut q: Query<StepQuery>,
 ) {
     let dt = clock.physics_dt();
@@ -248,8 +241,8 @@ pub fn step_bodies(
     }
     // The bodies of one model and scheme, in query order.
     while let Some(first) = together.first() {
-        let (human, integrator) = (first.0.body.clone(), first.0.integrator);
-        let same = |b: &StepItem| Arc::ptr_eq(&b.0.body, &human) && b.0.integrator == integrator;
+        let (model, integrator) = (first.0.model.clone(), first.0.integrator);
+        let same = |b: &StepItem| Arc::ptr_eq(&b.0.model, &model) && b.0.integrator == integrator;
         let mut group = if together.iter().all(same) {
             std::mem::take(&mut together)
         } else {
@@ -257,18 +250,18 @@ pub fn step_bodies(
             together = rest;
             group
         };
-        // Lane buffers per body, dropped with the last character of that body.
-        lanes.retain(|(h, _)| Arc::strong_count(h) > 1);
-        let k = match lanes.iter().position(|(h, _)| Arc::ptr_eq(h, &human)) {
+        // Lane buffers per model, dropped with the last holder of that model.
+        lanes.retain(|(m, _)| Arc::strong_count(m) > 1);
+        let k = match lanes.iter().position(|(m, _)| Arc::ptr_eq(m, &model)) {
             Some(k) => k,
             None => {
-                lanes.push((human.clone(), LaneData::new(&human.model)));
+                lanes.push((model.clone(), LaneData::new(&model)));
                 lanes.len() - 1
             }
         };
         let settings = StepSettings { integrator, dt };
         step_together(
-            &human.model,
+            &model,
             settings,
             clock.substeps,
             &mut group,
@@ -296,7 +289,7 @@ fn step_alone(item: StepItem, dt: f64, substeps: u32) {
     let (body, mut state, pd, limits, contact, external, mut ws, mut monitor, mut status) = item;
     let external = external.map_or(&[][..], |e| e.all());
     let forces = Forces {
-        dofs: &body.body.dof_v,
+        dofs: &body.dofs,
         pd: pd.map(|p| &p.0),
         limits: limits.map(|l| &l.0),
         contact: contact.map(|c| &*c.0),
@@ -309,7 +302,7 @@ fn step_alone(item: StepItem, dt: f64, substeps: u32) {
     for _ in 0..substeps {
         let refined = body.refinement.map_or(1, |r| r.substeps_at(state.0.time_s));
         if let Err(e) = pipeline::step_refined(
-            &body.body.model,
+            &body.model,
             settings,
             refined,
             &forces,
@@ -339,7 +332,7 @@ fn step_together(
             .map(
                 |(body, state, pd, limits, contact, external, ws, monitor, _)| LaneBody {
                     forces: Forces {
-                        dofs: &body.body.dof_v,
+                        dofs: &body.dofs,
                         pd: pd.map(|p| &p.0),
                         limits: limits.map(|l| &l.0),
                         contact: contact.map(|c| &*c.0),
@@ -369,43 +362,21 @@ fn step_together(
     }
 }
 
-/// Sets the joint state of every drawn body from its configuration: the pelvis from the
-/// floating base, every other joint from its DOF angles (as a model clip does).
-pub fn publish_body_pose(
-    mut scratch: Local<(Vec<f64>, Vec<f64>)>,
-    mut q: Query<(&PhysicsBody, &BodyState, &mut JointState)>,
-) {
-    let (all, angles) = &mut *scratch;
-    for (body, state, mut joints) in &mut q {
-        let b = &*body.body;
-        all.resize(b.model.nv, 0.0);
-        b.model.angles(&state.q, all);
-        angles.clear();
-        angles.extend(b.dof_v.iter().map(|&k| all[k]));
-        let js = &mut *joints;
-        b.figure.local_rotations(angles, &mut js.rotations);
-        for (t, j) in js.translations.iter_mut().zip(&b.figure.joints) {
-            *t = j.offset;
-        }
-        let qs = &state.q;
-        js.translations[0] = DVec3::new(qs[0], qs[1], qs[2]);
-        js.rotations[0] = DQuat::from_xyzw(qs[3], qs[4], qs[5], qs[6]);
-    }
-}
-
-/// Adds the physics systems to `schedule`: [`step_bodies`] in [`MotionSet::Physics`],
-/// [`publish_body_pose`] in [`MotionSet::Pose`].
+/// Adds the physics systems to `schedule`: [`step_bodies`] in [`MotionSet::Physics`], and
+/// [`publish_body_pose`](super::human::publish_body_pose) in [`MotionSet::Pose`] for the
+/// drawn human bodies.
 pub fn add_physics_systems(schedule: &mut Schedule) {
     configure_motion_sets(schedule);
     schedule.add_systems((
         step_bodies.in_set(MotionSet::Physics),
-        publish_body_pose.in_set(MotionSet::Pose),
+        super::human::publish_body_pose.in_set(MotionSet::Pose),
     ));
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use glam::DVec3;
 
     fn force(body: usize) -> ExternalForce {
         ExternalForce {

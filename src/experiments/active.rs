@@ -17,9 +17,9 @@ use crate::ecs::character::{
     CharacterError, CharacterLog, FeetOnFloor, PhysicalSettings, Reaction, character_schedule,
     spawn_physical_character,
 };
+use crate::ecs::human::HumanFigure;
 use crate::ecs::physics::{
-    BodyState, ExternalForces, JointLimits, PdController, PhysicsBody, PhysicsMonitor,
-    PhysicsStatus,
+    BodyState, ExternalForces, JointLimits, PdController, PhysicsMonitor, PhysicsStatus,
 };
 use crate::ecs::{Clock, Recorder};
 use crate::humanoid::ModelClip;
@@ -266,7 +266,7 @@ pub fn run_active(
     } else {
         Vec::new()
     };
-    let b = &world.get::<PhysicsBody>(e).expect("body").body;
+    let b = &world.get::<HumanFigure>(e).expect("body").0;
     let motion = body_clip(b, &configurations, every as f64 * config.dt_s);
     let mut o = outcome(config, b, pd, (&log, feet), &reaction, &rec.frames, motion);
     o.range_excursion_deg = b

@@ -37,14 +37,16 @@ use glam::{DMat3, DVec3};
 #[derive(Clone, Debug)]
 pub struct HumanBody {
     /// The articulated body (bodies = the figure's joints/links in the same order; body 0 =
-    /// pelvis).
-    pub model: Model,
+    /// pelvis), shared with the physics components that step it
+    /// ([`crate::ecs::physics::PhysicsBody`]).
+    pub model: Arc<Model>,
     /// The figure model it was built from, scaled to the subject's height.
     pub figure: figure::Model,
     /// Contact box of each link.
     pub boxes: Vec<LinkBox>,
-    /// For each figure DOF (model order), its index in the velocity vector `v`.
-    pub dof_v: Vec<usize>,
+    /// For each figure DOF (model order), its index in the velocity vector `v` (shared with the
+    /// physics components as their actuated DOFs).
+    pub dof_v: Arc<[usize]>,
     /// Link names in body order.
     pub link_names: Vec<String>,
 }
@@ -159,8 +161,8 @@ pub fn fall21_body(height: f64, mass: f64, g: f64) -> Result<HumanBody, HumanErr
 
 /// The fall21 human of [`fall21_body`], shared: while any holder keeps it, every call with the
 /// same `height` (m), `mass` (kg) and `g` returns that same body (equal parameters build equal
-/// bodies), so characters built one by one share one body, as the engine's step needs to
-/// take their articulated-body algorithms together in vector lanes
+/// bodies), so characters built one by one share one body and its model, as the engine's step
+/// needs to take their articulated-body algorithms together in vector lanes
 /// ([`crate::ecs::physics::step_bodies`]).
 pub fn shared_fall21_body(height: f64, mass: f64, g: f64) -> Result<Arc<HumanBody>, HumanError> {
     type Key = (u64, u64, u64);
@@ -228,10 +230,10 @@ pub fn human_body(
         boxes.push(bx);
     }
     let model = Model::new(bodies, DVec3::new(0.0, -g, 0.0))?;
-    let dof_v = dof_velocity_indices(&fig, &model);
+    let dof_v = dof_velocity_indices(&fig, &model).into();
     let link_names = fig.joints.iter().map(|j| j.link.clone()).collect();
     Ok(HumanBody {
-        model,
+        model: Arc::new(model),
         figure: fig,
         boxes,
         dof_v,
@@ -638,7 +640,7 @@ mod tests {
         let shin = b.link_index("right_shin").unwrap();
         assert_eq!(b.dof_v[knee], b.model.v_idx[shin]);
         // Every velocity DOF past the root is hit exactly once.
-        let mut seen = b.dof_v.clone();
+        let mut seen = b.dof_v.to_vec();
         seen.sort();
         assert_eq!(seen, (6..27).collect::<Vec<_>>());
     }
@@ -660,7 +662,7 @@ mod tests {
             assert_eq!(b.model.bodies[i].joint, JointType::Fixed, "{link}");
         }
         // Every velocity DOF past the root is one humanoid24 DOF, exactly once.
-        let mut seen = b.dof_v.clone();
+        let mut seen = b.dof_v.to_vec();
         seen.sort();
         assert_eq!(seen, (6..30).collect::<Vec<_>>());
         // The limbs are de Leva's, as on fall21: the same segment masses and inertias.

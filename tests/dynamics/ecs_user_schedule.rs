@@ -11,7 +11,8 @@ use bevy_ecs::prelude::*;
 use glam::DVec3;
 use marionette::clips::KeyframeClip;
 use marionette::dynamics::forces::external::ExternalForce;
-use marionette::ecs::physics::{BodyState, ExternalForces, PhysicsBody, add_physics_systems};
+use marionette::ecs::human::{HumanFigure, drawn_body};
+use marionette::ecs::physics::{BodyState, ExternalForces, add_physics_systems};
 use marionette::ecs::primitive::{PrimitivePlayer, add_primitive_systems};
 use marionette::ecs::{
     Clock, MotionSet, Recorder, SkeletonRef, add_core_systems, add_motion_systems,
@@ -46,13 +47,13 @@ fn gameplay(
     clock: Res<Clock>,
     mut seen: ResMut<Seen>,
     players: Query<&PrimitivePlayer>,
-    mut bodies: Query<(&BodyState, &PhysicsBody, &mut ExternalForces), With<Target>>,
+    mut bodies: Query<(&BodyState, &HumanFigure, &mut ExternalForces), With<Target>>,
 ) {
     let elapsed = players.iter().next().map_or(f64::NAN, |p| p.elapsed());
-    for (state, body, mut forces) in &mut bodies {
+    for (state, human, mut forces) in &mut bodies {
         seen.0.push((clock.tick, elapsed, state.time_s));
         if clock.tick == 60 {
-            let torso = body.body.link_index("torso").unwrap();
+            let torso = human.link_index("torso").unwrap();
             forces.push(ExternalForce {
                 body: torso,
                 point: DVec3::new(0.0, 0.2, 0.0),
@@ -92,12 +93,11 @@ fn world_and_schedule(hit: bool) -> (World, Schedule, Entity, Entity) {
     cfg.dt_s = clock.physics_dt();
     cfg.duration_s = TICKS as f64 * TICK;
     let faller = build_fall(&cfg).unwrap();
-    let body: Arc<HumanBody> = faller.physics.body.body.clone();
+    let body: Arc<HumanBody> = faller.human.0.clone();
     let faller = spawn_fall(&mut world, faller).unwrap();
-    world.entity_mut(faller).insert((
-        marionette::ecs::physics::drawn_body("faller", &body),
-        Target,
-    ));
+    world
+        .entity_mut(faller)
+        .insert((drawn_body("faller", &body), Target));
 
     let mut schedule = Schedule::default();
     add_core_systems(&mut schedule);

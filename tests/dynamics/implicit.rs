@@ -55,7 +55,7 @@ fn at_a_small_step_the_linearised_fall_is_the_explicit_one() {
 /// The forces of the fall `ch` without PD control and push: a passive body with its joint
 /// model on the floor.
 fn passive(ch: &FallCharacter) -> Forces<'_> {
-    let body = &ch.physics.body.body;
+    let body = &ch.human.0;
     Forces {
         dofs: &body.dof_v,
         pd: None,
@@ -69,7 +69,7 @@ fn passive(ch: &FallCharacter) -> Forces<'_> {
 /// at step `dt`: the mechanical energy `T + V` (J) at every step, or the step's error.
 fn drop(integrator: Integrator, dt: f64, lift: f64, seconds: f64) -> Result<Vec<f64>, StepError> {
     let ch = build_fall(&FallConfig::paper(AgeGroup::Elderly)).unwrap();
-    let body = &ch.physics.body.body;
+    let body = &ch.human.0;
     let model = &body.model;
     let forces = passive(&ch);
     let start = &ch.physics.state.0;
@@ -128,7 +128,7 @@ fn stepped_damage(cfg: &FallConfig, integrator: Integrator, dt: f64) -> Result<f
     cfg.integrator = EXPLICIT;
     cfg.dt_s = 5e-4;
     let mut ch = build_fall(&cfg).unwrap();
-    let body = ch.physics.body.body.clone();
+    let body = ch.human.0.clone();
     let mut pd = ch.pd.0.clone();
     let mut state = ch.physics.state.0.clone();
     let mut ws = StepWorkspace::new(&body.model);
@@ -478,7 +478,7 @@ fn a_refined_step_is_its_sub_steps() {
     // one step of h.
     use marionette::dynamics::pipeline::step_refined;
     let ch = build_fall(&FallConfig::paper(AgeGroup::Elderly)).unwrap();
-    let body = &ch.physics.body.body;
+    let body = &ch.human.0;
     let model = &body.model;
     let forces = passive(&ch);
     let mut q = ch.physics.state.0.q.clone();

@@ -23,7 +23,7 @@ use marionette::humanoid::ranges::AgeGroup;
 /// touched the floor (the fall happened).
 fn fall_steps() -> Vec<String> {
     let ch = build_fall(&FallConfig::paper(AgeGroup::Elderly)).expect("the paper's fall builds");
-    let body = &ch.physics.body.body;
+    let body = &ch.human.0;
     let forces = Forces {
         dofs: &body.dof_v,
         pd: Some(&ch.pd.0),
@@ -112,7 +112,7 @@ fn bodies_stepped_in_lanes_have_the_bits_of_bodies_stepped_alone() {
     // `step`: the same states at every step and the same monitors; with joint damping
     // taken implicitly (the fall's scheme) and explicitly.
     let ch = build_fall(&FallConfig::paper(AgeGroup::Elderly)).expect("the paper's fall builds");
-    let body = &ch.physics.body.body;
+    let body = &ch.human.0;
     let model = &body.model;
     let nd = body.dof_v.len();
     let pds: Vec<PdTargets> = (0..5)

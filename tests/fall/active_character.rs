@@ -162,9 +162,8 @@ fn spawn(
     .unwrap();
     if pushed {
         let link = world
-            .get::<marionette::ecs::physics::PhysicsBody>(e)
+            .get::<marionette::ecs::human::HumanFigure>(e)
             .unwrap()
-            .body
             .link_index("chest")
             .unwrap();
         world

@@ -17,6 +17,7 @@ use super::{FallCharacter, FallConfig, FallController, FallRecorder, FallResult,
 use crate::dynamics::crba::NotPositiveDefinite;
 use crate::dynamics::lanes::LANES;
 use crate::dynamics::stability::StiffnessBasis;
+use crate::ecs::human::HumanFigure;
 use crate::ecs::physics::{
     BodyState, ExternalForces, FloorContact, JointLimits, PdController, PhysicsBody,
     PhysicsMonitor, PhysicsStatus, PhysicsWorkspace, add_physics_systems,
@@ -42,7 +43,7 @@ pub fn fall_control_system(
 /// Records every falling body that stepped (frames, rest) and stops it once its run is over.
 pub fn fall_record_system(
     mut q: Query<(
-        &PhysicsBody,
+        &HumanFigure,
         &BodyState,
         &mut PhysicsWorkspace,
         &PhysicsMonitor,
@@ -50,11 +51,11 @@ pub fn fall_record_system(
         &mut PhysicsStatus,
     )>,
 ) {
-    for (body, state, mut ws, monitor, mut recorder, mut status) in &mut q {
+    for (human, state, mut ws, monitor, mut recorder, mut status) in &mut q {
         if status.error.is_some() {
             continue;
         }
-        let b = &*body.body;
+        let b = &**human;
         recorder.record(b, state, ws.kinematics_of(&b.model, state), monitor);
         if recorder.finished(state) {
             status.stopped = true;
@@ -86,7 +87,7 @@ pub fn fall_schedule() -> Schedule {
 pub fn spawn_fall(world: &mut World, mut ch: FallCharacter) -> Result<Entity, SimError> {
     check_clock(world, &ch)?;
     let p = &mut ch.physics;
-    let b = &*p.body.body;
+    let b = &*ch.human;
     let data = p.workspace.kinematics_of(&b.model, &p.state);
     ch.recorder.record(b, &p.state, data, &p.monitor);
     if ch.recorder.finished(&p.state) {
@@ -100,6 +101,7 @@ fn spawn_components(world: &mut World, ch: FallCharacter) -> Entity {
     world
         .spawn((
             ch.physics,
+            ch.human,
             ch.pd,
             ch.limits,
             ch.contact,
@@ -120,6 +122,7 @@ fn character_of(world: &World, e: Entity) -> Option<FallCharacter> {
             monitor: world.get::<PhysicsMonitor>(e)?.clone(),
             status: world.get::<PhysicsStatus>(e)?.clone(),
         },
+        human: world.get::<HumanFigure>(e)?.clone(),
         pd: world.get::<PdController>(e)?.clone(),
         limits: world.get::<JointLimits>(e)?.clone(),
         contact: world.get::<FloorContact>(e)?.clone(),
@@ -207,7 +210,7 @@ impl ReactionStart {
         world: &mut World,
         cfg: &FallConfig,
     ) -> Result<Entity, SimError> {
-        super::validate_reaction(cfg, self.standing.physics.body.body.dof_v.len())?;
+        super::validate_reaction(cfg, self.standing.physics.body.dofs.len())?;
         super::check_stability_with(cfg, &self.standing, &self.stiffness)?;
         let mut ch = self.reacting.clone();
         ch.controller.key = super::key_targets(cfg);
@@ -256,7 +259,7 @@ pub fn run_fall_world(world: &mut World) -> Vec<Result<FallResult, Arc<SimError>
 pub fn fall_results(world: &mut World) -> Vec<Result<FallResult, Arc<SimError>>> {
     let mut q = world.query::<(
         Entity,
-        &PhysicsBody,
+        &HumanFigure,
         &BodyState,
         &PhysicsMonitor,
         &FallRecorder,
@@ -264,8 +267,8 @@ pub fn fall_results(world: &mut World) -> Vec<Result<FallResult, Arc<SimError>>>
     )>();
     let mut out: Vec<(Entity, Result<FallResult, Arc<SimError>>)> = q
         .iter(world)
-        .map(|(e, body, state, monitor, recorder, status)| {
-            (e, result_of(body, state, monitor, recorder, status))
+        .map(|(e, human, state, monitor, recorder, status)| {
+            (e, result_of(human, state, monitor, recorder, status))
         })
         .collect();
     out.sort_by_key(|(e, _)| e.index());
@@ -274,7 +277,7 @@ pub fn fall_results(world: &mut World) -> Vec<Result<FallResult, Arc<SimError>>>
 
 /// The result of one falling body from its components.
 fn result_of(
-    body: &PhysicsBody,
+    human: &HumanFigure,
     state: &BodyState,
     monitor: &PhysicsMonitor,
     recorder: &FallRecorder,
@@ -282,7 +285,7 @@ fn result_of(
 ) -> Result<FallResult, Arc<SimError>> {
     match &status.error {
         Some(err) => Err(Arc::new(SimError::Step((**err).clone()))),
-        None => Ok(recorder.result(&body.body, state, monitor)),
+        None => Ok(recorder.result(human, state, monitor)),
     }
 }
 
@@ -295,14 +298,14 @@ fn take_finished(world: &mut World, e: Entity) -> Option<Result<FallResult, Arc<
             return None;
         }
         let parts = (
-            world.get::<PhysicsBody>(e),
+            world.get::<HumanFigure>(e),
             world.get::<BodyState>(e),
             world.get::<PhysicsMonitor>(e),
             world.get::<FallRecorder>(e),
         );
         match parts {
-            (Some(body), Some(state), Some(monitor), Some(recorder)) => {
-                result_of(body, state, monitor, recorder, status)
+            (Some(human), Some(state), Some(monitor), Some(recorder)) => {
+                result_of(human, state, monitor, recorder, status)
             }
             _ => Err(Arc::new(SimError::Config {
                 field: "world".into(),

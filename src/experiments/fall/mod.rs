@@ -38,6 +38,7 @@ use crate::dynamics::pipeline::{self, Forces, StepRefinement, StepSettings};
 use crate::dynamics::stability::{
     DofStiffness, StiffestMode, StiffnessBasis, inverse_joint_inertia, scheme_name,
 };
+use crate::ecs::human::{HumanFigure, human_physics};
 use crate::ecs::physics::{ExternalForces, FloorContact, JointLimits, PdController, PhysicsBundle};
 use crate::humanoid::body::{HumanBody, shared_fall21_body};
 use crate::humanoid::ranges::RangeTable;
@@ -354,8 +355,10 @@ struct Resolved {
 /// The components of one falling character.
 #[derive(Clone, Debug)]
 pub struct FallCharacter {
-    /// Body, state, buffers, monitor and status.
+    /// Model, state, buffers, monitor and status.
     pub physics: PhysicsBundle,
+    /// The human the body is (figure, DOF map, link names).
+    pub human: HumanFigure,
     /// PD targets and gains (the stance first).
     pub pd: PdController,
     /// Joint ranges of the age group and the joint model.
@@ -416,7 +419,7 @@ pub(crate) fn check_stability_with(
     ch: &FallCharacter,
     basis: &Result<StiffnessBasis, NotPositiveDefinite>,
 ) -> Result<(), SimError> {
-    let body = &*ch.physics.body.body;
+    let body = &*ch.human;
     let basis = basis.as_ref().map_err(|e| cfg_err("body", e.to_string()))?;
     match basis.stiffest_mode(&dof_stiffness(cfg, ch)) {
         Some(m) if cfg.dt_s > m.bound_s => Err(SimError::Unstable {
@@ -448,7 +451,7 @@ pub(crate) fn stiffness_basis(
     cfg: &FallConfig,
     ch: &FallCharacter,
 ) -> Result<StiffnessBasis, NotPositiveDefinite> {
-    let body = &*ch.physics.body.body;
+    let body = &*ch.human;
     StiffnessBasis::new(
         &body.model,
         &ch.physics.state.q,
@@ -460,7 +463,7 @@ pub(crate) fn stiffness_basis(
 /// Each DOF's stiffness for the stability check: its larger PD gain plus its limit spring, its
 /// damping explicit unless the scheme takes it implicitly.
 fn dof_stiffness(cfg: &FallConfig, ch: &FallCharacter) -> Vec<DofStiffness> {
-    let body = &*ch.physics.body.body;
+    let body = &*ch.human;
     let implicit = matches!(
         cfg.integrator,
         crate::dynamics::integrator::Integrator::SemiImplicitEuler {
@@ -601,10 +604,11 @@ fn assemble(cfg: &FallConfig) -> Result<FallCharacter, SimError> {
         None => Vec::new(),
     };
     let nv = body.model.nv;
-    let mut physics = PhysicsBundle::new(body, cfg.integrator, q);
+    let (mut physics, human) = human_physics(body, cfg.integrator, q);
     physics.body.refinement = reaction_refinement(cfg);
     Ok(FallCharacter {
         physics,
+        human,
         pd: PdController(stance.clone()),
         limits: JointLimits(JointRanges {
             ranges,
@@ -654,16 +658,16 @@ const SETTLED_QDD: f64 = 1e-6;
 /// per DOF (N·m); with them `q̈ = 0` to rounding, so the push acts on a body at rest: forces in
 /// equilibrium, foot force equal to the weight.
 fn settle(cfg: &FallConfig, ch: &FallCharacter) -> Result<(pipeline::State, Vec<f64>), SimError> {
-    let body = &*ch.physics.body.body;
-    let model = &body.model;
+    let physics = &ch.physics.body;
+    let model = &*physics.model;
     let mut state = ch.physics.state.0.clone();
     let mut ws = pipeline::StepWorkspace::new(model);
     let settings = StepSettings {
-        integrator: ch.physics.body.integrator,
+        integrator: physics.integrator,
         dt: cfg.dt_s,
     };
     let forces = Forces {
-        dofs: &body.dof_v,
+        dofs: &physics.dofs,
         pd: Some(&ch.pd.0),
         limits: Some(&ch.limits.0),
         contact: Some(&ch.contact.0),
@@ -679,10 +683,10 @@ fn settle(cfg: &FallConfig, ch: &FallCharacter) -> Result<(pipeline::State, Vec<
         base,
         BalanceSettings::default(),
     )?;
-    let hold = holding_torques(model, &forces, &state, &mut ws, &body.dof_v)?;
+    let hold = holding_torques(model, &forces, &state, &mut ws, &physics.dofs)?;
     let mut held = ch.pd.0.clone();
     held.feedforward = hold.clone();
-    check_holding_strength(body, &held, &state)?;
+    check_holding_strength(&ch.human, &held, &state)?;
     let mut qdd = vec![0.0; model.nv];
     let held_forces = Forces {
         pd: Some(&held),
@@ -775,6 +779,7 @@ pub fn simulate_fall(config: &FallConfig) -> Result<FallResult, SimError> {
     let mut ch = build_fall(config)?;
     let FallCharacter {
         physics,
+        human,
         pd,
         limits,
         contact,
@@ -782,7 +787,8 @@ pub fn simulate_fall(config: &FallConfig) -> Result<FallResult, SimError> {
         controller,
         recorder,
     } = &mut ch;
-    let body = &*physics.body.body;
+    let body = &*human.0;
+    let (model, dofs) = (&*physics.body.model, &*physics.body.dofs);
     let state = &mut physics.state.0;
     let ws = &mut physics.workspace.0;
     let monitor = &mut physics.monitor.0;
@@ -791,19 +797,19 @@ pub fn simulate_fall(config: &FallConfig) -> Result<FallResult, SimError> {
         dt: config.dt_s,
     };
     let refinement = physics.body.refinement;
-    recorder.record(body, state, ws.kinematics_of(&body.model, state), monitor);
+    recorder.record(body, state, ws.kinematics_of(model, state), monitor);
     while !recorder.finished(state) {
         controller.apply(state.time_s, &mut pd.0);
         let forces = Forces {
-            dofs: &body.dof_v,
+            dofs,
             pd: Some(&pd.0),
             limits: Some(&limits.0),
             contact: Some(&contact.0),
             external: external.all(),
         };
         let substeps = refinement.map_or(1, |r| r.substeps_at(state.time_s));
-        pipeline::step_refined(&body.model, settings, substeps, &forces, state, ws, monitor)?;
-        recorder.record(body, state, ws.kinematics_of(&body.model, state), monitor);
+        pipeline::step_refined(model, settings, substeps, &forces, state, ws, monitor)?;
+        recorder.record(body, state, ws.kinematics_of(model, state), monitor);
     }
     Ok(recorder.result(body, state, monitor))
 }
