@@ -47,6 +47,75 @@ fn default_seeds() -> Vec<u64> {
 fn default_kp_scale() -> f64 {
     1.0
 }
+/// How the GA's falls are stepped when given outright ([`EvolveFallScene::step`]): e.g. the
+/// linearised implicit step at 2 ms with the reaction's first 100 ms in four sub-steps
+/// (`(integrator: LinearlyImplicitEuler, dt_s: 0.002, reaction_window_s: 0.1,
+/// reaction_substeps: 4)`). The elite check steps at half of `dt_s`, the same window and
+/// sub-steps.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GaStep {
+    /// The integration scheme.
+    pub integrator: crate::dynamics::integrator::Integrator,
+    /// The step, seconds.
+    pub dt_s: f64,
+    /// Seconds after the reaction starts stepped finer ([`FallConfig::reaction_window_s`];
+    /// default 0: none).
+    #[serde(default)]
+    pub reaction_window_s: f64,
+    /// Sub-steps per step in that window ([`FallConfig::reaction_substeps`]; default 1).
+    #[serde(default = "one_substep")]
+    pub reaction_substeps: u32,
+}
+
+fn one_substep() -> u32 {
+    1
+}
+
+impl GaStep {
+    /// Puts this stepping into `fall`.
+    fn apply(&self, fall: &mut FallConfig) {
+        fall.integrator = self.integrator;
+        fall.dt_s = self.dt_s;
+        fall.reaction_window_s = self.reaction_window_s;
+        fall.reaction_substeps = self.reaction_substeps;
+    }
+
+    /// Errors: a step outside (0, 10 ms], a window outside [0, 1 s], sub-steps outside 1..=64.
+    fn validate(&self) -> Result<(), SceneError> {
+        let checks = [
+            (
+                "step.dt_s",
+                "(0, 0.01] seconds",
+                self.dt_s,
+                self.dt_s > 0.0 && self.dt_s <= 0.01,
+            ),
+            (
+                "step.reaction_window_s",
+                "[0, 1] seconds",
+                self.reaction_window_s,
+                (0.0..=1.0).contains(&self.reaction_window_s),
+            ),
+            (
+                "step.reaction_substeps",
+                "1..=64",
+                f64::from(self.reaction_substeps),
+                (1..=64).contains(&self.reaction_substeps),
+            ),
+        ];
+        for (field, range, value, ok) in checks {
+            if !ok {
+                return Err(SceneError::NotInRange {
+                    field,
+                    range,
+                    value,
+                });
+            }
+        }
+        Ok(())
+    }
+}
+
 fn default_step_margin() -> f64 {
     crate::experiments::evolve_fall::STEP_MARGIN
 }
@@ -84,6 +153,10 @@ pub struct EvolveFallScene {
     /// win through the step. Ignored when `fall` is given (it keeps its own `dt_s`).
     #[serde(default = "default_step_margin")]
     pub step_margin: f64,
+    /// The GA's time stepping given outright (integrator, step, finer reaction), in place of
+    /// `step_margin` of the explicit step's stability bound; ignored when `fall` is given.
+    #[serde(default)]
+    pub step: Option<GaStep>,
     /// The fall every genome is tried on, per field (default: the paper's push of the age
     /// group at the GA's step, [`crate::experiments::evolve_fall::stable_step_for`]; its
     /// key pose and k_p are the genes). A fall given here takes the group's ranges and strength
@@ -167,6 +240,9 @@ impl EvolveFallScene {
             });
         }
         self.ga.validate()?;
+        if let Some(step) = &self.step {
+            step.validate()?;
+        }
         let falls = self.groups.len() as u64
             * self.seeds.len() as u64
             * self.ga.population as u64
@@ -180,6 +256,9 @@ impl EvolveFallScene {
             .map(|&g| {
                 // The step is derived from the strongest genome of the scaled k_p box.
                 let mut p = FallProblem::with_strength(g, self.kp_max_scale, self.step_margin);
+                if let Some(step) = &self.step {
+                    step.apply(&mut p.fall);
+                }
                 if let Some(f) = &self.fall {
                     p.fall = f.clone();
                     p.fall.ranges = crate::experiments::fall::Ranges::Builtin(g);
@@ -272,6 +351,12 @@ fn controller_ron(problem: &FallProblem, genes: &[f64]) -> Result<String, SceneE
         start_s: Some(problem.fall.control_start_s),
         dt_s: Some(problem.fall.dt_s),
         contact_implicit_damping: Some(problem.fall.contact.implicit_damping),
+        integrator: (problem.fall.integrator != FallConfig::paper(problem.age_group).integrator)
+            .then_some(problem.fall.integrator),
+        reaction_window_s: (problem.fall.reaction_window_s > 0.0)
+            .then_some(problem.fall.reaction_window_s),
+        reaction_substeps: (problem.fall.reaction_substeps > 1)
+            .then_some(problem.fall.reaction_substeps),
         evolved_for: Some(problem.age_group),
     };
     let text = ron::ser::to_string_pretty(&controller, ron::ser::PrettyConfig::default())
@@ -760,6 +845,7 @@ mod tests {
             ga: GaConfig::default(),
             kp_max_scale,
             step_margin,
+            step: None,
             fall: None,
             checkpoint_every: 10,
             checkpoint_dir: None,
@@ -822,6 +908,84 @@ mod tests {
         for bad in [0.0, -0.5, 1.5, f64::NAN] {
             let e = scene(bad, 1.0).config().unwrap_err().to_string();
             assert!(e.contains("step_margin must be in (0, 1]"), "{e}");
+        }
+    }
+
+    #[test]
+    fn a_step_given_outright_replaces_the_margin_and_a_bad_one_is_refused() {
+        use crate::dynamics::integrator::Integrator;
+        let step = GaStep {
+            integrator: Integrator::LinearlyImplicitEuler,
+            dt_s: 0.002,
+            reaction_window_s: 0.1,
+            reaction_substeps: 4,
+        };
+        let mut s = scene(STEP_MARGIN, 1.0);
+        s.step = Some(step.clone());
+        let c = s.config().unwrap();
+        let f = &c.problems[0].fall;
+        assert_eq!(
+            (
+                f.integrator,
+                f.dt_s,
+                f.reaction_window_s,
+                f.reaction_substeps
+            ),
+            (Integrator::LinearlyImplicitEuler, 0.002, 0.1, 4)
+        );
+        // Everything else is the paper's problem.
+        let paper = FallProblem::paper(AgeGroup::Adult);
+        assert_eq!(f.push, paper.fall.push);
+        assert_eq!(c.problems[0].kp_max, paper.kp_max);
+        // The controller file carries the stepping, so a Fall scene replays it so; the
+        // paper's stepping writes nothing new.
+        let genes = vec![0.0; 2 * fall21().dof_names().len()];
+        let text = controller_ron(&c.problems[0], &genes).unwrap();
+        for field in [
+            "integrator: Some(LinearlyImplicitEuler)",
+            "reaction_window_s: Some(0.1)",
+            "reaction_substeps: Some(4)",
+        ] {
+            assert!(text.contains(field), "{field} in {text}");
+        }
+        let plain = controller_ron(&paper, &genes).unwrap();
+        assert!(
+            !plain.contains("integrator") && !plain.contains("reaction_"),
+            "{plain}"
+        );
+        for (bad, field) in [
+            (
+                GaStep {
+                    dt_s: 0.0,
+                    ..step.clone()
+                },
+                "step.dt_s",
+            ),
+            (
+                GaStep {
+                    dt_s: f64::NAN,
+                    ..step.clone()
+                },
+                "step.dt_s",
+            ),
+            (
+                GaStep {
+                    reaction_window_s: -0.1,
+                    ..step.clone()
+                },
+                "step.reaction_window_s",
+            ),
+            (
+                GaStep {
+                    reaction_substeps: 0,
+                    ..step.clone()
+                },
+                "step.reaction_substeps",
+            ),
+        ] {
+            s.step = Some(bad);
+            let e = s.config().unwrap_err().to_string();
+            assert!(e.contains(field), "{e}");
         }
     }
 }

@@ -41,6 +41,19 @@ pub struct Controller {
     /// fall replays with the same contact. A scene's own `controller` block overrides the
     /// file's; left out everywhere, the fall's `contact` decides.
     pub contact_implicit_damping: Option<bool>,
+    /// The integration scheme this controller was evolved with (written when it is not the
+    /// paper fall's): the fall replays with it. Overridden and left out as
+    /// `contact_implicit_damping`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub integrator: Option<crate::dynamics::integrator::Integrator>,
+    /// The finer reaction it was evolved with ([`FallConfig::reaction_window_s`], seconds;
+    /// written when above 0): the fall replays with it, as `integrator`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reaction_window_s: Option<f64>,
+    /// Sub-steps per step in that window ([`FallConfig::reaction_substeps`]; written when above
+    /// 1), as `integrator`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reaction_substeps: Option<u32>,
     /// The age group whose fall this controller was evolved on (an evolution writes it): that
     /// group's fall replays its evolved damage. The report names it
     /// (`controller_evolved_for`), and a fall of other groups only is noted on standard error.
@@ -326,6 +339,28 @@ impl FallScene {
         {
             c.contact.implicit_damping = b;
         }
+        let file = from_file.as_ref();
+        if let Some(i) = self
+            .controller
+            .integrator
+            .or(file.and_then(|f| f.integrator))
+        {
+            c.integrator = i;
+        }
+        if let Some(w) = self
+            .controller
+            .reaction_window_s
+            .or(file.and_then(|f| f.reaction_window_s))
+        {
+            c.reaction_window_s = w;
+        }
+        if let Some(k) = self
+            .controller
+            .reaction_substeps
+            .or(file.and_then(|f| f.reaction_substeps))
+        {
+            c.reaction_substeps = k;
+        }
         let evolved_for = self
             .controller
             .evolved_for
@@ -365,6 +400,37 @@ mod tests {
         assert_eq!(
             c.torque_limits_nm,
             FallConfig::paper(AgeGroup::Adult).torque_limits_nm
+        );
+    }
+
+    #[test]
+    fn a_controller_replays_with_the_scheme_it_was_evolved_with() {
+        use crate::dynamics::integrator::Integrator;
+        let f = fall(
+            "controller: (dt_s: Some(0.002), integrator: Some(LinearlyImplicitEuler), \
+             reaction_window_s: Some(0.1), reaction_substeps: Some(4))",
+        )
+        .unwrap();
+        let c = f.config(Path::new(".")).unwrap();
+        assert_eq!(
+            (
+                c.integrator,
+                c.dt_s,
+                c.reaction_window_s,
+                c.reaction_substeps
+            ),
+            (Integrator::LinearlyImplicitEuler, 0.002, 0.1, 4)
+        );
+        // Left out: the fall's own.
+        let c = fall("").unwrap().config(Path::new(".")).unwrap();
+        let paper = FallConfig::paper(AgeGroup::Adult);
+        assert_eq!(
+            (c.integrator, c.reaction_window_s, c.reaction_substeps),
+            (
+                paper.integrator,
+                paper.reaction_window_s,
+                paper.reaction_substeps
+            )
         );
     }
 
