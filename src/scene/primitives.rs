@@ -22,7 +22,7 @@ use crate::humanoid::{Model, ModelClip};
 use crate::primitive::{
     EventConfig, Gamma, JumpEvents, LearnConfig, Learned, Primitive, Trajectory,
 };
-use crate::render::{Figure, Page, PageMotion, PagePlot, Plot, Series, Track, plot};
+use crate::render::{Page, PageMotion, PagePlot, Plot, Series, StickFigure, Track, plot};
 
 /// Pictures of a primitive scene.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -137,7 +137,7 @@ pub(super) fn draw(
     out: &Path,
 ) -> Result<Vec<PageMotion>, SceneError> {
     let clips: Vec<_> = tracks.iter().map(|(_, m)| m.to_clip()).collect();
-    let figures: Vec<_> = clips.iter().map(|c| Figure::of(&c.skeleton)).collect();
+    let figures: Vec<_> = clips.iter().map(|c| StickFigure::of(&c.skeleton)).collect();
     let frames: Vec<_> = clips.iter().map(|c| c.point_frames()).collect();
     let t: Vec<Track> = tracks
         .iter()

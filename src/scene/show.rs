@@ -12,7 +12,7 @@ use crate::analysis::clip_contacts;
 use crate::ecs::{Clock, Recorder, kinematic_schedule, new_world, spawn_clip_character};
 use crate::humanoid::{Model, ModelClip};
 use crate::mapping::effector_errors;
-use crate::render::{Figure, Page, PageMotion, Plot, Series, Track, plot, pose_png};
+use crate::render::{Page, PageMotion, Plot, Series, StickFigure, Track, plot, pose_png};
 use crate::skeleton::Clip;
 
 /// What pictures a scene draws.
@@ -84,7 +84,7 @@ pub fn run_show(
     let mut report = json!({ "clip": scene.clip.file });
     let (clip, model_clip) = shown_clip(scene, &motion, &mut report)?;
     let frames = play_through_ecs(&clip);
-    let figure = Figure::of(&clip.skeleton);
+    let figure = StickFigure::of(&clip.skeleton);
     let label = match &scene.model {
         Some(m) => format!("{} on {m}", scene.name),
         None => scene.name.clone(),

@@ -5,7 +5,7 @@
 use marionette::bvh;
 use marionette::humanoid::Model;
 use marionette::mapping::{Mapping, effector_errors, retarget};
-use marionette::render::Figure;
+use marionette::render::StickFigure;
 use marionette::skeleton::Clip;
 
 use crate::common::data_dir;
@@ -40,7 +40,7 @@ fn every_data_file_maps_onto_both_models_and_looks_like_itself() {
             );
             // It renders: a filmstrip of the mapped clip.
             let shown = mapped.to_clip();
-            let figure = Figure::of(&shown.skeleton);
+            let figure = StickFigure::of(&shown.skeleton);
             let frames = shown.point_frames();
             let track = marionette::render::Track {
                 figure: &figure,

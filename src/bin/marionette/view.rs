@@ -51,7 +51,7 @@ fn motion(
         Some(name) => loaded.on_model(&Model::by_name(name)?)?.to_clip(),
         None => loaded.clip(),
     };
-    let figure = marionette::render::Figure::of(&clip.skeleton);
+    let figure = marionette::render::StickFigure::of(&clip.skeleton);
     let frames = clip.point_frames();
     let stem = file
         .file_stem()
