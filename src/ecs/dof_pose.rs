@@ -10,7 +10,7 @@ use glam::{DQuat, DVec3};
 
 use super::motion::JointState;
 use super::physics::PhysicsBody;
-use crate::humanoid::{Model, ROOT_CHANNELS};
+use crate::humanoid::{Figure, ROOT_CHANNELS};
 use crate::primitive::{Primitive, PrimitiveError};
 
 /// A character's current DOF state, written by its motion source (e.g. a primitive player).
@@ -40,7 +40,7 @@ impl DofPose {
 #[derive(Component, Clone, Debug)]
 pub struct ModelBinding {
     /// The model the pose drives.
-    pub model: Arc<Model>,
+    pub model: Arc<Figure>,
     dof_cols: Vec<usize>,
     root_cols: [usize; 6],
 }
@@ -48,7 +48,7 @@ pub struct ModelBinding {
 impl ModelBinding {
     /// Binds pose entries named `names` to `model`; every model DOF and root channel must be
     /// among them.
-    pub fn new(model: Arc<Model>, names: &[String]) -> Result<ModelBinding, PrimitiveError> {
+    pub fn new(model: Arc<Figure>, names: &[String]) -> Result<ModelBinding, PrimitiveError> {
         let col = |n: &str| {
             names
                 .iter()
@@ -86,7 +86,7 @@ impl ModelBinding {
 
 /// Sets every bound kinematic character's joint state from its DOF pose: the root from the
 /// root channels, every other joint's rotation from its DOF angles (see
-/// [`Model::local_rotations`]). A simulated character's joint state comes from its body instead
+/// [`Figure::local_rotations`]). A simulated character's joint state comes from its body instead
 /// ([`publish_body_pose`](super::human::publish_body_pose)); its DOF pose is the PD target.
 pub fn pose_from_dofs(
     mut q: Query<(&ModelBinding, &DofPose, &mut JointState), Without<PhysicsBody>>,

@@ -21,7 +21,7 @@ use super::clock::Clock;
 use super::dof_pose::{DofPose, ModelBinding, pose_from_dofs};
 use super::motion::{Character, JointState, Recorder, SkeletonRef};
 use super::sets::{MotionSet, configure_motion_sets};
-use crate::humanoid::Model;
+use crate::humanoid::Figure;
 
 use crate::primitive::blend::{BlendPlacement, Gamma};
 use crate::primitive::connect::HandOver;
@@ -300,7 +300,7 @@ pub fn add_primitive_systems(schedule: &mut Schedule) {
 pub fn spawn_primitive_character(
     world: &mut World,
     name: &str,
-    model: Arc<Model>,
+    model: Arc<Figure>,
     sequence: Vec<Arc<Primitive>>,
 ) -> Result<Entity> {
     let player = PrimitivePlayer::new(sequence)?;

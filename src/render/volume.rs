@@ -24,8 +24,8 @@
 //!
 //!   A root that only stands in for the ground (see [`super::figure::ground_proxy`]) gets none.
 //!
-//! Every volume carries the side of its point ([`super::StickFigure::sides`]) for its colour (but the
-//! head's).
+//! Every volume carries the side of its point ([`super::StickFigure::sides`]) for its colour
+//! (but the head's).
 
 use glam::{DMat3, DQuat, DVec3};
 
@@ -116,7 +116,7 @@ pub struct Volumes {
 }
 
 /// Bodies of the models the project simulates: (name, model).
-fn models() -> [(&'static str, humanoid::Model); 2] {
+fn models() -> [(&'static str, humanoid::Figure); 2] {
     [
         ("fall21", humanoid::fall21()),
         ("humanoid24", humanoid::humanoid24()),
@@ -158,7 +158,7 @@ impl Volumes {
     /// model cannot be built at that height.
     fn boxes(
         fig: &StickFigure,
-        model: &humanoid::Model,
+        model: &humanoid::Figure,
         height: f64,
         name: &str,
     ) -> Option<Volumes> {
@@ -379,7 +379,7 @@ fn parents_first(fig: &StickFigure) -> Vec<usize> {
 mod tests {
     use super::*;
 
-    fn model_track(model: &humanoid::Model, pts: &[Vec<DVec3>]) -> Volumes {
+    fn model_track(model: &humanoid::Figure, pts: &[Vec<DVec3>]) -> Volumes {
         let fig = StickFigure::of(&model.skeleton());
         let t = Track {
             figure: &fig,

@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Result, bail};
 
-use marionette::humanoid::Model;
+use marionette::humanoid::Figure;
 use marionette::render::{StickFigure, Track, animation_gif, filmstrip_png};
 use marionette::scene::{ClipSource, MAX_FILMSTRIP_FRAMES, load_motion};
 
@@ -73,7 +73,7 @@ pub fn render(args: Args) -> Result<()> {
     };
     let motion = load_motion(&src, base)?;
     let clip = match &model {
-        Some(name) => motion.on_model(&Model::by_name(name)?)?.to_clip(),
+        Some(name) => motion.on_model(&Figure::by_name(name)?)?.to_clip(),
         None => motion.clip(),
     };
     let figure = StickFigure::of(&clip.skeleton);
