@@ -18,7 +18,7 @@ use std::sync::Arc;
 use bevy_ecs::prelude::*;
 
 use super::clock::Clock;
-use super::dof_pose::{DofPose, ModelBinding, pose_from_dofs};
+use super::dof_pose::{DofPose, FigureBinding, pose_from_dofs};
 use super::motion::{Character, JointState, Recorder, SkeletonRef};
 use super::sets::{MotionSet, configure_motion_sets};
 use crate::humanoid::Figure;
@@ -280,7 +280,7 @@ pub fn step_blend_players(clock: Res<Clock>, mut q: Query<(&mut BlendPlayer, &mu
 
 /// Adds the primitive systems to `schedule`: [`PrimitiveSet::Players`] then
 /// [`PrimitiveSet::Blends`] inside [`MotionSet::Animate`], and [`pose_from_dofs`] in
-/// [`MotionSet::Pose`] (characters with a [`ModelBinding`] get their joint state from their DOF
+/// [`MotionSet::Pose`] (characters with a [`FigureBinding`] get their joint state from their DOF
 /// pose).
 pub fn add_primitive_systems(schedule: &mut Schedule) {
     configure_motion_sets(schedule);
@@ -305,7 +305,7 @@ pub fn spawn_primitive_character(
 ) -> Result<Entity> {
     let player = PrimitivePlayer::new(sequence)?;
     let pose = player.pose();
-    let binding = ModelBinding::new(model.clone(), &pose.names)?;
+    let binding = FigureBinding::new(model.clone(), &pose.names)?;
     let skeleton = Arc::new(model.skeleton());
     let n = skeleton.joints.len();
     Ok(world
