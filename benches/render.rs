@@ -9,11 +9,11 @@ use std::hint::black_box;
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::DVec3;
 use marionette::render::{
-    Figure, Plot, Series, Track, animation_gif, filmstrip_png, plot, pose_png,
+    Plot, Series, StickFigure, Track, animation_gif, filmstrip_png, plot, pose_png,
 };
 
 /// A 16-point walker at 120 Hz: legs and arms swing at 1 Hz, the body advances 1.2 m/s along +Z.
-fn walker(frames: usize) -> (Figure, Vec<Vec<DVec3>>) {
+fn walker(frames: usize) -> (StickFigure, Vec<Vec<DVec3>>) {
     let names = [
         "Hips",
         "Spine",
@@ -50,7 +50,7 @@ fn walker(frames: usize) -> (Figure, Vec<Vec<DVec3>>) {
         Some(13),
         Some(14),
     ];
-    let fig = Figure {
+    let fig = StickFigure {
         names: names.map(String::from).to_vec(),
         parents,
     };

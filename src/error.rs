@@ -19,7 +19,7 @@ pub enum Error {
     Mapping(#[from] crate::mapping::MappingError),
     /// An unknown model or a trajectory that does not fit one.
     #[error(transparent)]
-    Model(#[from] crate::humanoid::ModelError),
+    Figure(#[from] crate::humanoid::FigureError),
     /// A joint-range table.
     #[error(transparent)]
     Ranges(#[from] crate::humanoid::ranges::RangeError),
@@ -144,7 +144,9 @@ mod tests {
         let e = parse_missing_file().unwrap_err();
         assert!(matches!(e, Error::Keyframes(_)), "{e:?}");
         assert!(e.to_string().contains("/nonexistent/clip.ron"), "{e}");
-        let m: Error = crate::humanoid::Model::by_name("robot").unwrap_err().into();
+        let m: Error = crate::humanoid::Figure::by_name("robot")
+            .unwrap_err()
+            .into();
         assert_eq!(
             m.to_string(),
             "unknown model 'robot': expected one of humanoid24, fall21"

@@ -38,7 +38,7 @@ use super::database::Database;
 use super::eros::{Pca, eros_weights, pca};
 use super::features::{mirror_partners, motion_intensity, pose_rows};
 use super::segments::{Segment, boundary, leading_axes};
-use crate::humanoid::{Model, ModelClip, humanoid24};
+use crate::humanoid::{Figure, FigureClip, humanoid24};
 
 /// How a segment of an augmented database was made from a segment of the source database.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -62,7 +62,7 @@ pub struct Augmented {
 
 /// For every DOF of `model`, the DOF its angle goes to in the mirror image and the sign it takes
 /// there (module docs).
-pub fn mirror_dofs(model: &Model) -> Vec<(usize, f64)> {
+pub fn mirror_dofs(model: &Figure) -> Vec<(usize, f64)> {
     let names: Vec<String> = model.joints.iter().map(|j| j.name.clone()).collect();
     let partners = mirror_partners(&names);
     model
@@ -90,7 +90,7 @@ pub fn mirror_dofs(model: &Model) -> Vec<(usize, f64)> {
 }
 
 /// The mirror image of a motion on `clip.model` (module docs).
-pub fn mirror_clip(clip: &ModelClip) -> ModelClip {
+pub fn mirror_clip(clip: &FigureClip) -> FigureClip {
     let map = mirror_dofs(&clip.model);
     let d = clip.dof_count();
     let mut angles = vec![0.0; clip.angles.len()];
@@ -99,7 +99,7 @@ pub fn mirror_clip(clip: &ModelClip) -> ModelClip {
             angles[f * d + to] = sign * row[i];
         }
     }
-    ModelClip {
+    FigureClip {
         model: clip.model.clone(),
         frame_time: clip.frame_time,
         root_translation: clip
@@ -117,9 +117,9 @@ pub fn mirror_clip(clip: &ModelClip) -> ModelClip {
 }
 
 /// Frames `from..from + n` of `clip`.
-fn frames(clip: &ModelClip, from: usize, n: usize) -> ModelClip {
+fn frames(clip: &FigureClip, from: usize, n: usize) -> FigureClip {
     let d = clip.dof_count();
-    ModelClip {
+    FigureClip {
         model: clip.model.clone(),
         frame_time: clip.frame_time,
         root_translation: clip.root_translation[from..from + n].to_vec(),
@@ -129,7 +129,7 @@ fn frames(clip: &ModelClip, from: usize, n: usize) -> ModelClip {
 }
 
 /// The per-frame W(f) of a clip with the weights `alpha` (missing count 1).
-fn w_of(clip: &ModelClip, alpha: &[f64]) -> (Vec<f64>, Vec<Vec<glam::DVec3>>) {
+fn w_of(clip: &FigureClip, alpha: &[f64]) -> (Vec<f64>, Vec<Vec<glam::DVec3>>) {
     let points = clip.to_clip().point_frames();
     let a: Vec<f64> = (0..points.first().map_or(0, |p| p.len()))
         .map(|i| alpha.get(i).copied().unwrap_or(1.0))
@@ -140,7 +140,7 @@ fn w_of(clip: &ModelClip, alpha: &[f64]) -> (Vec<f64>, Vec<Vec<glam::DVec3>>) {
 /// Everything of a [`Segment`] that follows from its motion, recomputed for `clip` (one bar);
 /// `scale[f]` multiplies W at frame f (module docs).
 fn describe(
-    clip: &ModelClip,
+    clip: &FigureClip,
     like: &Segment,
     start_s: f64,
     scale: &[f64],
@@ -225,7 +225,7 @@ pub fn augment_with_variants(db: &Database, target_segments: usize, seed: u64) -
 }
 
 /// Each segment's factor from the W recomputed on `model` to its stored intensity.
-fn intensity_factors(db: &Database, model: &Model) -> Vec<f64> {
+fn intensity_factors(db: &Database, model: &Figure) -> Vec<f64> {
     let alpha = &db.params.alpha;
     db.segments
         .par_iter()
@@ -289,7 +289,7 @@ fn choose_variants(db: &Database, target_segments: usize, seed: u64) -> Vec<Vari
 
 /// The segment of variant `v`: its source bar (continued into the next bar by its offset,
 /// mirrored if it is), described afresh with the sources' intensity `factors`.
-fn variant_segment(db: &Database, model: &Model, factors: &[f64], v: &Variant) -> Segment {
+fn variant_segment(db: &Database, model: &Figure, factors: &[f64], v: &Variant) -> Segment {
     let (alpha, axes) = (&db.params.alpha, db.params.eros_axes);
     let s = &db.segments[v.source];
     let n = s.frame_count();
@@ -354,7 +354,7 @@ mod tests {
                 angles[f * d + i] = 0.3 * ((f * 7 + i * 3) as f64 * 0.37).sin();
             }
         }
-        let clip = ModelClip {
+        let clip = FigureClip {
             model: model.clone(),
             frame_time: 1.0 / 30.0,
             root_translation: (0..n)

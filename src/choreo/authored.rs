@@ -20,7 +20,7 @@ use std::f64::consts::PI;
 use glam::{DMat3, DQuat, DVec2, DVec3};
 use serde::{Deserialize, Serialize};
 
-use crate::humanoid::{Model, ModelClip, humanoid24};
+use crate::humanoid::{Figure, FigureClip, humanoid24};
 
 /// What to generate.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -77,7 +77,7 @@ pub struct AuthoredClip {
     pub families: Vec<&'static str>,
     /// The motion on humanoid24; frame 0 is the first bar's downbeat, and the clip holds the last
     /// pose for one more beat after its last bar.
-    pub motion: ModelClip,
+    pub motion: FigureClip,
 }
 
 impl AuthoredClip {
@@ -628,7 +628,7 @@ struct Leg {
 }
 
 impl Leg {
-    fn of(model: &Model, side: &str) -> Leg {
+    fn of(model: &Figure, side: &str) -> Leg {
         let j = |n: &str| {
             model
                 .joint_index(&format!("{side}_{n}"))
@@ -728,7 +728,7 @@ fn full_reach(leg: &Leg) -> f64 {
 }
 
 /// Standing pelvis height of the model with the toes on the floor, metres.
-fn standing_height(model: &Model) -> f64 {
+fn standing_height(model: &Figure) -> f64 {
     let leg = Leg::of(model, "left");
     leg.thigh + leg.shin - leg.toe.y
 }
@@ -770,7 +770,7 @@ fn generate_clip(p: &AuthoredDance, c: usize) -> AuthoredClip {
     let dofs = DanceDofs::of(&model);
     let legs = [Leg::of(&model, "left"), Leg::of(&model, "right")];
     let stand = standing_height(&model);
-    let mut motion = ModelClip::with_capacity(model.clone(), 1.0 / p.fps, frames);
+    let mut motion = FigureClip::with_capacity(model.clone(), 1.0 / p.fps, frames);
     for f in 0..frames {
         let t = f as f64 / p.fps;
         let x = t / beat;
@@ -832,7 +832,7 @@ struct DanceDofs {
 }
 
 impl DanceDofs {
-    fn of(model: &Model) -> DanceDofs {
+    fn of(model: &Figure) -> DanceDofs {
         let dof = |n: &str| model.dof_index(n).expect("humanoid24 DOF");
         DanceDofs {
             count: model.dofs.len(),
@@ -918,7 +918,7 @@ mod tests {
     #[test]
     fn leg_ik_puts_the_toe_on_its_target() {
         let model = humanoid24();
-        let clip = ModelClip {
+        let clip = FigureClip {
             model: model.clone(),
             frame_time: 0.1,
             root_translation: vec![DVec3::new(0.05, 0.82, 0.02)],
@@ -972,7 +972,7 @@ mod tests {
     }
 
     /// Heights and horizontal speeds of both toes and ankles, per frame.
-    fn feet(c: &ModelClip) -> Vec<[DVec3; 4]> {
+    fn feet(c: &FigureClip) -> Vec<[DVec3; 4]> {
         let names = c.model.skeleton().point_names();
         let idx: Vec<usize> = [
             "left_ankle",

@@ -60,7 +60,7 @@ use super::database::Database;
 use super::music::Bar;
 use super::segments::{BEATS_PER_BAR, Segment, speed_curve};
 use super::warp::{Warp, count_minima};
-use crate::humanoid::{ModelClip, humanoid24};
+use crate::humanoid::{FigureClip, humanoid24};
 
 /// Slowest frame rate of a dance, frames per second.
 pub const MIN_FPS: f64 = 1.0;
@@ -122,7 +122,7 @@ impl Default for DanceParams {
 #[derive(Debug, Clone, PartialEq)]
 pub struct Dance {
     /// The whole dance on humanoid24; frame 0 at the first bar's start.
-    pub clip: ModelClip,
+    pub clip: FigureClip,
     /// The song time of frame 0 (the first bar's start), seconds.
     pub start_s: f64,
     /// The time of every seam (the start of bars 1, 2, …) from frame 0, seconds.
@@ -275,7 +275,7 @@ pub fn assemble(
     } else {
         Default::default()
     };
-    let parts: Vec<(usize, ModelClip)> = segments
+    let parts: Vec<(usize, FigureClip)> = segments
         .par_iter()
         .zip(bars)
         .enumerate()
@@ -294,7 +294,7 @@ pub fn assemble(
         })
         .collect();
 
-    let mut clip = ModelClip::with_capacity(model.clone(), dt, frames);
+    let mut clip = FigureClip::with_capacity(model.clone(), dt, frames);
     // The carry-on of the previous bar: its rotation about Y and horizontal offset, and where
     // its segment ends (extrapolated to phase 1) in the dance.
     let mut end: Option<(DVec3, f64)> = None;
@@ -355,7 +355,7 @@ fn phase_one_end(seg: &Segment, turn: DQuat, offset: DVec3) -> (DVec3, f64) {
 
 /// Every seam of `clip` (at the first frame of each bar of `bar_frames` after the first)
 /// rewritten over `w` frames on each side as `seam` says; nothing when `w` is 0.
-fn rewrite_seams(clip: &mut ModelClip, bar_frames: &[(usize, usize)], w: usize, seam: Seam) {
+fn rewrite_seams(clip: &mut FigureClip, bar_frames: &[(usize, usize)], w: usize, seam: Seam) {
     if w == 0 {
         return;
     }
@@ -518,7 +518,7 @@ pub const BEAT_SUBSAMPLES: usize = 4;
 /// bar of 32 frames at 85 BPM has a frame every 88 ms, too coarse for beats judged within
 /// σ = 50 ms). The speed is taken at one frame per unit time: a bar's length scales the curve,
 /// not where its minima are.
-pub fn segment_beats(seg: &Segment, model: &crate::humanoid::Model) -> Vec<Option<f64>> {
+pub fn segment_beats(seg: &Segment, model: &crate::humanoid::Figure) -> Vec<Option<f64>> {
     let n = seg.frame_count() * BEAT_SUBSAMPLES;
     let step = 1.0 / BEAT_SUBSAMPLES as f64;
     let mut clip = sample(seg, model.dofs.len(), (0..n).map(|i| i as f64 * step));
@@ -554,7 +554,7 @@ fn bar_warp(bar: &Bar, beats_s: &[f64], own: &[Option<f64>]) -> Warp {
 /// the segment's frames (C², so that the time-resized motion has no kinks at the frames; past
 /// the last frame its last piece continues), the root orientation by slerp between frames (held
 /// past the last); a whole frame is that frame exactly.
-fn sample(seg: &Segment, dofs: usize, xs: impl Iterator<Item = f64>) -> ModelClip {
+fn sample(seg: &Segment, dofs: usize, xs: impl Iterator<Item = f64>) -> FigureClip {
     let m = seg.frame_count();
     let channels = dofs + 3;
     // Channel-major values and the spline's second derivatives.
@@ -569,7 +569,7 @@ fn sample(seg: &Segment, dofs: usize, xs: impl Iterator<Item = f64>) -> ModelCli
         .map(|c| (0..m).map(|i| value(c, i)).collect())
         .collect();
     let second: Vec<Vec<f64>> = y.iter().map(|v| natural_spline(v)).collect();
-    let mut out = ModelClip {
+    let mut out = FigureClip {
         model: humanoid24(),
         frame_time: 1.0,
         root_translation: vec![],
@@ -680,7 +680,7 @@ fn log(q: DQuat) -> DVec3 {
 
 /// Rewrites frames [s − w, s + w) of `out` by the natural cubic spline through the
 /// [`SEAM_KNOTS`] frames of `src` on each side of the window (module docs).
-fn rewrite_seam(src: &ModelClip, out: &mut ModelClip, s: usize, w: usize) {
+fn rewrite_seam(src: &FigureClip, out: &mut FigureClip, s: usize, w: usize) {
     let knots: Vec<usize> = (s - w - SEAM_KNOTS..s - w)
         .chain(s + w..s + w + SEAM_KNOTS)
         .collect();
@@ -704,8 +704,8 @@ type Values<'a> = &'a dyn Fn(usize) -> f64;
 /// frame q_a before the window (q = q_a exp(r), each on q_a's hemisphere), each channel's new
 /// values over the window given by `channel` from its values in `src` at any frame.
 fn rewrite_window(
-    src: &ModelClip,
-    out: &mut ModelClip,
+    src: &FigureClip,
+    out: &mut FigureClip,
     window: std::ops::Range<usize>,
     mut channel: impl FnMut(Values) -> Vec<f64>,
 ) {
@@ -764,7 +764,7 @@ fn acceleration_fade(tau: f64) -> f64 {
 /// ([`offset_fade`], [`velocity_fade`], [`acceleration_fade`]). Both sides then meet at s with
 /// the mean of their positions, velocities and accelerations, and the window's
 /// ends keep their frames' position, velocity and acceleration.
-fn offset_seam(src: &ModelClip, out: &mut ModelClip, s: usize, w: usize) {
+fn offset_seam(src: &FigureClip, out: &mut FigureClip, s: usize, w: usize) {
     let half = w as f64;
     let shift = |value: Values| -> Vec<f64> {
         let (p1, p2, p3) = (value(s - 1), value(s - 2), value(s - 3));
@@ -985,10 +985,10 @@ mod offset_seam_tests {
 
     /// A humanoid24 clip of `n` frames whose every angle and root coordinate follows
     /// `value(frame)`, and its heading a tenth of it.
-    fn clip(n: usize, value: impl Fn(usize) -> f64) -> ModelClip {
+    fn clip(n: usize, value: impl Fn(usize) -> f64) -> FigureClip {
         let model = humanoid24();
         let d = model.dofs.len();
-        ModelClip {
+        FigureClip {
             model,
             frame_time: 1.0 / 30.0,
             root_translation: (0..n).map(|f| DVec3::splat(value(f))).collect(),
@@ -1026,7 +1026,7 @@ mod offset_seam_tests {
         let mut spline = src.clone();
         rewrite_seam(&src, &mut spline, s, w);
         let d = src.dof_count();
-        let track = |c: &ModelClip| -> Vec<f64> { (0..40).map(|f| c.angles[f * d]).collect() };
+        let track = |c: &FigureClip| -> Vec<f64> { (0..40).map(|f| c.angles[f * d]).collect() };
         let (o, p) = (track(&offset), track(&spline));
         let step = |x: &[f64], f: usize| (x[f + 1] - x[f]).abs();
         // Outside the window nothing moves.

@@ -26,7 +26,7 @@ pub use super::segments::BuildParams;
 use super::segments::{
     Beat, Segment, SegmentError, TempoSource, check_tempo, cut_segments, kinematic_beat,
 };
-use crate::humanoid::{ModelClip, humanoid24};
+use crate::humanoid::{FigureClip, humanoid24};
 
 /// Newest manifest format this build reads.
 pub const MANIFEST_VERSION: u32 = 1;
@@ -246,7 +246,7 @@ fn clip_segments(
 /// A clip on humanoid24: a BVH mapped with the detected mapping, retargeted and played on
 /// humanoid24's own proportions with its root path scaled by the ratio of the leg lengths
 /// ([`crate::mapping::onto_model`]), or a keyframed .ron clip; set on its floor ([`grounded`]).
-pub fn load_model_clip(path: &Path) -> Result<ModelClip, SegmentError> {
+pub fn load_model_clip(path: &Path) -> Result<FigureClip, SegmentError> {
     load_unground(path, None).map(grounded)
 }
 
@@ -255,7 +255,7 @@ pub fn load_model_clip(path: &Path) -> Result<ModelClip, SegmentError> {
 pub fn load_model_clip_with(
     path: &Path,
     mapping: Option<&Path>,
-) -> Result<ModelClip, SegmentError> {
+) -> Result<FigureClip, SegmentError> {
     load_unground(path, mapping).map(grounded)
 }
 
@@ -264,7 +264,7 @@ pub fn load_model_clip_with(
 /// lowest foot point), so clips captured or mapped with their feet above or below y = 0 (a
 /// mapped skeleton's feet are not the source's) stand on one floor when their bars are
 /// joined. A clip without feet is returned as it is.
-pub fn grounded(mut clip: ModelClip) -> ModelClip {
+pub fn grounded(mut clip: FigureClip) -> FigureClip {
     let config = crate::analysis::ContactConfig::default();
     if let Some(c) = crate::analysis::clip_contacts_with(&clip.to_clip(), &config) {
         let floor = c.floor_y_m;
@@ -277,7 +277,7 @@ pub fn grounded(mut clip: ModelClip) -> ModelClip {
     clip
 }
 
-fn load_unground(path: &Path, mapping: Option<&Path>) -> Result<ModelClip, SegmentError> {
+fn load_unground(path: &Path, mapping: Option<&Path>) -> Result<FigureClip, SegmentError> {
     let load = |e: crate::Error| SegmentError::Load {
         path: path.display().to_string(),
         source: Box::new(e),
@@ -409,7 +409,7 @@ impl Database {
     /// A database from clips already on humanoid24 (e.g. the project's own dance, built in
     /// memory), each with its name and its beat when known (else the kinematic beat).
     pub fn from_clips(
-        clips: &[(String, ModelClip, Option<Beat>)],
+        clips: &[(String, FigureClip, Option<Beat>)],
         params: &BuildParams,
     ) -> Result<Database, SegmentError> {
         if clips.is_empty() {
@@ -789,7 +789,7 @@ mod tests {
         let d = model.dofs.len();
         let n = 60;
         for y in [0.3, 0.95, 2.0] {
-            let clip = ModelClip {
+            let clip = FigureClip {
                 model: model.clone(),
                 frame_time: 1.0 / 30.0,
                 root_translation: vec![DVec3::new(0.5, y, -1.0); n],

@@ -51,7 +51,7 @@ use serde::{Deserialize, Serialize};
 use crate::analysis::{
     ContactConfig, ContactReference, Contacts, PointRef, foot_points, ground_contacts_against,
 };
-use crate::humanoid::ModelClip;
+use crate::humanoid::FigureClip;
 use crate::humanoid::leg_ik::{Leg, chain_globals, frame_globals, reach_along, with_ancestors};
 use crate::skeleton::{Skeleton, Transform};
 
@@ -118,7 +118,7 @@ pub struct Planting {
 
 /// Sole height of every foot point: its height in the rest pose of `clip.model` standing on the
 /// floor, `[left, right]` in [`foot_points`] order, metres.
-pub fn rest_sole_heights(clip: &ModelClip) -> [Vec<f64>; 2] {
+pub fn rest_sole_heights(clip: &FigureClip) -> [Vec<f64>; 2] {
     let skeleton = clip.model.skeleton();
     let feet = foot_points(&skeleton);
     let mut g = vec![];
@@ -210,7 +210,7 @@ fn hermite(c0: DVec3, v0: DVec3, c1: DVec3, v1: DVec3, len: usize, at: usize) ->
 
 /// Plants the feet of `clip` (module docs); a model without two legs ([`Leg::of`]) or feet is
 /// left as it is.
-pub fn plant_feet(clip: &mut ModelClip, p: &PlantParams) -> Planting {
+pub fn plant_feet(clip: &mut FigureClip, p: &PlantParams) -> Planting {
     let mut report = Planting::default();
     let n = clip.frame_count();
     let legs = [Leg::of(&clip.model, "left"), Leg::of(&clip.model, "right")];
@@ -264,7 +264,7 @@ struct Plan {
 /// The [`Plan`] of `clip`, whose foot points are at `before` (module docs: contact, ground,
 /// lift, lock, smoothing).
 fn plan(
-    clip: &ModelClip,
+    clip: &FigureClip,
     model: &Feet,
     before: &[[Vec<DVec3>; 2]],
     p: &PlantParams,
@@ -318,7 +318,7 @@ struct LegReach {
 /// The foot points of `clip` at every frame ([`Feet::positions`]) and its [`LegReach`], the
 /// cap taken over ±`blend` frames.
 fn placed(
-    clip: &ModelClip,
+    clip: &FigureClip,
     legs: &[Leg; 2],
     model: &Feet,
     blend: usize,
@@ -423,7 +423,7 @@ struct Feet {
 
 impl Feet {
     /// The foot points of both feet at frame `f` of `clip`, world space.
-    fn positions(&self, clip: &ModelClip, f: usize, g: &mut Vec<Transform>) -> [Vec<DVec3>; 2] {
+    fn positions(&self, clip: &FigureClip, f: usize, g: &mut Vec<Transform>) -> [Vec<DVec3>; 2] {
         let (t, q) = (clip.root_translation[f], clip.root_rotation[f]);
         chain_globals(&clip.model, &self.chain, t, q, clip.frame_angles(f), g);
         self.points_in(g)
@@ -450,7 +450,7 @@ fn sole_height(pts: &[DVec3], rest: &[f64]) -> f64 {
 
 /// Both feet's contact spans against the floor y = 0 and the rest heights `rest`.
 fn floor_contacts(
-    clip: &ModelClip,
+    clip: &FigureClip,
     before: &[[Vec<DVec3>; 2]],
     rest: &[Vec<f64>; 2],
     config: &ContactConfig,
@@ -692,7 +692,7 @@ fn smooth_and_floor(
 /// The legs sent to their targets: each foot moved by its correction, the ankle reached by IK
 /// and the foot's residual added to the ankle's target, [`IK_ROUNDS`] times at most.
 fn reach_targets(
-    clip: &mut ModelClip,
+    clip: &mut FigureClip,
     legs: &[Leg; 2],
     model: &Feet,
     before: &[[Vec<DVec3>; 2]],
@@ -774,7 +774,7 @@ mod tests {
     /// humanoid24 for `frames` frames at 60 fps, knees bent `knee` rad (hips flexed to keep the
     /// shins upright), its sole `sole` m off the floor (negative: in it), the pelvis gliding
     /// along x at `speed` m/s.
-    fn stance(knee: f64, sole: f64, speed: f64, frames: usize) -> ModelClip {
+    fn stance(knee: f64, sole: f64, speed: f64, frames: usize) -> FigureClip {
         let model = humanoid24();
         let d = model.dofs.len();
         let mut pose = vec![0.0; d];
@@ -782,7 +782,7 @@ mod tests {
             pose[model.dof_index(&format!("{side}_knee")).unwrap()] = knee;
             pose[model.dof_index(&format!("{side}_hip_flexion")).unwrap()] = knee;
         }
-        let mut clip = ModelClip {
+        let mut clip = FigureClip {
             model,
             frame_time: 1.0 / 60.0,
             root_translation: vec![DVec3::ZERO; frames],
@@ -812,7 +812,7 @@ mod tests {
         clip
     }
 
-    fn foot_tracks(clip: &ModelClip) -> [Vec<Vec<DVec3>>; 2] {
+    fn foot_tracks(clip: &FigureClip) -> [Vec<Vec<DVec3>>; 2] {
         let c = clip.to_clip();
         let [l, r] = foot_points(&c.skeleton);
         [
@@ -855,7 +855,7 @@ mod tests {
         // throughout: the legs may not stretch further, so the pelvis comes down 2 cm and the
         // soles with it, the knees kept. Without `pelvis` the feet stay up (the legs are
         // capped at their own stretch), and without `ground` the figure is left alone.
-        let lowest = |clip: &ModelClip| {
+        let lowest = |clip: &FigureClip| {
             let rest = rest_sole_heights(clip);
             let tracks = foot_tracks(clip);
             (0..2)

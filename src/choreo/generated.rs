@@ -10,7 +10,7 @@ use rand::{Rng, RngExt, SeedableRng};
 use super::database::{BuildParams, DATABASE_VERSION, Database, Source};
 use super::eros::eros_weights;
 use super::segments::{Beat, SegmentError, TempoSource, cut_segments};
-use crate::humanoid::{ModelClip, humanoid24};
+use crate::humanoid::{FigureClip, humanoid24};
 
 /// One move of a generated dance: per DOF an offset, an amplitude, a phase and a frequency (½
 /// or ¼ per beat: one or two swings a bar); a turn rate and a travel speed of the root.
@@ -45,7 +45,7 @@ fn generated_clip(
     bpm: f64,
     bars: usize,
     fps: f64,
-) -> ModelClip {
+) -> FigureClip {
     let model = humanoid24();
     let d = model.dofs.len();
     let beat = 60.0 / bpm;
@@ -59,7 +59,7 @@ fn generated_clip(
             out[j] += off + amp * (TAU * freq * t / beat + ph).sin();
         }
     };
-    let mut clip = ModelClip {
+    let mut clip = FigureClip {
         model,
         frame_time: 1.0 / fps,
         root_translation: Vec::with_capacity(frames),

@@ -49,7 +49,7 @@ use crate::analysis::{
     ContactConfig, ContactReference, Contacts, clip_contacts_and_feet, ground_contacts_against,
     point_tracks,
 };
-use crate::humanoid::ModelClip;
+use crate::humanoid::FigureClip;
 
 /// σ of the beat alignment score: 3 frames at 60 fps, seconds.
 pub const BAS_SIGMA_S: f64 = 3.0 / 60.0;
@@ -134,7 +134,7 @@ pub struct FootPenetration {
 
 /// The foot penetration of a clip against the floor y = 0 (module docs); zeros for a clip
 /// without feet.
-pub fn foot_penetration(clip: &ModelClip) -> FootPenetration {
+pub fn foot_penetration(clip: &FigureClip) -> FootPenetration {
     let n = clip.frame_count();
     let Some((contacts, feet)) = floor_contacts(clip) else {
         return FootPenetration::default();
@@ -288,7 +288,7 @@ pub fn source_metrics(db: &Database, segments: &[usize], fps: f64) -> SourceMetr
 }
 
 /// The motion beats of a clip (module docs), seconds from its first frame.
-pub fn motion_beats(clip: &ModelClip) -> Vec<f64> {
+pub fn motion_beats(clip: &FigureClip) -> Vec<f64> {
     let fps = 1.0 / clip.frame_time;
     let v = speed_curve(&clip.to_clip().point_frames(), fps);
     let order = ((BEAT_ORDER_S * fps).round() as usize).max(1);
@@ -322,7 +322,7 @@ pub fn beat_alignment_score(motion_s: &[f64], music_s: &[f64], sigma_s: f64) -> 
 }
 
 /// The angular jerk magnitude of every sample f = 1 .. frames − 2 (index f − 1), rad/s³.
-pub fn angular_jerk(clip: &ModelClip) -> Vec<f64> {
+pub fn angular_jerk(clip: &FigureClip) -> Vec<f64> {
     let n = clip.frame_count();
     let dt3 = clip.frame_time.powi(3);
     if n < 4 {
@@ -372,7 +372,7 @@ pub fn seam_jerk(dance: &Dance) -> (Jerk, Jerk) {
 
 /// Foot skating of a clip: (mean horizontal speed in contact m/s, contact fraction of the
 /// foot points' frames) (module docs), the floor and rest heights estimated from the clip.
-pub fn foot_skating(clip: &ModelClip) -> (f64, f64) {
+pub fn foot_skating(clip: &FigureClip) -> (f64, f64) {
     let c = clip.to_clip();
     match clip_contacts_and_feet(&c, &ContactConfig::default()) {
         Some((contacts, feet)) => skating(clip, &contacts, &feet),
@@ -383,7 +383,7 @@ pub fn foot_skating(clip: &ModelClip) -> (f64, f64) {
 /// [`foot_skating`] against the floor y = 0 and the rest heights of the model standing on it
 /// ([`super::feet::rest_sole_heights`]): the measure of a dance and of its source segments,
 /// which all stand on that floor, so that one floor and one standard judge them all.
-pub fn foot_skating_on_floor(clip: &ModelClip) -> (f64, f64) {
+pub fn foot_skating_on_floor(clip: &FigureClip) -> (f64, f64) {
     match floor_contacts(clip) {
         Some((contacts, feet)) => skating(clip, &contacts, &feet),
         None => (0.0, 0.0),
@@ -392,7 +392,7 @@ pub fn foot_skating_on_floor(clip: &ModelClip) -> (f64, f64) {
 
 /// The contacts of `clip`'s feet against the floor y = 0 and the model's standing rest heights
 /// ([`ground_contacts_against`]), and the foot points' tracks; `None` without feet.
-pub fn floor_contacts(clip: &ModelClip) -> Option<(Contacts, [Vec<Vec<DVec3>>; 2])> {
+pub fn floor_contacts(clip: &FigureClip) -> Option<(Contacts, [Vec<Vec<DVec3>>; 2])> {
     let c = clip.to_clip();
     let [lf, rf] = crate::analysis::foot_points(&c.skeleton);
     if lf.is_empty() || rf.is_empty() {
@@ -416,7 +416,7 @@ pub fn floor_contacts(clip: &ModelClip) -> Option<(Contacts, [Vec<Vec<DVec3>>; 2
 }
 
 /// Skating of the foot tracks `feet` under `contacts` (module docs).
-fn skating(clip: &ModelClip, contacts: &Contacts, feet: &[Vec<Vec<DVec3>>; 2]) -> (f64, f64) {
+fn skating(clip: &FigureClip, contacts: &Contacts, feet: &[Vec<Vec<DVec3>>; 2]) -> (f64, f64) {
     let n = clip.frame_count();
     if n < 2 {
         return (0.0, 0.0);
@@ -482,7 +482,7 @@ pub fn dance_metrics(dance: &Dance, beats_s: &[f64], fill: &Fill) -> DanceMetric
 /// k with t_k within the clip, k < 0 included), σ = [`BAS_SIGMA_S`]; what the dance's own score is
 /// measured against. 0 for a tempo that is not a positive number of BPM, a beat shorter than a
 /// frame, or a clip without motion beats.
-pub fn source_beat_alignment(clip: &ModelClip, beat: &super::segments::Beat) -> f64 {
+pub fn source_beat_alignment(clip: &FigureClip, beat: &super::segments::Beat) -> f64 {
     let period = 60.0 / beat.tempo_bpm;
     if !(period.is_finite() && period >= clip.frame_time && beat.first_beat_s.is_finite()) {
         return 0.0;
@@ -513,11 +513,11 @@ mod tests {
 
     /// humanoid24 standing still (angles 0) for 2 s at 60 fps, its pelvis at `y` and gliding
     /// along x at `speed` m/s.
-    fn gliding(y: f64, speed: f64) -> ModelClip {
+    fn gliding(y: f64, speed: f64) -> FigureClip {
         let model = crate::humanoid::humanoid24();
         let d = model.dofs.len();
         let n = 120;
-        ModelClip {
+        FigureClip {
             model,
             frame_time: 1.0 / 60.0,
             root_translation: (0..n)
@@ -571,7 +571,7 @@ mod tests {
             let t = f as f64 / fps;
             angles[f * d] = 2.0 * t * t * t; // x''' = 12
         }
-        let clip = ModelClip {
+        let clip = FigureClip {
             model,
             frame_time: 1.0 / fps,
             root_translation: vec![DVec3::ZERO; n],

@@ -27,7 +27,7 @@ use super::eros::{Pca, pca};
 pub use super::error::SegmentError;
 use super::features::{joint_speeds, mean_motion_intensity, pose_rows};
 use crate::analysis::signal::{gaussian_smooth, median};
-use crate::humanoid::ModelClip;
+use crate::humanoid::FigureClip;
 
 /// Counts (beats) per segment: one bar of 4/4.
 pub const BEATS_PER_BAR: usize = 4;
@@ -259,7 +259,7 @@ pub fn kinematic_first_beat(speed: &[f64], fps: f64, tempo_bpm: f64) -> f64 {
 /// steady speed, module docs); with
 /// the song's tempo `music_bpm`, the octave level nearest it ([`kinematic_tempo`]).
 pub fn kinematic_beat(
-    clip: &ModelClip,
+    clip: &FigureClip,
     name: &str,
     music_bpm: Option<f64>,
 ) -> Result<Beat, SegmentError> {
@@ -387,9 +387,9 @@ impl Segment {
 
     /// The segment's motion as a clip on `model` (humanoid24) at its real timing: the bar's
     /// length spread over its resampled frames.
-    pub fn clip(&self, model: &crate::humanoid::Model) -> ModelClip {
+    pub fn clip(&self, model: &crate::humanoid::Figure) -> FigureClip {
         let n = self.frame_count().max(1);
-        ModelClip {
+        FigureClip {
             model: model.clone(),
             frame_time: (self.end_s - self.start_s) / n as f64,
             root_translation: self.root_translation.clone(),
@@ -401,10 +401,10 @@ impl Segment {
 
 /// `clip` resampled at the times `times` (seconds): angles and pelvis position interpolated
 /// linearly, pelvis orientation by slerp; times are clamped to the clip.
-pub fn resample(clip: &ModelClip, times: &[f64]) -> ModelClip {
+pub fn resample(clip: &FigureClip, times: &[f64]) -> FigureClip {
     let n = clip.frame_count();
     let d = clip.dof_count();
-    let mut out = ModelClip {
+    let mut out = FigureClip {
         model: clip.model.clone(),
         frame_time: if times.len() > 1 {
             times[1] - times[0]
@@ -486,7 +486,7 @@ fn check_beat(name: &str, beat: &Beat) -> Result<(), SegmentError> {
 
 /// The motion intensity of the bar from `start_s` to `end_s` at the clip's own timing, over the
 /// frames of the bar, the points weighted by `alpha` (1 past its end).
-fn bar_intensity(clip: &ModelClip, start_s: f64, end_s: f64, alpha: &[f64]) -> f64 {
+fn bar_intensity(clip: &FigureClip, start_s: f64, end_s: f64, alpha: &[f64]) -> f64 {
     let fps = 1.0 / clip.frame_time;
     let first = (start_s * fps).round() as usize;
     let last = ((end_s * fps).round() as usize).min(clip.frame_count() - 1);
@@ -508,7 +508,7 @@ fn bar_intensity(clip: &ModelClip, start_s: f64, end_s: f64, alpha: &[f64]) -> f
 /// point in the motion intensity (missing weights count 1). A clip shorter than a bar is an
 /// error.
 pub fn cut_segments(
-    clip: &ModelClip,
+    clip: &FigureClip,
     name: &str,
     clip_index: usize,
     beat: &Beat,

@@ -10,7 +10,7 @@ use glam::DVec3;
 use super::GRAVITY;
 use crate::dynamics::data::Data;
 use crate::dynamics::kinematics::kinematics;
-use crate::humanoid::ModelClip;
+use crate::humanoid::FigureClip;
 use crate::humanoid::body::{HumanBody, HumanError, human_body};
 
 /// Nominal mass of the body whose centre of mass is taken, kg (the centre of mass does not
@@ -26,7 +26,7 @@ const REFERENCE_HEIGHT_M: f64 = 1.70;
 /// `c = r + (h/h₀) Σ m_i (p_i + R_i c_i) / Σ m_i` over the links of the body of its model built
 /// at height h₀ = [`REFERENCE_HEIGHT_M`] with its root at the origin, r the clip's root and h its
 /// model's height. Fails only for a model whose root is not a free pelvis.
-pub fn centre_of_mass_track(clip: &ModelClip) -> Result<Vec<DVec3>, HumanError> {
+pub fn centre_of_mass_track(clip: &FigureClip) -> Result<Vec<DVec3>, HumanError> {
     let body: HumanBody = human_body(&clip.model, REFERENCE_HEIGHT_M, NOMINAL_MASS_KG, GRAVITY)?;
     let scale = clip.model.height / REFERENCE_HEIGHT_M;
     let mut data = Data::new(&body.model);
@@ -55,7 +55,7 @@ pub fn centre_of_mass_track(clip: &ModelClip) -> Result<Vec<DVec3>, HumanError> 
 /// `c(t) = c_a + (c_b − c_a)(t − a)/T + ½ g (t − a)(t − b)` with T = b − a (straight and uniform
 /// horizontally). Returns the largest root displacement, metres.
 pub fn make_flights_ballistic(
-    clip: &mut ModelClip,
+    clip: &mut FigureClip,
     flights: &[(f64, f64)],
 ) -> Result<f64, HumanError> {
     let com = centre_of_mass_track(clip)?;
@@ -87,7 +87,7 @@ pub fn make_flights_ballistic(
 /// `max(−(c̈_y + g))/g` over the frames, `c̈` the centred second difference of
 /// [`centre_of_mass_track`] (a floor only pushes up, so a motion a body can make has ≤ 0),
 /// with the time (s) where it is largest.
-pub fn max_downward_pull_bw(clip: &ModelClip) -> Result<(f64, f64), HumanError> {
+pub fn max_downward_pull_bw(clip: &FigureClip) -> Result<(f64, f64), HumanError> {
     let com = centre_of_mass_track(clip)?;
     let dt = clip.frame_time;
     let mut worst = (f64::NEG_INFINITY, 0.0);

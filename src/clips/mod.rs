@@ -19,7 +19,7 @@ use std::path::Path;
 use glam::{DQuat, DVec3};
 use serde::{Deserialize, Serialize};
 
-use crate::humanoid::{Model, ModelClip};
+use crate::humanoid::{Figure, FigureClip};
 
 /// The RON format version this build reads.
 pub const FORMAT_VERSION: u32 = 1;
@@ -98,7 +98,7 @@ pub enum KeyframeError {
 
 /// Key `i`'s root values within their bounds and its DOFs those of `model` (named
 /// `model_name`), at finite angles within ±[`MAX_KEY_ANGLE_DEG`]; otherwise what is wrong.
-fn check_key(i: usize, k: &Key, model: &Model, model_name: &str) -> Result<(), String> {
+fn check_key(i: usize, k: &Key, model: &Figure, model_name: &str) -> Result<(), String> {
     let root = [
         ("forward", k.forward, MAX_KEY_POSITION_M, "m"),
         ("lateral", k.lateral, MAX_KEY_POSITION_M, "m"),
@@ -172,7 +172,7 @@ impl KeyframeClip {
                 ));
             }
         }
-        let model = Model::by_name(&c.model).map_err(|e| KeyframeError::Content {
+        let model = Figure::by_name(&c.model).map_err(|e| KeyframeError::Content {
             path: origin.into(),
             message: e.to_string(),
         })?;
@@ -206,8 +206,8 @@ impl KeyframeClip {
     }
 
     /// Samples the clip at its frame rate into a motion on its model.
-    pub fn to_model_clip(&self) -> ModelClip {
-        let base = Model::by_name(&self.model).expect("checked in parse");
+    pub fn to_model_clip(&self) -> FigureClip {
+        let base = Figure::by_name(&self.model).expect("checked in parse");
         let model = match self.height {
             Some(h) => base.scaled_to_height(h),
             None => base,
@@ -232,7 +232,7 @@ impl KeyframeClip {
         let turn = series(&|k: &Key| k.turn.map(f64::to_radians));
         let at = |s: &(Vec<f64>, Vec<f64>), t: f64| pchip(&s.0, &s.1, t);
 
-        let mut clip = ModelClip::with_capacity(model.clone(), dt, frames);
+        let mut clip = FigureClip::with_capacity(model.clone(), dt, frames);
         for f in 0..frames {
             let t = f as f64 * dt;
             let angles: Vec<f64> = dof_keys.iter().map(|s| at(s, t)).collect();

@@ -29,7 +29,7 @@ use bevy_ecs::prelude::*;
 use glam::{DMat3, DQuat, DVec3};
 
 use super::clock::Clock;
-use super::dof_pose::{DofPose, ModelBinding};
+use super::dof_pose::{DofPose, FigureBinding};
 use super::human::{HumanFigure, drawn_body, human_physics};
 use super::physics::{
     BodyState, ExternalForces, FloorContact, JointLimits, PdController, PhysicsMonitor,
@@ -218,7 +218,7 @@ type FeetQuery<'a> = (
     &'a HumanFigure,
     &'a BodyState,
     &'a FloorContact,
-    &'a ModelBinding,
+    &'a FigureBinding,
     &'a DofPose,
     &'a Reaction,
     &'a mut FeetOnFloor,
@@ -342,7 +342,7 @@ pub enum CharacterError {
 /// [`crate::dynamics::joint::dexp`]: [`crate::dynamics::Model::velocity_from_rates`]).
 pub fn pose_configuration(
     body: &HumanBody,
-    binding: &ModelBinding,
+    binding: &FigureBinding,
     pose: &DofPose,
 ) -> (Vec<f64>, Vec<f64>) {
     let angles: Vec<f64> = binding
@@ -385,7 +385,7 @@ pub fn spawn_physical_character(
     check_physical_settings(settings)?;
     let player = PrimitivePlayer::new(sequence)?;
     let pose = player.pose();
-    let binding = ModelBinding::new(Arc::new(body.figure.clone()), &pose.names)?;
+    let binding = FigureBinding::new(Arc::new(body.figure.clone()), &pose.names)?;
     let model = &body.model;
     let (q, v) = pose_configuration(&body, &binding, &pose);
     let mut data = Data::new(model);
@@ -620,7 +620,7 @@ pub struct Feedforward {
 /// What [`pd_targets_from_pose`] reads and writes.
 type TargetQuery<'a> = (
     &'a HumanFigure,
-    &'a ModelBinding,
+    &'a FigureBinding,
     &'a DofPose,
     &'a mut PdController,
     Option<&'a mut Feedforward>,
@@ -692,7 +692,7 @@ pub fn react_to_pushes(mut q: Query<ReactionQuery>) {
 /// What [`root_assist`] reads and writes.
 type AssistQuery<'a> = (
     &'a BodyState,
-    &'a ModelBinding,
+    &'a FigureBinding,
     &'a DofPose,
     &'a mut RootAssist,
     Option<&'a mut ExternalForces>,
@@ -712,7 +712,7 @@ pub fn root_assist(mut q: Query<AssistQuery>) {
 
 /// Sets `a.wrench` for this tick ([`root_assist_wrench`]; zero once released) toward the
 /// animated root of `pose`, its angular velocity the rate of the animated rotation vector.
-fn assist_wrench(state: &BodyState, binding: &ModelBinding, pose: &DofPose, a: &mut RootAssist) {
+fn assist_wrench(state: &BodyState, binding: &FigureBinding, pose: &DofPose, a: &mut RootAssist) {
     if a.released {
         a.wrench = Wrench::ZERO;
         return;
@@ -737,7 +737,7 @@ pub fn log_characters(
         &BodyState,
         &PhysicsMonitor,
         &PdController,
-        &ModelBinding,
+        &FigureBinding,
         &DofPose,
         &Reaction,
         Option<&RootAssist>,

@@ -1,5 +1,5 @@
 //! A character's pose as DOF values ([`DofPose`]: θ and θ̇ per DOF and root channel, written by
-//! the primitive players or any other source) and its binding to a model ([`ModelBinding`]):
+//! the primitive players or any other source) and its binding to a figure ([`FigureBinding`]):
 //! [`pose_from_dofs`] turns it into the joint state, which then goes through forward kinematics
 //! and recording like any other character's.
 
@@ -10,7 +10,7 @@ use glam::{DQuat, DVec3};
 
 use super::motion::JointState;
 use super::physics::PhysicsBody;
-use crate::humanoid::{Model, ROOT_CHANNELS};
+use crate::humanoid::{Figure, ROOT_CHANNELS};
 use crate::primitive::{Primitive, PrimitiveError};
 
 /// A character's current DOF state, written by its motion source (e.g. a primitive player).
@@ -38,17 +38,17 @@ impl DofPose {
 /// Which entries of a character's [`DofPose`] are its model's DOFs and its six root channels
 /// (`root_tx, root_ty, root_tz` in metres, `root_rx, root_ry, root_rz` a rotation vector).
 #[derive(Component, Clone, Debug)]
-pub struct ModelBinding {
+pub struct FigureBinding {
     /// The model the pose drives.
-    pub model: Arc<Model>,
+    pub model: Arc<Figure>,
     dof_cols: Vec<usize>,
     root_cols: [usize; 6],
 }
 
-impl ModelBinding {
+impl FigureBinding {
     /// Binds pose entries named `names` to `model`; every model DOF and root channel must be
     /// among them.
-    pub fn new(model: Arc<Model>, names: &[String]) -> Result<ModelBinding, PrimitiveError> {
+    pub fn new(model: Arc<Figure>, names: &[String]) -> Result<FigureBinding, PrimitiveError> {
         let col = |n: &str| {
             names
                 .iter()
@@ -66,7 +66,7 @@ impl ModelBinding {
         for (k, n) in ROOT_CHANNELS.iter().enumerate() {
             root_cols[k] = col(n)?;
         }
-        Ok(ModelBinding {
+        Ok(FigureBinding {
             model,
             dof_cols,
             root_cols,
@@ -86,10 +86,10 @@ impl ModelBinding {
 
 /// Sets every bound kinematic character's joint state from its DOF pose: the root from the
 /// root channels, every other joint's rotation from its DOF angles (see
-/// [`Model::local_rotations`]). A simulated character's joint state comes from its body instead
+/// [`Figure::local_rotations`]). A simulated character's joint state comes from its body instead
 /// ([`publish_body_pose`](super::human::publish_body_pose)); its DOF pose is the PD target.
 pub fn pose_from_dofs(
-    mut q: Query<(&ModelBinding, &DofPose, &mut JointState), Without<PhysicsBody>>,
+    mut q: Query<(&FigureBinding, &DofPose, &mut JointState), Without<PhysicsBody>>,
 ) {
     for (b, pose, mut state) in &mut q {
         let angles: Vec<f64> = b.dof_cols.iter().map(|&c| pose.theta[c]).collect();

@@ -5,7 +5,7 @@
 //!   drawable points; forward kinematics and recording treat all alike;
 //! - kinematic motion: a [`ClipPlayback`], or primitive players
 //!   ([`primitive::PrimitivePlayer`], [`primitive::BlendPlayer`]) writing a
-//!   [`DofPose`] that a [`ModelBinding`] turns into the joint state;
+//!   [`DofPose`] that a [`FigureBinding`] turns into the joint state;
 //! - physics: a [`physics::PhysicsBundle`] (the rigid-body model, nothing human) and the force
 //!   components the step reads ([`physics::PdController`], [`physics::JointLimits`],
 //!   [`physics::FloorContact`], [`physics::ExternalForces`]); a human body also carries a
@@ -33,7 +33,7 @@ mod systems;
 pub mod worlds;
 
 pub use clock::{Clock, advance_clock};
-pub use dof_pose::{DofPose, ModelBinding, pose_from_dofs};
+pub use dof_pose::{DofPose, FigureBinding, pose_from_dofs};
 pub use motion::{Character, ClipPlayback, JointState, Recorder, SkeletonRef};
 pub use primitive::spawn_primitive_character;
 pub use sets::{MotionSet, add_core_systems, configure_motion_sets};

@@ -18,10 +18,10 @@ use std::sync::Arc;
 use bevy_ecs::prelude::*;
 
 use super::clock::Clock;
-use super::dof_pose::{DofPose, ModelBinding, pose_from_dofs};
+use super::dof_pose::{DofPose, FigureBinding, pose_from_dofs};
 use super::motion::{Character, JointState, Recorder, SkeletonRef};
 use super::sets::{MotionSet, configure_motion_sets};
-use crate::humanoid::Model;
+use crate::humanoid::Figure;
 
 use crate::primitive::blend::{BlendPlacement, Gamma};
 use crate::primitive::connect::HandOver;
@@ -280,7 +280,7 @@ pub fn step_blend_players(clock: Res<Clock>, mut q: Query<(&mut BlendPlayer, &mu
 
 /// Adds the primitive systems to `schedule`: [`PrimitiveSet::Players`] then
 /// [`PrimitiveSet::Blends`] inside [`MotionSet::Animate`], and [`pose_from_dofs`] in
-/// [`MotionSet::Pose`] (characters with a [`ModelBinding`] get their joint state from their DOF
+/// [`MotionSet::Pose`] (characters with a [`FigureBinding`] get their joint state from their DOF
 /// pose).
 pub fn add_primitive_systems(schedule: &mut Schedule) {
     configure_motion_sets(schedule);
@@ -300,12 +300,12 @@ pub fn add_primitive_systems(schedule: &mut Schedule) {
 pub fn spawn_primitive_character(
     world: &mut World,
     name: &str,
-    model: Arc<Model>,
+    model: Arc<Figure>,
     sequence: Vec<Arc<Primitive>>,
 ) -> Result<Entity> {
     let player = PrimitivePlayer::new(sequence)?;
     let pose = player.pose();
-    let binding = ModelBinding::new(model.clone(), &pose.names)?;
+    let binding = FigureBinding::new(model.clone(), &pose.names)?;
     let skeleton = Arc::new(model.skeleton());
     let n = skeleton.joints.len();
     Ok(world

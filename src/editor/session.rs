@@ -17,7 +17,7 @@ use super::scene::DanceFile;
 use crate::choreo::edit::Edit;
 use crate::choreo::fill::Fill;
 use crate::experiments::dance::{DanceFigures, figures, perform};
-use crate::humanoid::{Model, ModelClip, humanoid24};
+use crate::humanoid::{Figure, FigureClip, humanoid24};
 use crate::scene::{load_dance, scene_pins, song_timed_bvh};
 
 /// The song the edit dances to.
@@ -80,7 +80,7 @@ pub struct Session {
     edit: Edit,
     file: DanceFile,
     song: Arc<Song>,
-    model: Model,
+    model: Figure,
     fill: Option<Fill>,
     /// The pins the last fill was made for: when they differ from the edit's, the unpinned
     /// bars' fills are stale until the next Generate.
@@ -416,7 +416,7 @@ impl Session {
 }
 
 /// Every frame's drawable points of `clip`, less `origin`, in single precision.
-fn points(clip: &ModelClip, origin: DVec3) -> Frames {
+fn points(clip: &FigureClip, origin: DVec3) -> Frames {
     clip.to_clip()
         .point_frames()
         .into_iter()

@@ -22,7 +22,7 @@ use crate::ecs::physics::{
     BodyState, ExternalForces, JointLimits, PdController, PhysicsMonitor, PhysicsStatus,
 };
 use crate::ecs::{Clock, Recorder};
-use crate::humanoid::ModelClip;
+use crate::humanoid::FigureClip;
 use crate::humanoid::body::{HumanBody, HumanError, humanoid24_body};
 use crate::primitive::Primitive;
 
@@ -146,7 +146,7 @@ pub struct ActiveOutcome {
     /// Drawable points of the body (joints, then End Sites) at `record_hz`.
     pub frames: Vec<Vec<DVec3>>,
     /// The body's motion as a clip on its model (DOF angles and pelvis), at `record_hz`.
-    pub motion: ModelClip,
+    pub motion: FigureClip,
     /// Seconds between frames.
     pub frame_time_s: f64,
     /// Joint-angle RMS error against the primitives over all DOFs and ticks before the push
@@ -417,7 +417,7 @@ fn frame_stride(config: &ActiveConfig) -> usize {
 }
 
 /// The body's configurations as a clip on its figure model.
-fn body_clip(body: &HumanBody, configurations: &[Vec<f64>], frame_time: f64) -> ModelClip {
+fn body_clip(body: &HumanBody, configurations: &[Vec<f64>], frame_time: f64) -> FigureClip {
     let mut all = vec![0.0; body.model.nv];
     let mut angles = Vec::with_capacity(configurations.len() * body.dof_v.len());
     let mut root_translation = Vec::with_capacity(configurations.len());
@@ -430,7 +430,7 @@ fn body_clip(body: &HumanBody, configurations: &[Vec<f64>], frame_time: f64) -> 
         root_translation.push(DVec3::new(q[0], q[1], q[2]));
         root_rotation.push(glam::DQuat::from_xyzw(q[3], q[4], q[5], q[6]));
     }
-    ModelClip {
+    FigureClip {
         model: body.figure.clone(),
         frame_time,
         root_translation,
@@ -446,7 +446,7 @@ fn outcome(
     (log, feet): (&CharacterLog, &FeetOnFloor),
     reaction: &Reaction,
     all_frames: &[Vec<DVec3>],
-    motion: ModelClip,
+    motion: FigureClip,
 ) -> ActiveOutcome {
     let n = log.tracked_ticks.max(1) as f64;
     let dof_rms_deg: Vec<(String, f64)> = body

@@ -31,13 +31,13 @@
 //! [`knee_kick`](super::knee_kick) starts from them); [`run`] also plays them and measures them:
 //! the paper's Fig. 8 (the left knee's crouch flexion of each jump) and what each jump did
 //! ([`JumpFigures`]: apex above standing, flight from foot contact, the feet's lowest point).
-//! Plain data in and out: the demonstrations come as [`ModelClip`]s already on the model,
+//! Plain data in and out: the demonstrations come as [`FigureClip`]s already on the model,
 //! nothing is read or written.
 
 use super::jump_figures::{JumpFigures, contact_reference, jump_figures_against, standing_root_m};
 use crate::analysis::{ContactReference, Span};
 use crate::clips::GRAVITY;
-use crate::humanoid::{Model, ModelClip};
+use crate::humanoid::{Figure, FigureClip};
 use crate::primitive::{
     BlendPlacement, EventConfig, Gamma, LearnConfig, Learned, Primitive, PrimitiveError, Relearn,
     Trajectory, blend, find_jump_events,
@@ -54,7 +54,7 @@ pub enum PrimitiveExperimentError {
     Primitive(#[from] PrimitiveError),
     /// A played trajectory does not fit the model (a model DOF or root channel is missing).
     #[error(transparent)]
-    OnModel(#[from] crate::humanoid::ModelError),
+    OnModel(#[from] crate::humanoid::FigureError),
     /// A DOF the experiment measures is not in the trajectory.
     #[error("no DOF '{0}'")]
     NoDof(String),
@@ -82,12 +82,12 @@ pub struct Jumps<T> {
 #[derive(Clone, Debug, PartialEq)]
 pub struct HighJumpConfig {
     /// The model the results are put on (humanoid24): rollouts become clips on it.
-    pub model: Model,
+    pub model: Figure,
     /// The low jump demonstration (A), on `model`'s DOFs.
-    pub low: ModelClip,
+    pub low: FigureClip,
     /// The normal jump demonstration (B), on `model`'s DOFs; its frame time is the time step of
     /// every rollout.
-    pub normal: ModelClip,
+    pub normal: FigureClip,
     /// γ(t′) of the blend (the paper: [`PAPER_GAMMA`]).
     pub gamma: Gamma,
     /// Learning settings (formulation, kernels, regression) of every primitive.
@@ -197,11 +197,11 @@ pub struct HighJumpOutcome {
     pub rollouts: Jumps<Trajectory>,
     /// Each jump played over its own duration (the low jump not time-scaled) as a clip on the
     /// model.
-    pub clips: Jumps<ModelClip>,
+    pub clips: Jumps<FigureClip>,
     /// The low jump time-scaled to T as a clip (`rollouts.low`).
-    pub low_time_scaled: ModelClip,
+    pub low_time_scaled: FigureClip,
     /// How far each of `clips` was lifted where a foot of its rollout went below the floor
-    /// ([`ModelClip::lift_above_floor`]), metres: the largest lift.
+    /// ([`FigureClip::lift_above_floor`]), metres: the largest lift.
     pub floor_lift_m: Jumps<f64>,
     /// What each of `clips` did: apex above standing, flight from foot contact, lowest foot.
     pub figures: Jumps<JumpFigures>,
@@ -221,10 +221,10 @@ pub struct HighJumpOutcome {
 
 /// A trajectory as a clip on `model`.
 pub(super) fn on_model(
-    model: &Model,
+    model: &Figure,
     traj: &Trajectory,
-) -> Result<ModelClip, PrimitiveExperimentError> {
-    Ok(ModelClip::from_trajectory(model, traj)?)
+) -> Result<FigureClip, PrimitiveExperimentError> {
+    Ok(FigureClip::from_trajectory(model, traj)?)
 }
 
 /// Plays `p` over [0, τ] at step `dt`.
@@ -245,7 +245,7 @@ pub(super) fn peak_deg(traj: &Trajectory, dof: &str) -> Result<f64, PrimitiveExp
 }
 
 /// Root height and each foot's lowest point over time (`feet[foot][frame]`), metres.
-pub(super) fn heights(clip: &ModelClip) -> (Vec<f64>, Vec<Vec<f64>>) {
+pub(super) fn heights(clip: &FigureClip) -> (Vec<f64>, Vec<Vec<f64>>) {
     let root: Vec<f64> = clip.root_translation.iter().map(|t| t.y).collect();
     (root, clip.foot_heights().into())
 }
@@ -293,7 +293,7 @@ pub fn learn_primitives(
     let gamma_at_bend = config.gamma.at(ev.bend / t);
     let gamma_at_apex = config.gamma.at(fn_.apex_time_s / t);
     let mix = |g: f64, a: f64, b: f64| g * a + (1.0 - g) * b;
-    let crouch = |c: &ModelClip| crouch_peak_deg(c, dt);
+    let crouch = |c: &FigureClip| crouch_peak_deg(c, dt);
     let crouch_knee_flexion_deg = mix(gamma_at_bend, crouch(&low_clip)?, crouch(&normal_clip)?);
     let apex_root_m = mix(gamma_at_apex, fl.apex_root_m, fn_.apex_root_m);
 
@@ -335,7 +335,7 @@ fn blend_jumps(
     (low, normal): (&Primitive, &Primitive),
     t: f64,
     dt: f64,
-) -> Result<ModelClip, PrimitiveExperimentError> {
+) -> Result<FigureClip, PrimitiveExperimentError> {
     let placement = BlendPlacement {
         a_start: 0.0,
         a_end: t,
@@ -363,7 +363,7 @@ pub const STANDING_FOOT_M: f64 = 0.005;
 /// before they touch): from its start back, and from its end forward, the lowest foot point of
 /// `clip` is followed down to the first frame where it is within [`STANDING_FOOT_M`] of `floor`
 /// or stops coming down. Seconds.
-fn feet_leave_and_touch(clip: &ModelClip, flight: Span, floor: f64) -> (f64, f64) {
+fn feet_leave_and_touch(clip: &FigureClip, flight: Span, floor: f64) -> (f64, f64) {
     let [l, r] = clip.foot_heights();
     let dt = clip.frame_time;
     let low: Vec<f64> = l.iter().zip(&r).map(|(a, b)| a.min(*b)).collect();
@@ -378,7 +378,7 @@ fn feet_leave_and_touch(clip: &ModelClip, flight: Span, floor: f64) -> (f64, f64
 
 /// Left-knee flexion of a jump's crouch, degrees: its peak before take-off (found by
 /// [`find_jump_events`]), as in the paper's Fig. 8.
-fn crouch_peak_deg(clip: &ModelClip, dt: f64) -> Result<f64, PrimitiveExperimentError> {
+fn crouch_peak_deg(clip: &FigureClip, dt: f64) -> Result<f64, PrimitiveExperimentError> {
     let (root_y, feet) = heights(clip);
     let ev = find_jump_events(&root_y, dt, Some(&feet), &EventConfig::default())?;
     let traj = clip.to_trajectory();
@@ -401,12 +401,12 @@ pub fn ballistic_flight_s(y0: f64, apex: f64, y1: f64) -> f64 {
 /// flight, later frames follow shifted; the root's arc over the line from take-off to landing is
 /// then scaled so that its top is at `apex_y`.
 fn lengthen_flight(
-    clip: &ModelClip,
+    clip: &FigureClip,
     take_off: f64,
     land: f64,
     apex_y: f64,
     normal_apex_y: f64,
-) -> Result<(ModelClip, FlightPlan), PrimitiveExperimentError> {
+) -> Result<(FigureClip, FlightPlan), PrimitiveExperimentError> {
     let dt = clip.frame_time;
     let n = clip.frame_count();
     let frame = |t: f64| ((t / dt).round().max(0.0) as usize).min(n - 1);
@@ -448,11 +448,11 @@ fn lengthen_flight(
 
 /// `clip` with its flight frames `fa..=fb` stretched in time, linearly, over `nf` frames
 /// (joint angles, root path and orientation interpolated), the later frames following shifted.
-fn stretch_flight(clip: &ModelClip, fa: usize, fb: usize, nf: usize) -> ModelClip {
+fn stretch_flight(clip: &FigureClip, fa: usize, fb: usize, nf: usize) -> FigureClip {
     let (dt, n) = (clip.frame_time, clip.frame_count());
     let shift = nf as isize - (fb - fa) as isize;
     let m = (n as isize + shift) as usize;
-    let mut out = ModelClip::with_capacity(clip.model.clone(), dt, m);
+    let mut out = FigureClip::with_capacity(clip.model.clone(), dt, m);
     for k in 0..m {
         let src = if k <= fa {
             k as f64
@@ -477,7 +477,7 @@ fn stretch_flight(clip: &ModelClip, fa: usize, fb: usize, nf: usize) -> ModelCli
 /// Scales the root's arc over the chord from take-off (frame `fa`) to landing (`fa + nf`) so
 /// that its top is at `apex_y`. Returns the root's take-off and landing heights and the scale.
 fn raise_arc(
-    out: &mut ModelClip,
+    out: &mut FigureClip,
     fa: usize,
     nf: usize,
     apex_y: f64,

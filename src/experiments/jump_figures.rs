@@ -11,7 +11,7 @@ use crate::analysis::signal::median;
 use crate::analysis::{
     ContactConfig, ContactReference, Contacts, Span, clip_contacts, clip_contacts_against,
 };
-use crate::humanoid::ModelClip;
+use crate::humanoid::FigureClip;
 
 /// Height above the floor under which a foot point counts as touching it, metres (as
 /// `marionette inspect` and the show scenes use).
@@ -52,7 +52,7 @@ pub struct JumpFigures {
 /// point; the flight is the longest span in which [`clip_contacts`] (threshold
 /// [`CONTACT_THRESHOLD_M`], shortest flight [`MIN_FLIGHT_S`]) finds no foot touching, the
 /// clip's own floor and rest heights found in it.
-pub fn jump_figures(clip: &ModelClip, floor_y: f64) -> JumpFigures {
+pub fn jump_figures(clip: &FigureClip, floor_y: f64) -> JumpFigures {
     let contacts = clip_contacts(&clip.to_clip(), CONTACT_THRESHOLD_M, MIN_FLIGHT_S);
     let own = longest_flight(contacts.as_ref());
     figures(clip, floor_y, own, own)
@@ -64,7 +64,7 @@ pub fn jump_figures(clip: &ModelClip, floor_y: f64) -> JumpFigures {
 /// from the reference floor. So two jumps are compared by one standard: with rest heights
 /// estimated per clip, a point that rests just under the estimate's height limit in one jump and
 /// just over it in the other touches in one only, which moves the flight's ends.
-pub fn jump_figures_against(clip: &ModelClip, reference: &ContactReference) -> JumpFigures {
+pub fn jump_figures_against(clip: &FigureClip, reference: &ContactReference) -> JumpFigures {
     let c = clip.to_clip();
     let against = clip_contacts_against(&c, &contact_config(), reference);
     let own = clip_contacts(&c, CONTACT_THRESHOLD_M, MIN_FLIGHT_S);
@@ -89,7 +89,7 @@ fn longest_flight(contacts: Option<&Contacts>) -> Option<Span> {
 /// The floor and foot-point rest heights of `clip` (as [`jump_figures`] finds them), to measure
 /// other jumps of its model against ([`jump_figures_against`]); `None` when the model has no
 /// feet.
-pub fn contact_reference(clip: &ModelClip) -> Option<ContactReference> {
+pub fn contact_reference(clip: &FigureClip) -> Option<ContactReference> {
     clip_contacts(&clip.to_clip(), CONTACT_THRESHOLD_M, MIN_FLIGHT_S).map(|c| c.reference())
 }
 
@@ -102,7 +102,12 @@ fn contact_config() -> ContactConfig {
 }
 
 /// The figures of `clip` with its flight found (`own`: with its own contacts).
-fn figures(clip: &ModelClip, floor_y: f64, flight: Option<Span>, own: Option<Span>) -> JumpFigures {
+fn figures(
+    clip: &FigureClip,
+    floor_y: f64,
+    flight: Option<Span>,
+    own: Option<Span>,
+) -> JumpFigures {
     let root: Vec<f64> = clip.root_translation.iter().map(|t| t.y).collect();
     let standing_root_m = standing_root_m(clip);
     let (apex_frame, apex_root_m) =
@@ -133,7 +138,7 @@ fn figures(clip: &ModelClip, floor_y: f64, flight: Option<Span>, own: Option<Spa
 
 /// Root height of `clip` while standing: the median over its first [`STANDING_WINDOW_S`],
 /// metres.
-pub fn standing_root_m(clip: &ModelClip) -> f64 {
+pub fn standing_root_m(clip: &FigureClip) -> f64 {
     let root: Vec<f64> = clip.root_translation.iter().map(|t| t.y).collect();
     let window = ((STANDING_WINDOW_S / clip.frame_time).round() as usize).clamp(1, root.len());
     median(&root[..window])
@@ -141,7 +146,7 @@ pub fn standing_root_m(clip: &ModelClip) -> f64 {
 
 /// The floor a clip stands on: the height [`clip_contacts`] finds its feet touching, metres
 /// (`None` when the clip has no feet).
-pub fn floor_of(clip: &ModelClip) -> Option<f64> {
+pub fn floor_of(clip: &FigureClip) -> Option<f64> {
     clip_contacts(&clip.to_clip(), CONTACT_THRESHOLD_M, MIN_FLIGHT_S).map(|c| c.floor_y_m)
 }
 

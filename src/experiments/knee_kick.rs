@@ -16,12 +16,12 @@
 //! connection's pull from the kick posture back onto the jump's course) with the feet on the
 //! floor from Land on, so that the figure lands without sinking. What the parts' DMP fits and
 //! the connection still miss by (millimetres) is taken up by the floor constraint on the
-//! connected motion ([`ModelClip::lift_above_floor`], as on the high jump's rollouts): no foot
+//! connected motion ([`FigureClip::lift_above_floor`], as on the high jump's rollouts): no foot
 //! goes below the floor.
 //!
 //! [`run`] returns the primitives, the played motions and the paper's checks: the postures at
 //! Bend and Leap, the jumps at the junction, the figure airborne at Leap and both feet down
-//! after landing. Plain data in and out: the demonstrations come as [`ModelClip`]s already on
+//! after landing. Plain data in and out: the demonstrations come as [`FigureClip`]s already on
 //! the model, nothing is read or written. Playing the connected sequence in an ECS world is left
 //! to the caller.
 
@@ -30,7 +30,7 @@ use super::high_jump::{
     on_model, peak_deg, rollout,
 };
 use super::jump_figures::{JumpFigures, jump_figures, jump_figures_against};
-use crate::humanoid::ModelClip;
+use crate::humanoid::FigureClip;
 use crate::primitive::{
     Arrangement, BlendPlacement, Connected, EventConfig, Gamma, JumpEvents, Learned, Primitive,
     ROOT_DOF_NAMES, Relearn, Samples, Trajectory, blend, connect, find_jump_events,
@@ -54,7 +54,7 @@ pub struct KneeKickConfig {
     pub jump: HighJumpConfig,
     /// The knee kick demonstration (B) on the jump's model, from its start to the strike (knee
     /// highest).
-    pub kick: ModelClip,
+    pub kick: FigureClip,
     /// γ(t′) of the kick blend (the paper: [`PAPER_GAMMA`]).
     pub gamma: Gamma,
     /// Jump-event detection on A.
@@ -100,7 +100,7 @@ pub struct KneeKickOutcome {
     /// A played over its duration.
     pub jump_rollout: Trajectory,
     /// A as a clip on the model, lifted where a foot went below the floor.
-    pub jump_clip: ModelClip,
+    pub jump_clip: FigureClip,
     /// A's events (Start, Bend, take-off, Leap, Land), seconds, found on `jump_clip`.
     pub events: JumpEvents,
     /// B learned from the kick demonstration (`knee_kick`).
@@ -108,7 +108,7 @@ pub struct KneeKickOutcome {
     /// B played over its own duration.
     pub kick_rollout: Trajectory,
     /// B as a clip on the model.
-    pub kick_clip: ModelClip,
+    pub kick_clip: FigureClip,
     /// B time-scaled to Leap − Bend, played from its own start (it is placed at `events.bend`).
     pub kick_placed_rollout: Trajectory,
     /// Which of the six arrangements the placement (A on [0, T_A], B on [Bend, Leap]) is.
@@ -119,9 +119,9 @@ pub struct KneeKickOutcome {
     /// The two parts connected, sampled at `jump.dt`.
     pub connected: Connected,
     /// The connected motion as a clip on the model, lifted where a foot of it went below the
-    /// floor ([`ModelClip::lift_above_floor`]; `connected` is the motion as the primitives play
+    /// floor ([`FigureClip::lift_above_floor`]; `connected` is the motion as the primitives play
     /// it, before the lift).
-    pub result_clip: ModelClip,
+    pub result_clip: FigureClip,
     /// The largest lift that put `result_clip`'s feet on or above the floor, metres.
     pub floor_lift_m: f64,
     /// The jumps at the junction.
@@ -229,7 +229,7 @@ pub fn run(config: &KneeKickConfig) -> Result<KneeKickOutcome, PrimitiveExperime
 /// events, figures and flight.
 struct PlayedJump {
     rollout: Trajectory,
-    clip: ModelClip,
+    clip: FigureClip,
     /// The root's height in each frame of `clip`, metres.
     root_y: Vec<f64>,
     events: JumpEvents,
@@ -402,11 +402,11 @@ fn paper_checks(
     config: &KneeKickConfig,
     jump: &HighJumpPrimitives,
     played: &PlayedJump,
-    result_clip: &ModelClip,
+    result_clip: &FigureClip,
 ) -> PaperChecks {
     let (dt, floor, ev) = (jump.dt, jump.floor_y_m, &played.events);
     let frame_at = |t: f64| ((t / dt).round() as usize).min(result_clip.frame_count() - 1);
-    let posture_gap = |a_clip: &ModelClip, fa: usize, fb: usize| -> f64 {
+    let posture_gap = |a_clip: &FigureClip, fa: usize, fb: usize| -> f64 {
         a_clip
             .frame_angles(fa)
             .iter()
@@ -450,7 +450,7 @@ fn paper_checks(
 /// is zero, and between these frames it is interpolated linearly (held beyond the last known
 /// one). Returns the largest correction, metres.
 fn stand_on_floor(
-    clip: &mut ModelClip,
+    clip: &mut FigureClip,
     from: usize,
     ground: &dyn Fn(usize) -> bool,
     pinned: usize,

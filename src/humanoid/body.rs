@@ -1,5 +1,5 @@
 //! A humanoid model as an articulated body: the joint tree, DOF names, axes and offsets of a
-//! [`figure::Model`] ([`crate::humanoid::fall21`], [`crate::humanoid::humanoid24`], or any model
+//! [`Figure`] ([`crate::humanoid::fall21`], [`crate::humanoid::humanoid24`], or any model
 //! with the same link names), scaled to the subject's height, with segment masses, centres of
 //! mass and inertias from **de Leva (1996)**, *Adjustments to Zatsiorsky–Seluyanov's segment
 //! inertia parameters*, J. Biomech. 29(9):1223–1230, Table 4 (males: stature 1741 mm, 73.0 kg),
@@ -30,7 +30,7 @@ use crate::dynamics::joint::JointType;
 use crate::dynamics::model::{Body, Model, ModelError};
 use crate::dynamics::spatial::{Inertia, SpatialTransform};
 use crate::humanoid::anthropometry::*;
-use crate::humanoid::{self as figure, JointKind};
+use crate::humanoid::{self, Figure, FigureJoint, JointKind};
 use glam::{DMat3, DVec3};
 
 /// A human ready to simulate.
@@ -41,7 +41,7 @@ pub struct HumanBody {
     /// ([`crate::ecs::physics::PhysicsBody`]).
     pub model: Arc<Model>,
     /// The figure model it was built from, scaled to the subject's height.
-    pub figure: figure::Model,
+    pub figure: Figure,
     /// Contact box of each link.
     pub boxes: Vec<LinkBox>,
     /// For each figure DOF (model order), its index in the velocity vector `v` (shared with the
@@ -156,7 +156,7 @@ fn rod(m: f64, len: f64, r: f64, p0: DVec3, dir: DVec3) -> Inertia {
 /// Builds the fall21 human of standing height `height` (m) and mass `mass` (kg) under gravity
 /// `(0, −g, 0)`.
 pub fn fall21_body(height: f64, mass: f64, g: f64) -> Result<HumanBody, HumanError> {
-    human_body(&figure::fall21(), height, mass, g)
+    human_body(&humanoid::fall21(), height, mass, g)
 }
 
 /// The fall21 human of [`fall21_body`], shared: while any holder keeps it, every call with the
@@ -185,18 +185,13 @@ pub fn shared_fall21_body(height: f64, mass: f64, g: f64) -> Result<Arc<HumanBod
 /// Builds the humanoid24 human (the motor-primitive model) of standing height `height` (m) and
 /// mass `mass` (kg) under gravity `(0, −g, 0)`.
 pub fn humanoid24_body(height: f64, mass: f64, g: f64) -> Result<HumanBody, HumanError> {
-    human_body(&figure::humanoid24(), height, mass, g)
+    human_body(&humanoid::humanoid24(), height, mass, g)
 }
 
 /// Builds the articulated body of `model` (a figure whose root is a free pelvis and whose links
 /// are named as in the module doc) for a subject of standing height `height` (m) and mass `mass`
 /// (kg) under gravity `(0, −g, 0)`.
-pub fn human_body(
-    model: &figure::Model,
-    height: f64,
-    mass: f64,
-    g: f64,
-) -> Result<HumanBody, HumanError> {
+pub fn human_body(model: &Figure, height: f64, mass: f64, g: f64) -> Result<HumanBody, HumanError> {
     check_subject(model, height, mass)?;
     let fig = model.scaled_to_height(height);
     // The girdle's mass comes out of the upper trunk (see [`CLAVICLE_SHARE`]).
@@ -243,7 +238,7 @@ pub fn human_body(
 
 /// The subject's height (m) and mass (kg) within the ranges the tables cover, and a figure
 /// whose root is free.
-fn check_subject(model: &figure::Model, height: f64, mass: f64) -> Result<(), HumanError> {
+fn check_subject(model: &Figure, height: f64, mass: f64) -> Result<(), HumanError> {
     if !(1.0..=2.3).contains(&height) {
         return Err(HumanError::Subject {
             what: "height_m",
@@ -277,7 +272,7 @@ struct Subject {
 }
 
 /// The offset of the child of joint `j` whose joint name ends with `name`.
-fn child_offset(fig: &figure::Model, j: &figure::ModelJoint, name: &str) -> Option<DVec3> {
+fn child_offset(fig: &Figure, j: &FigureJoint, name: &str) -> Option<DVec3> {
     fig.joints
         .iter()
         .find(|c| c.parent.is_some_and(|p| fig.joints[p].name == j.name) && c.name.ends_with(name))
@@ -287,8 +282,8 @@ fn child_offset(fig: &figure::Model, j: &figure::ModelJoint, name: &str) -> Opti
 /// The inertia (de Leva's segment tables) and contact box of the link of joint `j`, by body
 /// part (the link name without its side).
 fn link_inertia(
-    fig: &figure::Model,
-    j: &figure::ModelJoint,
+    fig: &Figure,
+    j: &FigureJoint,
     subject: &Subject,
 ) -> Result<(Inertia, LinkBox), HumanError> {
     let link = j
@@ -311,8 +306,8 @@ fn link_inertia(
 /// waist joint down to the hip line (the pelvis origin), so that pelvis and torso meet at the
 /// waist without overlapping.
 fn pelvis_link(
-    fig: &figure::Model,
-    j: &figure::ModelJoint,
+    fig: &Figure,
+    j: &FigureJoint,
     &Subject { h, mass, .. }: &Subject,
 ) -> (Inertia, LinkBox) {
     let top = child_offset(fig, j, "waist").unwrap_or(DVec3::new(0.0, 0.07 * h, 0.0));
@@ -328,8 +323,8 @@ fn pelvis_link(
 /// Upper trunk (cervicale → xiphion) over middle trunk (xiphion → omphalion), filling the
 /// waist → neck span in de Leva's proportions.
 fn trunk_link(
-    fig: &figure::Model,
-    j: &figure::ModelJoint,
+    fig: &Figure,
+    j: &FigureJoint,
     &Subject { h, mass, clavicles }: &Subject,
 ) -> (Inertia, LinkBox) {
     let neck = child_offset(fig, j, "neck").unwrap_or(DVec3::new(0.0, 0.23 * h, 0.0));
@@ -361,7 +356,7 @@ fn trunk_link(
 }
 
 /// Head + neck from the vertex (the head's end site) down to the neck joint.
-fn head_link(j: &figure::ModelJoint, &Subject { h, mass, .. }: &Subject) -> (Inertia, LinkBox) {
+fn head_link(j: &FigureJoint, &Subject { h, mass, .. }: &Subject) -> (Inertia, LinkBox) {
     let top = j
         .end_site
         .unwrap_or(DVec3::new(0.0, table_length(&DE_LEVA_HEAD, h), 0.0));
@@ -377,8 +372,8 @@ fn head_link(j: &figure::ModelJoint, &Subject { h, mass, .. }: &Subject) -> (Ine
 /// A slender rod from the sterno-clavicular joint to the shoulder, as thick as the upper arm's
 /// box.
 fn clavicle_link(
-    fig: &figure::Model,
-    j: &figure::ModelJoint,
+    fig: &Figure,
+    j: &FigureJoint,
     &Subject { h, mass, .. }: &Subject,
 ) -> (Inertia, LinkBox) {
     let end = child_offset(fig, j, "shoulder").unwrap_or(DVec3::new(0.11 * h, 0.0, 0.0));
@@ -396,8 +391,8 @@ fn clavicle_link(
 /// A long bone of arm or leg (`link` without its side): from this joint to the next one down
 /// the limb.
 fn limb_link(
-    fig: &figure::Model,
-    j: &figure::ModelJoint,
+    fig: &Figure,
+    j: &FigureJoint,
     link: &str,
     &Subject { h, mass, .. }: &Subject,
 ) -> (Inertia, LinkBox) {
@@ -419,7 +414,7 @@ fn limb_link(
 }
 
 /// Wrist → third metacarpale (de Leva's length) inside the box to the fingertips.
-fn hand_link(j: &figure::ModelJoint, &Subject { h, mass, .. }: &Subject) -> (Inertia, LinkBox) {
+fn hand_link(j: &FigureJoint, &Subject { h, mass, .. }: &Subject) -> (Inertia, LinkBox) {
     let end = j.end_site.unwrap_or(DVec3::new(0.0, -0.108 * h, 0.0));
     (
         segment(
@@ -438,7 +433,7 @@ fn hand_link(j: &figure::ModelJoint, &Subject { h, mass, .. }: &Subject) -> (Ine
 }
 
 /// Heel → toe tip, de Leva's length ending at the toe end site.
-fn foot_link(j: &figure::ModelJoint, &Subject { h, mass, .. }: &Subject) -> (Inertia, LinkBox) {
+fn foot_link(j: &FigureJoint, &Subject { h, mass, .. }: &Subject) -> (Inertia, LinkBox) {
     let toe = j.end_site.unwrap_or(DVec3::new(0.0, -0.039 * h, 0.117 * h));
     let l = table_length(&DE_LEVA_FOOT, h);
     let heel = DVec3::new(0.0, toe.y * 0.5, toe.z - l);
@@ -457,7 +452,7 @@ fn foot_link(j: &figure::ModelJoint, &Subject { h, mass, .. }: &Subject) -> (Ine
 const DOWN: DVec3 = DVec3::new(-0.0, -1.0, -0.0);
 
 /// The dynamics joint of the figure's joint `j`, with its DOF axes.
-fn joint_type(fig: &figure::Model, j: &figure::ModelJoint) -> JointType {
+fn joint_type(fig: &Figure, j: &FigureJoint) -> JointType {
     let axes: Vec<DVec3> = j.dofs.iter().map(|&d| fig.dofs[d].axis).collect();
     match j.kind {
         JointKind::Free => JointType::Free,
@@ -474,7 +469,7 @@ fn joint_type(fig: &figure::Model, j: &figure::ModelJoint) -> JointType {
 }
 
 /// Each figure DOF's index in the model's velocity vector.
-fn dof_velocity_indices(fig: &figure::Model, model: &Model) -> Vec<usize> {
+fn dof_velocity_indices(fig: &Figure, model: &Model) -> Vec<usize> {
     fig.dofs
         .iter()
         .map(|d| {
@@ -717,7 +712,7 @@ mod tests {
 
     #[test]
     fn a_figure_without_a_free_root_is_refused() {
-        let mut m = figure::humanoid24();
+        let mut m = humanoid::humanoid24();
         m.joints[0].kind = JointKind::Fixed;
         assert!(matches!(
             human_body(&m, 1.7, 65.0, 9.81),

@@ -8,7 +8,7 @@
 
 use glam::DVec3;
 
-use super::{Dof, JointKind, Model, ModelJoint};
+use super::{Dof, Figure, FigureJoint, JointKind};
 
 /// Reference standing height of the model definitions, metres.
 pub const REFERENCE_HEIGHT: f64 = 1.70;
@@ -62,8 +62,8 @@ const fn row(
 
 /// Builds a model from its table: joints in table order (limbs right then left), each
 /// parent before its children.
-fn build(name: &str, parts: &[Part<'_>]) -> Model {
-    let mut model = Model {
+fn build(name: &str, parts: &[Part<'_>]) -> Figure {
+    let mut model = Figure {
         name: name.into(),
         height: REFERENCE_HEIGHT,
         joints: vec![],
@@ -109,7 +109,7 @@ fn build(name: &str, parts: &[Part<'_>]) -> Model {
                 axis: axis(*a),
             });
         }
-        model.joints.push(ModelJoint {
+        model.joints.push(FigureJoint {
             name: joint_name,
             link: format!("{side}{}", r.link),
             parent,
@@ -144,7 +144,7 @@ const HAND_END: Option<[f64; 3]> = Some([0.0, -0.108, 0.0]);
 /// elbow 2, each hip 3, each knee 1. Root motion (pelvis translation and orientation) is carried
 /// apart from the 24 DOFs.
 #[rustfmt::skip]
-pub fn humanoid24() -> Model {
+pub fn humanoid24() -> Figure {
     build("humanoid24", &[
         Part::Centre(row("pelvis", "pelvis", None, Free, [0.0, 0.530, 0.0], &[], None)),
         Part::Centre(row("waist", "chest", Some("pelvis"), Universal, [0.0, 0.07, 0.0], &[("flexion", X), ("lateral", Z)], None)),
@@ -166,7 +166,7 @@ pub fn humanoid24() -> Model {
 /// The 21-DOF, 15-link model of the falling paper: neck 3, each shoulder 2, each elbow 1, each
 /// wrist 1, waist 2, each hip 2, each knee 1, each ankle 1; the pelvis is the floating base.
 #[rustfmt::skip]
-pub fn fall21() -> Model {
+pub fn fall21() -> Figure {
     build("fall21", &[
         Part::Centre(row("pelvis", "pelvis", None, Free, [0.0, 0.530, 0.0], &[], None)),
         Part::Centre(row("waist", "torso", Some("pelvis"), Universal, [0.0, 0.07, 0.0], &[("flexion", X), ("rotation", Y)], None)),

@@ -20,7 +20,7 @@
 
 use glam::{DQuat, DVec3};
 
-use super::{JointKind, Model, project_rotation};
+use super::{Figure, JointKind, project_rotation};
 use crate::skeleton::Transform;
 #[cfg(doc)]
 use crate::skeleton::forward_kinematics;
@@ -40,7 +40,7 @@ impl Leg {
     /// The leg of a side (`"left"` or `"right"`): joints `{side}_hip`, `{side}_knee` (a pin,
     /// child of the hip) and `{side}_ankle` (child of the knee); `None` when the model has no
     /// such chain or the hip carries no DOF.
-    pub fn of(model: &Model, side: &str) -> Option<Leg> {
+    pub fn of(model: &Figure, side: &str) -> Option<Leg> {
         let hip = model.joint_index(&format!("{side}_hip"))?;
         let knee = model.joint_index(&format!("{side}_knee"))?;
         let ankle = model.joint_index(&format!("{side}_ankle"))?;
@@ -77,7 +77,7 @@ pub fn soft_distance(d: f64, full: f64) -> f64 {
 /// Global transforms of every joint of `model` at one frame: the root at `root_t`, `root_q`,
 /// the DOF `angles` (radians, model order); written to `out`.
 pub fn frame_globals(
-    model: &Model,
+    model: &Figure,
     root_t: DVec3,
     root_q: DQuat,
     angles: &[f64],
@@ -101,7 +101,7 @@ pub fn frame_globals(
 
 /// `joints` with every ancestor of each, in model order (parents before children): the joints
 /// whose global transforms [`chain_globals`] needs to place `joints`.
-pub fn with_ancestors(model: &Model, joints: &[usize]) -> Vec<usize> {
+pub fn with_ancestors(model: &Figure, joints: &[usize]) -> Vec<usize> {
     let mut inside = vec![false; model.joints.len()];
     for &j in joints {
         let mut at = Some(j);
@@ -117,7 +117,7 @@ pub fn with_ancestors(model: &Model, joints: &[usize]) -> Vec<usize> {
 /// [`with_ancestors`] gives): the same transforms, bit for bit, at the cost of the chain; the
 /// other entries of `out` are left as they were.
 pub fn chain_globals(
-    model: &Model,
+    model: &Figure,
     chain: &[usize],
     root_t: DVec3,
     root_q: DQuat,
@@ -142,7 +142,7 @@ pub fn chain_globals(
 /// `root_q`. Returns the distance left between the ankle and the target, metres (0 up to
 /// rounding when the target is within reach and the hip has 3 DOFs).
 pub fn reach(
-    model: &Model,
+    model: &Figure,
     leg: Leg,
     root_t: DVec3,
     root_q: DQuat,
@@ -160,7 +160,7 @@ pub fn reach(
 /// already ([`chain_globals`]), and leaves holding for the new angles: the same angles, bit for
 /// bit, without an allocation or a second placing per call, for legs moved round after round.
 pub fn reach_along(
-    model: &Model,
+    model: &Figure,
     leg: Leg,
     chain: &[usize],
     g: &mut Vec<Transform>,
@@ -229,7 +229,7 @@ mod tests {
     use crate::humanoid::humanoid24;
 
     /// A frame of humanoid24 with every DOF at a pseudo-random angle of up to ±`amp` rad.
-    fn pose(model: &Model, seed: u64, amp: f64) -> Vec<f64> {
+    fn pose(model: &Figure, seed: u64, amp: f64) -> Vec<f64> {
         let mut x = seed
             .wrapping_mul(6364136223846793005)
             .wrapping_add(1442695040888963407);

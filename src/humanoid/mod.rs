@@ -1,5 +1,5 @@
-//! The engine's humanoid models: joint trees whose joints carry named, anatomical degrees of
-//! freedom (DOFs).
+//! The engine's humanoid models ([`Figure`]s): joint trees whose joints carry named, anatomical
+//! degrees of freedom (DOFs).
 //!
 //! Frame: Y up, the figure faces +Z, its left is +X, metres. In the rest pose (every DOF zero) the
 //! figure stands straight with arms hanging at its sides, palms facing the thighs, feet forward,
@@ -9,7 +9,7 @@
 //! axis `(a.x, −a.y, −a.z)` so that the same number means the same motion on both sides.
 //!
 //! - [`humanoid24`]: the 24-DOF model of the motor-primitive paper (SPEC §1).
-//! - [`ModelClip`]: a motion on a model (DOF angles plus root motion).
+//! - [`FigureClip`]: a motion on a model (DOF angles plus root motion).
 //! - [`leg_ik`]: two-bone inverse kinematics of a leg (the ankle put at a point).
 //! - [`fall21`]: the 21-DOF, 15-link model of the falling paper (SPEC §3), with age-dependent
 //!   joint ranges in [`ranges`].
@@ -18,16 +18,16 @@ pub mod anthropometry;
 pub mod body;
 mod definition;
 pub mod export;
+mod figure_clip;
 mod joint_angles;
 pub mod leg_ik;
-mod model_clip;
 pub mod ranges;
 pub mod strength;
 pub mod tissue;
 
 pub use definition::{fall21, humanoid24};
+pub use figure_clip::{FigureClip, ROOT_CHANNELS};
 pub use joint_angles::{local_rotation, project_rotation, rotation_vector_near, unwrap_near};
-pub use model_clip::{ModelClip, ROOT_CHANNELS};
 
 use glam::{DQuat, DVec3};
 use serde::{Deserialize, Serialize};
@@ -73,7 +73,7 @@ impl JointKind {
 pub struct Dof {
     /// Anatomical name, e.g. `left_knee`, `right_hip_flexion`.
     pub name: String,
-    /// Index of the joint that carries it in [`Model::joints`].
+    /// Index of the joint that carries it in [`Figure::joints`].
     pub joint: usize,
     /// Unit rotation axis in rest (world-aligned) coordinates; positive angle = the named motion.
     pub axis: DVec3,
@@ -81,7 +81,7 @@ pub struct Dof {
 
 /// One joint of a model, which also names the link (segment) that hangs from it.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct ModelJoint {
+pub struct FigureJoint {
     /// Joint name, e.g. `left_knee`.
     pub name: String,
     /// Name of the link moved by this joint, e.g. `left_shin`.
@@ -92,29 +92,29 @@ pub struct ModelJoint {
     pub kind: JointKind,
     /// Position relative to the parent joint in the rest pose, metres.
     pub offset: DVec3,
-    /// Indices of its DOFs in [`Model::dofs`], in axis order.
+    /// Indices of its DOFs in [`Figure::dofs`], in axis order.
     pub dofs: Vec<usize>,
     /// End point of a terminal link (head top, hand, toe), relative to the joint, metres.
     pub end_site: Option<DVec3>,
 }
 
-/// A humanoid model: joints in depth-first order (each parent before its children) and the DOFs
-/// they carry, in joint order.
+/// A humanoid figure (one of the engine's models): joints in depth-first order (each parent
+/// before its children) and the DOFs they carry, in joint order.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Model {
+pub struct Figure {
     /// `humanoid24` or `fall21`.
     pub name: String,
     /// Standing height the offsets were made for, metres.
     pub height: f64,
     /// Joints, parents first.
-    pub joints: Vec<ModelJoint>,
+    pub joints: Vec<FigureJoint>,
     /// DOFs in joint order.
     pub dofs: Vec<Dof>,
 }
 
-/// Errors about models.
+/// Errors about figures (the engine's models).
 #[derive(Debug, thiserror::Error)]
-pub enum ModelError {
+pub enum FigureError {
     /// The name is not one of the engine's models.
     #[error("unknown model '{0}': expected one of humanoid24, fall21")]
     Unknown(String),
@@ -123,13 +123,13 @@ pub enum ModelError {
     MissingChannel(String),
 }
 
-impl Model {
+impl Figure {
     /// The engine's model with this name (`humanoid24` or `fall21`), at the reference height.
-    pub fn by_name(name: &str) -> Result<Model, ModelError> {
+    pub fn by_name(name: &str) -> Result<Figure, FigureError> {
         match name {
             "humanoid24" => Ok(humanoid24()),
             "fall21" => Ok(fall21()),
-            other => Err(ModelError::Unknown(other.to_string())),
+            other => Err(FigureError::Unknown(other.to_string())),
         }
     }
 
@@ -173,7 +173,7 @@ impl Model {
     }
 
     /// A copy with every offset and end site scaled so that the standing height is `height` m.
-    pub fn scaled_to_height(&self, height: f64) -> Model {
+    pub fn scaled_to_height(&self, height: f64) -> Figure {
         let s = height / self.height;
         let mut m = self.clone();
         m.height = height;

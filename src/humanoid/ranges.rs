@@ -7,7 +7,7 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use super::Model;
+use super::Figure;
 
 /// The RON format version this build reads and writes.
 pub const FORMAT_VERSION: u32 = 1;
@@ -114,7 +114,7 @@ impl RangeTable {
 
     /// `(lower, upper)` in radians for every DOF of `model`, in model order. The full DOF name is
     /// looked up first, then the name without its `left_`/`right_` prefix.
-    pub fn for_model(&self, model: &Model) -> Result<Vec<(f64, f64)>, RangeError> {
+    pub fn for_model(&self, model: &Figure) -> Result<Vec<(f64, f64)>, RangeError> {
         let known: Vec<String> = model.dofs.iter().map(|d| d.name.clone()).collect();
         for k in self.ranges.keys() {
             let matches = known.iter().any(|n| n == k || strip_side(n) == k);

@@ -115,7 +115,7 @@ pub struct NoStrength(pub String);
 
 /// The torque range `(τ_min, τ_max)` (N·m) of every DOF of `model` in model order for `group`.
 pub fn torque_limits_for(
-    model: &crate::humanoid::Model,
+    model: &crate::humanoid::Figure,
     group: AgeGroup,
 ) -> Result<Vec<(f64, f64)>, NoStrength> {
     model

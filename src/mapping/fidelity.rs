@@ -3,7 +3,7 @@
 use serde::Serialize;
 
 use super::{Mapping, MappingError};
-use crate::humanoid::ModelClip;
+use crate::humanoid::FigureClip;
 use crate::skeleton::Clip;
 
 /// Distance between where the source and the mapped model put one end effector, metres.
@@ -31,7 +31,7 @@ const EFFECTORS: [(&str, &str, bool, &str); 5] = [
 pub fn effector_errors(
     source: &Clip,
     mapping: &Mapping,
-    mapped: &ModelClip,
+    mapped: &FigureClip,
 ) -> Result<Vec<EffectorError>, MappingError> {
     let model_clip = mapped.to_clip();
     let mut out = vec![];

@@ -4,7 +4,7 @@
 //! anatomical landmark (pelvis, waist, neck, head, and per side clavicle, shoulder, elbow, wrist,
 //! hand, hip, knee, ankle, toe), the source joint or End Site that marks it. [`retarget`] turns a
 //! clip into the model's DOF angle trajectories plus root motion
-//! ([`ModelClip`](crate::humanoid::ModelClip)).
+//! ([`FigureClip`](crate::humanoid::FigureClip)).
 //!
 //! A skeleton none of the built-in files fits is mapped automatically ([`detect_automatic`]):
 //! the five chains by structure ([`structure`]), the landmarks along them by names

@@ -15,8 +15,8 @@
 use glam::{DMat3, DQuat, DVec3};
 
 use super::{Landmark, Mapping, MappingError};
-use crate::humanoid::ModelClip;
-use crate::humanoid::{JointKind, Model, local_rotation, project_rotation};
+use crate::humanoid::FigureClip;
+use crate::humanoid::{Figure, JointKind, local_rotation, project_rotation};
 use crate::skeleton::Clip;
 
 /// Which landmark an End Site of a model joint stands for.
@@ -86,7 +86,7 @@ fn perp(v: DVec3, axis: DVec3) -> DVec3 {
 /// Target global orientation of model joint `j`'s link at one frame, or `None` when the source
 /// gives no direction for it (then the link keeps its parent's orientation).
 fn target_frame(
-    model: &Model,
+    model: &Figure,
     j: usize,
     p: &Points,
     targets: &[Option<DQuat>],
@@ -159,7 +159,7 @@ fn torso_frame(role: &str, link: &Link) -> Option<DQuat> {
 
 /// The target frame of an arm's clavicle, upper arm (shoulder), forearm (elbow) or hand
 /// (wrist).
-fn arm_frame(role: &str, link: &Link, model: &Model, targets: &[Option<DQuat>]) -> Option<DQuat> {
+fn arm_frame(role: &str, link: &Link, model: &Figure, targets: &[Option<DQuat>]) -> Option<DQuat> {
     let l = |name: &str| link.l(name);
     let parent_frame = link.parent;
     match role {
@@ -229,7 +229,11 @@ fn leg_frame(role: &str, link: &Link) -> Option<DQuat> {
 /// Maps `clip` onto `model` through `mapping`: DOF angle trajectories (radians, unwrapped over
 /// time), root translation (the pelvis landmark, metres) and root orientation, on a copy of the
 /// model whose offsets are the source's (median landmark geometry).
-pub fn retarget(clip: &Clip, mapping: &Mapping, model: &Model) -> Result<ModelClip, MappingError> {
+pub fn retarget(
+    clip: &Clip,
+    mapping: &Mapping,
+    model: &Figure,
+) -> Result<FigureClip, MappingError> {
     let names = needed_landmarks(model);
     let resolved: Vec<Landmark> = names
         .iter()
@@ -267,7 +271,7 @@ pub fn retarget(clip: &Clip, mapping: &Mapping, model: &Model) -> Result<ModelCl
     let root_translation = (0..frames)
         .map(|f| lm.positions[f * k + pelvis_lm])
         .collect();
-    Ok(ModelClip {
+    Ok(FigureClip {
         model: mapped_model,
         frame_time: clip.frame_time,
         root_translation,
@@ -277,7 +281,7 @@ pub fn retarget(clip: &Clip, mapping: &Mapping, model: &Model) -> Result<ModelCl
 }
 
 /// The landmarks `model` needs: one per joint, plus those of End Sites, plus the hints'.
-fn needed_landmarks(model: &Model) -> Vec<String> {
+fn needed_landmarks(model: &Figure) -> Vec<String> {
     let mut names: Vec<String> = vec![];
     let mut need = |n: String| {
         if !names.contains(&n) {
@@ -348,7 +352,7 @@ impl LandmarkTracks {
 
 /// A copy of `model` with the source's offsets and End Sites: the median of the landmark
 /// geometry in the parent's target frame (the model's own where the source gives none).
-fn mapped_model(model: &Model, lm: &LandmarkTracks, targets: &[Option<DQuat>]) -> Model {
+fn mapped_model(model: &Figure, lm: &LandmarkTracks, targets: &[Option<DQuat>]) -> Figure {
     let (n, k, frames) = (model.joints.len(), lm.names.len(), lm.frames);
     let positions = &lm.positions;
     let mut mapped_model = model.clone();
@@ -379,7 +383,7 @@ fn mapped_model(model: &Model, lm: &LandmarkTracks, targets: &[Option<DQuat>]) -
 /// each joint's from its parent's achieved frame and the link's target (`targets`, frame by
 /// frame), unwrapped against the frame before.
 fn dof_angles(
-    model: &Model,
+    model: &Figure,
     targets: &[Option<DQuat>],
     rest_dirs: &[DVec3],
     frames: usize,
@@ -442,7 +446,7 @@ fn median_local(frames: usize, sample: impl Fn(usize) -> Option<DVec3>) -> Optio
 }
 
 /// Standing height of a model in its rest pose (top point minus lowest point), metres.
-fn height_of(model: &Model) -> f64 {
+fn height_of(model: &Figure) -> f64 {
     let pts = model.skeleton().rest_points();
     let hi = pts.iter().map(|p| p.y).fold(f64::MIN, f64::max);
     let lo = pts.iter().map(|p| p.y).fold(f64::MAX, f64::min);
@@ -452,7 +456,7 @@ fn height_of(model: &Model) -> f64 {
 /// Leg length of a model at rest, metres: the mean over the sides that have them of the height
 /// of the `…_hip` joint above the lowest point at or below its `…_ankle` joint (the ankle, its
 /// End Site, any joint under it); `None` for a model without hips and ankles.
-pub fn leg_length(model: &Model) -> Option<f64> {
+pub fn leg_length(model: &Figure) -> Option<f64> {
     let skeleton = model.skeleton();
     let pts = skeleton.rest_points();
     let parents = skeleton.point_parents();
@@ -485,12 +489,12 @@ pub fn leg_length(model: &Model) -> Option<f64> {
 /// tall put on legs of a 1.65 m figure keeps her pelvis at her own height and so stands in the
 /// floor; scaled, the pelvis rides as high above the feet, and the steps are as long, in
 /// proportion to the legs. Without legs on either model the translation is kept (s = 1).
-pub fn onto_model(clip: &ModelClip, target: &Model) -> ModelClip {
+pub fn onto_model(clip: &FigureClip, target: &Figure) -> FigureClip {
     let s = match (leg_length(target), leg_length(&clip.model)) {
         (Some(t), Some(c)) if t > 0.0 && c > 0.0 => t / c,
         _ => 1.0,
     };
-    ModelClip {
+    FigureClip {
         model: target.clone(),
         frame_time: clip.frame_time,
         root_translation: clip.root_translation.iter().map(|t| *t * s).collect(),
@@ -520,7 +524,7 @@ mod tests {
         let source = target.scaled_to_height(1.53);
         let d = target.dofs.len();
         let n = 10;
-        let clip = ModelClip {
+        let clip = FigureClip {
             model: source.clone(),
             frame_time: 0.1,
             root_translation: (0..n)
@@ -537,12 +541,12 @@ mod tests {
         assert_eq!(out.angles, clip.angles);
         assert_eq!(out.model, target);
         // Standing straight with its sole on the floor on the source, so it does on the target.
-        let stand = |m: &Model| {
+        let stand = |m: &Figure| {
             leg_length(m).unwrap()
                 + (m.skeleton().rest_points()[0].y
                     - m.skeleton().rest_points()[m.joint_index("left_hip").unwrap()].y)
         };
-        let still = ModelClip {
+        let still = FigureClip {
             root_translation: vec![DVec3::new(0.0, stand(&source), 0.0)],
             root_rotation: vec![DQuat::IDENTITY],
             angles: vec![0.0; d],

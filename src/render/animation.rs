@@ -27,7 +27,7 @@ use super::canvas::{
 };
 use super::figure::{Track, validate_tracks};
 use super::text::{Align, Pen, ascent, draw_text, font};
-use super::volume::Body;
+use super::volume::Volumes;
 use super::{RenderError, require_extension, write};
 
 /// Height of each view (pixels).
@@ -161,7 +161,7 @@ pub fn animation_gif(tracks: &[Track], fps: f64, path: &Path) -> Result<(), Rend
         )));
     }
     let frames = steps as usize + 1;
-    let bodies: Vec<Body> = tracks.iter().map(Body::of).collect();
+    let bodies: Vec<Volumes> = tracks.iter().map(Volumes::of).collect();
     let lut = lookup();
     let time_base = MARGIN as f32 + ascent(font, style.text);
     let mut still = vec![0u8; (width * page.height) as usize];

@@ -397,7 +397,7 @@ impl Camera {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::render::figure::Figure;
+    use crate::render::figure::StickFigure;
 
     #[test]
     fn views_are_right_handed_and_put_the_left_on_the_viewers_right_in_front() {
@@ -414,8 +414,8 @@ mod tests {
     }
 
     /// A figure of one point moving by `step` (m) a frame for 20 frames.
-    fn mover(step: DVec3) -> (Figure, Vec<Vec<DVec3>>) {
-        let f = Figure {
+    fn mover(step: DVec3) -> (StickFigure, Vec<Vec<DVec3>>) {
+        let f = StickFigure {
             names: vec!["Hips".into()],
             parents: vec![None],
         };
@@ -455,8 +455,8 @@ mod tests {
         assert!((az(DVec3::Y * 0.05) - 45.0).abs() < 1e-9);
     }
 
-    fn walker() -> (Figure, Vec<Vec<DVec3>>) {
-        let f = Figure {
+    fn walker() -> (StickFigure, Vec<Vec<DVec3>>) {
+        let f = StickFigure {
             names: vec!["Hips".into(), "Head".into()],
             parents: vec![None, Some(0)],
         };

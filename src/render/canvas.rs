@@ -11,7 +11,7 @@ use super::RenderError;
 use super::camera::Camera;
 use super::figure::{Side, Track};
 use super::text::{Align, Pen, draw_text, text_width};
-use super::volume::{Body, Solid};
+use super::volume::{Solid, Volumes};
 
 /// Page background.
 pub(crate) const WHITE: [u8; 3] = [255, 255, 255];
@@ -236,7 +236,7 @@ pub(crate) fn draw_body(
     p: &mut Pixmap,
     cam: &Camera,
     track: &Track,
-    body: &Body,
+    body: &Volumes,
     k: usize,
     style: Style,
 ) {
@@ -720,12 +720,12 @@ pub(crate) fn encode_png(p: &Pixmap) -> Result<Vec<u8>, RenderError> {
 mod tests {
     use super::*;
     use crate::render::camera::{Eye, PanelLimits, View, scale_for};
-    use crate::render::figure::Figure;
+    use crate::render::figure::StickFigure;
     use crate::render::volume::Shape;
 
     /// Hips with two straight legs (hip, knee, foot), feet `stance` m either side, 0.95 m tall.
-    fn legs(stance: f64) -> (Figure, Vec<DVec3>) {
-        let fig = Figure {
+    fn legs(stance: f64) -> (StickFigure, Vec<DVec3>) {
+        let fig = StickFigure {
             names: [
                 "Hips",
                 "LeftUpLeg",
@@ -764,7 +764,7 @@ mod tests {
         let cam = Camera::fit(tracks, eye, mpp, pad, limits);
         let mut p = new_pixmap(cam.width, cam.height, WHITE).unwrap();
         let style = Style::for_height(300);
-        draw_body(&mut p, &cam, track, &Body::of(track), 0, style);
+        draw_body(&mut p, &cam, track, &Volumes::of(track), 0, style);
         (p, cam)
     }
 
@@ -836,7 +836,7 @@ mod tests {
             frame_time: 0.1,
         };
         // Lift the body so that the shins' capsules rest on the floor.
-        let r = Body::of(&t)
+        let r = Volumes::of(&t)
             .shapes
             .iter()
             .find_map(|(s, _)| match *s {
@@ -900,7 +900,7 @@ mod tests {
     #[test]
     fn a_nearer_volume_covers_a_farther_one_whatever_their_order() {
         // Two arms crossing in front of the viewer: one 0.5 m nearer than the other.
-        let fig = Figure {
+        let fig = StickFigure {
             names: ["Chest", "LeftHand", "RightHand"]
                 .map(String::from)
                 .to_vec(),

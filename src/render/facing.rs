@@ -4,8 +4,9 @@
 //!
 //! The figure's left is the mean over the motion of (mean of its left limb roots − mean of its
 //! right limb roots), horizontal: a limb root is a point on one side (by
-//! [`super::Figure::sides`]) hanging from a mid-line point: hips, clavicles or shoulders, not the
-//! swinging hands and feet. Its facing is left × up. A figure without sides is drawn as it is.
+//! [`super::StickFigure::sides`]) hanging from a mid-line point: hips, clavicles or shoulders,
+//! not the swinging hands and feet. Its facing is left × up. A figure without sides is drawn as
+//! it is.
 
 use glam::{DQuat, DVec3};
 
@@ -123,18 +124,18 @@ pub(crate) fn with_frames<'a>(
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
-    use crate::render::Figure;
+    use crate::render::StickFigure;
 
     /// A pelvis with its two hips.
-    fn hips() -> Figure {
-        Figure {
+    fn hips() -> StickFigure {
+        StickFigure {
             names: vec!["pelvis".into(), "left_hip".into(), "right_hip".into()],
             parents: vec![None, Some(0), Some(0)],
         }
     }
 
     /// A track of `frames` at 10 frames/s (shared with the filmstrip tests).
-    pub(crate) fn track<'a>(fig: &'a Figure, frames: &'a [Vec<DVec3>]) -> Track<'a> {
+    pub(crate) fn track<'a>(fig: &'a StickFigure, frames: &'a [Vec<DVec3>]) -> Track<'a> {
         Track {
             figure: fig,
             frames,

@@ -1,4 +1,4 @@
-//! What is drawn: a stick figure's topology ([`Figure`]), a motion of it ([`Track`]), the
+//! What is drawn: a stick figure's topology ([`StickFigure`]), a motion of it ([`Track`]), the
 //! left/right rule that colours its limbs ([`side_from_name`]) and the checks that turn bad input
 //! into a [`RenderError`] before anything is drawn.
 
@@ -12,7 +12,7 @@ pub use crate::skeleton::{Side, side_from_name};
 /// hangs from (`None` for a root). Each point with a parent is drawn as a bone from the parent
 /// to the point, each point as a dot.
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub struct Figure {
+pub struct StickFigure {
     /// Point names (joint or end-site names); they decide the limb colour, see [`side_from_name`].
     pub names: Vec<String>,
     /// `parents[i]`: index of the point that point `i` hangs from, `None` for a root.
@@ -24,7 +24,7 @@ pub struct Figure {
 #[derive(Debug, Clone)]
 pub struct Track<'a> {
     /// The topology shared by every frame.
-    pub figure: &'a Figure,
+    pub figure: &'a StickFigure,
     /// `frames[k][i]`: global position of point `i` at time `k · frame_time` (metres).
     pub frames: &'a [Vec<DVec3>],
     /// Name shown above the track (e.g. "adult, before evolution").
@@ -34,10 +34,10 @@ pub struct Track<'a> {
     pub frame_time: f64,
 }
 
-impl Figure {
+impl StickFigure {
     /// The stick figure of `skeleton`: its point names and parents (joints, then End Sites).
     pub fn of(skeleton: &Skeleton) -> Self {
-        Figure {
+        StickFigure {
             names: skeleton.point_names(),
             parents: skeleton.point_parents(),
         }
@@ -45,7 +45,7 @@ impl Figure {
 
     /// The side of every point: [`side_from_name`] of its name, or, when that is
     /// [`Side::Centre`], the side of its parent (so an unnamed end site below `LeftHand` is left).
-    /// Points may be listed in any order; on a cyclic figure (which [`Figure::validate`]
+    /// Points may be listed in any order; on a cyclic figure (which [`StickFigure::validate`]
     /// rejects) the walk stops after as many steps as there are points.
     pub fn sides(&self) -> Vec<Side> {
         let n = self.names.len();
@@ -195,7 +195,7 @@ pub(crate) fn validate_tracks(tracks: &[Track]) -> Result<(), RenderError> {
 /// floor under `Hips`): a root with one child, lower than a tenth of the figure's height above
 /// its lowest point and farther from that child than a quarter of the height. Its bone would
 /// be drawn as a third leg, so it is not drawn.
-pub(crate) fn ground_proxy(fig: &Figure, pts: &[DVec3]) -> Option<usize> {
+pub(crate) fn ground_proxy(fig: &StickFigure, pts: &[DVec3]) -> Option<usize> {
     let root = fig.root();
     let mut children = fig
         .parents
@@ -219,7 +219,7 @@ mod tests {
 
     #[test]
     fn end_sites_inherit_their_parents_side() {
-        let f = Figure {
+        let f = StickFigure {
             names: ["Hips", "LeftHand", "Site", "Neck", "RightFoot", "Toe_End"]
                 .map(String::from)
                 .to_vec(),
@@ -231,17 +231,17 @@ mod tests {
 
     #[test]
     fn bad_topologies_are_errors() {
-        let cyc = Figure {
+        let cyc = StickFigure {
             names: vec!["a".into(), "b".into()],
             parents: vec![Some(1), Some(0)],
         };
         assert!(matches!(cyc.validate(), Err(RenderError::BadFigure(_))));
-        let out = Figure {
+        let out = StickFigure {
             names: vec!["a".into()],
             parents: vec![Some(3)],
         };
         assert!(matches!(out.validate(), Err(RenderError::BadFigure(_))));
-        let uneven = Figure {
+        let uneven = StickFigure {
             names: vec!["a".into()],
             parents: vec![],
         };
@@ -250,7 +250,7 @@ mod tests {
 
     #[test]
     fn non_finite_and_miscounted_frames_name_the_frame_and_point() {
-        let f = Figure {
+        let f = StickFigure {
             names: vec!["Hips".into(), "Head".into()],
             parents: vec![None, Some(0)],
         };
@@ -288,7 +288,7 @@ mod tests {
 
     #[test]
     fn frame_at_rounds_and_holds() {
-        let f = Figure {
+        let f = StickFigure {
             names: vec!["a".into()],
             parents: vec![None],
         };
@@ -312,7 +312,7 @@ mod tests {
         let names = [
             "root", "hips", "l_knee", "l_foot", "r_knee", "r_foot", "head",
         ];
-        let fig = Figure {
+        let fig = StickFigure {
             names: names.iter().map(|s| s.to_string()).collect(),
             parents: vec![None, Some(0), Some(1), Some(2), Some(1), Some(4), Some(1)],
         };
@@ -328,7 +328,7 @@ mod tests {
         ];
         assert_eq!(ground_proxy(&fig, &pts), Some(0));
         // The same body without the floor root: the hips are the root, with three children.
-        let body = Figure {
+        let body = StickFigure {
             names: fig.names[1..].to_vec(),
             parents: vec![None, Some(0), Some(1), Some(0), Some(3), Some(0)],
         };

@@ -14,7 +14,7 @@ use super::canvas::{
 };
 use super::figure::{Side, Track, validate_tracks};
 use super::text::{Align, Pen, ascent, draw_text, font};
-use super::volume::Body;
+use super::volume::Volumes;
 use super::{RenderError, require_extension, write};
 use crate::analysis::{ContactConfig, ground_contacts};
 use glam::DVec3;
@@ -403,7 +403,7 @@ fn draw_columns(
             },
         );
         y += label_row;
-        let body = Body::of(track);
+        let body = Volumes::of(track);
         for (j, &t) in times.iter().enumerate() {
             let mut cell = background.clone();
             draw_body(&mut cell, cam, track, &body, track.frame_at(t), style);
@@ -429,7 +429,7 @@ fn draw_columns(
 mod tests {
     use super::*;
 
-    use crate::render::Figure;
+    use crate::render::StickFigure;
     use crate::render::facing::tests::track;
     use glam::DVec3;
 
@@ -437,7 +437,7 @@ mod tests {
     fn every_flight_gets_a_column_at_its_apex() {
         // A figure standing on two feet (ankles 0.08 m up, toes on the floor) that jumps 0.5 m
         // forward three times, ballistic flights 1.0–1.4 s, 2.2–2.5 s and 3.3–3.8 s.
-        let fig = Figure {
+        let fig = StickFigure {
             names: [
                 "pelvis",
                 "left_ankle",
@@ -512,7 +512,7 @@ mod tests {
 
     #[test]
     fn each_column_is_labelled_with_the_time_of_the_frame_it_shows() {
-        let fig = Figure {
+        let fig = StickFigure {
             names: vec!["a".into()],
             parents: vec![None],
         };
@@ -547,7 +547,7 @@ mod tests {
 
     #[test]
     fn columns_follow_the_motion_and_span_the_whole_duration() {
-        let fig = Figure {
+        let fig = StickFigure {
             names: vec!["a".into()],
             parents: vec![None],
         };

@@ -1,6 +1,6 @@
 //! Pictures of poses and motions, and plots, independent of any skeleton type.
 //!
-//! A motion is given as a [`Track`]: a [`Figure`] (point names and parents) and the global
+//! A motion is given as a [`Track`]: a [`StickFigure`] (point names and parents) and the global
 //! position of every point in every frame (metres, Y up, the figure faces +Z, its left is +X).
 //! From tracks this module draws
 //!
@@ -20,7 +20,7 @@
 //!
 //! Conventions of every picture: orthographic views ([`View`]) of the figure turned to face +Z
 //! (its facing found from its left and right points, so "front" is its front); the body drawn
-//! as volumes ([`Body`]: the contact boxes of the project's models, capsules along the bones
+//! as volumes ([`Volumes`]: the contact boxes of the project's models, capsules along the bones
 //! of any other skeleton), shaded against one light and sorted back to front, over its shadow
 //! on the floor; the figure's left limbs blue, its right limbs vermillion, mid-line grey
 //! (decided from point names by [`side_from_name`]); the floor y = 0 as a line over a light
@@ -47,7 +47,7 @@ use std::path::{Path, PathBuf};
 
 pub use animation::{MAX_GIF_FPS, MAX_GIF_FRAMES, animation_gif};
 pub use camera::{ELEVATION, Eye, View, three_quarter};
-pub use figure::{Figure, Side, Track, side_from_name};
+pub use figure::{Side, StickFigure, Track, side_from_name};
 pub use filmstrip::{filmstrip_at_png, filmstrip_png, filmstrip_view_png};
 pub use music::music_png;
 pub use page::{
@@ -57,7 +57,7 @@ pub use page::{
 pub use plot::{Plot, Series, plot};
 pub use pose::pose_png;
 pub use text::FONT_TTF;
-pub use volume::{Body, Shape, Solid};
+pub use volume::{Shape, Solid, Volumes};
 
 /// Why a picture or plot could not be made.
 #[derive(Debug, thiserror::Error)]

@@ -13,7 +13,7 @@ use super::canvas::{
 };
 use super::figure::Track;
 use super::text::{Align, Pen, ascent, draw_text, font};
-use super::volume::Body;
+use super::volume::Volumes;
 use super::{RenderError, require_extension, write};
 
 /// Height of each view (pixels).
@@ -56,7 +56,7 @@ pub fn pose_png(track: &Track, frame: usize, path: &Path) -> Result<(), RenderEr
 
     draw_header(&mut sheet, font, style, track, frame);
 
-    let body = Body::of(track);
+    let body = Volumes::of(track);
     let mut x = MARGIN + (width - 2 * MARGIN - panels_w) / 2;
     let y = MARGIN + header;
     for cam in &cams {

@@ -24,12 +24,12 @@
 //!
 //!   A root that only stands in for the ground (see [`super::figure::ground_proxy`]) gets none.
 //!
-//! Every volume carries the side of its point ([`super::Figure::sides`]) for its colour (but the
-//! head's).
+//! Every volume carries the side of its point ([`super::StickFigure::sides`]) for its colour
+//! (but the head's).
 
 use glam::{DMat3, DQuat, DVec3};
 
-use super::figure::{Figure, Side, Track};
+use super::figure::{Side, StickFigure, Track};
 use crate::humanoid::{self, body::human_body};
 
 /// One volume of a body, in the figure's terms.
@@ -98,9 +98,10 @@ impl Solid {
     }
 }
 
-/// A figure's body as volumes (see the module doc for the two kinds and their rules).
+/// A figure's body as volumes (see the module doc for the two kinds and their rules): the
+/// shapes with their sides, and how to place them on a frame.
 #[derive(Debug, Clone)]
-pub struct Body {
+pub struct Volumes {
     /// Every volume with the side that colours it.
     pub shapes: Vec<(Shape, Side)>,
     /// What the volumes are, for captions: "fall21 contact boxes", "capsules".
@@ -115,18 +116,18 @@ pub struct Body {
 }
 
 /// Bodies of the models the project simulates: (name, model).
-fn models() -> [(&'static str, humanoid::Model); 2] {
+fn models() -> [(&'static str, humanoid::Figure); 2] {
     [
         ("fall21", humanoid::fall21()),
         ("humanoid24", humanoid::humanoid24()),
     ]
 }
 
-impl Body {
+impl Volumes {
     /// The body of `track`'s figure: the model's contact boxes when the figure is one of the
     /// project's models and its height (bone lengths in the first frame against the model's)
     /// is one the model is built for (1.0–2.3 m), capsules otherwise.
-    pub fn of(track: &Track) -> Body {
+    pub fn of(track: &Track) -> Volumes {
         let fig = track.figure;
         for (name, model) in models() {
             let skel = model.skeleton();
@@ -155,7 +156,12 @@ impl Body {
 
     /// The contact boxes of `model` (whose figure `fig` is) at `height` m; `None` when the
     /// model cannot be built at that height.
-    fn boxes(fig: &Figure, model: &humanoid::Model, height: f64, name: &str) -> Option<Body> {
+    fn boxes(
+        fig: &StickFigure,
+        model: &humanoid::Figure,
+        height: f64,
+        name: &str,
+    ) -> Option<Volumes> {
         // Mass and gravity do not change the boxes.
         let body = human_body(model, height, 70.0, 9.81).ok()?;
         let rest = body.figure.skeleton().rest_points();
@@ -182,7 +188,7 @@ impl Body {
                 )
             })
             .collect();
-        Some(Body {
+        Some(Volumes {
             shapes,
             kind: format!("{name} contact boxes"),
             children,
@@ -192,7 +198,7 @@ impl Body {
     }
 
     /// Capsules along the bones of `track`'s figure by the proportion rule of the module doc.
-    fn capsules(track: &Track) -> Body {
+    fn capsules(track: &Track) -> Volumes {
         let fig = track.figure;
         let n = fig.names.len();
         let h = track
@@ -261,7 +267,7 @@ impl Body {
                 ))
             })
             .collect();
-        Body {
+        Volumes {
             shapes,
             kind: "capsules".into(),
             children: vec![Vec::new(); n],
@@ -356,8 +362,8 @@ fn triad(kids: &[(usize, DVec3)], drawn: &dyn Fn(usize) -> Option<DVec3>) -> Opt
 }
 
 /// Every point of `fig`, parents before children (roots first; a point in a cycle, which
-/// [`Figure::validate`] rejects, is left out).
-fn parents_first(fig: &Figure) -> Vec<usize> {
+/// [`StickFigure::validate`] rejects, is left out).
+fn parents_first(fig: &StickFigure) -> Vec<usize> {
     let n = fig.parents.len();
     let mut out: Vec<usize> = (0..n).filter(|&i| fig.parents[i].is_none()).collect();
     let mut k = 0;
@@ -373,15 +379,15 @@ fn parents_first(fig: &Figure) -> Vec<usize> {
 mod tests {
     use super::*;
 
-    fn model_track(model: &humanoid::Model, pts: &[Vec<DVec3>]) -> Body {
-        let fig = Figure::of(&model.skeleton());
+    fn model_track(model: &humanoid::Figure, pts: &[Vec<DVec3>]) -> Volumes {
+        let fig = StickFigure::of(&model.skeleton());
         let t = Track {
             figure: &fig,
             frames: pts,
             label: String::new(),
             frame_time: 0.1,
         };
-        Body::of(&t)
+        Volumes::of(&t)
     }
 
     #[test]
@@ -424,7 +430,7 @@ mod tests {
     #[test]
     fn any_other_skeleton_gets_capsules_by_the_proportion_rule() {
         // Hips, a spine to the head, and a left leg of thigh and shin, 1.7 m tall.
-        let fig = Figure {
+        let fig = StickFigure {
             names: [
                 "Hips",
                 "Chest",
@@ -454,7 +460,7 @@ mod tests {
             label: String::new(),
             frame_time: 0.1,
         };
-        let body = Body::of(&t);
+        let body = Volumes::of(&t);
         assert_eq!(body.kind, "capsules");
         let radius = |to: usize| {
             body.shapes

@@ -28,8 +28,8 @@ use crate::choreo::search::SearchParams;
 use crate::choreo::segments::{Beat, TempoSource};
 use crate::experiments::dance::{self as generated, DanceFigures, GenerateError, Generated};
 use crate::render::{
-    Figure, Page, PageMotion, PageSong, Plot, Series, Track, View, animation_gif, filmstrip_at_png,
-    plot,
+    Page, PageMotion, PageSong, Plot, Series, StickFigure, Track, View, animation_gif,
+    filmstrip_at_png, plot,
 };
 
 /// Where the song comes from.
@@ -453,7 +453,7 @@ fn write_dance(
     // Pictures of the dance itself (frame 0 at the first bar).
     let dclip = d.clip.to_clip();
     let frames = dclip.point_frames();
-    let figure = Figure::of(&dclip.skeleton);
+    let figure = StickFigure::of(&dclip.skeleton);
     let track = Track {
         figure: &figure,
         frames: &frames,

@@ -367,7 +367,7 @@ pub enum SceneError {
     Mapping(#[from] crate::mapping::MappingError),
     /// A model.
     #[error(transparent)]
-    Model(#[from] crate::humanoid::ModelError),
+    Figure(#[from] crate::humanoid::FigureError),
     /// A joint-range table.
     #[error(transparent)]
     Ranges(#[from] crate::humanoid::ranges::RangeError),
@@ -676,7 +676,7 @@ fn validate_show(s: &ShowScene) -> Result<(), SceneError> {
     check_pictures(s.render.filmstrip_frames, s.render.gif, s.render.gif_fps)?;
     // Without a model there are no DOFs: the plot is not drawn.
     if let Some(name) = &s.model {
-        let model = crate::humanoid::Model::by_name(name)?;
+        let model = crate::humanoid::Figure::by_name(name)?;
         for d in &s.render.plot {
             if model.dof_index(d).is_none() {
                 return Err(SceneError::UnknownName {

@@ -20,7 +20,7 @@ pub fn fall_motion(label: &str, r: &FallResult) -> Result<PageMotion, SceneError
     // The boxes' sizes follow the height only; the mass sets inertias, which are not drawn.
     let body =
         crate::humanoid::body::fall21_body(r.height_m, 65.0, 9.81).map_err(SceneError::FallBody)?;
-    let figure = crate::render::Figure::of(&clip.skeleton);
+    let figure = crate::render::StickFigure::of(&clip.skeleton);
     let joints = clip.joint_count();
     if body.boxes.len() != joints {
         return Err(SceneError::BoxCount {

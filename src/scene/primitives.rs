@@ -18,11 +18,11 @@ use crate::ecs::{
 };
 use crate::experiments::high_jump::{self, HighJumpConfig, HighJumpOutcome};
 use crate::experiments::knee_kick::{self, KneeKickConfig, KneeKickOutcome};
-use crate::humanoid::{Model, ModelClip};
+use crate::humanoid::{Figure, FigureClip};
 use crate::primitive::{
     EventConfig, Gamma, JumpEvents, LearnConfig, Learned, Primitive, Trajectory,
 };
-use crate::render::{Figure, Page, PageMotion, PagePlot, Plot, Series, Track, plot};
+use crate::render::{Page, PageMotion, PagePlot, Plot, Series, StickFigure, Track, plot};
 
 /// Pictures of a primitive scene.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -107,7 +107,7 @@ pub struct JumpingKneeKickScene {
 }
 
 /// Loads a clip onto humanoid24 as a primitive trajectory.
-fn demo(src: &ClipSource, base: &Path, model: &Model) -> Result<ModelClip, SceneError> {
+fn demo(src: &ClipSource, base: &Path, model: &Figure) -> Result<FigureClip, SceneError> {
     load_motion(src, base)?.on_model(model)
 }
 
@@ -115,7 +115,7 @@ fn demo(src: &ClipSource, base: &Path, model: &Model) -> Result<ModelClip, Scene
 fn high_jump_config(
     scene: &HighJumpScene,
     base: &Path,
-    model: &Model,
+    model: &Figure,
 ) -> Result<HighJumpConfig, SceneError> {
     Ok(HighJumpConfig {
         model: model.clone(),
@@ -132,12 +132,12 @@ fn fit_json(l: &Learned) -> serde_json::Value {
 
 /// Draws tracks of model clips: filmstrip, GIF; returns them as motions of the results page.
 pub(super) fn draw(
-    tracks: &[(&str, &ModelClip)],
+    tracks: &[(&str, &FigureClip)],
     render: &PrimitiveRender,
     out: &Path,
 ) -> Result<Vec<PageMotion>, SceneError> {
     let clips: Vec<_> = tracks.iter().map(|(_, m)| m.to_clip()).collect();
-    let figures: Vec<_> = clips.iter().map(|c| Figure::of(&c.skeleton)).collect();
+    let figures: Vec<_> = clips.iter().map(|c| StickFigure::of(&c.skeleton)).collect();
     let frames: Vec<_> = clips.iter().map(|c| c.point_frames()).collect();
     let t: Vec<Track> = tracks
         .iter()
@@ -206,7 +206,7 @@ pub fn run_high_jump(
     out: &Path,
 ) -> Result<serde_json::Value, SceneError> {
     scene.gamma.validate()?;
-    let model = Model::by_name("humanoid24")?;
+    let model = Figure::by_name("humanoid24")?;
     let config = high_jump_config(scene, base, &model)?;
     let hj = high_jump::run(&config).map_err(SceneError::from)?;
     let learned = &hj.primitives.learned;
@@ -323,7 +323,7 @@ const FLIGHTS_AGAINST: &str = "the normal jump's floor and foot rest heights \
     clip's flight with its own, as `marionette inspect` finds it in the written BVH";
 
 /// Writes a clip on the model as BVH.
-pub(super) fn write_bvh(path: &Path, clip: &ModelClip) -> Result<(), SceneError> {
+pub(super) fn write_bvh(path: &Path, clip: &FigureClip) -> Result<(), SceneError> {
     write_output(
         path,
         crate::bvh::to_string(&clip.to_clip().to_bvh()).as_bytes(),
@@ -335,9 +335,9 @@ pub(super) fn write_bvh(path: &Path, clip: &ModelClip) -> Result<(), SceneError>
 /// the kernel's `expected` motion, metres. The recorder holds the state after each step, so
 /// recorded frame i is expected frame i + 1.
 fn play_in_world(
-    model: &Model,
+    model: &Figure,
     sequence: &[Primitive],
-    expected: &ModelClip,
+    expected: &FigureClip,
 ) -> Result<f64, SceneError> {
     let dt = expected.frame_time;
     let mut world = new_world(Clock::new(dt, 1));
@@ -374,7 +374,7 @@ pub fn knee_kick_config(
 ) -> Result<KneeKickConfig, SceneError> {
     scene.gamma.validate()?;
     scene.jump.gamma.validate()?;
-    let model = Model::by_name("humanoid24")?;
+    let model = Figure::by_name("humanoid24")?;
     Ok(KneeKickConfig {
         jump: high_jump_config(&scene.jump, base, &model)?,
         kick: demo(&scene.kick, base, &model)?,
@@ -392,11 +392,11 @@ pub fn run_jumping_knee_kick(
     base: &Path,
     out: &Path,
 ) -> Result<serde_json::Value, SceneError> {
-    let model = Model::by_name("humanoid24")?;
+    let model = Figure::by_name("humanoid24")?;
     let config = knee_kick_config(scene, base)?;
     let kk = knee_kick::run(&config).map_err(SceneError::from)?;
     // The world plays the primitives, so it is compared with the motion before the floor lift.
-    let played = ModelClip::from_trajectory(&model, &kk.connected.trajectory)?;
+    let played = FigureClip::from_trajectory(&model, &kk.connected.trajectory)?;
     let ecs_gap = play_in_world(&model, &kk.sequence(), &played)?;
     let ev = &kk.events;
 

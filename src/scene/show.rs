@@ -10,9 +10,9 @@ use super::source::{ClipSource, LoadedMotion, load_motion};
 use super::{SceneError, draw_tracks, page, write_output};
 use crate::analysis::clip_contacts;
 use crate::ecs::{Clock, Recorder, kinematic_schedule, new_world, spawn_clip_character};
-use crate::humanoid::{Model, ModelClip};
+use crate::humanoid::{Figure, FigureClip};
 use crate::mapping::effector_errors;
-use crate::render::{Figure, Page, PageMotion, Plot, Series, Track, plot, pose_png};
+use crate::render::{Page, PageMotion, Plot, Series, StickFigure, Track, plot, pose_png};
 use crate::skeleton::Clip;
 
 /// What pictures a scene draws.
@@ -84,7 +84,7 @@ pub fn run_show(
     let mut report = json!({ "clip": scene.clip.file });
     let (clip, model_clip) = shown_clip(scene, &motion, &mut report)?;
     let frames = play_through_ecs(&clip);
-    let figure = Figure::of(&clip.skeleton);
+    let figure = StickFigure::of(&clip.skeleton);
     let label = match &scene.model {
         Some(m) => format!("{} on {m}", scene.name),
         None => scene.name.clone(),
@@ -162,10 +162,10 @@ fn shown_clip(
     scene: &ShowScene,
     motion: &LoadedMotion,
     report: &mut serde_json::Value,
-) -> Result<(Clip, Option<ModelClip>), SceneError> {
+) -> Result<(Clip, Option<FigureClip>), SceneError> {
     let (clip, model_clip) = match &scene.model {
         Some(name) => {
-            let model = Model::by_name(name)?;
+            let model = Figure::by_name(name)?;
             let m = motion.on_model(&model)?;
             (m.to_clip(), Some(m))
         }
@@ -190,7 +190,7 @@ fn shown_clip(
 /// maximum, degrees). Errors: a name that is not a DOF of the model.
 fn plotted_angles(
     names: &[String],
-    m: &ModelClip,
+    m: &FigureClip,
 ) -> Result<(Vec<Series>, serde_json::Map<String, serde_json::Value>), SceneError> {
     let mut series = vec![];
     let mut peaks = serde_json::Map::new();

@@ -8,7 +8,7 @@ use serde::{Deserialize, Serialize};
 use super::SceneError;
 use crate::bvh::{self, Bvh};
 use crate::clips::KeyframeClip;
-use crate::humanoid::{Model, ModelClip};
+use crate::humanoid::{Figure, FigureClip};
 use crate::mapping::{Mapping, retarget};
 use crate::skeleton::Clip;
 
@@ -60,7 +60,7 @@ pub enum LoadedMotion {
         mapping: Option<Box<Mapping>>,
     },
     /// A keyframed clip, already on its model.
-    Keyframed(ModelClip),
+    Keyframed(FigureClip),
 }
 
 impl LoadedMotion {
@@ -73,7 +73,7 @@ impl LoadedMotion {
     }
 
     /// The motion on `model` (retargeted from a capture; a keyframed clip must already be on it).
-    pub fn on_model(&self, model: &Model) -> Result<ModelClip, SceneError> {
+    pub fn on_model(&self, model: &Figure) -> Result<FigureClip, SceneError> {
         match self {
             LoadedMotion::Captured {
                 clip,

@@ -21,8 +21,8 @@ pub enum Side {
 /// 3. it ends with a separator followed by `l`/`L` (`hip_L`, `knee.l`, `Arm-L`).
 ///
 /// The same with `right` / `r` / `R` gives **right**; a name that matches both or neither is
-/// [`Side::Centre`]. `render::Figure::sides` additionally lets a point whose own name is undecided
-/// inherit its parent's side (end sites, `Site`).
+/// [`Side::Centre`]. `render::StickFigure::sides` additionally lets a point whose own name is
+/// undecided inherit its parent's side (end sites, `Site`).
 pub fn side_from_name(name: &str) -> Side {
     let left = names_side(name, "left", 'l');
     let right = names_side(name, "right", 'r');

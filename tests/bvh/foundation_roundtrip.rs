@@ -4,13 +4,13 @@
 
 use marionette::bvh;
 use marionette::clips::KeyframeClip;
-use marionette::humanoid::{Model, ModelClip};
+use marionette::humanoid::{Figure, FigureClip};
 use marionette::mapping::{Mapping, effector_errors, retarget};
 use marionette::skeleton::Clip;
 
 /// A clip with known angles: the left knee swings 0 → 95 → 30°, the right knee stays at 10°,
 /// the hips, shoulders and waist move too, and the pelvis turns and travels.
-fn known_clip() -> ModelClip {
+fn known_clip() -> FigureClip {
     let text = r#"(format_version: 1, name: "known", model: "humanoid24", fps: 60.0, duration: 2.0,
         keys: [
           (t: 0.0, forward: 0.0, turn: 0.0, dofs: {"left_knee": 0.0, "right_knee": 10.0, "left_hip_flexion": 0.0,
@@ -85,7 +85,7 @@ fn reading_with_the_wrong_euler_order_is_detected_by_positions() {
 
 #[test]
 fn known_knee_angles_survive_bvh_and_mapping_within_a_degree() {
-    let model = Model::by_name("humanoid24").unwrap();
+    let model = Figure::by_name("humanoid24").unwrap();
     let known = known_clip();
     let read = through_bvh(&known.to_clip(), [2, 1, 0]);
     let mapping = Mapping::detect(&read.skeleton).unwrap();
@@ -120,7 +120,7 @@ fn known_knee_angles_survive_bvh_and_mapping_within_a_degree() {
 
 #[test]
 fn a_swapped_left_right_mapping_is_caught_by_the_feet() {
-    let model = Model::by_name("humanoid24").unwrap();
+    let model = Figure::by_name("humanoid24").unwrap();
     let read = through_bvh(&known_clip().to_clip(), [2, 0, 1]);
     let mut swapped = Mapping::detect(&read.skeleton).unwrap();
     let original = swapped.landmarks.clone();
@@ -146,7 +146,7 @@ fn a_swapped_left_right_mapping_is_caught_by_the_feet() {
 fn end_sites_are_placed_by_their_parent_joint() {
     // The head top is the neck's End Site: at rest straight above the neck by its offset, and it
     // turns with the neck.
-    let model = Model::by_name("humanoid24").unwrap();
+    let model = Figure::by_name("humanoid24").unwrap();
     let clip = known_clip().to_clip();
     let read = through_bvh(&clip, [2, 0, 1]);
     let neck = read.skeleton.index("neck").unwrap();

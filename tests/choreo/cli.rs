@@ -148,7 +148,7 @@ fn dance_db_builds_from_a_manifest_and_refuses_an_empty_folder() {
 #[test]
 fn dance_db_skips_what_it_cannot_use_and_says_why() {
     use marionette::choreo::authored::{AuthoredDance, generate, write_bvh_folder};
-    use marionette::humanoid::ModelClip;
+    use marionette::humanoid::FigureClip;
 
     let dir = std::env::temp_dir().join(format!("marionette-dance-skip-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
@@ -165,7 +165,7 @@ fn dance_db_skips_what_it_cannot_use_and_says_why() {
         std::fs::create_dir_all(d).unwrap();
         let like = &clips[0].motion;
         let n = (12.0 / like.frame_time) as usize;
-        let still = ModelClip {
+        let still = FigureClip {
             model: like.model.clone(),
             frame_time: like.frame_time,
             root_translation: vec![like.root_translation[0]; n],

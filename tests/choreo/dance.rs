@@ -291,7 +291,7 @@ fn the_salsa_scene_runs_on_the_shared_data() {
 /// legs and waist swinging one way per beat, θ = A (1 − cos πτ) / 2, so that every point stops
 /// once per beat, where τ is a whole number: at the times t_j = (j + off[j mod 4]) × 0.5 s.
 /// With `off` = 0 the speed minima sit on the counts; else count j mod 4 is late or early.
-fn swinging(bars: usize, off: [f64; 4]) -> marionette::humanoid::ModelClip {
+fn swinging(bars: usize, off: [f64; 4]) -> marionette::humanoid::FigureClip {
     let model = marionette::humanoid::humanoid24();
     let d = model.dofs.len();
     let beat = 0.5;
@@ -324,7 +324,7 @@ fn swinging(bars: usize, off: [f64; 4]) -> marionette::humanoid::ModelClip {
             angles[f * d + j] = a * s;
         }
     }
-    marionette::humanoid::ModelClip {
+    marionette::humanoid::FigureClip {
         model,
         frame_time: 1.0 / fps,
         root_translation: vec![glam::DVec3::new(0.0, 0.93, 0.0); frames],

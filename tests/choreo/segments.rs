@@ -13,7 +13,7 @@ use marionette::choreo::database::{
 use marionette::choreo::segments::{
     Beat, LEVEL_BPM, MAX_BPM, MIN_BPM, SegmentError, TempoSource, cut_segments, kinematic_beat,
 };
-use marionette::humanoid::{ModelClip, humanoid24};
+use marionette::humanoid::{FigureClip, humanoid24};
 
 use glam::{DQuat, DVec3};
 
@@ -121,7 +121,7 @@ fn dance_bars_at_120_bpm_give_its_four_bars() {
 
 /// A humanoid24 clip whose arms and legs swing from one extreme to the other on every beat
 /// (a smooth step per beat, at rest on the beat) at `bpm`, its first beat at `phase_s`.
-fn generated(bpm: f64, phase_s: f64, fps: f64, seconds: f64) -> ModelClip {
+fn generated(bpm: f64, phase_s: f64, fps: f64, seconds: f64) -> FigureClip {
     let model = humanoid24();
     let d = model.dofs.len();
     let period = 60.0 / bpm;
@@ -147,7 +147,7 @@ fn generated(bpm: f64, phase_s: f64, fps: f64, seconds: f64) -> ModelClip {
             angles[f * d + i] = amp * x + 0.1;
         }
     }
-    ModelClip {
+    FigureClip {
         model,
         frame_time: 1.0 / fps,
         root_translation: vec![DVec3::new(0.0, 0.95, 0.0); n],
@@ -362,10 +362,10 @@ fn folder_with_bad_clips(name: &str) -> PathBuf {
 }
 
 /// `still.bvh` (the first pose of `like` held for 12 s) and `a_broken.bvh` (not BVH) in `dir`.
-fn write_still_and_broken(dir: &Path, like: &ModelClip) {
+fn write_still_and_broken(dir: &Path, like: &FigureClip) {
     let n = (12.0 / like.frame_time) as usize;
     let d = like.dof_count();
-    let still = ModelClip {
+    let still = FigureClip {
         model: like.model.clone(),
         frame_time: like.frame_time,
         root_translation: vec![like.root_translation[0]; n],

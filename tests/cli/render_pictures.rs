@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 use glam::DVec3;
 use marionette::render::{
-    Figure, Plot, RenderError, Series, Track, View, animation_gif, filmstrip_png,
+    Plot, RenderError, Series, StickFigure, Track, View, animation_gif, filmstrip_png,
     filmstrip_view_png, plot, pose_png,
 };
 
@@ -18,8 +18,8 @@ fn out_dir(test: &str) -> PathBuf {
 }
 
 /// A 5-point stick man: hips, chest, head, left hand, right hand (arms out along ±X).
-fn stick_man() -> (Figure, Vec<DVec3>) {
-    let fig = Figure {
+fn stick_man() -> (StickFigure, Vec<DVec3>) {
+    let fig = StickFigure {
         names: ["Hips", "Chest", "Head", "LeftHand", "RightHand"]
             .map(String::from)
             .to_vec(),
@@ -36,8 +36,8 @@ fn stick_man() -> (Figure, Vec<DVec3>) {
 }
 
 /// A pendulum of length 1 m hanging from (0, 2, 0), swinging ±40° in the X–Y plane at 120 Hz.
-fn pendulum(seconds: f64) -> (Figure, Vec<Vec<DVec3>>) {
-    let fig = Figure {
+fn pendulum(seconds: f64) -> (StickFigure, Vec<Vec<DVec3>>) {
+    let fig = StickFigure {
         names: vec!["Pivot".into(), "Bob".into()],
         parents: vec![None, Some(0)],
     };
@@ -122,7 +122,7 @@ fn three_quarter_view_from_the_front_left_puts_a_forward_leg_on_screen_left() {
     // Legs in a stride: left foot forward (+Z), right foot back; the hips say where the figure
     // faces (+Z, its left +X). Without motion the filmstrip looks from 45° on the figure's left,
     // where forward is towards screen left (as in the side view it used before).
-    let fig = Figure {
+    let fig = StickFigure {
         names: ["Hips", "LeftHip", "LeftFoot", "RightHip", "RightFoot"]
             .map(String::from)
             .to_vec(),

@@ -11,7 +11,7 @@ use std::path::PathBuf;
 
 use glam::{DQuat, DVec3};
 use marionette::choreo::database::{BuildParams, Database, Manifest, ManifestClip, OnRefusal};
-use marionette::humanoid::{ModelClip, humanoid24};
+use marionette::humanoid::{FigureClip, humanoid24};
 
 /// A fresh scratch folder.
 pub fn scratch(name: &str) -> PathBuf {
@@ -70,7 +70,7 @@ const MOVES: [&[(&str, f64, f64, f64)]; 6] = [
 
 /// Clip `c` on humanoid24: `bars` bars at `bpm`, morphing from move c to move c + 1 and back
 /// over three bars, a bounce on every beat and a slow turn; 60 fps.
-pub fn generated_clip(c: usize, bars: usize, bpm: f64) -> ModelClip {
+pub fn generated_clip(c: usize, bars: usize, bpm: f64) -> FigureClip {
     let model = humanoid24();
     let d = model.dofs.len();
     let fps = 60.0;
@@ -91,7 +91,7 @@ pub fn generated_clip(c: usize, bars: usize, bpm: f64) -> ModelClip {
         }
     }
     let turn = 0.3 * (c as f64 - 2.5);
-    ModelClip {
+    FigureClip {
         model,
         frame_time: 1.0 / fps,
         root_translation: (0..n)

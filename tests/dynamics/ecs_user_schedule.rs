@@ -23,7 +23,7 @@ use marionette::experiments::fall::{FallConfig, build_fall};
 use marionette::humanoid::ranges::AgeGroup;
 use marionette::humanoid::{body::HumanBody, humanoid24};
 use marionette::primitive::{LearnConfig, Primitive};
-use marionette::render::{Figure, Track, filmstrip_png};
+use marionette::render::{StickFigure, Track, filmstrip_png};
 
 const TICK: f64 = 1.0 / 120.0;
 const SUBSTEPS: u32 = 16;
@@ -193,8 +193,8 @@ fn a_kinematic_and_a_physical_character_share_one_schedule_and_one_clock() {
     assert!(results[0].as_ref().unwrap().damage > 0.0);
 
     // Both are drawn from their recordings.
-    let fig_j = Figure::of(&world.get::<SkeletonRef>(jumper).unwrap().0);
-    let fig_f = Figure::of(&world.get::<SkeletonRef>(faller).unwrap().0);
+    let fig_j = StickFigure::of(&world.get::<SkeletonRef>(jumper).unwrap().0);
+    let fig_f = StickFigure::of(&world.get::<SkeletonRef>(faller).unwrap().0);
     let tracks = [
         Track {
             figure: &fig_j,

@@ -5,7 +5,7 @@
 //! feet as closely as the hand-written files do (to a millimetre).
 
 use marionette::bvh;
-use marionette::humanoid::Model;
+use marionette::humanoid::Figure;
 use marionette::mapping::{Mapping, Synonyms, effector_errors, retarget};
 use marionette::skeleton::Clip;
 
@@ -56,7 +56,7 @@ fn every_real_file_maps_automatically_as_with_its_hand_written_file() {
             );
         }
         for model in ["humanoid24", "fall21"] {
-            let m = Model::by_name(model).unwrap();
+            let m = Figure::by_name(model).unwrap();
             let a = retarget(&clip, &auto.mapping, &m).unwrap();
             let h = retarget(&clip, builtin, &m).unwrap();
             let worst = a
@@ -88,7 +88,7 @@ fn every_real_file_maps_automatically_as_with_its_hand_written_file() {
 )]
 fn real_files_with_meaningless_joint_names_map_by_structure_within_the_same_bounds() {
     let Some(files) = real_files() else { return };
-    let model = Model::by_name("humanoid24").unwrap();
+    let model = Figure::by_name("humanoid24").unwrap();
     for file in &files {
         let (b, _) = bvh::parse_file(file).unwrap();
         let clip = Clip::from_bvh(&b, None).unwrap();

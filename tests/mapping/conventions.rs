@@ -12,12 +12,12 @@ use std::collections::BTreeMap;
 
 use glam::{DQuat, DVec3};
 use marionette::clips::KeyframeClip;
-use marionette::humanoid::{Model, ModelClip};
+use marionette::humanoid::{Figure, FigureClip};
 use marionette::mapping::{AutoMapping, Mapping, Synonyms, effector_errors, retarget};
 use marionette::skeleton::{Clip, Joint, Skeleton, Transform};
 
 /// The motion every rig carries.
-fn motion() -> ModelClip {
+fn motion() -> FigureClip {
     KeyframeClip::parse(
         include_str!("../../scenes/clips/knee_kick.ron"),
         "knee_kick.ron",
@@ -492,7 +492,7 @@ fn fill(t: &str, left: bool) -> String {
 
 /// A rig's clip carrying `motion`, and where each landmark is expected: (landmark → the rig
 /// point at that place, by name `"<joint>"` or `"<joint>:end"`).
-fn build(rig: &Rig, motion: &ModelClip) -> (Clip, BTreeMap<String, String>) {
+fn build(rig: &Rig, motion: &FigureClip) -> (Clip, BTreeMap<String, String>) {
     let model = &motion.model;
     let link = |n: &str| Some(model.joint_index(n).unwrap());
     let mut b = Builder {
@@ -703,7 +703,7 @@ fn build(rig: &Rig, motion: &ModelClip) -> (Clip, BTreeMap<String, String>) {
 }
 
 /// The rest orientation of each model link in a rig's rest pose.
-fn rest_rotations(model: &Model, rest: Rest) -> Vec<DQuat> {
+fn rest_rotations(model: &Figure, rest: Rest) -> Vec<DQuat> {
     model
         .joints
         .iter()
@@ -736,7 +736,7 @@ fn rest_rotations(model: &Model, rest: Rest) -> Vec<DQuat> {
 
 /// The rig's clip: each rig joint rides its model link, its frame turned by the inverse of the
 /// link's rest orientation so that the rig's rest pose is `rest` and its motion is the model's.
-fn clip_of(joints: &[RigJoint], rest: Rest, motion: &ModelClip) -> Clip {
+fn clip_of(joints: &[RigJoint], rest: Rest, motion: &FigureClip) -> Clip {
     let model = &motion.model;
     let mclip = motion.to_clip();
     let p = rest_rotations(model, rest);
@@ -837,7 +837,7 @@ fn point(clip: &Clip, name: &str) -> DVec3 {
     g[i].translation + g[i].rotation * e
 }
 
-fn check_rig(rig: &Rig, motion: &ModelClip) -> AutoMapping {
+fn check_rig(rig: &Rig, motion: &FigureClip) -> AutoMapping {
     let (clip, expect) = build(rig, motion);
     // The rig really carries the motion: its rest pose is not the motion's first frame.
     let auto = Mapping::automatic(&clip, Synonyms::builtin())
@@ -857,7 +857,7 @@ fn check_rig(rig: &Rig, motion: &ModelClip) -> AutoMapping {
         assert!(!finding.reason.is_empty());
     }
     // Through the same retargeting and report as `export --bvh --model`.
-    let model = Model::by_name("humanoid24").unwrap();
+    let model = Figure::by_name("humanoid24").unwrap();
     let mapped = retarget(&clip, &auto.mapping, &model).unwrap();
     let errs = effector_errors(&clip, &auto.mapping, &mapped).unwrap();
     for e in &errs {
@@ -952,7 +952,7 @@ fn a_mirrored_rig_is_mapped_by_its_geometry_not_its_side_words() {
         }
     }
     let (clip, _) = build(&rig, &motion);
-    let model = Model::by_name("humanoid24").unwrap();
+    let model = Figure::by_name("humanoid24").unwrap();
     let mapped = retarget(&clip, &by_names, &model).unwrap();
     let errs = effector_errors(&clip, &auto.mapping, &mapped).unwrap();
     let foot = errs.iter().find(|e| e.effector == "right_foot").unwrap();

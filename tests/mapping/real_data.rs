@@ -3,9 +3,9 @@
 //! does (feet within 5 cm on the CMU jumps).
 
 use marionette::bvh;
-use marionette::humanoid::Model;
+use marionette::humanoid::Figure;
 use marionette::mapping::{Mapping, effector_errors, retarget};
-use marionette::render::Figure;
+use marionette::render::StickFigure;
 use marionette::skeleton::Clip;
 
 use crate::common::data_dir;
@@ -31,7 +31,7 @@ fn every_data_file_maps_onto_both_models_and_looks_like_itself() {
         let clip = Clip::from_bvh(&b, None).unwrap();
         let mapping = Mapping::detect(&clip.skeleton).unwrap();
         for model in ["humanoid24", "fall21"] {
-            let m = Model::by_name(model).unwrap();
+            let m = Figure::by_name(model).unwrap();
             let mapped = retarget(&clip, &mapping, &m).unwrap();
             assert_eq!(mapped.frame_count(), clip.frame_count());
             assert!(
@@ -40,7 +40,7 @@ fn every_data_file_maps_onto_both_models_and_looks_like_itself() {
             );
             // It renders: a filmstrip of the mapped clip.
             let shown = mapped.to_clip();
-            let figure = Figure::of(&shown.skeleton);
+            let figure = StickFigure::of(&shown.skeleton);
             let frames = shown.point_frames();
             let track = marionette::render::Track {
                 figure: &figure,

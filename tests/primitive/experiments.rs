@@ -6,10 +6,10 @@ use std::path::PathBuf;
 use marionette::clips::KeyframeClip;
 use marionette::experiments::high_jump::{self, HighJumpConfig};
 use marionette::experiments::knee_kick::{self, KneeKickConfig};
-use marionette::humanoid::{Model, ModelClip};
+use marionette::humanoid::{Figure, FigureClip};
 use marionette::primitive::{EventConfig, LearnConfig};
 
-fn clip(name: &str) -> ModelClip {
+fn clip(name: &str) -> FigureClip {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
         .join("scenes/clips")
         .join(name);
@@ -18,7 +18,7 @@ fn clip(name: &str) -> ModelClip {
 
 fn jump_config() -> HighJumpConfig {
     HighJumpConfig {
-        model: Model::by_name("humanoid24").unwrap(),
+        model: Figure::by_name("humanoid24").unwrap(),
         low: clip("low_jump.ron"),
         normal: clip("normal_jump.ron"),
         gamma: high_jump::PAPER_GAMMA,

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result, bail};
 
 use marionette::bvh;
-use marionette::humanoid::Model;
+use marionette::humanoid::Figure;
 use marionette::mapping::{effector_errors, retarget};
 use marionette::skeleton::Clip;
 
@@ -64,7 +64,7 @@ pub fn export(args: Args) -> Result<()> {
         );
     } else if let Some(a) = angles {
         let (model_name, out) = (&a[0], PathBuf::from(&a[1]));
-        let model = Model::by_name(model_name)?;
+        let model = Figure::by_name(model_name)?;
         let clip = Clip::from_bvh(&b, unit_scale).with_context(|| file.display().to_string())?;
         let m = mapping_for(&clip, &mapping)?;
         let mapped = retarget(&clip, &m, &model)?;
@@ -123,7 +123,7 @@ fn write_mapped_bvh(
     unit_scale: Option<f64>,
     out: &Path,
 ) -> Result<()> {
-    let model = Model::by_name(model_name)?;
+    let model = Figure::by_name(model_name)?;
     let clip = Clip::from_bvh(b, unit_scale).with_context(|| file.display().to_string())?;
     let m = mapping_for(&clip, mapping)?;
     let mapped = retarget(&clip, &m, &model)?;

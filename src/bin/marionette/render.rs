@@ -4,8 +4,8 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Result, bail};
 
-use marionette::humanoid::Model;
-use marionette::render::{Figure, Track, animation_gif, filmstrip_png};
+use marionette::humanoid::Figure;
+use marionette::render::{StickFigure, Track, animation_gif, filmstrip_png};
 use marionette::scene::{ClipSource, MAX_FILMSTRIP_FRAMES, load_motion};
 
 // The command's arguments (its help text is on `Command::Render`).
@@ -73,10 +73,10 @@ pub fn render(args: Args) -> Result<()> {
     };
     let motion = load_motion(&src, base)?;
     let clip = match &model {
-        Some(name) => motion.on_model(&Model::by_name(name)?)?.to_clip(),
+        Some(name) => motion.on_model(&Figure::by_name(name)?)?.to_clip(),
         None => motion.clip(),
     };
-    let figure = Figure::of(&clip.skeleton);
+    let figure = StickFigure::of(&clip.skeleton);
     let points = clip.point_frames();
     let stem = file
         .file_stem()

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 
-use marionette::humanoid::Model;
+use marionette::humanoid::Figure;
 use marionette::render::{
     Page, PageMotion, PagePlot, PageSong, Plot, Series, Track, stand_upright, write_page,
 };
@@ -48,10 +48,10 @@ fn motion(
     };
     let loaded = load_motion(&src, Path::new("."))?;
     let clip = match model {
-        Some(name) => loaded.on_model(&Model::by_name(name)?)?.to_clip(),
+        Some(name) => loaded.on_model(&Figure::by_name(name)?)?.to_clip(),
         None => loaded.clip(),
     };
-    let figure = marionette::render::Figure::of(&clip.skeleton);
+    let figure = marionette::render::StickFigure::of(&clip.skeleton);
     let frames = clip.point_frames();
     let stem = file
         .file_stem()

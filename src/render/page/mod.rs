@@ -15,7 +15,7 @@ use std::path::Path;
 use glam::DVec3;
 use serde_json::json;
 
-use super::{Figure, Plot, RenderError};
+use super::{Plot, RenderError, StickFigure};
 
 /// The orbit camera shared by the results page and the editor: a canvas, drag to orbit, wheel
 /// to zoom, a projection and a floor grid (a plain script defining `class OrbitView`).
@@ -60,7 +60,7 @@ pub struct PageMotion {
     /// Name shown in the motion list.
     pub label: String,
     /// Point names and parents; bones are drawn as capsules when `boxes` is `None`.
-    pub figure: Figure,
+    pub figure: StickFigure,
     /// Time between frames (s).
     pub frame_time: f64,
     /// Time on the shared timeline of frame 0 (s); the first frame is held before it.
@@ -567,7 +567,7 @@ mod tests {
 
     /// A figure standing 1.7 m tall: hips, spine, chest (neck, both hands), head, both feet.
     fn walker(frames: usize) -> PageMotion {
-        let figure = Figure {
+        let figure = StickFigure {
             names: [
                 "Hips",
                 "Chest",

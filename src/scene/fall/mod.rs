@@ -14,7 +14,7 @@ use crate::experiments::fall::ecs::run_parallel;
 use crate::experiments::fall::{FallConfig, FallResult, Ranges};
 use crate::humanoid::ranges::AgeGroup;
 use crate::humanoid::strength::torque_limits;
-use crate::render::{Figure, Page, PageMotion, Plot, Series, Track, plot};
+use crate::render::{Page, PageMotion, Plot, Series, StickFigure, Track, plot};
 
 /// Per-link values as a JSON object keyed by link name.
 fn per_link(names: &[String], values: &[f64]) -> serde_json::Value {
@@ -83,7 +83,7 @@ pub(super) fn write_falls(
             crate::bvh::to_string(&clip.to_bvh()).as_bytes(),
         )?;
     }
-    let figures: Vec<_> = clips.iter().map(|c| Figure::of(&c.skeleton)).collect();
+    let figures: Vec<_> = clips.iter().map(|c| StickFigure::of(&c.skeleton)).collect();
     let frames: Vec<_> = clips.iter().map(|c| c.point_frames()).collect();
     let tracks: Vec<Track> = (0..clips.len())
         .map(|k| Track {

@@ -2,7 +2,7 @@
 
 use glam::{DQuat, DVec3};
 
-use crate::humanoid::{Model, ModelError, rotation_vector_near};
+use crate::humanoid::{Figure, FigureError, rotation_vector_near};
 use crate::primitive::Trajectory;
 
 /// Names of the root channels in a primitive trajectory: translation (m), then orientation as a
@@ -12,12 +12,13 @@ pub const ROOT_CHANNELS: [&str; 6] = [
 ];
 use crate::skeleton::Clip;
 
-/// A motion expressed on one of the engine's models: per frame, every DOF angle (radians, model
-/// order, unwrapped over time), the root (pelvis) position in metres and its orientation.
+/// A motion expressed on one of the engine's models (a [`Figure`]): per frame, every DOF angle
+/// (radians, model order, unwrapped over time), the root (pelvis) position in metres and its
+/// orientation.
 #[derive(Clone, Debug, PartialEq)]
-pub struct ModelClip {
+pub struct FigureClip {
     /// The model, with offsets taken from the source skeleton.
-    pub model: Model,
+    pub model: Figure,
     /// Seconds per frame.
     pub frame_time: f64,
     /// Pelvis position per frame, metres.
@@ -28,11 +29,11 @@ pub struct ModelClip {
     pub angles: Vec<f64>,
 }
 
-impl ModelClip {
+impl FigureClip {
     /// An empty clip on `model` at `frame_time` seconds per frame, with room for `frames` frames.
-    pub fn with_capacity(model: Model, frame_time: f64, frames: usize) -> ModelClip {
+    pub fn with_capacity(model: Figure, frame_time: f64, frames: usize) -> FigureClip {
         let dofs = model.dofs.len();
-        ModelClip {
+        FigureClip {
             model,
             frame_time,
             root_translation: Vec::with_capacity(frames),
@@ -76,14 +77,14 @@ impl ModelClip {
     }
 
     /// The frames whose times lie in `[start_s, end_s)`; `None` if that is empty.
-    pub fn window(&self, start_s: f64, end_s: f64) -> Option<ModelClip> {
+    pub fn window(&self, start_s: f64, end_s: f64) -> Option<FigureClip> {
         let first = (start_s / self.frame_time).round().max(0.0) as usize;
         let last = ((end_s / self.frame_time).round().max(0.0) as usize).min(self.frame_count());
         if first >= last {
             return None;
         }
         let d = self.dof_count();
-        Some(ModelClip {
+        Some(FigureClip {
             model: self.model.clone(),
             frame_time: self.frame_time,
             root_translation: self.root_translation[first..last].to_vec(),
@@ -136,13 +137,13 @@ impl ModelClip {
     }
 
     /// A motion on `model` from a trajectory holding every model DOF (by name) and the six root
-    /// channels of [`ModelClip::to_trajectory`].
-    pub fn from_trajectory(model: &Model, traj: &Trajectory) -> Result<ModelClip, ModelError> {
+    /// channels of [`FigureClip::to_trajectory`].
+    pub fn from_trajectory(model: &Figure, traj: &Trajectory) -> Result<FigureClip, FigureError> {
         let index = |name: &str| {
             traj.names
                 .iter()
                 .position(|n| n == name)
-                .ok_or_else(|| ModelError::MissingChannel(name.to_string()))
+                .ok_or_else(|| FigureError::MissingChannel(name.to_string()))
         };
         let dof_cols: Vec<usize> = model
             .dofs
@@ -154,7 +155,7 @@ impl ModelClip {
             .map(|n| index(n))
             .collect::<Result<_, _>>()?;
         let frames = traj.frames();
-        let mut clip = ModelClip {
+        let mut clip = FigureClip {
             model: model.clone(),
             frame_time: traj.dt,
             root_translation: Vec::with_capacity(frames),
