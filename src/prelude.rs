@@ -28,7 +28,7 @@ pub use crate::primitive::{
 pub use crate::experiments::fall::{FallConfig, FallResult, simulate_fall};
 
 // The ECS wiring: the clock, the sets, each domain's systems, characters and the World pool.
-pub use crate::ecs::human::{HumanFigure, human_physics};
+pub use crate::ecs::human::{HumanFigure, add_human_physics_systems, human_physics};
 pub use crate::ecs::physics::{
     BodyState, ExternalForces, FloorContact, JointLimits, PdController, PhysicsBundle,
     add_physics_systems,

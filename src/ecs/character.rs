@@ -840,7 +840,7 @@ pub fn add_all_character_systems(schedule: &mut Schedule) {
     super::add_motion_systems(schedule);
     super::primitive::add_primitive_systems(schedule);
     add_character_systems(schedule);
-    super::physics::add_physics_systems(schedule);
+    super::human::add_human_physics_systems(schedule);
 }
 
 /// True while the character's body steps.

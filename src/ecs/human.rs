@@ -14,7 +14,6 @@ use glam::{DQuat, DVec3};
 
 use super::motion::{Character, JointState, Recorder, SkeletonRef};
 use super::physics::{BodyState, PhysicsBody, PhysicsBundle};
-#[cfg(doc)]
 use super::sets::MotionSet;
 use crate::dynamics::integrator::Integrator;
 use crate::humanoid::body::HumanBody;
@@ -78,4 +77,12 @@ pub fn publish_body_pose(
         js.translations[0] = DVec3::new(qs[0], qs[1], qs[2]);
         js.rotations[0] = DQuat::from_xyzw(qs[3], qs[4], qs[5], qs[6]);
     }
+}
+
+/// Adds the physics systems ([`super::physics::add_physics_systems`]) and
+/// [`publish_body_pose`] in [`MotionSet::Pose`] to `schedule`: simulated human bodies that are
+/// drawn and recorded as characters.
+pub fn add_human_physics_systems(schedule: &mut Schedule) {
+    super::physics::add_physics_systems(schedule);
+    schedule.add_systems(publish_body_pose.in_set(MotionSet::Pose));
 }

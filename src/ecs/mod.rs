@@ -18,7 +18,8 @@
 //! hierarchy of sets, [`MotionSet`], that a user orders their own systems against. Each domain
 //! adds its systems to the user's schedule: [`add_core_systems`] (sets and clock, once),
 //! [`add_motion_systems`], [`primitive::add_primitive_systems`],
-//! [`physics::add_physics_systems`]. A World holds one experiment and is `Send`; a
+//! [`physics::add_physics_systems`] (with the human bodies' pose,
+//! [`human::add_human_physics_systems`]). A World holds one experiment and is `Send`; a
 //! [`WorldPool`] runs many in parallel, each with its own seeded generator.
 
 pub mod character;

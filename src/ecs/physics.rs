@@ -7,10 +7,9 @@
 //! removes that force; a controller of the user's (a primitive player, a GA genome, a game's
 //! input) writes [`PdController`] in [`MotionSet::Control`]. [`step_bodies`] takes the clock's
 //! substeps in [`MotionSet::Physics`] through [`pipeline::step`]. Nothing here knows what the
-//! body is: a human's figure, DOF names and links are its
-//! [`HumanFigure`](super::human::HumanFigure), from which
-//! [`publish_body_pose`](super::human::publish_body_pose) hands the pose to the same joint
-//! state, forward kinematics and recorder as a kinematic character in [`MotionSet::Pose`].
+//! body is: a human's figure, DOF names and links are its `ecs::human::HumanFigure`, from
+//! which `ecs::human::publish_body_pose` hands the pose to the same joint state, forward
+//! kinematics and recorder as a kinematic character in [`MotionSet::Pose`].
 
 use std::ops::{Deref, DerefMut};
 use std::sync::Arc;
@@ -362,15 +361,12 @@ fn step_together(
     }
 }
 
-/// Adds the physics systems to `schedule`: [`step_bodies`] in [`MotionSet::Physics`], and
-/// [`publish_body_pose`](super::human::publish_body_pose) in [`MotionSet::Pose`] for the
-/// drawn human bodies.
+/// Adds the physics systems to `schedule`: [`step_bodies`] in [`MotionSet::Physics`]. Human
+/// bodies drawn as characters also need their pose published
+/// (`ecs::human::add_human_physics_systems` adds both).
 pub fn add_physics_systems(schedule: &mut Schedule) {
     configure_motion_sets(schedule);
-    schedule.add_systems((
-        step_bodies.in_set(MotionSet::Physics),
-        super::human::publish_body_pose.in_set(MotionSet::Pose),
-    ));
+    schedule.add_systems(step_bodies.in_set(MotionSet::Physics));
 }
 
 #[cfg(test)]

@@ -11,8 +11,8 @@ use bevy_ecs::prelude::*;
 use glam::DVec3;
 use marionette::clips::KeyframeClip;
 use marionette::dynamics::forces::external::ExternalForce;
-use marionette::ecs::human::{HumanFigure, drawn_body};
-use marionette::ecs::physics::{BodyState, ExternalForces, add_physics_systems};
+use marionette::ecs::human::{HumanFigure, add_human_physics_systems, drawn_body};
+use marionette::ecs::physics::{BodyState, ExternalForces};
 use marionette::ecs::primitive::{PrimitivePlayer, add_primitive_systems};
 use marionette::ecs::{
     Clock, MotionSet, Recorder, SkeletonRef, add_core_systems, add_motion_systems,
@@ -103,7 +103,7 @@ fn world_and_schedule(hit: bool) -> (World, Schedule, Entity, Entity) {
     add_core_systems(&mut schedule);
     add_motion_systems(&mut schedule);
     add_primitive_systems(&mut schedule);
-    add_physics_systems(&mut schedule);
+    add_human_physics_systems(&mut schedule);
     add_fall_systems(&mut schedule);
     schedule.configure_sets(
         GameplaySet

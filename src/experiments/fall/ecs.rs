@@ -17,10 +17,10 @@ use super::{FallCharacter, FallConfig, FallController, FallRecorder, FallResult,
 use crate::dynamics::crba::NotPositiveDefinite;
 use crate::dynamics::lanes::LANES;
 use crate::dynamics::stability::StiffnessBasis;
-use crate::ecs::human::HumanFigure;
+use crate::ecs::human::{HumanFigure, add_human_physics_systems};
 use crate::ecs::physics::{
     BodyState, ExternalForces, FloorContact, JointLimits, PdController, PhysicsBody,
-    PhysicsMonitor, PhysicsStatus, PhysicsWorkspace, add_physics_systems,
+    PhysicsMonitor, PhysicsStatus, PhysicsWorkspace,
 };
 use crate::ecs::{Clock, MotionSet, WorldPool, WorldSeed, add_core_systems, configure_motion_sets};
 
@@ -77,7 +77,7 @@ pub fn add_fall_systems(schedule: &mut Schedule) {
 pub fn fall_schedule() -> Schedule {
     let mut s = Schedule::default();
     add_core_systems(&mut s);
-    add_physics_systems(&mut s);
+    add_human_physics_systems(&mut s);
     add_fall_systems(&mut s);
     s
 }
