@@ -19,11 +19,11 @@ use super::data::Data;
 use super::joint::JointType;
 use super::kinematics::{base_acceleration, kinematics};
 use super::model::Model;
-use super::spatial::{ArticulatedInertia, ForceVec};
-use super::width::{
-    Accelerations, ColumnsOps, ForceOps, InertiaOps, JointForces, Mat3Ops, MotionOps, Real,
-    TransformOps, Vec3Ops,
+use super::real::{
+    ColumnsOps, ForceOps, InertiaOps, Mat3Ops, MotionOps, Real, TransformOps, Vec3Ops,
 };
+use super::spatial::{ArticulatedInertia, ForceVec};
+use super::width::{Accelerations, JointForces};
 use std::marker::PhantomData;
 
 /// Forward dynamics: returns `q̈` (size nv, in `data.qdd`) for configuration `q` (nq), velocity

@@ -5,7 +5,7 @@
 //! products: `R A Rᵀ` costs 24 multiplications instead of 54, `A R` 12 instead of 27, `R v` 4
 //! instead of 9.
 
-use super::width::{Mat3Ops, Real, Vec3Ops};
+use super::real::{Mat3Ops, Real, Vec3Ops};
 use glam::{DMat3, DVec3};
 
 /// A signed coordinate axis `sign · e_k` (`k` = 0, 1, 2 for x, y, z; `sign` = ±1).

@@ -31,6 +31,7 @@ pub mod lanes;
 pub mod linearly_implicit;
 pub mod model;
 pub mod pipeline;
+mod real;
 pub mod rnea;
 pub mod spatial;
 pub mod stability;

@@ -20,12 +20,10 @@ use serde::{Deserialize, Serialize};
 use serde_json::value::RawValue;
 
 use super::error::{CheckpointError, EvolveError};
+pub use super::formats::FORMAT_VERSION;
 
 /// The checkpoint file inside a run's folder.
 pub const FILE: &str = "checkpoint.json";
-
-/// The format this version writes and reads (1: the bare state, before versions and checksums).
-pub const FORMAT_VERSION: u32 = 2;
 
 /// A state a checkpoint may hold: it says what in it disagrees.
 pub trait Consistent {

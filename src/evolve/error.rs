@@ -6,9 +6,8 @@
 use std::path::PathBuf;
 use std::process::ExitStatus;
 
-use super::checkpoint::FORMAT_VERSION;
-use super::evaluator::{MAX_LINE, MAX_REFINE, PROTOCOL};
 use super::failure::Failure;
+use super::formats::{FORMAT_VERSION, MAX_LINE, MAX_REFINE, PROTOCOL};
 
 /// Why a run could not go on.
 #[derive(Debug, thiserror::Error)]

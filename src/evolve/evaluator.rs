@@ -28,14 +28,8 @@ use serde::{Deserialize, Serialize};
 pub use super::error::EvolveError;
 use super::error::{EvaluatorError, LastWords, LineError, WorkerFailure, WorkerFault};
 use super::failure::EvaluationError;
+pub use super::formats::{MAX_LINE, MAX_REFINE, PROTOCOL};
 use super::genome::Genome;
-
-/// The protocol's name and version.
-/// Version 2 added `refine`; a version-1 worker would ignore it and answer at the problem's
-/// own resolution, so the version is checked.
-/// Version 3 tagged each message by its key and refuses unknown fields (a version-2 line is
-/// refused as an unknown message).
-pub const PROTOCOL: &str = "marionette-eval/3";
 
 /// The result of one evaluation: the damage (lower is fitter) or why it failed.
 pub type Evaluation = Result<f64, EvaluationError>;
@@ -552,13 +546,6 @@ impl Drop for JsonLines {
         let _ = self.child.wait();
     }
 }
-
-/// Longest protocol line accepted (bytes).
-pub const MAX_LINE: usize = 1 << 20;
-
-/// Largest refinement a worker accepts (a fall at 1/64 of its step already takes 64 times as
-/// long).
-pub const MAX_REFINE: u32 = 64;
 
 /// The worker side: reads the header, reads its problem as a `P` and builds the evaluator of
 /// it with `make`, then answers batches until its input ends (a batch mixing refinements is evaluated per

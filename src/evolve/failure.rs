@@ -10,7 +10,12 @@ use std::sync::Arc;
 
 use serde::{Deserialize, Serialize};
 
-use super::ga::{ELITE_CHECK, ELITE_CHECK_REFINE};
+/// How the failure log's entries of the elite check begin.
+pub const ELITE_CHECK: &str = "elite check";
+
+/// The refinement at which elites are checked (`GaConfig::elite_check_tolerance`): twice
+/// the resolution, a fall at half its time step.
+pub const ELITE_CHECK_REFINE: u32 = 2;
 
 /// The error a problem's own evaluation gave (for a fall: why it could not be simulated),
 /// shared and type-erased so that the GA kernel knows no problem; [`Self::downcast_ref`] gives

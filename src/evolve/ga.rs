@@ -16,6 +16,7 @@ use serde::{Deserialize, Serialize};
 use super::checkpoint::Consistent;
 use super::error::{EvaluatorError, StopCause};
 use super::evaluator::{Evaluation, Evaluator, EvolveError};
+pub use super::failure::{ELITE_CHECK, ELITE_CHECK_REFINE};
 use super::failure::{EvaluationError, Failure};
 use super::genome::{Bounds, Genome};
 use super::logbook::GenerationRecord;
@@ -150,13 +151,6 @@ impl GaConfig {
         Ok(())
     }
 }
-
-/// How the failure log's entries of the elite check begin.
-pub const ELITE_CHECK: &str = "elite check";
-
-/// The refinement at which elites are checked ([`GaConfig::elite_check_tolerance`]): twice
-/// the resolution, a fall at half its time step.
-pub const ELITE_CHECK_REFINE: u32 = 2;
 
 /// The whole state of a run after a generation: what a checkpoint holds.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

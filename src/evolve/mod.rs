@@ -10,6 +10,7 @@ pub mod checkpoint;
 pub mod error;
 pub mod evaluator;
 pub mod failure;
+mod formats;
 pub mod ga;
 pub mod genome;
 pub mod logbook;
