@@ -228,7 +228,7 @@ pub fn plant_feet(clip: &mut FigureClip, p: &PlantParams) -> Planting {
     };
     let legs = legs.map(|l| l.expect("checked above"));
     let blend = (p.blend_s / clip.frame_time).round().max(1.0) as usize;
-    let (mut before, mut reach) = placed(clip, &legs, &model, blend);
+    let (mut before, reach) = placed(clip, &legs, &model, blend);
     let mut plan = self::plan(clip, &model, &before, p, blend, &mut report);
     if p.pelvis {
         let drop = pelvis_drop(&plan, &reach, blend);
@@ -240,8 +240,6 @@ pub fn plant_feet(clip: &mut FigureClip, p: &PlantParams) -> Planting {
                 let down = DVec3::Y * *r;
                 clip.root_translation[f] -= down;
                 before[f].iter_mut().flatten().for_each(|x| *x -= down);
-                reach.hip[f].iter_mut().for_each(|x| *x -= down);
-                reach.ankle[f].iter_mut().for_each(|x| *x -= down);
             }
             report = Planting {
                 pelvis_drop_max_m: most,
@@ -306,8 +304,8 @@ fn plan(
     Plan { targets, on: ons }
 }
 
-/// The legs as the dance puts them: per frame and leg, the hip's and ankle's places, and the
-/// cap on the hip–ankle distance (the leg's straightest within a blend of the frame, so that
+/// The legs as the dance puts them (before any pelvis drop): per frame and leg, the hip's and
+/// ankle's places, and the cap on the hip–ankle distance (the leg's straightest within a blend of the frame, so that
 /// no foot is put down by a knee straighter than the dancer's own nearby).
 struct LegReach {
     hip: Vec<[DVec3; 2]>,

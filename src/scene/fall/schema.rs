@@ -330,37 +330,22 @@ impl FallScene {
             if let Some(s) = ctrl.start_s {
                 c.control_start_s = s;
             }
+            // How it was stepped: the file's, then the scene's own block over it; left out
+            // everywhere, the fall's.
+            if let Some(b) = ctrl.contact_implicit_damping {
+                c.contact.implicit_damping = b;
+            }
+            if let Some(i) = ctrl.integrator {
+                c.integrator = i;
+            }
+            if let Some(w) = ctrl.reaction_window_s {
+                c.reaction_window_s = w;
+            }
+            if let Some(k) = ctrl.reaction_substeps {
+                c.reaction_substeps = k;
+            }
         }
         c.dt_s = self.step(from_file.as_ref())?;
-        if let Some(b) = self
-            .controller
-            .contact_implicit_damping
-            .or(from_file.as_ref().and_then(|f| f.contact_implicit_damping))
-        {
-            c.contact.implicit_damping = b;
-        }
-        let file = from_file.as_ref();
-        if let Some(i) = self
-            .controller
-            .integrator
-            .or(file.and_then(|f| f.integrator))
-        {
-            c.integrator = i;
-        }
-        if let Some(w) = self
-            .controller
-            .reaction_window_s
-            .or(file.and_then(|f| f.reaction_window_s))
-        {
-            c.reaction_window_s = w;
-        }
-        if let Some(k) = self
-            .controller
-            .reaction_substeps
-            .or(file.and_then(|f| f.reaction_substeps))
-        {
-            c.reaction_substeps = k;
-        }
         let evolved_for = self
             .controller
             .evolved_for
