@@ -4,7 +4,7 @@
 //! and kept across iterations as across a GA's generations, on a rayon pool of 1 and of 2
 //! threads. The ratio of the two rates is the parallel efficiency × 2. These are initial
 //! genomes, whose falls rest sooner than evolved ones: 15 000 / rate understates the paper's
-//! whole GA, which `benches/evolve_run.rs` times itself. Also one GA step alone (selection,
+//! whole GA, which `benches/evolve_vs_mujoco.rs` times against MuJoCo. Also one GA step alone (selection,
 //! crossover, mutation) without evaluation, and what a checkpoint costs at the size of
 //! `scenes/evolve_fall.ron` at its end (2 groups × 5 seeds, 30 × 42 genes, 501 logbook records
 //! each): written (checked, read back, written atomically) every generation by default.

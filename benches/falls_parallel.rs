@@ -1,27 +1,18 @@
-//! 64 pushed falls (3 s each) in parallel Worlds (up to four falls at a time in each) on a rayon
+//! 64 pushed falls (3 s each, the paper's explicit 0.5 ms step) in parallel Worlds (up to four falls at a time in each) on a rayon
 //! pool of 1 and of 2 threads:
 //! throughput in falls per second.
 //! Run: `cargo bench --bench falls_parallel`.
 
+mod common;
+
+use common::mujoco::pushed_falls;
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use marionette::experiments::fall::FallConfig;
 use marionette::experiments::fall::ecs::run_parallel;
-use marionette::humanoid::ranges::AgeGroup;
 use std::hint::black_box;
 use std::time::Duration;
 
 fn bench_parallel(c: &mut Criterion) {
-    let configs: Vec<FallConfig> = (0..64)
-        .map(|i| {
-            let mut cfg = FallConfig::paper(if i % 2 == 0 {
-                AgeGroup::Elderly
-            } else {
-                AgeGroup::Adult
-            });
-            cfg.push.force_n = 800.0 + 5.0 * i as f64;
-            cfg
-        })
-        .collect();
+    let configs = pushed_falls();
     // Every fall must succeed, or the bench would time error paths.
     let failures: Vec<String> = run_parallel(&configs)
         .into_iter()

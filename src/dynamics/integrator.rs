@@ -41,6 +41,26 @@ pub enum Integrator {
     /// terms, of the joint limits past their range, of the joint friction and of the pushing
     /// (and sticking) floor corners (1 evaluation per step; [`super::linearly_implicit`]).
     LinearlyImplicitEuler,
+    /// The same linearisation taken at the step's midpoint, `θ = ½`:
+    /// `(M + ½h D + ½h² K) Δv = h (f − ½h K v)`, i.e. the stiff forces act at
+    /// `(q + ½h v', ½(v + v'))`. Stable at every step like [`Self::LinearlyImplicitEuler`], with
+    /// half its numerical damping (a spring of `ω` loses a factor `1/√(1 + θω²h²)` of its
+    /// amplitude per step), so an impact's peak force is resolved at 2 ms where `θ = 1`
+    /// under-reads it; the stiffest modes alternate instead of dying out.
+    LinearlyImplicitMidpoint,
+}
+
+impl Integrator {
+    /// The weight `θ` at which a linearly implicit scheme takes its stiff forces
+    /// (`q + θh v'`, `v + θ(v' − v)`): 1 for [`Self::LinearlyImplicitEuler`], ½ for
+    /// [`Self::LinearlyImplicitMidpoint`]; `None` for the explicit schemes.
+    pub fn linearisation_weight(self) -> Option<f64> {
+        match self {
+            Integrator::LinearlyImplicitEuler => Some(1.0),
+            Integrator::LinearlyImplicitMidpoint => Some(0.5),
+            Integrator::Rk4 | Integrator::SemiImplicitEuler { .. } => None,
+        }
+    }
 }
 
 /// The acceleration function `q̈ = f(t, q, v)` a scheme integrates.
@@ -59,19 +79,22 @@ pub trait Dynamics {
         qdd: &mut [f64],
     ) -> Result<(), Self::Error>;
 
-    /// The acceleration of a linearly implicit step of `h` seconds: with the force's
-    /// stiffness `K = −∂f/∂q` and damping `D = −∂f/∂v` at `(q, v)`, it solves
-    /// `(H + h D + h² K) q̈ = f(q, v) − C − h K v`, so that `v' = v + h q̈` is the velocity at
-    /// which the linearised force `f(q + h v', v')` acts ([`super::linearly_implicit`]). A
-    /// dynamics that knows no stiffness takes its damping implicitly only (the default).
+    /// The acceleration of a linearly implicit step of `h` seconds at weight `theta`: with the
+    /// force's stiffness `K = −∂f/∂q` and damping `D = −∂f/∂v` at `(q, v)`, it solves
+    /// `(H + θh D + θh² K) q̈ = f(q, v) − C − θh K v`, so that `v' = v + h q̈` is the velocity
+    /// for which the linearised force `f(q + θh v', v + θ(v' − v))` acts
+    /// ([`super::linearly_implicit`]). A dynamics that knows no stiffness takes its damping
+    /// implicitly only (the default).
     fn acceleration_linearised(
         &mut self,
         t: f64,
         q: &[f64],
         v: &[f64],
         h: f64,
+        theta: f64,
         qdd: &mut [f64],
     ) -> Result<(), Self::Error> {
+        let _ = theta;
         self.acceleration(t, q, v, Some(h), qdd)
     }
 }
@@ -124,8 +147,9 @@ pub fn step<D: Dynamics>(
             let implicit = implicit_damping.then_some(h);
             semi_implicit_euler_step(model, ws, dynamics, t, implicit, h, (q, v))
         }
-        Integrator::LinearlyImplicitEuler => {
-            dynamics.acceleration_linearised(t, q, v, h, &mut ws.kv[0])?;
+        Integrator::LinearlyImplicitEuler | Integrator::LinearlyImplicitMidpoint => {
+            let theta = scheme.linearisation_weight().unwrap_or(1.0);
+            dynamics.acceleration_linearised(t, q, v, h, theta, &mut ws.kv[0])?;
             semi_implicit_euler_advance(model, ws, h, (q, v));
             Ok(())
         }

@@ -31,19 +31,22 @@ use super::forces::limits::JointRanges;
 use super::forces::pd::PdTargets;
 
 /// The linearised step's terms for one DOF whose joint torque `tau` (N·m) has damping `d`
-/// (N·m·s/rad) and stiffness `k` (N·m/rad) at velocity `v` (rad/s), step `h` (s): the armature
-/// `h d + h² k` (N·m·s²) the ABA adds to the DOF's inertia and the torque `tau − h k v`.
+/// (N·m·s/rad) and stiffness `k` (N·m/rad) at velocity `v` (rad/s), step `h` (s), weight
+/// `theta` (1 at the step end, ½ at its midpoint): the armature `θh (d + h k)` (N·m·s²) the
+/// ABA adds to the DOF's inertia and the torque `tau − θh k v`.
 #[inline(always)]
-pub fn joint(h: f64, tau: f64, d: f64, k: f64, v: f64) -> (f64, f64) {
-    (h * (d + h * k), tau - h * k * v)
+pub fn joint(h: f64, theta: f64, tau: f64, d: f64, k: f64, v: f64) -> (f64, f64) {
+    let th = theta * h;
+    (th * (d + h * k), tau - th * k * v)
 }
 
 /// The linearised step's terms for one pushing floor corner with spring `k` (N/m) and damper
-/// `c` (N·s/m) moving along the normal at `zd` (m/s), step `h` (s): the factor `h (c + h k)` of
-/// the corner's inertia `j jᵀ` and the normal-force correction `−h k ż` (N).
+/// `c` (N·s/m) moving along the normal at `zd` (m/s), step `h` (s), weight `theta`: the factor
+/// `θh (c + h k)` of the corner's inertia `j jᵀ` and the normal-force correction `−θh k ż` (N).
 #[inline(always)]
-pub fn corner(h: f64, k: f64, c: f64, zd: f64) -> (f64, f64) {
-    (h * (c + h * k), -h * k * zd)
+pub fn corner(h: f64, theta: f64, k: f64, c: f64, zd: f64) -> (f64, f64) {
+    let th = theta * h;
+    (th * (c + h * k), -th * k * zd)
 }
 
 /// The stiffness `−∂τ/∂θ` (N·m/rad) of DOF `d`'s PD torque `tau`: `k_p`, or 0 where the torque
@@ -69,20 +72,61 @@ pub fn limit_stiffness(limits: &JointRanges, d: usize, theta: f64) -> f64 {
 mod tests {
     use super::*;
 
-    /// Steps `ẍ = −ω² x − 2ζω ẋ` (unit mass) `n` times by the linearised step; the largest |x|
-    /// after the first step.
-    fn oscillate(omega: f64, zeta: f64, h: f64, n: usize) -> f64 {
+    /// Steps `ẍ = −ω² x − 2ζω ẋ` (unit mass) `n` times by the linearised step at weight
+    /// `theta`; the largest |x| after the first step.
+    fn oscillate_at(theta: f64, omega: f64, zeta: f64, h: f64, n: usize) -> f64 {
         let (k, c) = (omega * omega, 2.0 * zeta * omega);
         let (mut x, mut v) = (1.0f64, 0.0f64);
         let mut peak: f64 = 0.0;
         for _ in 0..n {
-            let (arm, f) = joint(h, -k * x - c * v, c, k, v);
+            let (arm, f) = joint(h, theta, -k * x - c * v, c, k, v);
             let a = f / (1.0 + arm);
             v += h * a;
             x += h * v;
             peak = peak.max(x.abs());
         }
         peak
+    }
+
+    fn oscillate(omega: f64, zeta: f64, h: f64, n: usize) -> f64 {
+        oscillate_at(1.0, omega, zeta, h, n)
+    }
+
+    #[test]
+    fn at_the_midpoint_an_undamped_spring_loses_the_predicted_amplitude_and_stays_bounded() {
+        // Per step the map (x, v) → (x', v') has determinant 1/(1 + θ ω²h²): the energy of an
+        // undamped spring shrinks by that factor each step, half as fast at θ = ½ as at θ = 1
+        // to first order, and no step makes it grow.
+        let (omega, h, n) = (300.0, 0.002, 200i32);
+        let a = (omega * h) * (omega * h);
+        for theta in [0.5, 1.0] {
+            let (k, mut x, mut v) = (omega * omega, 1.0f64, 0.0f64);
+            for _ in 0..n {
+                let (arm, f) = joint(h, theta, -k * x, 0.0, k, v);
+                v += h * f / (1.0 + arm);
+                x += h * v;
+            }
+            // The energy's geometric mean decay: |det|^n, up to the ellipse's phase.
+            let energy = 0.5 * (k * x * x + v * v) / (0.5 * k);
+            let predicted = (1.0 + theta * a).powi(-n);
+            let ratio = energy / predicted;
+            assert!(
+                ratio > 0.3 && ratio < 3.0,
+                "θ = {theta}: {energy:e} vs {predicted:e}"
+            );
+        }
+        // Stable far past the explicit bound (ω h = 2), without decay to speak of at ω h = 20:
+        // the stiffest modes alternate.
+        assert!(oscillate_at(0.5, 10_000.0, 0.0, 0.002, 2000) <= 1.0 + 1e-12);
+        // With its damper it settles: after 0.4 s (ζω t = 60) nothing is left.
+        let (k, c, h) = (9e4, 300.0, 0.002);
+        let (mut x, mut v) = (1.0f64, 0.0f64);
+        for _ in 0..200 {
+            let (arm, f) = joint(h, 0.5, -k * x - c * v, c, k, v);
+            v += h * f / (1.0 + arm);
+            x += h * v;
+        }
+        assert!(x.abs() < 1e-6 && v.abs() < 1e-3, "x = {x}, v = {v}");
     }
 
     #[test]
@@ -92,7 +136,7 @@ mod tests {
         // The step is backward Euler: x' = x + h v', v' = v + h(−k x' − c v').
         let (k, c, h) = (400.0, 3.0, 0.01);
         let (x, v) = (0.2, -1.5);
-        let (arm, f) = joint(h, -k * x - c * v, c, k, v);
+        let (arm, f) = joint(h, 1.0, -k * x - c * v, c, k, v);
         let v1 = v + h * f / (1.0 + arm);
         let x1 = x + h * v1;
         assert!((v1 - (v + h * (-k * x1 - c * v1))).abs() < 1e-12);
@@ -100,7 +144,7 @@ mod tests {
         let (omega, h) = (10.0, 1e-5);
         let (mut x, mut v) = (1.0f64, 0.0f64);
         for _ in 0..(0.1 / h) as usize {
-            let (arm, f) = joint(h, -omega * omega * x, 0.0, omega * omega, v);
+            let (arm, f) = joint(h, 1.0, -omega * omega * x, 0.0, omega * omega, v);
             v += h * f / (1.0 + arm);
             x += h * v;
         }
@@ -122,7 +166,7 @@ mod tests {
         assert_eq!(limit_stiffness(&l, 0, 1.1), 700.0);
         assert_eq!(limit_stiffness(&l, 0, -0.6), 700.0);
         assert_eq!(
-            corner(0.002, 1e5, 100.0, -0.5),
+            corner(0.002, 1.0, 1e5, 100.0, -0.5),
             (0.002 * (100.0 + 200.0), 100.0)
         );
     }

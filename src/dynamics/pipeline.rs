@@ -495,14 +495,18 @@ fn contact_stage(
     e.implicit.clear();
     if let Some(cm) = forces.contact {
         let implicit = match settings.integrator {
-            Integrator::LinearlyImplicitEuler => Some(ImplicitFloor {
-                h: dt,
-                stiffness: true,
-            }),
+            Integrator::LinearlyImplicitEuler | Integrator::LinearlyImplicitMidpoint => {
+                Some(ImplicitFloor {
+                    h: dt,
+                    stiffness: true,
+                    theta: settings.integrator.linearisation_weight().unwrap_or(1.0),
+                })
+            }
             Integrator::SemiImplicitEuler { .. } if cm.params.implicit_damping => {
                 Some(ImplicitFloor {
                     h: dt,
                     stiffness: false,
+                    theta: 1.0,
                 })
             }
             _ => None,
@@ -655,9 +659,10 @@ impl Dynamics for Evaluation<'_> {
         q: &[f64],
         v: &[f64],
         h: f64,
+        theta: f64,
         qdd: &mut [f64],
     ) -> Result<(), StepError> {
-        self.evaluate(t, q, v, Implicit::Linearised(h), qdd)
+        self.evaluate(t, q, v, Implicit::Linearised { h, theta }, qdd)
     }
 }
 
@@ -703,8 +708,14 @@ enum Implicit {
     Explicit,
     /// The joint damping (armature `h d`).
     Damping(f64),
-    /// The joint forces' stiffness and damping ([`linearly_implicit::joint`]).
-    Linearised(f64),
+    /// The joint forces' stiffness and damping ([`linearly_implicit::joint`]) over the step
+    /// `h` at weight `theta`.
+    Linearised {
+        /// The step (s).
+        h: f64,
+        /// The weight (1: the step end, ½: its midpoint).
+        theta: f64,
+    },
 }
 
 /// The force evaluation before the ABA: kinematics and contact forces (unless the step-start
@@ -749,7 +760,7 @@ fn prepare(
     if (forces.pd.is_some() || forces.limits.is_some()) && !start_angles {
         read_angles(model, forces, q, &mut ws.reference, &mut ws.angles);
     }
-    let linearised = matches!(implicit, Implicit::Linearised(_));
+    let linearised = matches!(implicit, Implicit::Linearised { .. });
     for (d, &k) in forces.dofs.iter().enumerate() {
         let (th, thd) = (ws.angles[k], v[k]);
         let (mut tau, mut damp) = (0.0, 0.0);
@@ -790,10 +801,16 @@ fn implicit_armature(ws: &mut EvalScratch, v: &[f64], implicit: Implicit) -> boo
             }
             true
         }
-        Implicit::Linearised(h) => {
+        Implicit::Linearised { h, theta } => {
             for k in 0..ws.armature.len() {
-                let (arm, tau) =
-                    linearly_implicit::joint(h, ws.tau[k], ws.damping[k], ws.stiffness[k], v[k]);
+                let (arm, tau) = linearly_implicit::joint(
+                    h,
+                    theta,
+                    ws.tau[k],
+                    ws.damping[k],
+                    ws.stiffness[k],
+                    v[k],
+                );
                 ws.armature[k] = arm;
                 ws.tau[k] = tau;
             }

@@ -20,8 +20,8 @@ pub fn stable_step(integrator: Integrator, omega: f64, zeta: f64) -> f64 {
     match integrator {
         Integrator::Rk4 => 2.5 / (omega * (zeta + s)),
         Integrator::SemiImplicitEuler { .. } => 2.0 * (s - zeta) / omega,
-        // Backward Euler on the linearised oscillator: no bound.
-        Integrator::LinearlyImplicitEuler => f64::INFINITY,
+        // The linearised oscillator at θ ≥ ½: no bound.
+        Integrator::LinearlyImplicitEuler | Integrator::LinearlyImplicitMidpoint => f64::INFINITY,
     }
 }
 
@@ -34,6 +34,7 @@ pub fn scheme_name(i: Integrator) -> &'static str {
         } => "semi-implicit Euler (implicit damping)",
         Integrator::SemiImplicitEuler { .. } => "semi-implicit Euler",
         Integrator::LinearlyImplicitEuler => "linearly implicit Euler",
+        Integrator::LinearlyImplicitMidpoint => "linearly implicit midpoint",
     }
 }
 
@@ -204,9 +205,10 @@ mod tests {
                     v += h * f(x, v);
                     x += h * v;
                 }
-                Integrator::LinearlyImplicitEuler => {
+                Integrator::LinearlyImplicitEuler | Integrator::LinearlyImplicitMidpoint => {
+                    let th = integrator.linearisation_weight().unwrap_or(1.0) * h;
                     let (k, c) = (omega * omega, 2.0 * zeta * omega);
-                    v += h * (f(x, v) - h * k * v) / (1.0 + h * c + h * h * k);
+                    v += h * (f(x, v) - th * k * v) / (1.0 + th * c + th * h * k);
                     x += h * v;
                 }
                 Integrator::Rk4 => {

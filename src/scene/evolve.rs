@@ -72,7 +72,23 @@ fn one_substep() -> u32 {
     1
 }
 
+fn default_step() -> Option<GaStep> {
+    Some(GaStep::midpoint_2ms())
+}
+
 impl GaStep {
+    /// The GA's default stepping: the stiff forces linearised at the step's midpoint
+    /// ([`Integrator::LinearlyImplicitMidpoint`](crate::dynamics::integrator::Integrator)),
+    /// 2 ms, the reaction's first 100 ms in four sub-steps.
+    pub fn midpoint_2ms() -> Self {
+        Self {
+            integrator: crate::dynamics::integrator::Integrator::LinearlyImplicitMidpoint,
+            dt_s: 0.002,
+            reaction_window_s: 0.1,
+            reaction_substeps: 4,
+        }
+    }
+
     /// Puts this stepping into `fall`.
     fn apply(&self, fall: &mut FallConfig) {
         fall.integrator = self.integrator;
@@ -147,15 +163,17 @@ pub struct EvolveFallScene {
     /// for the age group's maximal torque).
     #[serde(default = "default_kp_scale")]
     pub kp_max_scale: f64,
-    /// The GA's time step as a fraction of the stability bound of the strongest genome, in
-    /// (0, 1] (default [`crate::experiments::evolve_fall::STEP_MARGIN`], 0.8): larger is faster
-    /// and less accurate; the elite check (`ga.elite_check_tolerance`) rejects individuals that
-    /// win through the step. Ignored when `fall` is given (it keeps its own `dt_s`).
+    /// With `step: None`, the GA's explicit time step as a fraction of the stability bound of
+    /// the strongest genome, in (0, 1] (default [`crate::experiments::evolve_fall::STEP_MARGIN`],
+    /// 0.8: 0.70 ms): larger is faster and less accurate; the elite check
+    /// (`ga.elite_check_tolerance`) rejects individuals that win through the step. Ignored when
+    /// `fall` is given (it keeps its own `dt_s`).
     #[serde(default = "default_step_margin")]
     pub step_margin: f64,
-    /// The GA's time stepping given outright (integrator, step, finer reaction), in place of
-    /// `step_margin` of the explicit step's stability bound; ignored when `fall` is given.
-    #[serde(default)]
+    /// The GA's time stepping (integrator, step, finer reaction); default
+    /// [`GaStep::midpoint_2ms`]. `None`: the explicit step at `step_margin`. Ignored when
+    /// `fall` is given.
+    #[serde(default = "default_step")]
     pub step: Option<GaStep>,
     /// The fall every genome is tried on, per field (default: the paper's push of the age
     /// group at the GA's step, [`crate::experiments::evolve_fall::stable_step_for`]; its
@@ -909,6 +927,33 @@ mod tests {
             let e = scene(bad, 1.0).config().unwrap_err().to_string();
             assert!(e.contains("step_margin must be in (0, 1]"), "{e}");
         }
+    }
+
+    #[test]
+    fn a_scene_without_a_step_takes_the_midpoint_at_2_ms_and_none_the_margin() {
+        use crate::dynamics::integrator::Integrator;
+        let parse = |extra: &str| {
+            let text = format!(
+                "EvolveFall(format_version: 1, name: \"t\", groups: [adult], seeds: [1]{extra})"
+            );
+            match crate::scene::Scene::parse(&text, "test").unwrap() {
+                crate::scene::Scene::EvolveFall(s) => s.config().unwrap().problems[0].fall.clone(),
+                other => panic!("{other:?}"),
+            }
+        };
+        let f = parse("");
+        assert_eq!(
+            (
+                f.integrator,
+                f.dt_s,
+                f.reaction_window_s,
+                f.reaction_substeps
+            ),
+            (Integrator::LinearlyImplicitMidpoint, 0.002, 0.1, 4)
+        );
+        let f = parse(", step: None");
+        assert_eq!(f.dt_s, FallProblem::paper(AgeGroup::Adult).fall.dt_s);
+        assert!(matches!(f.integrator, Integrator::SemiImplicitEuler { .. }));
     }
 
     #[test]

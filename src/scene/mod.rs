@@ -22,7 +22,9 @@ pub use dance::{
     DanceInputs, DanceRender, DanceScene, DatabaseSource, Pin, SongSource, load_dance, run_dance,
     scene_pins, song_timed_bvh, validate_dance,
 };
-pub use evolve::{EvaluatorChoice, EvolveFallScene, ResumeMismatch, SettingMismatch, run_evolve};
+pub use evolve::{
+    EvaluatorChoice, EvolveFallScene, GaStep, ResumeMismatch, SettingMismatch, run_evolve,
+};
 pub use fall::{Controller, FallScene, SceneFall, fall_report, run_fall};
 pub use page::{PAGE_FILE, RunPage, write_run_index};
 pub use primitives::{

@@ -176,6 +176,8 @@ fn fall_line(label: &str, f: &Report) -> String {
         .list("/impacts")
         .iter()
         .find(|i| i.get("link").and_then(Value::as_str) == Some("head"))
+        // A head that never reached the floor has an impact entry without a touchdown.
+        .filter(|i| i.get("touchdown_s").is_some_and(|t| !t.is_null()))
         .map(|i| {
             let i = Report(i);
             format!(
@@ -185,12 +187,14 @@ fn fall_line(label: &str, f: &Report) -> String {
             )
         })
         .unwrap_or_else(|| "the head never touched the floor".into());
+    let rest = match f.get("/rest_time_s").and_then(Value::as_f64) {
+        Some(_) => format!("at rest after {} s", f.num("/rest_time_s", 2)),
+        None => "not at rest by the end".into(),
+    };
     format!(
-        "{label}: damage {} N, {head}, pelvis lands at {} m/s, at rest: {} ({} s)",
+        "{label}: damage {} N, {head}, pelvis lands at {} m/s, {rest}",
         f.num("/damage", 0),
         f.num("/pelvis/impact_velocity_m_s", 2),
-        f.yes("/came_to_rest"),
-        f.num("/rest_time_s", 2)
     )
 }
 
@@ -292,4 +296,39 @@ fn dance(r: &Report) -> Vec<String> {
             r.num("/metrics/seam_jerk_mean_rad_s3", 0)
         ),
     ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde_json::json;
+
+    #[test]
+    fn a_fall_line_says_what_did_not_happen_instead_of_a_missing_field() {
+        let rolled = json!({
+            "damage": 5471.2,
+            "impacts": [{"link": "head", "touchdown_s": null, "peak_force_n": 0.0}],
+            "pelvis": {"impact_velocity_m_s": 0.21},
+            "came_to_rest": false,
+            "rest_time_s": null,
+        });
+        let line = fall_line("elderly fall", &Report(&rolled));
+        assert_eq!(
+            line,
+            "elderly fall: damage 5471 N, the head never touched the floor, pelvis lands at \
+             0.21 m/s, not at rest by the end"
+        );
+        let hit = json!({
+            "damage": 61320.0,
+            "impacts": [{"link": "head", "touchdown_s": 0.74, "peak_force_n": 4486.0}],
+            "pelvis": {"impact_velocity_m_s": 3.56},
+            "came_to_rest": true,
+            "rest_time_s": 1.11,
+        });
+        assert_eq!(
+            fall_line("elderly fall", &Report(&hit)),
+            "elderly fall: damage 61320 N, head peak force 4486 N at 0.740 s, pelvis lands at \
+             3.56 m/s, at rest after 1.11 s"
+        );
+    }
 }

@@ -18,6 +18,7 @@ use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64;
 
 const LINEARISED: Integrator = Integrator::LinearlyImplicitEuler;
+const MIDPOINT: Integrator = Integrator::LinearlyImplicitMidpoint;
 const EXPLICIT: Integrator = Integrator::SemiImplicitEuler {
     implicit_damping: true,
 };
@@ -35,20 +36,28 @@ fn relative(a: f64, b: f64) -> f64 {
 
 #[test]
 fn at_a_small_step_the_linearised_fall_is_the_explicit_one() {
-    // At 0.25 ms (a quarter of the explicit bound) both schemes are first order in h and their
-    // difference is the h·K, h·D terms: the damage agrees within 2 %.
+    // At 0.25 ms (a quarter of the explicit bound) the schemes are first order in h and their
+    // difference is the θh·K, θh·D terms: the damage agrees within 2 %, at the step end
+    // (θ = 1) and at its midpoint (θ = ½).
     for group in [AgeGroup::Elderly, AgeGroup::Adult] {
         let e = simulate_fall(&paper(group, EXPLICIT, 2.5e-4)).unwrap();
-        let l = simulate_fall(&paper(group, LINEARISED, 2.5e-4)).unwrap();
-        let r = relative(l.damage, e.damage);
-        println!(
-            "{group:?} at 0.25 ms: damage explicit {:.1} N, linearised {:.1} N ({:+.2} %)",
-            e.damage,
-            l.damage,
-            100.0 * (l.damage - e.damage) / e.damage
-        );
-        assert!(r < 0.02, "{group:?}: {} vs {}", l.damage, e.damage);
-        assert_eq!(l.came_to_rest, e.came_to_rest);
+        for scheme in [LINEARISED, MIDPOINT] {
+            let l = simulate_fall(&paper(group, scheme, 2.5e-4)).unwrap();
+            let r = relative(l.damage, e.damage);
+            println!(
+                "{group:?} at 0.25 ms: damage explicit {:.1} N, {scheme:?} {:.1} N ({:+.2} %)",
+                e.damage,
+                l.damage,
+                100.0 * (l.damage - e.damage) / e.damage
+            );
+            assert!(
+                r < 0.02,
+                "{group:?} {scheme:?}: {} vs {}",
+                l.damage,
+                e.damage
+            );
+            assert_eq!(l.came_to_rest, e.came_to_rest);
+        }
     }
 }
 
@@ -97,26 +106,29 @@ fn a_passive_drop_at_2_ms_gains_no_energy() {
     // The limp figure dropped from 20 cm: the spring energy stored in the floor and the joint
     // limits is never negative and friction and dampers only take energy out, so the
     // mechanical energy T + V never rises above its start; the body ends at rest below it.
-    let e = drop(LINEARISED, 2e-3, 0.2, 2.0).expect("the linearised drop runs at 2 ms");
-    let e0 = e[0];
-    let (k, max) = e
-        .iter()
-        .enumerate()
-        .fold((0, f64::MIN), |m, (k, &x)| if x > m.1 { (k, x) } else { m });
-    println!(
-        "passive drop at 2 ms: E0 = {e0:.3} J, largest E = {max:.3} J (step {k}), end {:.3} J",
-        e.last().unwrap()
-    );
-    assert!(
-        max <= e0 + 1e-9 * e0.abs(),
-        "E rose to {max} J at step {k} from {e0} J"
-    );
-    // It fell: more than the 20 cm's worth (65 kg · 9.81 · 0.2 ≈ 128 J) left the motion.
-    assert!(
-        *e.last().unwrap() < e0 - 100.0,
-        "end energy {}",
-        e.last().unwrap()
-    );
+    for scheme in [LINEARISED, MIDPOINT] {
+        let e = drop(scheme, 2e-3, 0.2, 2.0).expect("the linearised drop runs at 2 ms");
+        let e0 = e[0];
+        let (k, max) = e
+            .iter()
+            .enumerate()
+            .fold((0, f64::MIN), |m, (k, &x)| if x > m.1 { (k, x) } else { m });
+        println!(
+            "{scheme:?}, passive drop at 2 ms: E0 = {e0:.3} J, largest E = {max:.3} J (step {k}), \
+             end {:.3} J",
+            e.last().unwrap()
+        );
+        assert!(
+            max <= e0 + 1e-9 * e0.abs(),
+            "{scheme:?}: E rose to {max} J at step {k} from {e0} J"
+        );
+        // It fell: more than the 20 cm's worth (65 kg · 9.81 · 0.2 ≈ 128 J) left the motion.
+        assert!(
+            *e.last().unwrap() < e0 - 100.0,
+            "{scheme:?}: end energy {}",
+            e.last().unwrap()
+        );
+    }
 }
 
 /// The damage `Σ w_i f_i` of the fall `cfg` stepped by `pipeline::step` with `integrator` at

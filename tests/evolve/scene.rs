@@ -5,8 +5,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use marionette::evolve::checkpoint;
-use marionette::experiments::evolve_fall::FallProblem;
-use marionette::humanoid::ranges::AgeGroup;
+use marionette::scene::GaStep;
 
 fn marionette(args: &[&str]) -> std::process::Output {
     let out = Command::new(env!("CARGO_BIN_EXE_marionette"))
@@ -146,10 +145,7 @@ fn a_resumed_evolution_ends_where_an_uninterrupted_one_does() {
     let fall = report(&replay);
     assert_eq!(fall["controller_evolved_for"], "adult");
     assert_eq!(fall["age_group"], "adult");
-    assert_eq!(
-        fall["dt_s"].as_f64(),
-        Some(FallProblem::paper(AgeGroup::Adult).fall.dt_s)
-    );
+    assert_eq!(fall["dt_s"].as_f64(), Some(GaStep::midpoint_2ms().dt_s));
     let evolved = r["best_falls"]
         .as_array()
         .unwrap()
@@ -175,13 +171,13 @@ fn a_resumed_evolution_ends_where_an_uninterrupted_one_does() {
     // A scene step that contradicts the controller's is refused, naming the way out.
     let out = Command::new(env!("CARGO_BIN_EXE_marionette"))
         .args(["run", "scenes/fall.ron", "--out", &s(&replay)])
-        .args(["--set", &file, "--set", "fall.dt_s=0.0005"])
+        .args(["--set", &file, "--set", "fall.dt_s=0.001"])
         .current_dir(env!("CARGO_MANIFEST_DIR"))
         .output()
         .unwrap();
     assert!(!out.status.success());
     let err = String::from_utf8_lossy(&out.stderr);
-    let evolved_at = format!("dt_s = {} s", FallProblem::paper(AgeGroup::Adult).fall.dt_s);
+    let evolved_at = format!("dt_s = {} s", GaStep::midpoint_2ms().dt_s);
     assert!(
         err.contains("controller.dt_s") && err.contains(&evolved_at),
         "{err}"

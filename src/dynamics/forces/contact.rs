@@ -134,6 +134,9 @@ pub struct ImplicitFloor {
     pub h: f64,
     /// Take the spring implicitly too.
     pub stiffness: bool,
+    /// The weight of the linearisation with the spring ([`linearly_implicit::corner`]: 1 at
+    /// the step end, ½ at its midpoint); the damping alone is always taken at the step end.
+    pub theta: f64,
 }
 
 /// One corner through the floor as its implicit terms need it: link `link`'s corner `cl`
@@ -444,7 +447,7 @@ impl ContactModel {
         let j = ForceVec::at_point(rot.transpose() * n, cl);
         if imp.stiffness {
             // I + h (c + h k) j jᵀ, and the force at the step end's position.
-            let (w, df) = linearly_implicit::corner(imp.h, k_c, c_c, zd);
+            let (w, df) = linearly_implicit::corner(imp.h, imp.theta, k_c, c_c, zd);
             ic.sub_outer(j, -w);
             *f_body += j * df;
             // A sticking corner's friction spring and damper along both tangents, the same
@@ -456,7 +459,7 @@ impl ContactModel {
                 );
                 for t in tangents(n) {
                     let jt = ForceVec::at_point(rot.transpose() * t, cl);
-                    let (w, df) = linearly_implicit::corner(imp.h, kt, ct, t.dot(xd));
+                    let (w, df) = linearly_implicit::corner(imp.h, imp.theta, kt, ct, t.dot(xd));
                     ic.sub_outer(jt, -w);
                     *f_body += jt * df;
                 }
