@@ -21,7 +21,7 @@ const TICKS: usize = 200;
 
 fn bench_active(c: &mut Criterion) {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes/clips/normal_jump.ron");
-    let clip = KeyframeClip::load(&path).expect("clip").to_model_clip();
+    let clip = KeyframeClip::load(&path).expect("clip").to_figure_clip();
     let jump = Arc::new(
         Primitive::learn("jump", &clip.to_trajectory(), &LearnConfig::default())
             .expect("learn")

@@ -30,7 +30,7 @@ fn bench(c: &mut Criterion) {
         "normal_jump_humanoid24",
         KeyframeClip::load(&root.join("scenes/clips/normal_jump.ron"))
             .unwrap()
-            .to_model_clip()
+            .to_figure_clip()
             .to_clip(),
     )];
     let data = marionette::io::data_dir();

@@ -35,7 +35,7 @@ fn jump() -> Arc<Primitive> {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes/clips/normal_jump.ron");
     let clip = KeyframeClip::load(&path)
         .expect("scenes/clips/normal_jump.ron")
-        .to_model_clip();
+        .to_figure_clip();
     Arc::new(
         Primitive::learn("jump", &clip.to_trajectory(), &LearnConfig::default())
             .expect("learn the jump")

@@ -56,7 +56,7 @@ mod tests {
             include_str!("../scenes/clips/normal_jump.ron"),
             "normal_jump.ron",
         )?
-        .to_model_clip();
+        .to_figure_clip();
         let skeleton: Skeleton = clip.to_clip().skeleton;
         let mapping = Mapping::detect(&skeleton)?;
         let on24 = retarget(&clip.to_clip(), &mapping, &humanoid24())?;

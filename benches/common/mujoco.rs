@@ -72,7 +72,7 @@ pub fn write_workload(dir: &Path) -> (PathBuf, PathBuf) {
     let cfg = FallConfig::paper(AgeGroup::Elderly);
     let body = fall21_body(cfg.height_m, cfg.mass_kg, cfg.gravity).expect("fall21");
     let ranges = RangeTable::builtin(AgeGroup::Elderly)
-        .for_model(&body.figure)
+        .for_figure(&body.figure)
         .expect("ranges");
     let limits = cfg.torque_limits_nm.clone().expect("strength");
     let dofs: Vec<_> = body

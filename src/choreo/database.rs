@@ -207,7 +207,7 @@ fn clip_segments(
         path: name.to_string(),
         message,
     })?;
-    let mut clip = load_model_clip_with(&c.file, c.mapping.as_deref())?;
+    let mut clip = load_figure_clip_with(&c.file, c.mapping.as_deref())?;
     if let Some((a, b)) = c.window {
         clip = clip.window(a, b).ok_or_else(|| SegmentError::Manifest {
             path: name.to_string(),
@@ -245,14 +245,14 @@ fn clip_segments(
 
 /// A clip on humanoid24: a BVH mapped with the detected mapping, retargeted and played on
 /// humanoid24's own proportions with its root path scaled by the ratio of the leg lengths
-/// ([`crate::mapping::onto_model`]), or a keyframed .ron clip; set on its floor ([`grounded`]).
-pub fn load_model_clip(path: &Path) -> Result<FigureClip, SegmentError> {
+/// ([`crate::mapping::onto_figure`]), or a keyframed .ron clip; set on its floor ([`grounded`]).
+pub fn load_figure_clip(path: &Path) -> Result<FigureClip, SegmentError> {
     load_unground(path, None).map(grounded)
 }
 
-/// [`load_model_clip`] with the BVH clip's landmark mapping read from `mapping` (a RON file)
+/// [`load_figure_clip`] with the BVH clip's landmark mapping read from `mapping` (a RON file)
 /// when given, instead of found from its skeleton.
-pub fn load_model_clip_with(
+pub fn load_figure_clip_with(
     path: &Path,
     mapping: Option<&Path>,
 ) -> Result<FigureClip, SegmentError> {
@@ -287,7 +287,7 @@ fn load_unground(path: &Path, mapping: Option<&Path>) -> Result<FigureClip, Segm
         .is_some_and(|e| e.eq_ignore_ascii_case("ron"));
     if is_ron {
         return crate::clips::KeyframeClip::load(path)
-            .map(|k| k.to_model_clip())
+            .map(|k| k.to_figure_clip())
             .map_err(|e| load(e.into()));
     }
     let (bvh, _warnings) = crate::bvh::parse_file(path).map_err(|e| load(e.into()))?;
@@ -303,7 +303,7 @@ fn load_unground(path: &Path, mapping: Option<&Path>) -> Result<FigureClip, Segm
     let mapped = crate::mapping::retarget(&clip, &mapping, &model).map_err(|e| load(e.into()))?;
     // The source's angles on humanoid24 itself, the root path scaled with the legs, so that
     // every segment is measured and danced on the one figure it is played on.
-    Ok(crate::mapping::onto_model(&mapped, &model))
+    Ok(crate::mapping::onto_figure(&mapped, &model))
 }
 
 /// What one source clip gave the database.
@@ -676,7 +676,7 @@ mod tests {
     /// The project's four bars at 120 BPM as a database, built in memory.
     fn bars_db(tempo_bpm: f64, params: &BuildParams) -> Result<Database, SegmentError> {
         let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/clips/dance_bars.ron");
-        let clip = load_model_clip(&path).unwrap();
+        let clip = load_figure_clip(&path).unwrap();
         let beat = Beat {
             tempo_bpm,
             first_beat_s: 0.0,

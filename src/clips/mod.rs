@@ -206,7 +206,7 @@ impl KeyframeClip {
     }
 
     /// Samples the clip at its frame rate into a motion on its model.
-    pub fn to_model_clip(&self) -> FigureClip {
+    pub fn to_figure_clip(&self) -> FigureClip {
         let base = Figure::by_name(&self.model).expect("checked in parse");
         let model = match self.height {
             Some(h) => base.scaled_to_height(h),
@@ -273,7 +273,7 @@ mod tests {
 
     #[test]
     fn knee_keys_are_met_and_feet_touch_the_floor_outside_flight() {
-        let c = KeyframeClip::parse(JUMP, "jump").unwrap().to_model_clip();
+        let c = KeyframeClip::parse(JUMP, "jump").unwrap().to_figure_clip();
         let knee = c.model.dof_index("left_knee").unwrap();
         assert_eq!(c.frame_count(), 100);
         assert!((c.frame_angles(30)[knee].to_degrees() - 90.0).abs() < 1e-9);

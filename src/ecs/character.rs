@@ -557,7 +557,7 @@ fn joint_limits(
         message: format!("no built-in {g:?} joint ranges for model {name}"),
     })?;
     let ranges = table
-        .for_model(&body.figure)
+        .for_figure(&body.figure)
         .map_err(|e| CharacterError::Setting {
             field: "joint_ranges",
             message: e.to_string(),

@@ -111,7 +111,7 @@ mod tests {
         Arc::new(
             KeyframeClip::parse(text, "wave")
                 .unwrap()
-                .to_model_clip()
+                .to_figure_clip()
                 .to_clip(),
         )
     }

@@ -220,7 +220,7 @@ pub struct HighJumpOutcome {
 }
 
 /// A trajectory as a clip on `model`.
-pub(super) fn on_model(
+pub(super) fn on_figure(
     model: &Figure,
     traj: &Trajectory,
 ) -> Result<FigureClip, PrimitiveExperimentError> {
@@ -264,8 +264,8 @@ pub fn learn_primitives(
     let normal = Primitive::learn("normal_jump", &config.normal.to_trajectory(), &config.learn)?;
     let t = normal.primitive.duration;
     // What the demonstrations did, each at its own duration, on the normal jump's floor.
-    let mut normal_clip = on_model(model, &rollout(&normal.primitive, dt)?)?;
-    let mut low_clip = on_model(model, &rollout(&low.primitive, dt)?)?;
+    let mut normal_clip = on_figure(model, &rollout(&normal.primitive, dt)?)?;
+    let mut low_clip = on_figure(model, &rollout(&low.primitive, dt)?)?;
     // The normal jump's floor and foot rest heights: every jump is measured against them.
     let reference = contact_reference(&normal_clip)
         .ok_or_else(|| PrimitiveExperimentError::NoFlight("the model has no feet".into()))?;
@@ -351,7 +351,7 @@ fn blend_jumps(
         Relearn::No,
         &config.learn,
     )?;
-    on_model(&config.model, &result.trajectory)
+    on_figure(&config.model, &result.trajectory)
 }
 
 /// Height above the floor under which a foot still stands on it when the flight's ends are
@@ -524,9 +524,9 @@ pub fn run(config: &HighJumpConfig) -> Result<HighJumpOutcome, PrimitiveExperime
         high: rollout(&learned.high.primitive, dt)?,
     };
     let mut clips = Jumps {
-        low: on_model(model, &rollout(&learned.low.primitive, dt)?)?,
-        normal: on_model(model, &rollouts.normal)?,
-        high: on_model(model, &rollouts.high)?,
+        low: on_figure(model, &rollout(&learned.low.primitive, dt)?)?,
+        normal: on_figure(model, &rollouts.normal)?,
+        high: on_figure(model, &rollouts.high)?,
     };
     let floor = primitives.floor_y_m;
     // A rollout reproduces its demonstration to within millimetres, which puts a standing foot
@@ -536,7 +536,7 @@ pub fn run(config: &HighJumpConfig) -> Result<HighJumpOutcome, PrimitiveExperime
         normal: clips.normal.lift_above_floor(floor),
         high: clips.high.lift_above_floor(floor),
     };
-    let mut low_time_scaled = on_model(model, &rollouts.low)?;
+    let mut low_time_scaled = on_figure(model, &rollouts.low)?;
     low_time_scaled.lift_above_floor(floor);
     let reference = &primitives.contact_reference;
     let figures = Jumps {

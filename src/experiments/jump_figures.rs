@@ -164,7 +164,7 @@ mod tests {
         .unwrap();
         let clip = KeyframeClip::parse(&text, "normal_jump.ron")
             .unwrap()
-            .to_model_clip();
+            .to_figure_clip();
         let f = jump_figures(&clip, 0.0);
         // Keyed flight 0.92–1.32 s: the feet are more than 3 cm up for nearly all of it.
         let fl = f.flight.unwrap();

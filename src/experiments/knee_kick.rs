@@ -27,7 +27,7 @@
 
 use super::high_jump::{
     HighJumpConfig, HighJumpPrimitives, PrimitiveExperimentError, heights, learn_primitives,
-    on_model, peak_deg, rollout,
+    on_figure, peak_deg, rollout,
 };
 use super::jump_figures::{JumpFigures, jump_figures, jump_figures_against};
 use crate::humanoid::FigureClip;
@@ -185,12 +185,12 @@ pub fn run(config: &KneeKickConfig) -> Result<KneeKickOutcome, PrimitiveExperime
     // The floor constraint on the connected motion: the parts' DMP fits and the connection's
     // pull reproduce the landing to within millimetres, which puts a foot that far through the
     // floor; the root is lifted by the depth where it is.
-    let mut result_clip = on_model(model, &connected.trajectory)?;
+    let mut result_clip = on_figure(model, &connected.trajectory)?;
     let floor_lift_m = result_clip.lift_above_floor(jump.floor_y_m);
     let checks = paper_checks(config, &jump, &played, &result_clip);
     let ev = played.events;
     let kick_rollout = rollout(&kick.primitive, dt)?;
-    let kick_clip = on_model(model, &kick_rollout)?;
+    let kick_clip = on_figure(model, &kick_rollout)?;
     let kick_placed_rollout = rollout(&kick.primitive.with_duration(ev.leap - ev.bend)?, dt)?;
     let peak_knee_flexion_deg = KneePeaks {
         right_knee: peak_deg(&connected.trajectory, "right_knee")?,
@@ -245,7 +245,7 @@ fn play_jump(
 ) -> Result<PlayedJump, PrimitiveExperimentError> {
     let floor = jump.floor_y_m;
     let rollout = rollout(&jump.learned.high.primitive, jump.dt)?;
-    let mut clip = on_model(&config.jump.model, &rollout)?;
+    let mut clip = on_figure(&config.jump.model, &rollout)?;
     // The floor constraint on the rollout, as the high jump's own clips have it.
     clip.lift_above_floor(floor);
     let (root_y, feet) = heights(&clip);
@@ -327,7 +327,7 @@ fn blend_kick_into_jump(
         result.b_end_frame,
         frame(played.flight.1),
     );
-    let mut blended = on_model(&config.jump.model, &traj)?;
+    let mut blended = on_figure(&config.jump.model, &traj)?;
     let ground_correction_m = stand_on_floor(
         &mut blended,
         0,
@@ -373,7 +373,7 @@ fn learn_parts(
         jump.dt,
         None,
     )?;
-    let mut landing = on_model(&config.jump.model, &played.trajectory)?;
+    let mut landing = on_figure(&config.jump.model, &played.trajectory)?;
     let last = landing.frame_count() - 1;
     let landing_correction_m = stand_on_floor(
         &mut landing,

@@ -230,7 +230,7 @@ mod tests {
     fn the_files_name_every_dof_once_and_carry_the_whole_mass() {
         let b = crate::humanoid::body::fall21_body(1.70, 65.0, 9.81).unwrap();
         let r = RangeTable::builtin(AgeGroup::Elderly)
-            .for_model(&b.figure)
+            .for_figure(&b.figure)
             .unwrap();
         let t = crate::humanoid::strength::torque_limits(AgeGroup::Elderly);
         let urdf = to_urdf(&b, &r, &t);

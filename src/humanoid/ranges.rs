@@ -114,7 +114,7 @@ impl RangeTable {
 
     /// `(lower, upper)` in radians for every DOF of `model`, in model order. The full DOF name is
     /// looked up first, then the name without its `left_`/`right_` prefix.
-    pub fn for_model(&self, model: &Figure) -> Result<Vec<(f64, f64)>, RangeError> {
+    pub fn for_figure(&self, model: &Figure) -> Result<Vec<(f64, f64)>, RangeError> {
         let known: Vec<String> = model.dofs.iter().map(|d| d.name.clone()).collect();
         for k in self.ranges.keys() {
             let matches = known.iter().any(|n| n == k || strip_side(n) == k);
@@ -156,11 +156,11 @@ mod tests {
     fn builtin_tables_cover_every_fall21_dof() {
         let m = fall21();
         for g in [AgeGroup::Elderly, AgeGroup::Adult] {
-            let r = RangeTable::builtin(g).for_model(&m).unwrap();
+            let r = RangeTable::builtin(g).for_figure(&m).unwrap();
             assert_eq!(r.len(), 21);
         }
         let e = RangeTable::builtin(AgeGroup::Elderly)
-            .for_model(&m)
+            .for_figure(&m)
             .unwrap();
         let knee = m.dof_index("left_knee").unwrap();
         assert!(
@@ -173,7 +173,7 @@ mod tests {
     fn humanoid24_has_adult_ranges_for_every_dof() {
         let m = crate::humanoid::humanoid24();
         let t = RangeTable::builtin_for("humanoid24", AgeGroup::Adult).unwrap();
-        let r = t.for_model(&m).unwrap();
+        let r = t.for_figure(&m).unwrap();
         assert_eq!(r.len(), 24);
         for (d, (lo, hi)) in m.dofs.iter().zip(&r) {
             assert!(
@@ -206,9 +206,9 @@ mod tests {
     fn elderly_ranges_are_narrower_than_adult_ones() {
         let m = fall21();
         let e = RangeTable::builtin(AgeGroup::Elderly)
-            .for_model(&m)
+            .for_figure(&m)
             .unwrap();
-        let a = RangeTable::builtin(AgeGroup::Adult).for_model(&m).unwrap();
+        let a = RangeTable::builtin(AgeGroup::Adult).for_figure(&m).unwrap();
         for (i, d) in m.dofs.iter().enumerate() {
             assert!(e[i].1 - e[i].0 < a[i].1 - a[i].0, "{}", d.name);
         }
@@ -230,7 +230,7 @@ mod tests {
         let unknown = "(format_version: 1, name: \"x\", ranges: {\"tail\": (0.0, 1.0)})";
         let t = RangeTable::parse(unknown, "u.ron").unwrap();
         assert!(
-            t.for_model(&fall21())
+            t.for_figure(&fall21())
                 .unwrap_err()
                 .to_string()
                 .contains("tail")

@@ -20,7 +20,7 @@ mod structure;
 pub use automatic::{AutoMapping, Finding, detect_automatic};
 pub use fidelity::{EffectorError, effector_errors};
 pub use names::{NormalName, Synonyms};
-pub use retarget::{leg_length, onto_model, retarget};
+pub use retarget::{leg_length, onto_figure, retarget};
 
 use std::collections::BTreeMap;
 use std::path::Path;

@@ -265,14 +265,14 @@ pub fn retarget(
         targets[f * n..(f + 1) * n].copy_from_slice(&row);
     }
 
-    let mapped_model = mapped_model(model, &lm, &targets);
+    let mapped_figure = mapped_figure(model, &lm, &targets);
     let pelvis_lm = lm.index(&model.joints[0].name);
     let (angles, root_rotation) = dof_angles(model, &targets, &rest_dirs, frames);
     let root_translation = (0..frames)
         .map(|f| lm.positions[f * k + pelvis_lm])
         .collect();
     Ok(FigureClip {
-        model: mapped_model,
+        model: mapped_figure,
         frame_time: clip.frame_time,
         root_translation,
         root_rotation,
@@ -352,15 +352,15 @@ impl LandmarkTracks {
 
 /// A copy of `model` with the source's offsets and End Sites: the median of the landmark
 /// geometry in the parent's target frame (the model's own where the source gives none).
-fn mapped_model(model: &Figure, lm: &LandmarkTracks, targets: &[Option<DQuat>]) -> Figure {
+fn mapped_figure(model: &Figure, lm: &LandmarkTracks, targets: &[Option<DQuat>]) -> Figure {
     let (n, k, frames) = (model.joints.len(), lm.names.len(), lm.frames);
     let positions = &lm.positions;
-    let mut mapped_model = model.clone();
+    let mut mapped_figure = model.clone();
     for j in 0..n {
         let me = lm.index(&model.joints[j].name);
         if let Some(pj) = model.joints[j].parent {
             let parent = lm.index(&model.joints[pj].name);
-            mapped_model.joints[j].offset = median_local(frames, |f| {
+            mapped_figure.joints[j].offset = median_local(frames, |f| {
                 let q = targets[f * n + pj]?;
                 Some(q.inverse() * (positions[f * k + me] - positions[f * k + parent]))
             })
@@ -368,15 +368,15 @@ fn mapped_model(model: &Figure, lm: &LandmarkTracks, targets: &[Option<DQuat>]) 
         }
         if let Some(e) = end_landmark(&model.joints[j].name) {
             let end = lm.index(&e);
-            mapped_model.joints[j].end_site = median_local(frames, |f| {
+            mapped_figure.joints[j].end_site = median_local(frames, |f| {
                 let q = targets[f * n + j]?;
                 Some(q.inverse() * (positions[f * k + end] - positions[f * k + me]))
             })
             .or(model.joints[j].end_site);
         }
     }
-    mapped_model.height = height_of(&mapped_model);
-    mapped_model
+    mapped_figure.height = height_of(&mapped_figure);
+    mapped_figure
 }
 
 /// The DOF angles of every frame (`frames` × DOFs) and the root's rotation, parents first,
@@ -489,7 +489,7 @@ pub fn leg_length(model: &Figure) -> Option<f64> {
 /// tall put on legs of a 1.65 m figure keeps her pelvis at her own height and so stands in the
 /// floor; scaled, the pelvis rides as high above the feet, and the steps are as long, in
 /// proportion to the legs. Without legs on either model the translation is kept (s = 1).
-pub fn onto_model(clip: &FigureClip, target: &Figure) -> FigureClip {
+pub fn onto_figure(clip: &FigureClip, target: &Figure) -> FigureClip {
     let s = match (leg_length(target), leg_length(&clip.model)) {
         (Some(t), Some(c)) if t > 0.0 && c > 0.0 => t / c,
         _ => 1.0,
@@ -533,7 +533,7 @@ mod tests {
             root_rotation: vec![DQuat::IDENTITY; n],
             angles: (0..n * d).map(|i| 0.01 * i as f64).collect(),
         };
-        let out = onto_model(&clip, &target);
+        let out = onto_figure(&clip, &target);
         let s = target.height / 1.53;
         for (a, b) in clip.root_translation.iter().zip(&out.root_translation) {
             assert!((*b - *a * s).length() < 1e-12);
@@ -552,7 +552,7 @@ mod tests {
             angles: vec![0.0; d],
             ..clip
         };
-        let on = onto_model(&still, &target);
+        let on = onto_figure(&still, &target);
         let sole = on.foot_heights()[0][0];
         assert!(sole.abs() < 1e-9, "sole at {sole} m");
     }

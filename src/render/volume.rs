@@ -379,7 +379,7 @@ fn parents_first(fig: &StickFigure) -> Vec<usize> {
 mod tests {
     use super::*;
 
-    fn model_track(model: &humanoid::Figure, pts: &[Vec<DVec3>]) -> Volumes {
+    fn figure_track(model: &humanoid::Figure, pts: &[Vec<DVec3>]) -> Volumes {
         let fig = StickFigure::of(&model.skeleton());
         let t = Track {
             figure: &fig,
@@ -394,7 +394,7 @@ mod tests {
     fn fall21_gets_its_contact_boxes_at_its_height_and_they_follow_a_turned_body() {
         let model = humanoid::fall21().scaled_to_height(1.55);
         let rest = model.skeleton().rest_points();
-        let body = model_track(&model, std::slice::from_ref(&rest));
+        let body = figure_track(&model, std::slice::from_ref(&rest));
         assert_eq!(body.kind, "fall21 contact boxes");
         let want = human_body(&model, 1.55, 70.0, 9.81).unwrap().boxes;
         assert_eq!(body.shapes.len(), want.len());

@@ -16,7 +16,7 @@ pub const PAGE_FILE: &str = "index.html";
 /// them at its height) in every frame, and its impacts as events: each link's first touchdown
 /// with its peak floor force, and the head's lowest point.
 pub fn fall_motion(label: &str, r: &FallResult) -> Result<PageMotion, SceneError> {
-    let clip = r.to_model_clip().to_clip();
+    let clip = r.to_figure_clip().to_clip();
     // The boxes' sizes follow the height only; the mass sets inertias, which are not drawn.
     let body =
         crate::humanoid::body::fall21_body(r.height_m, 65.0, 9.81).map_err(SceneError::FallBody)?;

@@ -108,7 +108,7 @@ pub struct JumpingKneeKickScene {
 
 /// Loads a clip onto humanoid24 as a primitive trajectory.
 fn demo(src: &ClipSource, base: &Path, model: &Figure) -> Result<FigureClip, SceneError> {
-    load_motion(src, base)?.on_model(model)
+    load_motion(src, base)?.on_figure(model)
 }
 
 /// The high jump's configuration: the scene's clips loaded onto `model`.

@@ -166,7 +166,7 @@ fn shown_clip(
     let (clip, model_clip) = match &scene.model {
         Some(name) => {
             let model = Figure::by_name(name)?;
-            let m = motion.on_model(&model)?;
+            let m = motion.on_figure(&model)?;
             (m.to_clip(), Some(m))
         }
         None => (motion.clip(), None),

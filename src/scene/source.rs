@@ -73,7 +73,7 @@ impl LoadedMotion {
     }
 
     /// The motion on `model` (retargeted from a capture; a keyframed clip must already be on it).
-    pub fn on_model(&self, model: &Figure) -> Result<FigureClip, SceneError> {
+    pub fn on_figure(&self, model: &Figure) -> Result<FigureClip, SceneError> {
         match self {
             LoadedMotion::Captured {
                 clip,
@@ -133,7 +133,7 @@ pub fn load_motion(src: &ClipSource, base: &Path) -> Result<LoadedMotion, SceneE
         }
         "ron" => {
             let k = KeyframeClip::load(&path)?;
-            let mut m = k.to_model_clip();
+            let mut m = k.to_figure_clip();
             if src.start_s.is_some() || src.end_s.is_some() {
                 let span = m.frame_count() as f64 * m.frame_time;
                 let (a, b) = window(span);

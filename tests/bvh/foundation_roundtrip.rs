@@ -20,7 +20,7 @@ fn known_clip() -> FigureClip {
           (t: 2.0, forward: 0.5, turn: -20.0, dofs: {"left_knee": 30.0, "right_knee": 10.0, "left_hip_flexion": 10.0,
                "right_hip_abduction": 5.0, "waist_flexion": 5.0, "left_shoulder_abduction": 30.0, "right_elbow_flexion": 45.0}),
         ])"#;
-    KeyframeClip::parse(text, "known").unwrap().to_model_clip()
+    KeyframeClip::parse(text, "known").unwrap().to_figure_clip()
 }
 
 fn through_bvh(clip: &Clip, order: [usize; 3]) -> Clip {

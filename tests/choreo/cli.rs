@@ -566,7 +566,7 @@ fn dance_db_takes_a_clip_s_mapping_from_the_manifest() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let clip = marionette::clips::KeyframeClip::load(&root.join("scenes/clips/dance_bars.ron"))
         .unwrap()
-        .to_model_clip();
+        .to_figure_clip();
     marionette::bvh::write_file(&clip.to_clip().to_bvh(), &dir.join("bars.bvh")).unwrap();
     let bin = || Command::new(env!("CARGO_BIN_EXE_marionette"));
     let out = bin()

@@ -15,7 +15,10 @@ use marionette::clips::KeyframeClip;
 /// The dance's joint positions per frame, its joint names and its frame rate.
 fn dance() -> (Vec<Vec<DVec3>>, Vec<String>, f64) {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/clips/dance_bars.ron");
-    let clip = KeyframeClip::load(&path).unwrap().to_model_clip().to_clip();
+    let clip = KeyframeClip::load(&path)
+        .unwrap()
+        .to_figure_clip()
+        .to_clip();
     let mut g = Vec::new();
     let pos = (0..clip.frame_count())
         .map(|f| {

@@ -15,7 +15,7 @@ use std::sync::Arc;
 
 use dance_clips::{generated_database, scratch, tempo};
 use marionette::choreo::augment::{augment, augment_with_variants};
-use marionette::choreo::database::{BuildParams, Database, Manifest, OnRefusal, load_model_clip};
+use marionette::choreo::database::{BuildParams, Database, Manifest, OnRefusal, load_figure_clip};
 use marionette::choreo::edit::Edit;
 use marionette::choreo::eros::eros;
 use marionette::choreo::fill::FillParams;
@@ -62,7 +62,7 @@ fn augmented_segments_are_true_to_the_clips() {
         if v.shift_frames > 0 && !v.mirrored && shifted < 12 {
             // A time offset is the take re-cut at the shifted phase: cut the clip itself there.
             shifted += 1;
-            let clip = load_model_clip(&dir.join(format!("gen_{}.bvh", s.clip))).unwrap();
+            let clip = load_figure_clip(&dir.join(format!("gen_{}.bvh", s.clip))).unwrap();
             let bar_s = 240.0 / tempo(s.clip);
             let beat = Beat {
                 tempo_bpm: tempo(s.clip),

@@ -89,7 +89,7 @@ fn dance_bars_at_120_bpm_give_its_four_bars() {
     // Frame 0 of bar 2 is the clip at 4 s: bar 3's quarter turn starts there (turn 0 at 4 s).
     let clip = marionette::clips::KeyframeClip::load(&dance_bars())
         .unwrap()
-        .to_model_clip();
+        .to_figure_clip();
     let f = (4.0 / clip.frame_time).round() as usize;
     assert!(db.segments[2].root_rotation[0].angle_between(clip.root_rotation[f]) < 1e-9);
     // The motion intensity of each bar, printed for the report.
@@ -228,7 +228,7 @@ fn shared_dance_clips_segments_and_tempo() {
     }
     // A consistency check (no music exists for these takes): the kinematic tempo of each half.
     for c in &m.clips {
-        let clip = marionette::choreo::database::load_model_clip(&c.file).unwrap();
+        let clip = marionette::choreo::database::load_figure_clip(&c.file).unwrap();
         let half = clip.frame_count() as f64 * clip.frame_time / 2.0;
         let name = c.file.file_name().unwrap().to_string_lossy().to_string();
         let t: Vec<String> = [(0.0, half), (half, 2.0 * half)]
@@ -254,7 +254,7 @@ fn shared_dance_clips_segments_and_tempo() {
 fn boundary_links_do_not_depend_on_where_the_dancer_faces() {
     let clip = marionette::clips::KeyframeClip::load(&dance_bars())
         .unwrap()
-        .to_model_clip();
+        .to_figure_clip();
     let yaw = DQuat::from_rotation_y(1.1);
     let mut turned = clip.clone();
     for (t, r) in turned
@@ -526,7 +526,7 @@ fn every_shared_clip_gets_a_tempo_in_range_alone_and_for_the_song() {
     for dir in [dance, more] {
         let m = Manifest::from_folder(&dir).unwrap();
         for c in &m.clips {
-            let clip = marionette::choreo::database::load_model_clip(&c.file).unwrap();
+            let clip = marionette::choreo::database::load_figure_clip(&c.file).unwrap();
             let name = c.file.file_name().unwrap().to_string_lossy().to_string();
             let alone = kinematic_beat(&clip, &name, None).unwrap();
             let matched = kinematic_beat(&clip, &name, Some(music)).unwrap();
@@ -575,7 +575,7 @@ fn a_clip_danced_slower_or_faster_keeps_its_beat() {
     let mut errors = vec![];
     for dir in [dance, more] {
         for c in &Manifest::from_folder(&dir).unwrap().clips {
-            let clip = marionette::choreo::database::load_model_clip(&c.file).unwrap();
+            let clip = marionette::choreo::database::load_figure_clip(&c.file).unwrap();
             let fps = 1.0 / clip.frame_time;
             let v = speed_curve(&clip.to_clip().point_frames(), fps);
             let own = kinematic_tempo(&v, fps, Some(song)).unwrap();

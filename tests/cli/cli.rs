@@ -21,7 +21,7 @@ fn jump_bvh(name: &str) -> PathBuf {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
     let clip = marionette::clips::KeyframeClip::load(&root.join("scenes/clips/normal_jump.ron"))
         .unwrap()
-        .to_model_clip();
+        .to_figure_clip();
     let p = temp(name);
     marionette::bvh::write_file(&clip.to_clip().to_bvh(), &p).unwrap();
     p

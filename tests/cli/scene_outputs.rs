@@ -159,7 +159,7 @@ fn a_unit_scale_that_makes_no_human_is_refused_in_a_scene() {
         &Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/clips/normal_jump.ron"),
     )
     .unwrap()
-    .to_model_clip();
+    .to_figure_clip();
     marionette::bvh::write_file(&clip.to_clip().to_bvh(), &d.join("jump.bvh")).unwrap();
     let s = Scene::parse(
         r#"Show(format_version: 1, name: "unit", clip: (file: "jump.bvh"))"#,

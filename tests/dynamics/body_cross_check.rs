@@ -53,7 +53,7 @@ fn pinocchio_agrees_with_the_engines_rnea_and_aba_on_the_urdf() {
     let g = 9.81;
     let body = fall21_body(1.70, 65.0, g).unwrap();
     let group = AgeGroup::Elderly;
-    let ranges = RangeTable::builtin(group).for_model(&body.figure).unwrap();
+    let ranges = RangeTable::builtin(group).for_figure(&body.figure).unwrap();
     let urdf = to_urdf(&body, &ranges, &torque_limits(group));
     let m = &body.model;
     // Per DOF: its velocity index and (not for the ball joint) its configuration index.
@@ -135,7 +135,7 @@ fn mujoco_follows_the_pushed_fall_until_first_contact() {
     let r = simulate_fall(&cfg).unwrap();
     let body = fall21_body(cfg.height_m, cfg.mass_kg, cfg.gravity).unwrap();
     let ranges = RangeTable::builtin(AgeGroup::Elderly)
-        .for_model(&body.figure)
+        .for_figure(&body.figure)
         .unwrap();
     let mjcf = to_mjcf(&body, &ranges, cfg.gravity);
     // Until the first link other than the feet touches the floor.

@@ -68,7 +68,7 @@ fn gameplay(
 
 fn jump_primitive() -> Primitive {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes/clips/normal_jump.ron");
-    let clip = KeyframeClip::load(&path).unwrap().to_model_clip();
+    let clip = KeyframeClip::load(&path).unwrap().to_figure_clip();
     Primitive::learn("jump", &clip.to_trajectory(), &LearnConfig::default())
         .unwrap()
         .primitive

@@ -65,7 +65,7 @@ fn pushed_from_the_front_the_elderly_figure_falls_backward_and_rests() {
         );
     }
     // The record as a fall21 clip: 60 Hz over 3 s, every DOF.
-    let clip = r.to_model_clip();
+    let clip = r.to_figure_clip();
     assert_eq!(clip.frame_count(), 181);
     assert_eq!(clip.dof_count(), 21);
     assert_eq!(clip.frame_angles(90), &r.frames[90].angles[..]);
@@ -218,7 +218,7 @@ fn random_genes_within_the_ranges_all_simulate() {
         .take(8)
         .enumerate()
     {
-        let ranges = RangeTable::builtin(group).for_model(&fig).unwrap();
+        let ranges = RangeTable::builtin(group).for_figure(&fig).unwrap();
         let mut cfg = FallConfig::paper(group);
         for (d, &(lo, hi)) in ranges.iter().enumerate() {
             cfg.kp[d] = rng.random_range(0.0..800.0);

@@ -24,7 +24,7 @@ fn primitive(file: &str) -> Primitive {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
         .join("scenes/clips")
         .join(file);
-    let clip = KeyframeClip::load(&path).unwrap().to_model_clip();
+    let clip = KeyframeClip::load(&path).unwrap().to_figure_clip();
     Primitive::learn(file, &clip.to_trajectory(), &LearnConfig::default())
         .unwrap()
         .primitive
@@ -230,7 +230,7 @@ fn jumps() -> (Vec<Primitive>, Vec<Primitive>) {
         let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
             .join("scenes/clips")
             .join(file);
-        KeyframeClip::load(&path).unwrap().to_model_clip()
+        KeyframeClip::load(&path).unwrap().to_figure_clip()
     };
     let config = KneeKickConfig {
         jump: HighJumpConfig {
@@ -517,7 +517,7 @@ fn joint_ranges_hold_a_falling_character() {
     let model = marionette::humanoid::humanoid24();
     let ranges = RangeTable::builtin_for("humanoid24", AgeGroup::Adult)
         .unwrap()
-        .for_model(&model)
+        .for_figure(&model)
         .unwrap();
     let m = &free.motion;
     let free_ex: Vec<(String, f64)> = model

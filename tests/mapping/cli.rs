@@ -21,7 +21,7 @@ fn renamed_jump() -> PathBuf {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
     let clip = marionette::clips::KeyframeClip::load(&root.join("scenes/clips/normal_jump.ron"))
         .unwrap()
-        .to_model_clip();
+        .to_figure_clip();
     let text = marionette::bvh::to_string(&clip.to_clip().to_bvh());
     let mut k = 0;
     let renamed: Vec<String> = text

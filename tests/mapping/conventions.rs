@@ -23,7 +23,7 @@ fn motion() -> FigureClip {
         "knee_kick.ron",
     )
     .unwrap()
-    .to_model_clip()
+    .to_figure_clip()
 }
 
 /// How an End Site is placed: none, at the part's far end, or on the joint (zero offset).

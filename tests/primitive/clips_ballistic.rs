@@ -22,7 +22,7 @@ fn clip(file: &str) -> KeyframeClip {
 fn making_the_keyframed_flights_ballistic_puts_the_centre_of_mass_on_its_arc() {
     for file in ["low_jump.ron", "normal_jump.ron"] {
         let k = clip(file);
-        let mut m = k.to_model_clip();
+        let mut m = k.to_figure_clip();
         let (keyed_pull, keyed_at) = max_downward_pull_bw(&m).unwrap();
         let moved = make_flights_ballistic(&mut m, &k.flights).unwrap();
         let com = centre_of_mass_track(&m).unwrap();

@@ -13,7 +13,7 @@ fn clip(name: &str) -> FigureClip {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
         .join("scenes/clips")
         .join(name);
-    KeyframeClip::load(&path).unwrap().to_model_clip()
+    KeyframeClip::load(&path).unwrap().to_figure_clip()
 }
 
 fn jump_config() -> HighJumpConfig {

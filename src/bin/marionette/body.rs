@@ -50,7 +50,7 @@ pub fn body(a: Args) -> Result<()> {
         other => bail!("--age-group '{other}': expected elderly or adult"),
     };
     let body = fall21_body(a.height_m, a.mass_kg, a.gravity)?;
-    let ranges = RangeTable::builtin(group).for_model(&body.figure)?;
+    let ranges = RangeTable::builtin(group).for_figure(&body.figure)?;
     if let Some(p) = &a.urdf {
         std::fs::write(p, to_urdf(&body, &ranges, &torque_limits(group)))
             .with_context(|| format!("writing {}", p.display()))?;

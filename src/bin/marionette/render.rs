@@ -73,7 +73,7 @@ pub fn render(args: Args) -> Result<()> {
     };
     let motion = load_motion(&src, base)?;
     let clip = match &model {
-        Some(name) => motion.on_model(&Figure::by_name(name)?)?.to_clip(),
+        Some(name) => motion.on_figure(&Figure::by_name(name)?)?.to_clip(),
         None => motion.clip(),
     };
     let figure = StickFigure::of(&clip.skeleton);

@@ -48,7 +48,7 @@ fn motion(
     };
     let loaded = load_motion(&src, Path::new("."))?;
     let clip = match model {
-        Some(name) => loaded.on_model(&Figure::by_name(name)?)?.to_clip(),
+        Some(name) => loaded.on_figure(&Figure::by_name(name)?)?.to_clip(),
         None => loaded.clip(),
     };
     let figure = marionette::render::StickFigure::of(&clip.skeleton);

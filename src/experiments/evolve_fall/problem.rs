@@ -196,7 +196,7 @@ impl FallProblem {
             Ranges::Table(t) => t.clone(),
             Ranges::File(p) => RangeTable::load(p).map_err(SimError::from)?,
         };
-        Ok(table.for_model(&fall21()).map_err(SimError::from)?)
+        Ok(table.for_figure(&fall21()).map_err(SimError::from)?)
     }
 
     /// The gene box: θ_d within the ranges, k_p within `[0, kp_max]`.

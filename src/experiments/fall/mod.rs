@@ -105,7 +105,7 @@ fn validate(cfg: &FallConfig) -> Result<Resolved, SimError> {
         Ranges::Table(t) => t.clone(),
         Ranges::File(p) => RangeTable::load(p)?,
     };
-    let ranges = table.for_model(&body.figure)?;
+    let ranges = table.for_figure(&body.figure)?;
     check_torque_limits(cfg, &body)?;
     Ok(Resolved {
         body,

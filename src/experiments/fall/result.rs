@@ -144,7 +144,7 @@ pub struct TorqueSaturation {
 impl FallResult {
     /// The recorded motion as a clip on the fall21 model (scaled to the subject's height), ready
     /// for BVH output and pictures.
-    pub fn to_model_clip(&self) -> crate::humanoid::FigureClip {
+    pub fn to_figure_clip(&self) -> crate::humanoid::FigureClip {
         crate::humanoid::FigureClip {
             model: crate::humanoid::fall21().scaled_to_height(self.height_m),
             frame_time: 1.0 / self.record_hz,

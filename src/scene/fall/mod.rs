@@ -75,7 +75,7 @@ pub(super) fn write_falls(
 ) -> Result<Vec<PageMotion>, SceneError> {
     let clips: Vec<_> = falls
         .iter()
-        .map(|(_, _, r)| r.to_model_clip().to_clip())
+        .map(|(_, _, r)| r.to_figure_clip().to_clip())
         .collect();
     for ((file, _, _), clip) in falls.iter().zip(&clips) {
         write_output(
