@@ -44,8 +44,7 @@ fn bench(c: &mut Criterion) {
         let times: Vec<f64> = (0..1000).map(|k| k as f64 * demo.dt).collect();
         c.bench_function(&format!("learn 24 DOF x 1000 frames, {label}"), |b| {
             b.iter(|| {
-                marionette::primitive::learn::learn_dofs(black_box(&demo), &p.basis, cfg)
-                    .expect("learn")
+                marionette::primitive::learn_dofs(black_box(&demo), &p.basis, cfg).expect("learn")
             })
         });
         c.bench_function(&format!("rollout 24 DOF x 1000 steps, {label}"), |b| {

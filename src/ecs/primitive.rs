@@ -23,11 +23,11 @@ use super::motion::{Character, JointState, Recorder, SkeletonRef};
 use super::sets::{MotionSet, configure_motion_sets};
 use crate::humanoid::Figure;
 
+use crate::primitive::HandOver;
+use crate::primitive::Primitive;
+use crate::primitive::Rollout;
 use crate::primitive::blend::{BlendPlacement, Gamma};
-use crate::primitive::connect::HandOver;
 use crate::primitive::error::{PrimitiveError, Result};
-use crate::primitive::primitive::Primitive;
-use crate::primitive::rollout::Rollout;
 
 /// Plays a connected sequence of primitives.
 #[derive(Component, Clone, Debug)]

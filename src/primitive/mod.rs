@@ -55,26 +55,26 @@
 //! sample, fit, RON io), [`mod@connect`], [`mod@blend`], [`events`]; the ECS players are in
 //! [`crate::ecs`].
 
-pub mod basis;
-pub mod blend;
-pub mod canonical;
-pub mod connect;
-pub mod definition;
-pub mod dmp;
-pub mod error;
-pub mod events;
-pub mod learn;
+pub(crate) mod basis;
+pub(crate) mod blend;
+pub(crate) mod canonical;
+pub(crate) mod connect;
+pub(crate) mod definition;
+pub(crate) mod dmp;
+pub(crate) mod error;
+pub(crate) mod events;
+pub(crate) mod learn;
 #[allow(clippy::module_inception)] // the brief names the file `primitive/primitive.rs`
-pub mod primitive;
-pub mod rollout;
+pub(crate) mod primitive;
+pub(crate) mod rollout;
 pub mod synthetic;
-pub mod trajectory;
+pub(crate) mod trajectory;
 
 pub use basis::Basis;
 pub use blend::{
     Arrangement, BlendPlacement, BlendResult, GAMMA_MAX, GAMMA_MIN, Gamma, Relearn, blend,
 };
-pub use connect::{Connected, Junction, connect};
+pub use connect::{Connected, HANDOVER_WINDOW_S, HandOver, Junction, connect};
 
 pub use canonical::{CanonicalSystem, Phase};
 
@@ -82,7 +82,7 @@ pub use dmp::{Formulation, SpatialScaling};
 pub use error::PrimitiveError;
 pub use events::{EventConfig, JumpEvents, find_jump_events};
 
-pub use learn::{KernelCount, LearnConfig, Regression};
+pub use learn::{KernelCount, LearnConfig, Regression, learn_dofs};
 pub use primitive::{
     DofFit, DofPrimitive, FitReport, Learned, PRIMITIVE_FORMAT_VERSION, Primitive, ROOT_DOF_NAMES,
 };

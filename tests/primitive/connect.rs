@@ -139,7 +139,7 @@ fn a_hand_over_far_from_the_start_keeps_the_primitives_own_scaling() {
 /// accelerations differ by a step Δa (which would show as about Δa/2 in one tick).
 #[test]
 fn a_sequence_has_no_step_in_acceleration_at_its_junctions() {
-    use marionette::primitive::connect::HANDOVER_WINDOW_S;
+    use marionette::primitive::HANDOVER_WINDOW_S;
     let seq = [clip_primitive(1, 0, 150), clip_primitive(2, 200, 380)];
     let dt = 2e-4;
     let c = connect(&seq, dt, None).unwrap();
