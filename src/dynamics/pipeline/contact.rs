@@ -51,5 +51,4 @@ pub(super) fn contact_stage(
             .contact
             .accumulate(&monitor.sample, state.time_s, dt);
     }
-    e.step_start_ready = true;
 }

@@ -1,7 +1,10 @@
 //! Stage 4, **integrate**: the integrator's step, and the force model it evaluates at each of
 //! its stages ([`Evaluation`]: joint torques, contact and external forces, then the ABA).
 
-use super::{EvalScratch, Forces, State, StepError, StepSettings, StepWorkspace, read_angles};
+use super::{
+    EvalScratch, Forces, JointsAtStart, State, StepError, StepSettings, StepStart, StepWorkspace,
+    read_angles,
+};
 use crate::dynamics::aba::aba_passes;
 use crate::dynamics::forces::contact::ContactState;
 use crate::dynamics::forces::external::apply_external;
@@ -11,7 +14,8 @@ use crate::dynamics::linearly_implicit;
 use crate::dynamics::model::Model;
 use crate::dynamics::spatial::ForceVec;
 
-/// Stage 4: the integrator step; time becomes `steps · dt`.
+/// Stage 4: the integrator step from the step-start state, whose first evaluation reuses what
+/// the stages before it computed (`start`); time becomes `steps · dt`.
 #[inline(always)]
 pub(super) fn integrate_stage(
     model: &Model,
@@ -19,16 +23,10 @@ pub(super) fn integrate_stage(
     forces: &Forces,
     state: &mut State,
     ws: &mut StepWorkspace,
+    start: StepStart,
 ) -> Result<(), StepError> {
     let StepWorkspace { eval, iws } = ws;
-    // The stages overwrite `data`: the cached kinematics no longer match any state.
-    eval.kinematics_at_step = None;
-    let mut f = Evaluation {
-        model,
-        forces,
-        anchors: &state.anchors,
-        ws: eval,
-    };
+    let mut f = Evaluation::new(model, forces, &state.anchors, eval, Some(start));
     let t = state.time_s;
     integrator::step(
         settings.integrator,
@@ -46,10 +44,35 @@ pub(super) fn integrate_stage(
 /// The force model evaluated at every integrator stage: joint torques (PD + joint model),
 /// contact and external forces, then the ABA.
 pub(super) struct Evaluation<'a> {
-    pub(super) model: &'a Model,
-    pub(super) forces: &'a Forces<'a>,
-    pub(super) anchors: &'a ContactState,
-    pub(super) ws: &'a mut EvalScratch,
+    model: &'a Model,
+    forces: &'a Forces<'a>,
+    anchors: &'a ContactState,
+    ws: &'a mut EvalScratch,
+    /// What the stages left at the step-start state, for the first evaluation only.
+    start: Option<StepStart>,
+}
+
+impl<'a> Evaluation<'a> {
+    /// The evaluation of `forces` with the friction anchors `anchors` in the buffers `ws`; its
+    /// first evaluation reuses what `start` says the stages left (`None`: nothing). It
+    /// overwrites the kinematics in `ws`, so their cache no longer matches any state.
+    #[inline(always)]
+    pub(super) fn new(
+        model: &'a Model,
+        forces: &'a Forces<'a>,
+        anchors: &'a ContactState,
+        ws: &'a mut EvalScratch,
+        start: Option<StepStart>,
+    ) -> Self {
+        ws.kinematics_at_step = None;
+        Self {
+            model,
+            forces,
+            anchors,
+            ws,
+            start,
+        }
+    }
 }
 
 impl Dynamics for Evaluation<'_> {
@@ -93,16 +116,7 @@ impl Evaluation<'_> {
         implicit: Implicit,
         qdd: &mut [f64],
     ) -> Result<(), StepError> {
-        let arm = prepare(
-            self.model,
-            self.forces,
-            self.anchors,
-            self.ws,
-            t,
-            q,
-            v,
-            implicit,
-        );
+        let arm = self.prepare(t, q, v, implicit);
         let ws = &mut *self.ws;
         let arm = arm.then_some(&ws.armature[..]);
         aba_passes(
@@ -114,6 +128,60 @@ impl Evaluation<'_> {
             &ws.implicit,
         );
         finish(self.model, ws, t, qdd)
+    }
+
+    /// The force evaluation before the ABA: kinematics and contact forces (unless the
+    /// step-start stages left them), external forces, angles, PD and joint-model torques
+    /// `τ = k_p(θ_d − θ) + k_v(θ̇_d − θ̇)` plus the joint model's, and, with `implicit`, the
+    /// armature (`h·d`, or `h d + h² k` with the torques corrected by `−h k v`); returns
+    /// whether the armature applies. The first call takes what the stages left; later ones
+    /// compute everything.
+    #[inline(always)]
+    pub(super) fn prepare(&mut self, t: f64, q: &[f64], v: &[f64], implicit: Implicit) -> bool {
+        let (model, forces) = (self.model, self.forces);
+        let ws = &mut *self.ws;
+        let start = self.start.take();
+        let joints = start.map_or(JointsAtStart::Nothing, |s| s.joints);
+        if start.is_none() {
+            // The implicit contact damping belongs to the step-start evaluation only.
+            ws.implicit.clear();
+            kinematics(model, &mut ws.data, q, v);
+            ws.f_ext.fill(ForceVec::ZERO);
+            if let Some(cm) = forces.contact {
+                cm.apply(&ws.data, self.anchors, &mut ws.f_ext, &mut ws.normal);
+            }
+        }
+        apply_external(&ws.data, forces.external, t, &mut ws.f_ext);
+        if (forces.pd.is_some() || forces.limits.is_some()) && !joints.angles() {
+            read_angles(model, forces, q, &mut ws.reference, &mut ws.angles);
+        }
+        let linearised = matches!(implicit, Implicit::Linearised { .. });
+        for (d, &k) in forces.dofs.iter().enumerate() {
+            let (th, thd) = (ws.angles[k], v[k]);
+            let (mut tau, mut damp) = (0.0, 0.0);
+            if joints.pd() {
+                (tau, damp) = ws.pd_start[d];
+            } else if let Some(pd) = forces.pd {
+                (tau, damp) = pd.torque(d, th, thd);
+            }
+            if linearised {
+                let mut stiff = forces
+                    .pd
+                    .map_or(0.0, |pd| linearly_implicit::pd_stiffness(pd, d, tau));
+                if let Some(l) = forces.limits {
+                    stiff += linearly_implicit::limit_stiffness(l, d, th);
+                }
+                ws.stiffness[k] = stiff;
+            }
+            if let Some(l) = forces.limits {
+                let (t2, d2) = l.torque(d, th, thd);
+                tau += t2;
+                damp += d2;
+            }
+            ws.tau[k] = tau;
+            ws.damping[k] = damp;
+        }
+        implicit_armature(ws, v, implicit)
     }
 }
 
@@ -132,77 +200,6 @@ pub(super) enum Implicit {
         /// The weight (1: the step end, ½: its midpoint).
         theta: f64,
     },
-}
-
-/// The force evaluation before the ABA: kinematics and contact forces (unless the step-start
-/// stages left them), external forces, angles, PD and joint-model torques and, with
-/// `implicit`, the armature (`h·d`, or `h d + h² k` with the torques corrected by `−h k v`);
-/// returns whether the armature applies.
-#[inline(always)]
-#[allow(clippy::too_many_arguments)]
-pub(super) fn prepare(
-    model: &Model,
-    forces: &Forces,
-    anchors: &ContactState,
-    ws: &mut EvalScratch,
-    t: f64,
-    q: &[f64],
-    v: &[f64],
-    implicit: Implicit,
-) -> bool {
-    let at_start = ws.step_start_ready;
-    // The implicit contact damping belongs to the step-start evaluation only.
-    if !at_start {
-        ws.implicit.clear();
-    }
-    let (start_angles, start_pd) = (
-        at_start && ws.step_start_angles,
-        at_start && ws.step_start_pd,
-    );
-    ws.step_start_angles = false;
-    ws.step_start_pd = false;
-    if at_start {
-        // First evaluation of the step: the contact stage computed kinematics and contact
-        // forces at exactly this state (and the limits stage its angles and PD torques).
-        ws.step_start_ready = false;
-    } else {
-        kinematics(model, &mut ws.data, q, v);
-        ws.f_ext.fill(ForceVec::ZERO);
-        if let Some(cm) = forces.contact {
-            cm.apply(&ws.data, anchors, &mut ws.f_ext, &mut ws.normal);
-        }
-    }
-    apply_external(&ws.data, forces.external, t, &mut ws.f_ext);
-    if (forces.pd.is_some() || forces.limits.is_some()) && !start_angles {
-        read_angles(model, forces, q, &mut ws.reference, &mut ws.angles);
-    }
-    let linearised = matches!(implicit, Implicit::Linearised { .. });
-    for (d, &k) in forces.dofs.iter().enumerate() {
-        let (th, thd) = (ws.angles[k], v[k]);
-        let (mut tau, mut damp) = (0.0, 0.0);
-        if start_pd {
-            (tau, damp) = ws.pd_start[d];
-        } else if let Some(pd) = forces.pd {
-            (tau, damp) = pd.torque(d, th, thd);
-        }
-        if linearised {
-            let mut stiff = forces
-                .pd
-                .map_or(0.0, |pd| linearly_implicit::pd_stiffness(pd, d, tau));
-            if let Some(l) = forces.limits {
-                stiff += linearly_implicit::limit_stiffness(l, d, th);
-            }
-            ws.stiffness[k] = stiff;
-        }
-        if let Some(l) = forces.limits {
-            let (t2, d2) = l.torque(d, th, thd);
-            tau += t2;
-            damp += d2;
-        }
-        ws.tau[k] = tau;
-        ws.damping[k] = damp;
-    }
-    implicit_armature(ws, v, implicit)
 }
 
 /// The armature of the joint forces taken implicitly over the step `h`: `h·d` (damping), or

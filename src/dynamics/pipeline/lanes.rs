@@ -1,10 +1,10 @@
 //! The stages for several bodies at once: the articulated-body algorithm of [`LANES`](crate::dynamics::lanes::LANES) bodies in
 //! the lanes of one vector computation.
 
-use super::integrate::{Implicit, finish, prepare};
+use super::integrate::{Evaluation, Implicit, finish};
 use super::{
-    Forces, State, StepError, StepMonitor, StepSettings, StepWorkspace, check_stage, contact_stage,
-    limits_stage, position_stage, step_stages,
+    Forces, State, StepError, StepMonitor, StepSettings, StepWorkspace, check_stage, start_stages,
+    step_stages,
 };
 use crate::dynamics::aba_lanes::{LaneData, LaneInput, lanes_inline};
 use crate::dynamics::integrator::{self, Integrator};
@@ -61,7 +61,9 @@ unsafe fn step_lanes_avx2(
     step_lanes_stages(model, settings, bodies, lanes)
 }
 
-/// The stages of [`step_lanes`].
+/// The stages of [`step_lanes`]: per body the stages before the integrator and the forces of
+/// its one evaluation, the ABA of all bodies in lanes, then per body the semi-implicit Euler
+/// advance and the check.
 #[inline(always)]
 fn step_lanes_stages(
     model: &Model,
@@ -94,22 +96,11 @@ fn step_lanes_stages(
     };
     for b in bodies.iter_mut() {
         let (forces, state, ws, monitor) = (&b.forces, &mut *b.state, &mut *b.ws, &mut *b.monitor);
-        position_stage(model, state, ws);
-        limits_stage(model, forces, state, ws, monitor, h);
-        contact_stage(forces, settings, state, ws, monitor);
+        let start = start_stages(model, settings, forces, state, ws, monitor);
         // The integrate stage: its one evaluation's forces here, its ABA in the lanes below.
-        ws.eval.kinematics_at_step = None;
         let (t, q, v) = (state.time_s, &state.q, &state.v);
-        prepare(
-            model,
-            forces,
-            &state.anchors,
-            &mut ws.eval,
-            t,
-            q,
-            v,
-            implicit,
-        );
+        Evaluation::new(model, forces, &state.anchors, &mut ws.eval, Some(start))
+            .prepare(t, q, v, implicit);
     }
     lanes_inline(
         model,

@@ -1,11 +1,14 @@
 //! Stage 2, **limits**: each DOF's excursion past its range and whether its PD torque is at its
 //! strength limit at the step start, for the [`StepMonitor`].
 
-use super::{Forces, State, StepMonitor, StepWorkspace, read_angles};
+use super::{Forces, JointsAtStart, State, StepMonitor, StepWorkspace, read_angles};
 use crate::dynamics::model::Model;
 
-/// Stage 2: the largest excursion past each DOF's range at the step start, and which PD
-/// torques are at their strength limit.
+/// Stage 2: the largest excursion past each DOF's range at the step start (rad), and which PD
+/// torques are at their strength limit; returns what it left in the [`EvalScratch`] for the
+/// integrator's first evaluation.
+///
+/// [`EvalScratch`]: super::EvalScratch
 #[inline(always)]
 pub(super) fn limits_stage(
     model: &Model,
@@ -14,22 +17,21 @@ pub(super) fn limits_stage(
     ws: &mut StepWorkspace,
     monitor: &mut StepMonitor,
     dt: f64,
-) {
+) -> JointsAtStart {
     let limited = forces.pd.filter(|pd| !pd.torque_limits.is_empty());
     let e = &mut ws.eval;
-    e.step_start_angles = false;
-    e.step_start_pd = false;
     if forces.limits.is_none() && limited.is_none() {
-        return;
+        return JointsAtStart::Nothing;
     }
     read_angles(model, forces, &state.q, &mut e.reference, &mut e.angles);
     // The integrator's first evaluation is at this same state: it reuses the angles and the
     // PD torques computed here (the same bits, computed once).
-    e.step_start_angles = true;
-    if limited.is_some() {
+    let joints = if limited.is_some() {
         e.pd_start.resize(forces.dofs.len(), (0.0, 0.0));
-        e.step_start_pd = true;
-    }
+        JointsAtStart::AnglesAndPd
+    } else {
+        JointsAtStart::Angles
+    };
     for (d, &k) in forces.dofs.iter().enumerate() {
         if let Some(l) = forces.limits {
             let ex = l.excursion(d, e.angles[k]);
@@ -47,4 +49,5 @@ pub(super) fn limits_stage(
             }
         }
     }
+    joints
 }

@@ -1,18 +1,25 @@
 //! One simulation step as a pipeline of named stages, after MuJoCo's `mj_step`: every stage
 //! takes the immutable [`Model`], the forces the body feels ([`Forces`], plain parameters) and
-//! the mutable [`State`] and [`StepWorkspace`].
+//! the mutable [`State`] and [`StepWorkspace`]. Each stage has its file:
 //!
-//! 1. **position**: forward kinematics at the step start (reused when the previous step's check
-//!    left it in the workspace);
-//! 2. **limits**: each DOF's excursion past its range and whether its PD torque is at its
-//!    strength limit, for the [`StepMonitor`];
-//! 3. **contact**: friction anchors brought to the step start, contact forces there, per-link
-//!    statistics ([`ContactStats`]);
-//! 4. **integrate**: the scheme's evaluations of `q̈ = ABA(q, v, τ, f_ext)`, each summing PD
-//!    torques `τ = k_p(θ_d − θ) + k_v(θ̇_d − θ̇)` (θ read by [`read_angles`]: a ball joint's
-//!    rotation vector nearest its targets), the joint model, contact and external forces;
-//! 5. **check**: kinematics of the new state; a non-finite or runaway body stops the run with
-//!    its time, body and value.
+//! 1. **position** (`position.rs`): forward kinematics at the step start (reused when the
+//!    previous step's check left it in the workspace);
+//! 2. **limits** (`limits.rs`): each DOF's excursion past its range and whether its PD torque
+//!    is at its strength limit, for the [`StepMonitor`];
+//! 3. **contact** (`contact.rs`): friction anchors brought to the step start, contact forces
+//!    there, per-link statistics ([`ContactStats`]);
+//! 4. **integrate** (`integrate.rs`): the scheme's evaluations of `q̈ = ABA(q, v, τ, f_ext)`,
+//!    each summing PD torques `τ = k_p(θ_d − θ) + k_v(θ̇_d − θ̇)` (θ read by [`read_angles`]: a
+//!    ball joint's rotation vector nearest its targets), the joint model, contact and external
+//!    forces;
+//! 5. **check** (`check.rs`): kinematics of the new state; a non-finite or runaway body stops
+//!    the run with its time, body and value.
+//!
+//! Stages 1–3 are one sequence for [`step`] and [`step_lanes`] (`lanes.rs`); it returns what
+//! it computed at the step-start state (kinematics, contact forces, and the angles and PD
+//! torques when the limits stage read them) as a value the integrator's first evaluation,
+//! at that same state, takes and reuses. [`step_lanes`] differs from [`step`] only in running
+//! the ABA of several bodies in the lanes of one vector computation.
 //!
 //! A force whose parameters are absent (`None`, or no external forces) is simply not felt.
 
@@ -171,12 +178,8 @@ pub struct EvalScratch {
     /// Per-link normal forces (scratch).
     pub normal: Vec<f64>,
     /// PD torque and velocity coefficient per actuated DOF at the step start (N·m, N·m·s/rad),
-    /// when the limits stage computed them (`step_start_pd`).
+    /// when the limits stage computed them ([`JointsAtStart::AnglesAndPd`]).
     pub pd_start: Vec<(f64, f64)>,
-    /// `angles` hold the step-start angles (the limits stage computed them).
-    pub step_start_angles: bool,
-    /// `pd_start` holds the step-start PD torques.
-    pub step_start_pd: bool,
     /// The step-start contact's implicit inertias per touching link (body coordinates), when
     /// its damping is taken implicitly ([`ContactParams::implicit_damping`]).
     ///
@@ -184,9 +187,6 @@ pub struct EvalScratch {
     pub implicit: Vec<(usize, ArticulatedInertia)>,
     /// `data` holds the kinematics of the state after this many steps.
     pub kinematics_at_step: Option<u64>,
-    /// `data` and `f_ext` hold the step-start kinematics and contact forces, so the
-    /// integrator's first evaluation (always at the step-start state) reuses them.
-    pub step_start_ready: bool,
 }
 
 impl StepWorkspace {
@@ -205,11 +205,8 @@ impl StepWorkspace {
                 reference: vec![0.0; nv],
                 normal: vec![0.0; nb],
                 pd_start: Vec::new(),
-                step_start_angles: false,
-                step_start_pd: false,
                 implicit: Vec::with_capacity(nb),
                 kinematics_at_step: None,
-                step_start_ready: false,
             },
             iws: IntegratorWorkspace::new(model),
         }
@@ -371,6 +368,60 @@ pub fn step_refined(
     Ok(())
 }
 
+/// What the limits stage read of the joints at the step-start state and left in the
+/// [`EvalScratch`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum JointsAtStart {
+    /// Nothing: neither a joint model nor a PD strength limit to watch.
+    Nothing,
+    /// The angles ([`EvalScratch::angles`]).
+    Angles,
+    /// The angles and the PD torques ([`EvalScratch::angles`], [`EvalScratch::pd_start`]).
+    AnglesAndPd,
+}
+
+impl JointsAtStart {
+    /// The angles are there.
+    #[inline(always)]
+    pub(super) fn angles(self) -> bool {
+        self != Self::Nothing
+    }
+
+    /// The PD torques are there.
+    #[inline(always)]
+    pub(super) fn pd(self) -> bool {
+        self == Self::AnglesAndPd
+    }
+}
+
+/// What the stages before the integrator computed at the step-start state and left in the
+/// [`EvalScratch`]: the kinematics (position stage), the contact forces and implicit inertias
+/// (contact stage), and what `joints` says (limits stage). The integrator's first evaluation,
+/// at that same state, takes it and reuses them (the same bits, computed once); every later
+/// evaluation computes its own.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) struct StepStart {
+    /// The joint quantities the limits stage computed.
+    pub(super) joints: JointsAtStart,
+}
+
+/// The stages before the integrator (position, limits, contact), shared by [`step`] and
+/// [`step_lanes`]; returns what they left for the integrator's first evaluation.
+#[inline(always)]
+pub(super) fn start_stages(
+    model: &Model,
+    settings: StepSettings,
+    forces: &Forces,
+    state: &mut State,
+    ws: &mut StepWorkspace,
+    monitor: &mut StepMonitor,
+) -> StepStart {
+    position_stage(model, state, ws);
+    let joints = limits_stage(model, forces, state, ws, monitor, settings.dt);
+    contact_stage(forces, settings, state, ws, monitor);
+    StepStart { joints }
+}
+
 /// The five stages of [`step`].
 #[inline(always)]
 pub(super) fn step_stages(
@@ -381,10 +432,8 @@ pub(super) fn step_stages(
     ws: &mut StepWorkspace,
     monitor: &mut StepMonitor,
 ) -> Result<(), StepError> {
-    position_stage(model, state, ws);
-    limits_stage(model, forces, state, ws, monitor, settings.dt);
-    contact_stage(forces, settings, state, ws, monitor);
-    integrate_stage(model, settings, forces, state, ws)?;
+    let start = start_stages(model, settings, forces, state, ws, monitor);
+    integrate_stage(model, settings, forces, state, ws, start)?;
     check_stage(model, state, ws)
 }
 
@@ -399,17 +448,8 @@ pub fn acceleration(
     ws: &mut StepWorkspace,
     qdd: &mut [f64],
 ) -> Result<(), StepError> {
-    let eval = &mut ws.eval;
-    eval.kinematics_at_step = None;
-    eval.step_start_ready = false;
-    eval.step_start_angles = false;
-    eval.step_start_pd = false;
-    let mut f = Evaluation {
-        model,
-        forces,
-        anchors: &state.anchors,
-        ws: eval,
-    };
+    // Nothing computed at a step start: the evaluation computes every force itself.
+    let mut f = Evaluation::new(model, forces, &state.anchors, &mut ws.eval, None);
     f.acceleration(state.time_s, &state.q, &state.v, None, qdd)
 }
 
