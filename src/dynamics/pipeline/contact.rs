@@ -7,9 +7,12 @@ use crate::dynamics::integrator::Integrator;
 use crate::dynamics::spatial::ForceVec;
 
 /// Stage 3: anchors and contact forces at the step start, per-link statistics; with
-/// [`ContactParams::implicit_damping`](crate::dynamics::forces::contact::ContactParams::implicit_damping)
-/// and semi-implicit Euler, or with linearly implicit Euler, the implicit inertias of the
-/// touching links for the step.
+/// [`ContactParams::implicit_damping`] and semi-implicit Euler, or with a linearly implicit
+/// scheme, the implicit inertias of the touching links for the step. The forces stay in the
+/// [`EvalScratch`] for the integrator's first evaluation.
+///
+/// [`EvalScratch`]: super::EvalScratch
+/// [`ContactParams::implicit_damping`]: crate::dynamics::forces::contact::ContactParams::implicit_damping
 #[inline(always)]
 pub(super) fn contact_stage(
     forces: &Forces,

@@ -131,8 +131,8 @@ impl Evaluation<'_> {
     }
 
     /// The force evaluation before the ABA: kinematics and contact forces (unless the
-    /// step-start stages left them), external forces, angles, PD and joint-model torques
-    /// `τ = k_p(θ_d − θ) + k_v(θ̇_d − θ̇)` plus the joint model's, and, with `implicit`, the
+    /// step-start stages left them), external forces, angles, PD torques
+    /// `τ = k_p(θ_d − θ) + k_v(θ̇_d − θ̇)` and the joint model's, and, with `implicit`, the
     /// armature (`h·d`, or `h d + h² k` with the torques corrected by `−h k v`); returns
     /// whether the armature applies. The first call takes what the stages left; later ones
     /// compute everything.

@@ -1,5 +1,7 @@
-//! The stages for several bodies at once: the articulated-body algorithm of [`LANES`](crate::dynamics::lanes::LANES) bodies in
-//! the lanes of one vector computation.
+//! The stages for several bodies at once: the same sequence as [`step`](super::step), with the
+//! articulated-body algorithm of [`LANES`] bodies in the lanes of one vector computation.
+//!
+//! [`LANES`]: crate::dynamics::lanes::LANES
 
 use super::integrate::{Evaluation, Implicit, finish};
 use super::{
@@ -27,11 +29,14 @@ pub struct LaneBody<'a> {
 }
 
 /// One step of `settings.dt` seconds for each body of `bodies` (all of `model`): the same
-/// stages as [`step`](super::step), every body's state, monitor and result the bits [`step`](super::step) gives it
-/// alone, with the articulated-body algorithm of [`LANES`](crate::dynamics::lanes::LANES) bodies at a time in the lanes of
+/// stages as [`step`], every body's state, monitor and result the bits [`step`] gives it
+/// alone, with the articulated-body algorithm of [`LANES`] bodies at a time in the lanes of
 /// one vector computation ([`crate::dynamics::aba_lanes`]). That holds for semi-implicit
-/// Euler with the floor's damping explicit; any other scheme steps each body by [`step`](super::step).
+/// Euler with the floor's damping explicit; any other scheme steps each body by [`step`].
 /// A body whose step fails keeps its error in `result` and the others go on.
+///
+/// [`step`]: super::step
+/// [`LANES`]: crate::dynamics::lanes::LANES
 pub fn step_lanes(
     model: &Model,
     settings: StepSettings,

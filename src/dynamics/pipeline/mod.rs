@@ -178,7 +178,7 @@ pub struct EvalScratch {
     /// Per-link normal forces (scratch).
     pub normal: Vec<f64>,
     /// PD torque and velocity coefficient per actuated DOF at the step start (N·m, N·m·s/rad),
-    /// when the limits stage computed them ([`JointsAtStart::AnglesAndPd`]).
+    /// when the limits stage computed them (with PD strength limits to watch).
     pub pd_start: Vec<(f64, f64)>,
     /// The step-start contact's implicit inertias per touching link (body coordinates), when
     /// its damping is taken implicitly ([`ContactParams::implicit_damping`]).
