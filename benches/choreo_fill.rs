@@ -19,15 +19,15 @@
 use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use marionette::choreo::augment::augment;
-use marionette::choreo::dance::{DanceParams, assemble};
-use marionette::choreo::database::{BuildParams, Database, Manifest, OnRefusal};
-use marionette::choreo::feet::{PlantParams, plant_feet};
-use marionette::choreo::fill::{FillParams, Pins, fill, fill_dijkstra_with_table, fill_with_table};
-use marionette::choreo::generated::generated_database;
+use marionette::choreo::TransitionTable;
+use marionette::choreo::augment;
+use marionette::choreo::generated_database;
 use marionette::choreo::music::Bar;
-use marionette::choreo::relevance::percentile_ranks;
-use marionette::choreo::transition::TransitionTable;
+use marionette::choreo::percentile_ranks;
+use marionette::choreo::{BuildParams, Database, Manifest, OnRefusal};
+use marionette::choreo::{DanceParams, assemble};
+use marionette::choreo::{FillParams, Pins, fill, fill_dijkstra_with_table, fill_with_table};
+use marionette::choreo::{PlantParams, plant_feet};
 
 /// The tempo of the bench's song, BPM.
 const SONG_BPM: f64 = 136.0;

@@ -11,9 +11,9 @@ mod dance_clips;
 use std::hint::black_box;
 
 use criterion::{BatchSize, Criterion, Throughput, criterion_group, criterion_main};
-use marionette::choreo::augment::augment;
-use marionette::choreo::database::{BuildParams, Database, Manifest, OnRefusal};
-use marionette::choreo::search::{BarSearch, SearchIndex, SearchParams};
+use marionette::choreo::augment;
+use marionette::choreo::{BarSearch, SearchIndex, SearchParams};
+use marionette::choreo::{BuildParams, Database, Manifest, OnRefusal};
 
 fn bench(c: &mut Criterion) {
     let dir = marionette::io::data_dir().join("dance");

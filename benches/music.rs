@@ -6,9 +6,9 @@
 use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use marionette::choreo::music::decode::decode_file;
-use marionette::choreo::music::synth::{SynthSong, synthesize};
+use marionette::choreo::music::decode_file;
 use marionette::choreo::music::{MusicParams, analyze};
+use marionette::choreo::music::{SynthSong, synthesize};
 
 fn bench(c: &mut Criterion) {
     let song = synthesize(&SynthSong {

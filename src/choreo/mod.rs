@@ -26,21 +26,49 @@
 //! - [`authored`]: the project's own dance, generated in code at a known tempo;
 //! - [`generated`]: a database of dance clips generated in code (no shared data needed).
 
-pub mod augment;
-pub mod authored;
-pub mod dance;
-pub mod database;
-pub mod edit;
-pub mod eros;
+pub(crate) mod augment;
+pub(crate) mod authored;
+pub(crate) mod dance;
+pub(crate) mod database;
+pub(crate) mod edit;
+pub(crate) mod eros;
 mod error;
-pub mod features;
-pub mod feet;
-pub mod fill;
-pub mod generated;
-pub mod metrics;
+pub(crate) mod features;
+pub(crate) mod feet;
+pub(crate) mod fill;
+pub(crate) mod generated;
+pub(crate) mod metrics;
 pub mod music;
-pub mod relevance;
-pub mod search;
-pub mod segments;
-pub mod transition;
-pub mod warp;
+pub(crate) mod relevance;
+pub(crate) mod search;
+pub(crate) mod segments;
+pub(crate) mod transition;
+pub(crate) mod warp;
+
+pub use augment::{augment, augment_with_variants};
+pub use authored::{AuthoredDance, generate, write_bvh_folder};
+pub use dance::{Dance, DanceParams, assemble};
+pub use database::{
+    BuildParams, ClipOutcome, Database, Manifest, ManifestClip, OnRefusal, Source, load_figure_clip,
+};
+pub use edit::Edit;
+pub use eros::{eros, eros_distance, eros_weights, pca};
+pub use features::{mean_motion_intensity, mirror_motion, mirror_partners, pose_rows};
+pub use feet::{PlantParams, plant_feet};
+pub use fill::{
+    BUDGET_HALVINGS, DEFAULT_SEAM_BUDGET, FillParams, Pins, fill, fill_dijkstra,
+    fill_dijkstra_with_table, fill_with_table,
+};
+pub use generated::generated_database;
+pub use metrics::{
+    BAS_SIGMA_S, beat_alignment_score, dance_metrics, foot_skating, motion_beats, seam_jerk,
+    source_beat_alignment, spearman,
+};
+pub use relevance::{motion_intensity, percentile_ranks};
+pub use search::{BarSearch, SearchIndex, SearchParams, search_round};
+pub use segments::{
+    BAR_FRAMES_RANGE, Beat, LEVEL_BPM, MAX_BPM, MIN_BPM, SegmentError, TempoSource, check_tempo,
+    cut_segments, kinematic_beat, kinematic_tempo, speed_curve,
+};
+pub use transition::TransitionTable;
+pub use warp::Warp;

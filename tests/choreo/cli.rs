@@ -4,8 +4,8 @@
 use std::path::Path;
 use std::process::Command;
 
-use marionette::choreo::music::synth::{SynthSong, synthesize};
-use marionette::choreo::music::wav::wav_bytes;
+use marionette::choreo::music::wav_bytes;
+use marionette::choreo::music::{SynthSong, synthesize};
 
 #[test]
 fn music_prints_tempo_beats_bars_as_text_and_json_and_draws_them() {
@@ -147,7 +147,7 @@ fn dance_db_builds_from_a_manifest_and_refuses_an_empty_folder() {
 /// song's octave level and says so.
 #[test]
 fn dance_db_skips_what_it_cannot_use_and_says_why() {
-    use marionette::choreo::authored::{AuthoredDance, generate, write_bvh_folder};
+    use marionette::choreo::{AuthoredDance, generate, write_bvh_folder};
     use marionette::humanoid::FigureClip;
 
     let dir = std::env::temp_dir().join(format!("marionette-dance-skip-{}", std::process::id()));
@@ -281,7 +281,7 @@ fn dance_db_skips_what_it_cannot_use_and_says_why() {
     ]);
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{err}");
-    let d = marionette::choreo::database::Database::load(&slow).unwrap();
+    let d = marionette::choreo::Database::load(&slow).unwrap();
     assert_eq!(d.params.music_bpm, Some(58.0));
     for s in &d.sources {
         assert!((s.beat.tempo_bpm / 56.0 - 1.0).abs() < 0.02, "{:?}", s.beat);
@@ -474,12 +474,10 @@ fn sizes_and_tempi_out_of_bounds_are_refused_before_any_work() {
         );
         assert!(!db.exists());
     }
-    let t = marionette::choreo::music::synth::synthesize(
-        &marionette::choreo::music::synth::SynthSong {
-            bars: 4,
-            ..Default::default()
-        },
-    )
+    let t = marionette::choreo::music::synthesize(&marionette::choreo::music::SynthSong {
+        bars: 4,
+        ..Default::default()
+    })
     .unwrap();
     let song = dir.join("song.wav");
     std::fs::write(&song, wav_bytes(&t.samples, 1, t.sample_rate).unwrap()).unwrap();

@@ -162,26 +162,24 @@ fn every_bad_input_is_one_clear_error_and_leaves_the_outputs() {
 
     // A silent song, a song of less than a bar, a clip of less than a bar, an empty folder.
     let silent = d.join("silent.wav");
-    let wav = marionette::choreo::music::wav::wav_bytes(&vec![0.0; 22_050 * 4], 1, 22_050);
+    let wav = marionette::choreo::music::wav_bytes(&vec![0.0; 22_050 * 4], 1, 22_050);
     std::fs::write(&silent, wav.unwrap()).unwrap();
-    let bar = marionette::choreo::music::synth::synthesize(
-        &marionette::choreo::music::synth::SynthSong {
-            bars: 1,
-            lead_in_s: 0.0,
-            tail_s: 0.0,
-            ..Default::default()
-        },
-    )
+    let bar = marionette::choreo::music::synthesize(&marionette::choreo::music::SynthSong {
+        bars: 1,
+        lead_in_s: 0.0,
+        tail_s: 0.0,
+        ..Default::default()
+    })
     .unwrap();
     let part = d.join("part.wav");
     let three_quarters = &bar.samples[..bar.samples.len() * 3 / 4];
-    let wav = marionette::choreo::music::wav::wav_bytes(three_quarters, 1, bar.sample_rate);
+    let wav = marionette::choreo::music::wav_bytes(three_quarters, 1, bar.sample_rate);
     std::fs::write(&part, wav.unwrap()).unwrap();
     let empty = d.join("empty");
     std::fs::create_dir(&empty).unwrap();
     let short = d.join("short");
     std::fs::create_dir(&short).unwrap();
-    let clip = marionette::choreo::authored::generate(&Default::default()).unwrap();
+    let clip = marionette::choreo::generate(&Default::default()).unwrap();
     let one_s = clip[0].motion.window(0.0, 1.0).unwrap();
     std::fs::write(
         short.join("short.bvh"),
@@ -335,13 +333,13 @@ fn swinging(bars: usize, off: [f64; 4]) -> marionette::humanoid::FigureClip {
 
 #[test]
 fn beats_off_the_counts_are_warped_onto_the_music_and_the_seams_stay_smooth() {
-    use marionette::choreo::dance::{DanceParams, assemble};
-    use marionette::choreo::database::Database;
-    use marionette::choreo::metrics::{
+    use marionette::choreo::Database;
+    use marionette::choreo::music::Bar;
+    use marionette::choreo::{
         BAS_SIGMA_S, beat_alignment_score, motion_beats, seam_jerk, source_beat_alignment,
     };
-    use marionette::choreo::music::Bar;
-    use marionette::choreo::segments::{Beat, BuildParams, TempoSource};
+    use marionette::choreo::{Beat, BuildParams, TempoSource};
+    use marionette::choreo::{DanceParams, assemble};
 
     // Counts 2, 3, 4 of every bar 0.07 s late, 0.06 s early, 0.06 s late.
     let off = [0.0, 0.14, -0.12, 0.12];
@@ -396,7 +394,7 @@ fn beats_off_the_counts_are_warped_onto_the_music_and_the_seams_stay_smooth() {
     assert_eq!(uniform.warped_beats, vec![0; 6]);
     assert_eq!(warped.clip.frame_count(), uniform.clip.frame_count());
     let music: Vec<f64> = beats.iter().map(|t| t - 0.4).collect();
-    let bas = |d: &marionette::choreo::dance::Dance| {
+    let bas = |d: &marionette::choreo::Dance| {
         let m = motion_beats(&d.clip);
         (beat_alignment_score(&m, &music, BAS_SIGMA_S), m.len())
     };

@@ -6,10 +6,8 @@
 use std::path::Path;
 
 use glam::DVec3;
-use marionette::choreo::eros::{eros, eros_weights, pca};
-use marionette::choreo::features::{
-    mean_motion_intensity, mirror_motion, mirror_partners, pose_rows,
-};
+use marionette::choreo::{eros, eros_weights, pca};
+use marionette::choreo::{mean_motion_intensity, mirror_motion, mirror_partners, pose_rows};
 use marionette::clips::KeyframeClip;
 
 /// The dance's joint positions per frame, its joint names and its frame rate.

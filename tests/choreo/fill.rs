@@ -6,12 +6,12 @@
 
 use crate::common;
 
-use marionette::choreo::dance::{DanceParams, assemble};
-use marionette::choreo::database::{BuildParams, Database, Manifest, OnRefusal};
-use marionette::choreo::fill::{FillParams, Pins, fill, fill_dijkstra};
-use marionette::choreo::generated::generated_database;
-use marionette::choreo::metrics::dance_metrics;
+use marionette::choreo::dance_metrics;
+use marionette::choreo::generated_database;
 use marionette::choreo::music::Bar;
+use marionette::choreo::{BuildParams, Database, Manifest, OnRefusal};
+use marionette::choreo::{DanceParams, assemble};
+use marionette::choreo::{FillParams, Pins, fill, fill_dijkstra};
 use marionette::experiments::dance_fill::{DanceFillConfig, DanceFillOutcome, Strategy, run};
 
 /// The claims of Fig. 5 on an outcome.
@@ -150,8 +150,8 @@ fn fig5_on_the_shared_dance_database() {
 /// falls), the music term's mismatch falls, and the DP still agrees with Dijkstra.
 #[test]
 fn the_music_term_makes_the_fill_follow_the_music_and_zero_is_the_paper_s_fill() {
-    use marionette::choreo::metrics::spearman;
-    use marionette::choreo::relevance::{motion_intensity, percentile_ranks};
+    use marionette::choreo::spearman;
+    use marionette::choreo::{motion_intensity, percentile_ranks};
     let db = generated_database(21, 6, 8).unwrap();
     let n = db.segments.len();
     let bars = 24;
@@ -216,8 +216,8 @@ fn the_music_term_makes_the_fill_follow_the_music_and_zero_is_the_paper_s_fill()
 /// taken as given, and a budget of 1 keeps the paper's seam cost.
 #[test]
 fn the_seam_budget_takes_the_largest_kappa_whose_seams_stay_within_it() {
-    use marionette::choreo::fill::{BUDGET_HALVINGS, DEFAULT_SEAM_BUDGET};
-    use marionette::choreo::relevance::percentile_ranks;
+    use marionette::choreo::percentile_ranks;
+    use marionette::choreo::{BUDGET_HALVINGS, DEFAULT_SEAM_BUDGET};
     let db = generated_database(21, 6, 8).unwrap();
     let bars = 24;
     let loudness: Vec<f64> = (0..bars)

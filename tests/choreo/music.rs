@@ -5,9 +5,9 @@
 use crate::common;
 
 use marionette::choreo::music::eval::f_measure;
-use marionette::choreo::music::synth::{SynthSong, synthesize};
-use marionette::choreo::music::wav::wav_bytes;
+use marionette::choreo::music::wav_bytes;
 use marionette::choreo::music::{MusicError, MusicParams, analyze};
+use marionette::choreo::music::{SynthSong, synthesize};
 
 /// The MIREX beat tolerance (s).
 const TOL: f64 = 0.07;
@@ -143,7 +143,7 @@ fn silent_short_and_broken_songs_are_refused() {
 #[cfg(feature = "audio")]
 #[test]
 fn a_stereo_wav_decodes_to_its_mono_mix_and_analyses_like_the_buffer() {
-    use marionette::choreo::music::decode::decode_file;
+    use marionette::choreo::music::decode_file;
     let t = synthesize(&SynthSong {
         bpm: 111.0,
         bars: 8,
@@ -192,7 +192,7 @@ fn a_stereo_wav_decodes_to_its_mono_mix_and_analyses_like_the_buffer() {
     ignore = "needs the shared data: set MARIONETTE_DATA (default ../shared/data)"
 )]
 fn the_real_songs_decode_and_have_a_steady_beat() {
-    use marionette::choreo::music::decode::decode_file;
+    use marionette::choreo::music::decode_file;
     let Some(dir) = common::data_path("audio") else {
         return;
     };
@@ -242,7 +242,7 @@ fn bar_rms_follows_20_db_contrasts_on_a_steady_grid() {
 #[cfg(feature = "audio")]
 #[test]
 fn decoding_names_each_failure_and_warns_how_much_of_a_cut_file_was_read() {
-    use marionette::choreo::music::decode::decode_file;
+    use marionette::choreo::music::decode_file;
     let dir = std::env::temp_dir().join(format!("marionette-decode-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let t = synthesize(&SynthSong {

@@ -14,13 +14,13 @@ use crate::dance_clips;
 use std::sync::Arc;
 
 use dance_clips::{generated_database, scratch, tempo};
-use marionette::choreo::augment::{augment, augment_with_variants};
-use marionette::choreo::database::{BuildParams, Database, Manifest, OnRefusal, load_figure_clip};
-use marionette::choreo::edit::Edit;
-use marionette::choreo::eros::eros;
-use marionette::choreo::fill::FillParams;
-use marionette::choreo::search::{SearchIndex, SearchParams};
-use marionette::choreo::segments::{Beat, TempoSource, cut_segments};
+use marionette::choreo::Edit;
+use marionette::choreo::FillParams;
+use marionette::choreo::eros;
+use marionette::choreo::{Beat, TempoSource, cut_segments};
+use marionette::choreo::{BuildParams, Database, Manifest, OnRefusal, load_figure_clip};
+use marionette::choreo::{SearchIndex, SearchParams};
+use marionette::choreo::{augment, augment_with_variants};
 use marionette::experiments::dance_feedback::{FeedbackConfig, FeedbackOutcome, run};
 
 /// The τ_0 at which the likes must be felt in the second re-search: diversity and the likes
@@ -110,11 +110,7 @@ fn augmented_segments_are_true_to_the_clips() {
     // those stored by the build (on the body the BVH's offsets gave): printed for the report.
     let worst = (0..48)
         .map(|k| {
-            marionette::choreo::eros::eros(
-                &db.segments[k].eros,
-                &a.segments[k].eros,
-                &a.eros_weights,
-            )
+            marionette::choreo::eros(&db.segments[k].eros, &a.segments[k].eros, &a.eros_weights)
         })
         .fold(1.0, f64::min);
     eprintln!("lowest Eros between an original's stored and recomputed features: {worst:.5}");
@@ -240,8 +236,8 @@ fn fig4_on_the_shared_dance_clips() {
 
 #[test]
 fn an_edit_on_a_synthesized_song_prefers_intense_segments_for_loud_bars() {
-    use marionette::choreo::music::synth::{SynthSong, synthesize};
     use marionette::choreo::music::{MusicParams, analyze};
+    use marionette::choreo::music::{SynthSong, synthesize};
     let (db, _) = generated_database("edit", 6);
     let db = Arc::new(augment(&db, 200, 3));
     let song = synthesize(&SynthSong {

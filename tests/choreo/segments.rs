@@ -7,12 +7,10 @@ use crate::common;
 
 use std::path::{Path, PathBuf};
 
-use marionette::choreo::database::{
-    BuildParams, ClipOutcome, Database, Manifest, ManifestClip, OnRefusal,
-};
-use marionette::choreo::segments::{
+use marionette::choreo::{
     Beat, LEVEL_BPM, MAX_BPM, MIN_BPM, SegmentError, TempoSource, cut_segments, kinematic_beat,
 };
+use marionette::choreo::{BuildParams, ClipOutcome, Database, Manifest, ManifestClip, OnRefusal};
 use marionette::humanoid::{FigureClip, humanoid24};
 
 use glam::{DQuat, DVec3};
@@ -228,7 +226,7 @@ fn shared_dance_clips_segments_and_tempo() {
     }
     // A consistency check (no music exists for these takes): the kinematic tempo of each half.
     for c in &m.clips {
-        let clip = marionette::choreo::database::load_figure_clip(&c.file).unwrap();
+        let clip = marionette::choreo::load_figure_clip(&c.file).unwrap();
         let half = clip.frame_count() as f64 * clip.frame_time / 2.0;
         let name = c.file.file_name().unwrap().to_string_lossy().to_string();
         let t: Vec<String> = [(0.0, half), (half, 2.0 * half)]
@@ -349,14 +347,14 @@ fn bad_input_gives_one_clear_error_each() {
 /// the broken one comes first.
 fn folder_with_bad_clips(name: &str) -> PathBuf {
     let dir = scratch(name);
-    let p = marionette::choreo::authored::AuthoredDance {
+    let p = marionette::choreo::AuthoredDance {
         bpm: 112.0,
         clips: 2,
         bars_per_clip: 4,
         ..Default::default()
     };
-    let clips = marionette::choreo::authored::generate(&p).unwrap();
-    marionette::choreo::authored::write_bvh_folder(&clips, &dir).unwrap();
+    let clips = marionette::choreo::generate(&p).unwrap();
+    marionette::choreo::write_bvh_folder(&clips, &dir).unwrap();
     write_still_and_broken(&dir, &clips[0].motion);
     dir
 }
@@ -444,7 +442,7 @@ fn a_clip_that_cannot_be_used_is_skipped_named_and_recorded() {
 
     // Nothing usable: one error that names every clip and says why.
     let bad = scratch("skip-all-bad");
-    let one = marionette::choreo::authored::generate(&Default::default()).unwrap();
+    let one = marionette::choreo::generate(&Default::default()).unwrap();
     write_still_and_broken(&bad, &one[0].motion);
     let e = Database::build(
         &Manifest::from_folder(&bad).unwrap(),
@@ -517,7 +515,7 @@ fn every_shared_clip_gets_a_tempo_in_range_alone_and_for_the_song() {
     ) else {
         return;
     };
-    let audio = marionette::choreo::music::decode::decode_file(&song).unwrap();
+    let audio = marionette::choreo::music::decode_file(&song).unwrap();
     let music =
         marionette::choreo::music::analyze(&audio.samples, audio.sample_rate, &Default::default())
             .unwrap()
@@ -526,7 +524,7 @@ fn every_shared_clip_gets_a_tempo_in_range_alone_and_for_the_song() {
     for dir in [dance, more] {
         let m = Manifest::from_folder(&dir).unwrap();
         for c in &m.clips {
-            let clip = marionette::choreo::database::load_figure_clip(&c.file).unwrap();
+            let clip = marionette::choreo::load_figure_clip(&c.file).unwrap();
             let name = c.file.file_name().unwrap().to_string_lossy().to_string();
             let alone = kinematic_beat(&clip, &name, None).unwrap();
             let matched = kinematic_beat(&clip, &name, Some(music)).unwrap();
@@ -565,7 +563,7 @@ fn every_shared_clip_gets_a_tempo_in_range_alone_and_for_the_song() {
     ignore = "needs the shared data: set MARIONETTE_DATA (default ../shared/data)"
 )]
 fn a_clip_danced_slower_or_faster_keeps_its_beat() {
-    use marionette::choreo::segments::{kinematic_tempo, speed_curve};
+    use marionette::choreo::{kinematic_tempo, speed_curve};
     let (Some(dance), Some(more)) = (common::data_path("dance"), common::data_path("dance_more"))
     else {
         return;
@@ -575,7 +573,7 @@ fn a_clip_danced_slower_or_faster_keeps_its_beat() {
     let mut errors = vec![];
     for dir in [dance, more] {
         for c in &Manifest::from_folder(&dir).unwrap().clips {
-            let clip = marionette::choreo::database::load_figure_clip(&c.file).unwrap();
+            let clip = marionette::choreo::load_figure_clip(&c.file).unwrap();
             let fps = 1.0 / clip.frame_time;
             let v = speed_curve(&clip.to_clip().point_frames(), fps);
             let own = kinematic_tempo(&v, fps, Some(song)).unwrap();

@@ -10,7 +10,7 @@
 use std::path::PathBuf;
 
 use glam::{DQuat, DVec3};
-use marionette::choreo::database::{BuildParams, Database, Manifest, ManifestClip, OnRefusal};
+use marionette::choreo::{BuildParams, Database, Manifest, ManifestClip, OnRefusal};
 use marionette::humanoid::{FigureClip, humanoid24};
 
 /// A fresh scratch folder.

@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
 
-use marionette::choreo::music::decode::decode_file;
+use marionette::choreo::music::decode_file;
 use marionette::choreo::music::eval::{Annotations, BeatScores, read_annotations, score};
 use marionette::choreo::music::{MusicParams, analyze};
 

@@ -19,9 +19,9 @@ use std::path::{Path, PathBuf};
 use std::process::{Child, Command};
 
 use crate::fixture::{assert_bvh_lasts_the_bars, get, scene_on, start_editor};
-use marionette::choreo::augment::augment;
-use marionette::choreo::database::{BuildParams, Database, Manifest, OnRefusal};
-use marionette::choreo::generated::generated_database;
+use marionette::choreo::augment;
+use marionette::choreo::generated_database;
+use marionette::choreo::{BuildParams, Database, Manifest, OnRefusal};
 use marionette::editor::session::Session;
 
 /// The folder of the browser tests' screenshots and numbers.

@@ -10,8 +10,8 @@ use std::process::{Child, Command, Stdio};
 use std::time::Duration;
 use std::time::Instant;
 
-use marionette::choreo::database::Database;
-use marionette::choreo::generated::generated_database;
+use marionette::choreo::Database;
+use marionette::choreo::generated_database;
 
 /// A fresh folder holding `dance.db.json` (generated clips: `clips` × `bars_per_clip` bars) and
 /// `dance.ron` (a `Dance` scene: a 120 BPM synthesized song of `song_bars` bars, no pins);

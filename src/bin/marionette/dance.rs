@@ -8,10 +8,8 @@ use std::time::Instant;
 
 use anyhow::Result;
 
-use marionette::choreo::database::{
-    BuildParams, ClipOutcome, Database, Manifest, OnRefusal, Source,
-};
-use marionette::choreo::segments::{BAR_FRAMES_RANGE, TempoSource, check_tempo};
+use marionette::choreo::{BAR_FRAMES_RANGE, TempoSource, check_tempo};
+use marionette::choreo::{BuildParams, ClipOutcome, Database, Manifest, OnRefusal, Source};
 
 // The command's arguments (its help text is on `Command::Dance`).
 #[derive(clap::Args)]

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 use serde::Serialize;
 
-use marionette::choreo::music::decode::{Audio, decode_file};
+use marionette::choreo::music::{Audio, decode_file};
 use marionette::choreo::music::{Bar, MusicAnalysis, MusicParams, analyze};
 use marionette::render::music_png;
 

@@ -178,7 +178,7 @@ fn view_folder(page: &mut Page, input: &Path, unit_scale: Option<f64>) -> Result
     }
     let song = input.join("song.wav");
     if song.is_file() {
-        let a = marionette::choreo::music::decode::decode_file(&song)?;
+        let a = marionette::choreo::music::decode_file(&song)?;
         page.song = Some(PageSong {
             samples: a.samples,
             sample_rate: a.sample_rate,

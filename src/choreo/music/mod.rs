@@ -20,17 +20,17 @@
 //!
 //! [`analyze`] runs them in order.
 
-pub mod bars;
-pub mod beats;
-pub mod chroma;
+pub(crate) mod bars;
+pub(crate) mod beats;
+pub(crate) mod chroma;
 #[cfg(feature = "audio")]
-pub mod decode;
+pub(crate) mod decode;
 pub mod eval;
-pub mod intensity;
-pub mod onsets;
-pub mod synth;
-pub mod tempo;
-pub mod wav;
+pub(crate) mod intensity;
+pub(crate) mod onsets;
+pub(crate) mod synth;
+pub(crate) mod tempo;
+pub(crate) mod wav;
 
 use std::path::PathBuf;
 
@@ -38,10 +38,14 @@ use serde::{Deserialize, Serialize};
 
 pub use bars::{Bar, bars_from_downbeats, downbeat_evidence, track_downbeats};
 pub use beats::{BeatParams, track_beats};
-pub use chroma::{Chroma, ChromaParams, harmonic_change, interval_chroma};
+pub use chroma::{Chroma, ChromaParams, half_beat_chroma, harmonic_change, interval_chroma};
+#[cfg(feature = "audio")]
+pub use decode::{Audio, decode_file};
 pub use intensity::{bar_intensity, rms_db};
 pub use onsets::{OnsetEnvelope, OnsetParams, onset_envelope};
+pub use synth::{SynthSong, synthesize};
 pub use tempo::{TempoEstimate, TempoPrior, estimate_tempo};
+pub use wav::wav_bytes;
 
 /// Errors of music decoding and analysis.
 #[derive(Debug, thiserror::Error)]
