@@ -208,3 +208,53 @@ fn aba_agrees_with_rnea_and_crba_on_the_human_bodies() {
         assert!(e1 < 1e-9 && e2 < 1e-9, "{name}: {e1:e} {e2:e}");
     }
 }
+
+#[test]
+fn arguments_of_the_wrong_size_are_errors_that_name_both_sizes() {
+    use marionette::dynamics::ModelError;
+    use marionette::dynamics::kinematics::mechanical_energy;
+    let mut rng = Pcg64::seed_from_u64(11);
+    let m = random_model(&mut rng, 5, true);
+    let (q, v, tau, f_ext) = random_state(&mut rng, &m);
+    let (nq, nv, nb) = (m.nq(), m.nv(), m.nbodies());
+    let mut data = Data::new(&m);
+    let short = |x: &[f64]| x[..x.len() - 1].to_vec();
+    let mismatch = |e: ModelError, what: &'static str, expected: usize, found: usize| {
+        let msg = e.to_string();
+        assert_eq!(
+            e,
+            ModelError::SizeMismatch {
+                what,
+                expected,
+                found
+            }
+        );
+        assert_eq!(
+            msg,
+            format!("{what} has {found} entries, the model needs {expected}")
+        );
+    };
+    let e = aba(&m, &mut data, &short(&q), &v, &tau, &f_ext).unwrap_err();
+    mismatch(e, "q", nq, nq - 1);
+    let e = aba(&m, &mut data, &q, &short(&v), &tau, &f_ext).unwrap_err();
+    mismatch(e, "v", nv, nv - 1);
+    let e = aba(&m, &mut data, &q, &v, &short(&tau), &f_ext).unwrap_err();
+    mismatch(e, "tau", nv, nv - 1);
+    let e = aba(&m, &mut data, &q, &v, &tau, &f_ext[1..]).unwrap_err();
+    mismatch(e, "f_ext", nb, nb - 1);
+    let e = rnea(&m, &mut data, &q, &v, &short(&tau), &f_ext).unwrap_err();
+    mismatch(e, "qdd", nv, nv - 1);
+    let e = marionette::dynamics::crba(&m, &mut data, &short(&q)).unwrap_err();
+    mismatch(e, "q", nq, nq - 1);
+    let e = forward_dynamics_crba(&m, &mut data, &q, &v, &short(&tau), &f_ext).unwrap_err();
+    mismatch(e, "tau", nv, nv - 1);
+    let e = mechanical_energy(&m, &mut data, &q, &short(&v)).unwrap_err();
+    mismatch(e, "v", nv, nv - 1);
+    // A workspace of another model.
+    let other = random_model(&mut rng, 3, true);
+    let mut small = Data::new(&other);
+    let e = aba(&m, &mut small, &q, &v, &tau, &f_ext).unwrap_err();
+    mismatch(e, "data (bodies)", nb, other.nbodies());
+    // The right sizes still work.
+    assert!(aba(&m, &mut data, &q, &v, &tau, &f_ext).is_ok());
+}
