@@ -18,10 +18,10 @@ fn bench_aba(c: &mut Criterion) {
         DVec3::new(0.1, 0.9, -0.2),
         DQuat::from_axis_angle(DVec3::new(0.2, 1.0, 0.1).normalize(), 0.4),
     );
-    let v: Vec<f64> = (0..model.nv)
+    let v: Vec<f64> = (0..model.nv())
         .map(|k| 0.5 * ((k as f64) * 1.3).cos())
         .collect();
-    let tau: Vec<f64> = (0..model.nv)
+    let tau: Vec<f64> = (0..model.nv())
         .map(|k| {
             if k < 6 {
                 0.0
@@ -39,7 +39,7 @@ fn bench_aba(c: &mut Criterion) {
         })
         .collect();
     let mut data = Data::new(model);
-    assert_eq!(model.nv, 27);
+    assert_eq!(model.nv(), 27);
     c.bench_function("aba_fall21_27dof", |b| {
         b.iter(|| {
             let qdd = aba(
@@ -49,7 +49,8 @@ fn bench_aba(c: &mut Criterion) {
                 black_box(&v),
                 black_box(&tau),
                 black_box(&f_ext),
-            );
+            )
+            .unwrap();
             black_box(qdd[6])
         })
     });

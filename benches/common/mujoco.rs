@@ -90,7 +90,7 @@ pub fn write_workload(dir: &Path) -> (PathBuf, PathBuf) {
         .collect();
     let neck = body.link_index("head").expect("head");
     assert!(matches!(
-        body.model.bodies[neck].joint,
+        body.model.bodies()[neck].joint,
         JointType::Ball { .. }
     ));
     let start = simulate_fall(&cfg).expect("the paper's fall").frames[0].clone();

@@ -30,7 +30,7 @@ pub fn centre_of_mass_track(clip: &FigureClip) -> Result<Vec<DVec3>, HumanError>
     let body: HumanBody = human_body(&clip.model, REFERENCE_HEIGHT_M, NOMINAL_MASS_KG, GRAVITY)?;
     let scale = clip.model.height / REFERENCE_HEIGHT_M;
     let mut data = Data::new(&body.model);
-    let v = vec![0.0; body.model.nv];
+    let v = vec![0.0; body.model.nv()];
     let total = body.model.total_mass();
     Ok((0..clip.frame_count())
         .map(|f| {
@@ -38,7 +38,7 @@ pub fn centre_of_mass_track(clip: &FigureClip) -> Result<Vec<DVec3>, HumanError>
             kinematics(&body.model, &mut data, &q, &v);
             let offset = body
                 .model
-                .bodies
+                .bodies()
                 .iter()
                 .enumerate()
                 .map(|(i, b)| b.inertia.mass * (data.pos[i] + data.rot[i] * b.inertia.com))

@@ -18,7 +18,7 @@ use super::axis_rotation::{CoordAxis, JointAxes};
 use super::data::Data;
 use super::joint::JointType;
 use super::kinematics::{base_acceleration, kinematics};
-use super::model::Model;
+use super::model::{Model, ModelError};
 use super::real::{
     ColumnsOps, ForceOps, InertiaOps, Mat3Ops, MotionOps, Real, TransformOps, Vec3Ops,
 };
@@ -28,7 +28,8 @@ use std::marker::PhantomData;
 
 /// Forward dynamics: returns `q̈` (size nv, in `data.qdd`) for configuration `q` (nq), velocity
 /// `v` (nv), joint forces `tau` (nv; N·m, or the free root's `[n; f]` in body coordinates) and
-/// external forces `f_ext` on each body (body coordinates).
+/// external forces `f_ext` on each body (body coordinates). A vector or `data` of another size
+/// than the model's is a [`ModelError::SizeMismatch`].
 pub fn aba<'d>(
     model: &Model,
     data: &'d mut Data,
@@ -36,10 +37,13 @@ pub fn aba<'d>(
     v: &[f64],
     tau: &[f64],
     f_ext: &[ForceVec],
-) -> &'d [f64] {
+) -> Result<&'d [f64], ModelError> {
+    model.check_data(data)?;
+    model.check_state(q, v)?;
+    model.check_forces(tau, f_ext)?;
     kinematics(model, data, q, v);
     aba_passes(model, data, tau, f_ext, None, &[]);
-    &data.qdd
+    Ok(&data.qdd)
 }
 
 /// Passes 2 and 3 of the ABA on kinematics already in `data`. `armature` (size nv, N·m·s²)
@@ -60,6 +64,8 @@ pub fn aba_passes(
     armature: Option<&[f64]>,
     implicit: &[(usize, ArticulatedInertia)],
 ) {
+    debug_assert_eq!(tau.len(), model.nv);
+    debug_assert!(armature.is_none_or(|a| a.len() == model.nv));
     pass1_bias_forces(model, data, f_ext);
     if !implicit.is_empty() {
         implicit_inertias(model, data, implicit);

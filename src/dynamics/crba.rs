@@ -8,7 +8,7 @@
 use super::data::Data;
 use super::joint::JointType;
 use super::kinematics::kinematics;
-use super::model::Model;
+use super::model::{Model, ModelError, check_size};
 use super::rnea::rnea;
 use super::spatial::{ForceVec, MotionVec};
 use thiserror::Error;
@@ -31,8 +31,11 @@ fn column(data: &Data, joint: &JointType, i: usize, k: usize) -> MotionVec {
     }
 }
 
-/// Fills `data.h` (nv × nv, row-major) with the joint-space inertia matrix `H(q)`.
-pub fn crba<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> &'d [f64] {
+/// Fills `data.h` (nv × nv, row-major) with the joint-space inertia matrix `H(q)`. A `q` or
+/// `data` of another size than the model's is a [`ModelError::SizeMismatch`].
+pub fn crba<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> Result<&'d [f64], ModelError> {
+    model.check_data(data)?;
+    check_size("q", model.nq, q.len())?;
     let zeros = std::mem::take(&mut data.zeros);
     kinematics(model, data, q, &zeros);
     data.zeros = zeros;
@@ -72,7 +75,7 @@ pub fn crba<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> &'d [f64] {
             }
         }
     }
-    &data.h
+    Ok(&data.h)
 }
 
 /// Factors the symmetric positive definite `h` (n × n, row-major) in place into `L Lᵀ`
@@ -118,7 +121,8 @@ pub fn cholesky_solve(l: &[f64], n: usize, b: &mut [f64]) {
 }
 
 /// Forward dynamics by CRBA + Cholesky: `q̈ = H⁻¹(τ − C)` with `C = RNEA(q, q̇, 0, f_ext)`.
-/// Returns `q̈` in `data.qdd`.
+/// Returns `q̈` in `data.qdd`; a vector of another size than the model's is a
+/// [`ModelError::SizeMismatch`], a singular `H` a [`ModelError::NotPositiveDefinite`].
 pub fn forward_dynamics_crba<'d>(
     model: &Model,
     data: &'d mut Data,
@@ -126,15 +130,17 @@ pub fn forward_dynamics_crba<'d>(
     v: &[f64],
     tau: &[f64],
     f_ext: &[ForceVec],
-) -> Result<&'d [f64], NotPositiveDefinite> {
+) -> Result<&'d [f64], ModelError> {
+    check_size("tau", model.nv, tau.len())?;
     let nv = model.nv;
     let zeros = std::mem::take(&mut data.zeros);
-    rnea(model, data, q, v, &zeros, f_ext);
+    let c = rnea(model, data, q, v, &zeros, f_ext).map(|_| ());
     data.zeros = zeros;
+    c?;
     for k in 0..nv {
         data.qdd[k] = tau[k] - data.tau[k];
     }
-    crba(model, data, q);
+    crba(model, data, q)?;
     cholesky_factor(&mut data.h, nv)?;
     let mut b = std::mem::take(&mut data.qdd);
     cholesky_solve(&data.h, nv, &mut b);

@@ -151,7 +151,7 @@ pub fn imbalance(
     let nv = model.nv;
     let mut qdd = vec![0.0; nv];
     acceleration(model, forces, state, ws, &mut qdd)?;
-    let hm = crba(model, h, &state.q);
+    let hm = crba(model, h, &state.q)?;
     for (i, o) in out.iter_mut().enumerate() {
         *o = (0..nv).map(|k| hm[i * nv + k] * qdd[k]).sum();
     }

@@ -4,10 +4,12 @@
 
 use super::axis_rotation::JointRotation;
 use super::data::Data;
-use super::model::Model;
+use super::model::{Model, ModelError};
 use super::spatial::{MotionVec, SpatialTransform};
 
 /// Fills `data.xup, s, v, c, rot, pos` for configuration `q` (size nq) and velocity `v` (size nv).
+/// The first pass of every step, it does not check sizes (a wrong one panics on an index);
+/// callers check once at their entry ([`Model::check_state`], [`Model::check_data`]).
 #[inline(always)]
 pub fn kinematics(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) {
     debug_assert_eq!(q.len(), model.nq);
@@ -81,8 +83,16 @@ pub fn base_acceleration(model: &Model) -> MotionVec {
 }
 
 /// Mechanical energy `(T, V)` (J) of the tree: `T = Σ ½ v_iᵀ I_i v_i`,
-/// `V = −Σ m_i g·x_com,i` (zero potential at world height 0). Uses and overwrites `data`.
-pub fn mechanical_energy(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) -> (f64, f64) {
+/// `V = −Σ m_i g·x_com,i` (zero potential at world height 0). Uses and overwrites `data`. A
+/// vector or `data` of another size than the model's is a [`ModelError::SizeMismatch`].
+pub fn mechanical_energy(
+    model: &Model,
+    data: &mut Data,
+    q: &[f64],
+    v: &[f64],
+) -> Result<(f64, f64), ModelError> {
+    model.check_data(data)?;
+    model.check_state(q, v)?;
     kinematics(model, data, q, v);
     let mut t = 0.0;
     let mut pot = 0.0;
@@ -91,7 +101,7 @@ pub fn mechanical_energy(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) -
         let com = data.pos[i] + data.rot[i] * b.inertia.com;
         pot -= b.inertia.mass * model.gravity.dot(com);
     }
-    (t, pot)
+    Ok((t, pot))
 }
 
 /// World position of body `i`'s point `p` (body coordinates) after [`kinematics`].

@@ -6,12 +6,16 @@
 //! and free joints carry unit quaternions (4 numbers) for 3 rotational velocities.
 
 use super::axis_rotation::{CoordAxis, JointAxes};
+use super::crba::NotPositiveDefinite;
+use super::data::Data;
 use super::joint::JointType;
+use super::spatial::ForceVec;
 use super::spatial::{ArticulatedInertia, Inertia, SpatialTransform};
 use glam::DVec3;
 use thiserror::Error;
 
-/// An invalid model description: which body and what is wrong.
+/// An invalid model description (which body and what is wrong), or arguments that do not fit
+/// the model.
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum ModelError {
     /// A body's parent index is not an earlier body.
@@ -55,6 +59,34 @@ pub enum ModelError {
     /// The model has no bodies.
     #[error("the model has no bodies")]
     Empty,
+    /// A vector passed to the kernel does not have the size the model gives it (`q`: nq,
+    /// `v`/`tau`/`qdd`: nv, `f_ext`: one per body).
+    #[error("{what} has {found} entries, the model needs {expected}")]
+    SizeMismatch {
+        /// Which argument (e.g. "q", "tau", "f_ext").
+        what: &'static str,
+        /// The size the model needs.
+        expected: usize,
+        /// The size given.
+        found: usize,
+    },
+    /// The joint-space inertia matrix of a configuration is not positive definite.
+    #[error(transparent)]
+    NotPositiveDefinite(#[from] NotPositiveDefinite),
+}
+
+/// `Ok` when argument `what` has the `expected` size, else [`ModelError::SizeMismatch`].
+#[inline]
+pub fn check_size(what: &'static str, expected: usize, found: usize) -> Result<(), ModelError> {
+    if found == expected {
+        Ok(())
+    } else {
+        Err(ModelError::SizeMismatch {
+            what,
+            expected,
+            found,
+        })
+    }
 }
 
 /// One body of the tree and the joint that connects it to its parent.
@@ -74,31 +106,33 @@ pub struct Body {
     pub inertia: Inertia,
 }
 
-/// The immutable kinematic tree.
+/// The immutable kinematic tree, built and validated by [`Model::new`]. Its fields are read
+/// through accessors; the derived ones (offsets, sizes, inertia blocks, joint axes) always
+/// agree with the bodies because a changed model is a rebuilt one ([`Model::with_gravity`],
+/// or [`Model::new`] on edited [`Model::bodies`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Model {
     /// Bodies in depth-first order, parents first.
-    pub bodies: Vec<Body>,
+    pub(super) bodies: Vec<Body>,
     /// Gravity acceleration in world coordinates (m/s²), e.g. `(0, −9.81, 0)`.
-    pub gravity: DVec3,
+    pub(super) gravity: DVec3,
     /// Offset of each joint's block in `q`.
-    pub q_idx: Vec<usize>,
+    pub(super) q_idx: Vec<usize>,
     /// Offset of each joint's block in `v`.
-    pub v_idx: Vec<usize>,
+    pub(super) v_idx: Vec<usize>,
     /// Size of the configuration vector.
-    pub nq: usize,
+    pub(super) nq: usize,
     /// Size of the velocity vector (degrees of freedom).
-    pub nv: usize,
-    /// Each body's rigid inertia as 3×3 blocks, derived from `bodies` at construction (the
-    /// articulated-body algorithm starts from these; rebuild the model after editing inertias).
-    pub inertia_blocks: Vec<ArticulatedInertia>,
+    pub(super) nv: usize,
+    /// Each body's rigid inertia as 3×3 blocks, derived from `bodies` (the articulated-body
+    /// algorithm starts from these).
+    pub(super) inertia_blocks: Vec<ArticulatedInertia>,
     /// How each body's joint rotation factors into rotations about coordinate axes, derived
-    /// from `bodies` at construction (the kinematics and the ABA take the cheaper products where
-    /// it does).
-    pub joint_axes: Vec<JointAxes>,
+    /// from `bodies` (the kinematics and the ABA take the cheaper products where it does).
+    pub(super) joint_axes: Vec<JointAxes>,
     /// The entries of `q` that are angles of such coordinate-axis joints (one per pin, two per
     /// universal), whose sines and cosines the kinematics takes four at a time.
-    pub axis_angles: Vec<usize>,
+    pub(super) axis_angles: Vec<usize>,
 }
 
 /// The coordinate-axis structure of body `b`'s joint rotation: a pin or universal joint whose
@@ -200,10 +234,99 @@ impl Model {
         })
     }
 
+    /// The same model under gravity `gravity` (world coordinates, m/s²).
+    pub fn with_gravity(self, gravity: DVec3) -> Self {
+        Self { gravity, ..self }
+    }
+
     /// Number of bodies.
     #[inline]
     pub fn nbodies(&self) -> usize {
         self.bodies.len()
+    }
+
+    /// The bodies in depth-first order, parents first (body `i` is moved by joint `i`).
+    #[inline]
+    pub fn bodies(&self) -> &[Body] {
+        &self.bodies
+    }
+
+    /// Body `i`.
+    #[inline]
+    pub fn body(&self, i: usize) -> &Body {
+        &self.bodies[i]
+    }
+
+    /// Gravity acceleration in world coordinates (m/s²).
+    #[inline]
+    pub fn gravity(&self) -> DVec3 {
+        self.gravity
+    }
+
+    /// Size of the configuration vector `q`.
+    #[inline]
+    pub fn nq(&self) -> usize {
+        self.nq
+    }
+
+    /// Size of the velocity vector `v` (the degrees of freedom).
+    #[inline]
+    pub fn nv(&self) -> usize {
+        self.nv
+    }
+
+    /// Offset of joint `i`'s block in `q` (its size is `body(i).joint.nq()`).
+    #[inline]
+    pub fn q_offset(&self, i: usize) -> usize {
+        self.q_idx[i]
+    }
+
+    /// Offset of joint `i`'s block in `v` (its size is `body(i).joint.nv()`).
+    #[inline]
+    pub fn v_offset(&self, i: usize) -> usize {
+        self.v_idx[i]
+    }
+
+    /// Each body's rigid inertia as 3×3 blocks (body coordinates; kg, kg·m, kg·m²).
+    #[inline]
+    pub fn inertia_blocks(&self) -> &[ArticulatedInertia] {
+        &self.inertia_blocks
+    }
+
+    /// How each body's joint rotation factors into rotations about coordinate axes.
+    #[inline]
+    pub fn joint_axes(&self) -> &[JointAxes] {
+        &self.joint_axes
+    }
+
+    /// The entries of `q` that are angles of coordinate-axis pin and universal joints.
+    #[inline]
+    pub fn axis_angles(&self) -> &[usize] {
+        &self.axis_angles
+    }
+
+    /// `Ok` when `q` has size nq and `v` size nv, else [`ModelError::SizeMismatch`].
+    #[inline]
+    pub fn check_state(&self, q: &[f64], v: &[f64]) -> Result<(), ModelError> {
+        check_size("q", self.nq, q.len())?;
+        check_size("v", self.nv, v.len())
+    }
+
+    /// `Ok` when joint forces `tau` have size nv and external forces `f_ext` one entry per
+    /// body, else [`ModelError::SizeMismatch`].
+    #[inline]
+    pub fn check_forces(&self, tau: &[f64], f_ext: &[ForceVec]) -> Result<(), ModelError> {
+        check_size("tau", self.nv, tau.len())?;
+        check_size("f_ext", self.nbodies(), f_ext.len())
+    }
+
+    /// `Ok` when `data` was allocated for a model of this size ([`Data::new`]), else
+    /// [`ModelError::SizeMismatch`].
+    #[inline]
+    pub fn check_data(&self, data: &Data) -> Result<(), ModelError> {
+        check_size("data (bodies)", self.nbodies(), data.xup.len())?;
+        check_size("data (nq)", self.nq, data.q_sin_cos.0.len())?;
+        check_size("data (nv)", self.nv, data.qdd.len())
     }
 
     /// The neutral configuration: zero angles, identity quaternions, free base at the origin.
@@ -224,6 +347,7 @@ impl Model {
     /// `out = q ⊞ z` joint by joint (see [`JointType::retract`]); `z` has size nv.
     #[inline(always)]
     pub fn retract(&self, q: &[f64], z: &[f64], out: &mut [f64]) {
+        debug_assert!(q.len() == self.nq && z.len() == self.nv && out.len() == self.nq);
         for (i, b) in self.bodies.iter().enumerate() {
             let (iq, iv) = (self.q_idx[i], self.v_idx[i]);
             // Angle joints inline (the same sums as `JointType::retract`).
@@ -244,6 +368,7 @@ impl Model {
     /// [`JointType::chart_rate`]); all vectors but `q_stage` have size nv.
     #[inline(always)]
     pub fn chart_rate(&self, q_stage: &[f64], z: &[f64], v: &[f64], zdot: &mut [f64]) {
+        debug_assert!(q_stage.len() == self.nq && z.len() == self.nv && zdot.len() == self.nv);
         for (i, b) in self.bodies.iter().enumerate() {
             let (iq, iv) = (self.q_idx[i], self.v_idx[i]);
             // Angle joints inline: their chart rate is the velocity.
@@ -267,6 +392,7 @@ impl Model {
     /// The anatomical angle of every velocity DOF (rad; zeros for a free joint), size nv.
     #[inline(always)]
     pub fn angles(&self, q: &[f64], out: &mut [f64]) {
+        debug_assert!(q.len() == self.nq && out.len() == self.nv);
         for (i, b) in self.bodies.iter().enumerate() {
             let (iq, iv) = (self.q_idx[i], self.v_idx[i]);
             b.joint
@@ -278,6 +404,7 @@ impl Model {
     /// [`JointType::angles_near`]).
     #[inline(always)]
     pub fn angles_near(&self, q: &[f64], reference: &[f64], out: &mut [f64]) {
+        debug_assert!(q.len() == self.nq && reference.len() == self.nv && out.len() == self.nv);
         for (i, b) in self.bodies.iter().enumerate() {
             let (iq, iv) = (self.q_idx[i], self.v_idx[i]);
             // Angle joints inline: their angles are their coordinates.
@@ -300,6 +427,7 @@ impl Model {
     /// The joint velocities of angles `angles` moving at rates `rates` (all size nv; see
     /// [`JointType::velocity_from_rates`]); a free joint's entries of `v` are left as they are.
     pub fn velocity_from_rates(&self, angles: &[f64], rates: &[f64], v: &mut [f64]) {
+        debug_assert!(angles.len() == self.nv && rates.len() == self.nv && v.len() == self.nv);
         for (i, b) in self.bodies.iter().enumerate() {
             let iv = self.v_idx[i];
             let nv = b.joint.nv();

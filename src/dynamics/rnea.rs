@@ -7,13 +7,14 @@
 use super::data::Data;
 use super::joint::JointType;
 use super::kinematics::{base_acceleration, kinematics};
-use super::model::Model;
+use super::model::{Model, ModelError, check_size};
 use super::spatial::{ForceVec, MotionVec};
 use glam::DVec3;
 
 /// Inverse dynamics: returns `τ` (size nv, in `data.tau`) for `q` (nq), `v` (nv), `qdd` (nv)
 /// and external body forces `f_ext` (body coordinates). A free root's entry is `[n; f]` in body
-/// coordinates (zero for a consistent floating-base motion).
+/// coordinates (zero for a consistent floating-base motion). A vector or `data` of another size
+/// than the model's is a [`ModelError::SizeMismatch`].
 pub fn rnea<'d>(
     model: &Model,
     data: &'d mut Data,
@@ -21,7 +22,11 @@ pub fn rnea<'d>(
     v: &[f64],
     qdd: &[f64],
     f_ext: &[ForceVec],
-) -> &'d [f64] {
+) -> Result<&'d [f64], ModelError> {
+    model.check_data(data)?;
+    model.check_state(q, v)?;
+    check_size("qdd", model.nv, qdd.len())?;
+    check_size("f_ext", model.nbodies(), f_ext.len())?;
     kinematics(model, data, q, v);
     let a0 = base_acceleration(model);
     for (i, body) in model.bodies.iter().enumerate() {
@@ -69,5 +74,5 @@ pub fn rnea<'d>(
             data.f[p] += fp;
         }
     }
-    &data.tau
+    Ok(&data.tau)
 }

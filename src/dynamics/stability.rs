@@ -82,7 +82,7 @@ pub fn stiffest_mode(
     integrator: Integrator,
     contact: Option<&ContactModel>,
     dofs: &[DofStiffness],
-) -> Result<Option<StiffestMode>, super::crba::NotPositiveDefinite> {
+) -> Result<Option<StiffestMode>, super::model::ModelError> {
     Ok(StiffnessBasis::new(model, q, integrator, contact)?.stiffest_mode(dofs))
 }
 
@@ -107,7 +107,7 @@ impl StiffnessBasis {
         q: &[f64],
         integrator: Integrator,
         contact: Option<&ContactModel>,
-    ) -> Result<Self, super::crba::NotPositiveDefinite> {
+    ) -> Result<Self, super::model::ModelError> {
         // Contact damping taken implicitly in semi-implicit Euler leaves the undamped bound 2/ω.
         let implicit_damping = contact.is_some_and(|cm| {
             cm.params.implicit_damping && matches!(integrator, Integrator::SemiImplicitEuler { .. })
@@ -171,10 +171,10 @@ pub fn inverse_joint_inertia(
     model: &Model,
     q: &[f64],
     vs: &[usize],
-) -> Result<Vec<f64>, super::crba::NotPositiveDefinite> {
+) -> Result<Vec<f64>, super::model::ModelError> {
     let nv = model.nv;
     let mut data = Data::new(model);
-    crba(model, &mut data, q);
+    crba(model, &mut data, q)?;
     let mut h = data.h.clone();
     cholesky_factor(&mut h, nv)?;
     let mut e = vec![0.0; nv];

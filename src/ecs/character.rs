@@ -326,6 +326,9 @@ pub enum CharacterError {
     /// A link has no tissue region for its contact gains.
     #[error("link '{0}' has no tissue region (contact gains)")]
     Tissue(String),
+    /// A configuration that does not fit the body's model.
+    #[error(transparent)]
+    Model(#[from] crate::dynamics::ModelError),
     /// A setting out of range.
     #[error("{field}: {message}")]
     Setting {
@@ -354,7 +357,7 @@ pub fn pose_configuration(
     let at = |k: usize| pose.theta[r[k]];
     let rot = DQuat::from_scaled_axis(DVec3::new(at(3), at(4), at(5)));
     let q = body.configuration(&angles, DVec3::new(at(0), at(1), at(2)), rot);
-    let nv = body.model.nv;
+    let nv = body.model.nv();
     let (mut at_v, mut rates) = (vec![0.0; nv], vec![0.0; nv]);
     for (d, &c) in binding.dof_columns().iter().enumerate() {
         at_v[body.dof_v[d]] = pose.theta[c];
@@ -392,7 +395,7 @@ pub fn spawn_physical_character(
     kinematics(model, &mut data, &q, &v);
     let floor = floor_contact(&body, settings, &data)?;
     // Gains from the joint-space inertia at the start pose.
-    let h = crate::dynamics::crba(model, &mut data, &q).to_vec();
+    let h = crate::dynamics::crba(model, &mut data, &q)?.to_vec();
     let targets: Vec<f64> = binding
         .dof_columns()
         .iter()
@@ -486,7 +489,7 @@ fn floor_contact(
     data: &Data,
 ) -> Result<StartFloor, CharacterError> {
     let model = &body.model;
-    let masses: Vec<f64> = model.bodies.iter().map(|b| b.inertia.mass).collect();
+    let masses: Vec<f64> = model.bodies().iter().map(|b| b.inertia.mass).collect();
     let gains = body
         .link_names
         .iter()
@@ -512,7 +515,7 @@ fn floor_contact(
     } else {
         1.0
     };
-    let weight = carried * model.total_mass() * model.gravity.length();
+    let weight = carried * model.total_mass() * model.gravity().length();
     let feet: Vec<usize> = (0..body.link_names.len())
         .filter(|&i| body.link_names[i].ends_with("foot"))
         .collect();
@@ -535,7 +538,7 @@ fn pd_targets(
     targets: Vec<f64>,
 ) -> Result<PdTargets, CharacterError> {
     let (w, z) = (settings.joint_omega, settings.joint_zeta);
-    let (kp, kv) = inertia_scaled_gains(h, body.model.nv, &body.dof_v, w, z);
+    let (kp, kv) = inertia_scaled_gains(h, body.model.nv(), &body.dof_v, w, z);
     let limits = match settings.strength {
         Some(g) => torque_limits_for(&body.figure, g)?,
         None => Vec::new(),
@@ -578,7 +581,7 @@ fn new_root_assist(settings: &PhysicalSettings, model: &Model, h: &[f64]) -> Roo
             omega: settings.assist_omega,
             zeta: settings.assist_zeta,
             mass_kg: model.total_mass(),
-            inertia_kg_m2: root_rotational_inertia(h, model.nv),
+            inertia_kg_m2: root_rotational_inertia(h, model.nv()),
         },
         released: false,
         feedforward: Wrench::ZERO,
@@ -650,7 +653,11 @@ pub fn pd_targets_from_pose(clock: Res<Clock>, mut q: Query<TargetQuery, With<Tr
         }
         let Some(mut ff) = ff else { continue };
         let ff = &mut *ff;
-        let tau = ff.law.torques(&b.model, &q_d, v_d, clock.tick_s);
+        // `pose_configuration` sizes `q_d` and `v_d` by the model.
+        let tau = ff
+            .law
+            .torques(&b.model, &q_d, v_d, clock.tick_s)
+            .expect("a pose configuration has the model's sizes");
         pd.feedforward.clear();
         pd.feedforward.extend(b.dof_v.iter().map(|&k| tau[k]));
         if let Some(mut a) = assist.filter(|_| ff.root) {
@@ -747,8 +754,8 @@ pub fn log_characters(
     for (human, state, monitor, pd, binding, pose, reaction, assist, mut log) in &mut q {
         let b = &**human;
         let log = &mut *log;
-        log.angles.resize(b.model.nv, 0.0);
-        log.reference.resize(b.model.nv, 0.0);
+        log.angles.resize(b.model.nv(), 0.0);
+        log.reference.resize(b.model.nv(), 0.0);
         for (d, &c) in binding.dof_columns().iter().enumerate() {
             log.reference[b.dof_v[d]] = pose.theta[c];
         }
@@ -776,7 +783,7 @@ pub fn log_characters(
         }
         if before_push {
             log.tracked_ticks += 1;
-            let up = -b.model.gravity.normalize_or_zero();
+            let up = -b.model.gravity().normalize_or_zero();
             let pull = assist.map_or(0.0, |a| -a.feedforward.force.dot(up));
             if pull > log.max_pull_n {
                 log.max_pull_n = pull;

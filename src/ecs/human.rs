@@ -64,7 +64,7 @@ pub fn publish_body_pose(
     let (all, angles) = &mut *scratch;
     for (human, state, mut joints) in &mut q {
         let b = &**human;
-        all.resize(b.model.nv, 0.0);
+        all.resize(b.model.nv(), 0.0);
         b.model.angles(&state.q, all);
         angles.clear();
         angles.extend(b.dof_v.iter().map(|&k| all[k]));

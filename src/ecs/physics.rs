@@ -181,7 +181,7 @@ impl PhysicsBundle {
     /// A body of `model` actuated at the velocity indices `dofs`, at configuration `q`, at
     /// rest, integrated with `integrator`.
     pub fn new(model: Arc<Model>, dofs: Arc<[usize]>, integrator: Integrator, q: Vec<f64>) -> Self {
-        let state = State::new(q, vec![0.0; model.nv], model.nbodies());
+        let state = State::new(q, vec![0.0; model.nv()], model.nbodies());
         let workspace = StepWorkspace::new(&model);
         let monitor = StepMonitor::new(model.nbodies(), dofs.len());
         Self {

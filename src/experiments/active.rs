@@ -418,7 +418,7 @@ fn frame_stride(config: &ActiveConfig) -> usize {
 
 /// The body's configurations as a clip on its figure model.
 fn body_clip(body: &HumanBody, configurations: &[Vec<f64>], frame_time: f64) -> FigureClip {
-    let mut all = vec![0.0; body.model.nv];
+    let mut all = vec![0.0; body.model.nv()];
     let mut angles = Vec::with_capacity(configurations.len() * body.dof_v.len());
     let mut root_translation = Vec::with_capacity(configurations.len());
     let mut root_rotation = Vec::with_capacity(configurations.len());
@@ -481,7 +481,7 @@ fn outcome(
         .filter(|s| before(s.time_s))
         .map(|s| (s.time_s, s.mean_sq_error.sqrt().to_degrees()))
         .fold((0.0, 0.0), |a, b| if b.1 > a.1 { b } else { a });
-    let weight = body.model.total_mass() * body.model.gravity.length();
+    let weight = body.model.total_mass() * body.model.gravity().length();
     let pull = FloorPull {
         max_bw: log.max_pull_n / weight,
         at_s: log.max_pull_time_s,

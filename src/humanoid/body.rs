@@ -479,7 +479,7 @@ fn dof_velocity_indices(fig: &Figure, model: &Model) -> Vec<usize> {
                 .iter()
                 .position(|&x| fig.dofs[x].name == d.name)
                 .unwrap_or(0);
-            model.v_idx[j] + k
+            model.v_offset(j) + k
         })
         .collect()
 }
@@ -498,7 +498,7 @@ impl HumanBody {
         let r = root_rot.normalize();
         q[3..7].copy_from_slice(&[r.x, r.y, r.z, r.w]);
         for (j, joint) in self.figure.joints.iter().enumerate() {
-            let b = &self.model.bodies[j];
+            let b = &self.model.bodies()[j];
             let n = joint.dofs.len();
             if n == 0 {
                 continue;
@@ -507,7 +507,7 @@ impl HumanBody {
             for (k, &d) in joint.dofs.iter().enumerate() {
                 a[k] = angles[d];
             }
-            let iq = self.model.q_idx[j];
+            let iq = self.model.q_offset(j);
             b.joint.set_angles(&a[..n], &mut q[iq..iq + b.joint.nq()]);
         }
         q
@@ -527,8 +527,8 @@ mod tests {
     fn de_leva_masses_sum_to_the_body_mass() {
         let b = fall21_body(1.70, 65.0, 9.81).unwrap();
         assert_eq!(b.model.nbodies(), 15);
-        assert_eq!(b.model.nv, 27);
-        assert_eq!(b.model.nq, 29);
+        assert_eq!(b.model.nv(), 27);
+        assert_eq!(b.model.nq(), 29);
         assert!(
             (b.model.total_mass() - 65.0).abs() < 1e-9,
             "{}",
@@ -551,7 +551,7 @@ mod tests {
         let mut data = crate::dynamics::data::Data::new(&b.model);
         crate::dynamics::kinematics::kinematics(&b.model, &mut data, &q, &[0.0; 27]);
         let mut c = DVec3::ZERO;
-        for (i, body) in b.model.bodies.iter().enumerate() {
+        for (i, body) in b.model.bodies().iter().enumerate() {
             c += (data.pos[i] + data.rot[i] * body.inertia.com) * body.inertia.mass;
         }
         let c = c / b.model.total_mass();
@@ -585,7 +585,7 @@ mod tests {
             ("right_foot", (1, 0)),
         ] {
             let i = b.link_index(link).unwrap();
-            let ic = b.model.bodies[i].inertia.inertia_com;
+            let ic = b.model.bodies()[i].inertia.inertia_com;
             let d = [ic.x_axis.x, ic.y_axis.y, ic.z_axis.z];
             let boxm = box_moments(b.boxes[i].half).to_array();
             assert!(d[ax] > d[bx], "{link}: I = {d:?}");
@@ -593,8 +593,8 @@ mod tests {
         }
         // The torso's flexion inertia (about X) from de Leva's transverse radii.
         let torso = b.link_index("torso").unwrap();
-        let flex = b.model.bodies[torso].inertia.inertia_com.x_axis.x;
-        let lat = b.model.bodies[torso].inertia.inertia_com.z_axis.z;
+        let flex = b.model.bodies()[torso].inertia.inertia_com.x_axis.x;
+        let lat = b.model.bodies()[torso].inertia.inertia_com.z_axis.z;
         println!("torso flexion inertia {flex:.3} kg·m², lateral {lat:.3} kg·m²");
         assert!(flex < lat);
     }
@@ -608,8 +608,8 @@ mod tests {
         let pelvis = b.link_index("pelvis").unwrap();
         let waist_y = b.figure.joints[torso].offset.y;
         let neck_y = b.figure.joints[b.link_index("head").unwrap()].offset.y;
-        let pc = b.model.bodies[pelvis].inertia.com.y;
-        let tc = b.model.bodies[torso].inertia.com.y;
+        let pc = b.model.bodies()[pelvis].inertia.com.y;
+        let tc = b.model.bodies()[torso].inertia.com.y;
         assert!(
             pc > 0.0 && pc < waist_y,
             "pelvis COM {pc} vs waist {waist_y}"
@@ -633,7 +633,7 @@ mod tests {
         assert_eq!(b.dof_v.len(), 21);
         let knee = b.figure.dof_index("right_knee").unwrap();
         let shin = b.link_index("right_shin").unwrap();
-        assert_eq!(b.dof_v[knee], b.model.v_idx[shin]);
+        assert_eq!(b.dof_v[knee], b.model.v_offset(shin));
         // Every velocity DOF past the root is hit exactly once.
         let mut seen = b.dof_v.to_vec();
         seen.sort();
@@ -645,7 +645,7 @@ mod tests {
         let b = humanoid24_body(1.70, 65.0, 9.81).unwrap();
         // 17 links: the fixed neck, wrists and ankles weld head, hands and feet to their parents.
         assert_eq!(b.model.nbodies(), 17);
-        assert_eq!(b.model.nv, 6 + 24);
+        assert_eq!(b.model.nv(), 6 + 24);
         assert_eq!(b.dof_v.len(), 24);
         assert!(
             (b.model.total_mass() - 65.0).abs() < 1e-9,
@@ -654,7 +654,7 @@ mod tests {
         );
         for link in ["head", "left_hand", "right_foot"] {
             let i = b.link_index(link).unwrap();
-            assert_eq!(b.model.bodies[i].joint, JointType::Fixed, "{link}");
+            assert_eq!(b.model.bodies()[i].joint, JointType::Fixed, "{link}");
         }
         // Every velocity DOF past the root is one humanoid24 DOF, exactly once.
         let mut seen = b.dof_v.to_vec();
@@ -671,8 +671,8 @@ mod tests {
             "left_hand",
         ] {
             let (x, y) = (
-                &b.model.bodies[b.link_index(link).unwrap()].inertia,
-                &f.model.bodies[f.link_index(link).unwrap()].inertia,
+                &b.model.bodies()[b.link_index(link).unwrap()].inertia,
+                &f.model.bodies()[f.link_index(link).unwrap()].inertia,
             );
             assert!((x.mass - y.mass).abs() < 1e-12, "{link}");
             assert!(
@@ -681,11 +681,15 @@ mod tests {
             );
         }
         // The chest gives the girdle its share: chest + 2 clavicles = fall21's torso.
-        let chest = b.model.bodies[b.link_index("chest").unwrap()].inertia.mass;
-        let clav = b.model.bodies[b.link_index("left_clavicle").unwrap()]
+        let chest = b.model.bodies()[b.link_index("chest").unwrap()]
             .inertia
             .mass;
-        let torso = f.model.bodies[f.link_index("torso").unwrap()].inertia.mass;
+        let clav = b.model.bodies()[b.link_index("left_clavicle").unwrap()]
+            .inertia
+            .mass;
+        let torso = f.model.bodies()[f.link_index("torso").unwrap()]
+            .inertia
+            .mass;
         assert!((chest + 2.0 * clav - torso).abs() < 1e-9);
         assert!(clav > 0.0 && clav < 0.02 * 65.0);
     }
@@ -696,7 +700,7 @@ mod tests {
         // sagittal radius) than about X; the thigh's longitudinal moment (Y) is the smallest.
         let b = humanoid24_body(1.70, 65.0, 9.81).unwrap();
         let d = |link: &str| {
-            let ic = b.model.bodies[b.link_index(link).unwrap()]
+            let ic = b.model.bodies()[b.link_index(link).unwrap()]
                 .inertia
                 .inertia_com;
             [ic.x_axis.x, ic.y_axis.y, ic.z_axis.z]

@@ -36,7 +36,7 @@ fn inertia_urdf(i: DMat3) -> String {
 /// The revolute axes of body `b`'s joint, one per DOF, with the DOF names.
 fn revolutes(body: &HumanBody, b: usize) -> Vec<(String, DVec3)> {
     let j = &body.figure.joints[b];
-    let axes: Vec<DVec3> = match body.model.bodies[b].joint {
+    let axes: Vec<DVec3> = match body.model.bodies()[b].joint {
         JointType::Pin { axis } => vec![axis],
         JointType::Universal { axis1, axis2 } => vec![axis1, axis2],
         JointType::Ball { axes } => vec![axes.x_axis, axes.y_axis, axes.z_axis],
@@ -62,7 +62,7 @@ pub fn to_urdf(body: &HumanBody, ranges: &[(f64, f64)], strength: &[(f64, f64)])
     );
     let _ = writeln!(s, "<robot name=\"fall21\">");
     let dof_index = |name: &str| body.figure.dof_index(name).unwrap_or(0);
-    for (b, mb) in body.model.bodies.iter().enumerate() {
+    for (b, mb) in body.model.bodies().iter().enumerate() {
         let i = &mb.inertia;
         let bx = &body.boxes[b];
         let _ = writeln!(s, "  <link name=\"{}\">", mb.name);
@@ -83,7 +83,7 @@ pub fn to_urdf(body: &HumanBody, ranges: &[(f64, f64)], strength: &[(f64, f64)])
         let Some(parent) = mb.parent else { continue };
         let offset = body.figure.joints[b].offset;
         let revs = revolutes(body, b);
-        let mut from = body.model.bodies[parent].name.clone();
+        let mut from = body.model.bodies()[parent].name.clone();
         if matches!(mb.joint, JointType::Fixed) {
             let _ = writeln!(
                 s,
@@ -161,7 +161,7 @@ fn write_mjcf_body(
     depth: usize,
 ) {
     let pad = "  ".repeat(depth + 2);
-    let mb = &body.model.bodies[b];
+    let mb = &body.model.bodies()[b];
     let pos = if mb.parent.is_some() {
         body.figure.joints[b].offset
     } else {
@@ -213,7 +213,7 @@ fn write_mjcf_body(
         v3(bx.center),
         v3(bx.half)
     );
-    for (k, child) in body.model.bodies.iter().enumerate() {
+    for (k, child) in body.model.bodies().iter().enumerate() {
         if child.parent == Some(b) {
             write_mjcf_body(s, body, k, ranges, depth + 1);
         }

@@ -86,9 +86,9 @@ fn random_model(rng: &mut Pcg64, n: usize, free_root: bool) -> Model {
 }
 
 fn random_state(rng: &mut Pcg64, m: &Model) -> (Vec<f64>, Vec<f64>, Vec<f64>, Vec<ForceVec>) {
-    let mut q = vec![0.0; m.nq];
-    for (i, b) in m.bodies.iter().enumerate() {
-        let qi = &mut q[m.q_idx[i]..m.q_idx[i] + b.joint.nq()];
+    let mut q = vec![0.0; m.nq()];
+    for (i, b) in m.bodies().iter().enumerate() {
+        let qi = &mut q[m.q_offset(i)..m.q_offset(i) + b.joint.nq()];
         match b.joint {
             JointType::Ball { .. } => {
                 let qq = DQuat::from_axis_angle(unit(rng), rng.random_range(-3.0..3.0));
@@ -102,8 +102,8 @@ fn random_state(rng: &mut Pcg64, m: &Model) -> (Vec<f64>, Vec<f64>, Vec<f64>, Ve
             _ => qi.iter_mut().for_each(|x| *x = rng.random_range(-3.0..3.0)),
         }
     }
-    let v = (0..m.nv).map(|_| rng.random_range(-2.0..2.0)).collect();
-    let tau = (0..m.nv).map(|_| rng.random_range(-5.0..5.0)).collect();
+    let v = (0..m.nv()).map(|_| rng.random_range(-2.0..2.0)).collect();
+    let tau = (0..m.nv()).map(|_| rng.random_range(-5.0..5.0)).collect();
     let f_ext = (0..m.nbodies())
         .map(|_| ForceVec::new(unit(rng) * 2.0, unit(rng) * 3.0))
         .collect();
@@ -117,9 +117,9 @@ fn worst_disagreement(m: &Model, rng: &mut Pcg64, states: usize) -> (f64, f64) {
     let (mut worst_rnea, mut worst_crba) = (0.0f64, 0.0f64);
     for _ in 0..states {
         let (q, v, tau, f_ext) = random_state(rng, m);
-        let qdd = aba(m, &mut data, &q, &v, &tau, &f_ext).to_vec();
+        let qdd = aba(m, &mut data, &q, &v, &tau, &f_ext).unwrap().to_vec();
         assert!(qdd.iter().all(|x| x.is_finite()));
-        let tau2 = rnea(m, &mut data, &q, &v, &qdd, &f_ext).to_vec();
+        let tau2 = rnea(m, &mut data, &q, &v, &qdd, &f_ext).unwrap().to_vec();
         let scale = 1.0 + tau.iter().fold(0.0f64, |a, x| a.max(x.abs()));
         worst_rnea = worst_rnea.max(max_abs_diff(&tau, &tau2) / scale);
         let qdd2 = forward_dynamics_crba(m, &mut data, &q, &v, &tau, &f_ext)
@@ -148,9 +148,9 @@ fn aba_agrees_with_rnea_and_crba_on_random_trees() {
         let mut data = Data::new(&m);
         for _ in 0..3 {
             let (q, v, tau, f_ext) = random_state(&mut rng, &m);
-            let qdd = aba(&m, &mut data, &q, &v, &tau, &f_ext).to_vec();
+            let qdd = aba(&m, &mut data, &q, &v, &tau, &f_ext).unwrap().to_vec();
             assert!(qdd.iter().all(|x| x.is_finite()));
-            let tau2 = rnea(&m, &mut data, &q, &v, &qdd, &f_ext).to_vec();
+            let tau2 = rnea(&m, &mut data, &q, &v, &qdd, &f_ext).unwrap().to_vec();
             let scale = 1.0 + tau.iter().fold(0.0f64, |a, x| a.max(x.abs()));
             let e1 = max_abs_diff(&tau, &tau2) / scale;
             assert!(e1 < 1e-9, "trial {trial}: RNEA(ABA) − τ = {e1:e}");
@@ -173,18 +173,21 @@ fn aba_agrees_with_rnea_and_crba_on_random_trees() {
 fn crba_matrix_is_symmetric_positive_definite_and_matches_rnea_columns() {
     // H e_k = RNEA(q, 0, e_k) − RNEA(q, 0, 0) with gravity off.
     let mut rng = Pcg64::seed_from_u64(7);
-    let mut m = random_model(&mut rng, 9, true);
-    m.gravity = DVec3::ZERO;
+    let m = random_model(&mut rng, 9, true).with_gravity(DVec3::ZERO);
     let mut data = Data::new(&m);
     let (q, _, _, _) = random_state(&mut rng, &m);
-    let nv = m.nv;
-    let h = marionette::dynamics::crba(&m, &mut data, &q).to_vec();
+    let nv = m.nv();
+    let h = marionette::dynamics::crba(&m, &mut data, &q)
+        .unwrap()
+        .to_vec();
     let zero_f = vec![ForceVec::ZERO; m.nbodies()];
     let zeros = vec![0.0; nv];
     for k in 0..nv {
         let mut e = vec![0.0; nv];
         e[k] = 1.0;
-        let col = rnea(&m, &mut data, &q, &zeros, &e, &zero_f).to_vec();
+        let col = rnea(&m, &mut data, &q, &zeros, &e, &zero_f)
+            .unwrap()
+            .to_vec();
         for r in 0..nv {
             assert!((col[r] - h[r * nv + k]).abs() < 1e-10);
             assert!((h[r * nv + k] - h[k * nv + r]).abs() < 1e-12);
@@ -204,4 +207,54 @@ fn aba_agrees_with_rnea_and_crba_on_the_human_bodies() {
         println!("{name}: RNEA(ABA) vs τ {e1:e}, ABA vs CRBA {e2:e} (relative, 50 random states)");
         assert!(e1 < 1e-9 && e2 < 1e-9, "{name}: {e1:e} {e2:e}");
     }
+}
+
+#[test]
+fn arguments_of_the_wrong_size_are_errors_that_name_both_sizes() {
+    use marionette::dynamics::ModelError;
+    use marionette::dynamics::kinematics::mechanical_energy;
+    let mut rng = Pcg64::seed_from_u64(11);
+    let m = random_model(&mut rng, 5, true);
+    let (q, v, tau, f_ext) = random_state(&mut rng, &m);
+    let (nq, nv, nb) = (m.nq(), m.nv(), m.nbodies());
+    let mut data = Data::new(&m);
+    let short = |x: &[f64]| x[..x.len() - 1].to_vec();
+    let mismatch = |e: ModelError, what: &'static str, expected: usize, found: usize| {
+        let msg = e.to_string();
+        assert_eq!(
+            e,
+            ModelError::SizeMismatch {
+                what,
+                expected,
+                found
+            }
+        );
+        assert_eq!(
+            msg,
+            format!("{what} has {found} entries, the model needs {expected}")
+        );
+    };
+    let e = aba(&m, &mut data, &short(&q), &v, &tau, &f_ext).unwrap_err();
+    mismatch(e, "q", nq, nq - 1);
+    let e = aba(&m, &mut data, &q, &short(&v), &tau, &f_ext).unwrap_err();
+    mismatch(e, "v", nv, nv - 1);
+    let e = aba(&m, &mut data, &q, &v, &short(&tau), &f_ext).unwrap_err();
+    mismatch(e, "tau", nv, nv - 1);
+    let e = aba(&m, &mut data, &q, &v, &tau, &f_ext[1..]).unwrap_err();
+    mismatch(e, "f_ext", nb, nb - 1);
+    let e = rnea(&m, &mut data, &q, &v, &short(&tau), &f_ext).unwrap_err();
+    mismatch(e, "qdd", nv, nv - 1);
+    let e = marionette::dynamics::crba(&m, &mut data, &short(&q)).unwrap_err();
+    mismatch(e, "q", nq, nq - 1);
+    let e = forward_dynamics_crba(&m, &mut data, &q, &v, &short(&tau), &f_ext).unwrap_err();
+    mismatch(e, "tau", nv, nv - 1);
+    let e = mechanical_energy(&m, &mut data, &q, &short(&v)).unwrap_err();
+    mismatch(e, "v", nv, nv - 1);
+    // A workspace of another model.
+    let other = random_model(&mut rng, 3, true);
+    let mut small = Data::new(&other);
+    let e = aba(&m, &mut small, &q, &v, &tau, &f_ext).unwrap_err();
+    mismatch(e, "data (bodies)", nb, other.nbodies());
+    // The right sizes still work.
+    assert!(aba(&m, &mut data, &q, &v, &tau, &f_ext).is_ok());
 }

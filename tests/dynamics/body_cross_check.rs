@@ -61,13 +61,13 @@ fn pinocchio_agrees_with_the_engines_rnea_and_aba_on_the_urdf() {
     let mut neck_v = Vec::new();
     for (d, dof) in body.figure.dofs.iter().enumerate() {
         let b = dof.joint;
-        let k = body.dof_v[d] - m.v_idx[b];
-        let q = match m.bodies[b].joint {
+        let k = body.dof_v[d] - m.v_offset(b);
+        let q = match m.bodies()[b].joint {
             JointType::Ball { .. } => {
                 neck_v.push(body.dof_v[d]);
                 serde_json::Value::Null
             }
-            _ => json!(m.q_idx[b] + k),
+            _ => json!(m.q_offset(b) + k),
         };
         dofs.insert(dof.name.clone(), json!({"v": body.dof_v[d], "q": q}));
     }
@@ -92,16 +92,16 @@ fn pinocchio_agrees_with_the_engines_rnea_and_aba_on_the_urdf() {
         let mut q = body.configuration(&angles, pos, rot);
         // The neck at the identity and at rest (URDF writes it as three revolutes).
         let neck = body.link_index("head").unwrap();
-        let iq = m.q_idx[neck];
+        let iq = m.q_offset(neck);
         q[iq..iq + 4].copy_from_slice(&[0.0, 0.0, 0.0, 1.0]);
-        let mut v: Vec<f64> = (0..m.nv).map(|_| rng.random_range(-2.0..2.0)).collect();
+        let mut v: Vec<f64> = (0..m.nv()).map(|_| rng.random_range(-2.0..2.0)).collect();
         for &k in &neck_v {
             v[k] = 0.0;
         }
-        let a: Vec<f64> = (0..m.nv).map(|_| rng.random_range(-5.0..5.0)).collect();
-        let tau_in: Vec<f64> = (0..m.nv).map(|_| rng.random_range(-20.0..20.0)).collect();
-        let tau_rnea = rnea(m, &mut data, &q, &v, &a, &zero).to_vec();
-        let qdd_aba = aba(m, &mut data, &q, &v, &tau_in, &zero).to_vec();
+        let a: Vec<f64> = (0..m.nv()).map(|_| rng.random_range(-5.0..5.0)).collect();
+        let tau_in: Vec<f64> = (0..m.nv()).map(|_| rng.random_range(-20.0..20.0)).collect();
+        let tau_rnea = rnea(m, &mut data, &q, &v, &a, &zero).unwrap().to_vec();
+        let qdd_aba = aba(m, &mut data, &q, &v, &tau_in, &zero).unwrap().to_vec();
         states.push(json!({
             "q": q, "v": v, "a": a, "tau_rnea": tau_rnea, "tau_in": tau_in, "qdd_aba": qdd_aba,
         }));
@@ -165,7 +165,7 @@ fn mujoco_follows_the_pushed_fall_until_first_contact() {
         })
         .collect();
     let neck = body.link_index("head").unwrap();
-    let JointType::Ball { axes } = body.model.bodies[neck].joint else {
+    let JointType::Ball { axes } = body.model.bodies()[neck].joint else {
         panic!("the neck is a ball joint")
     };
     let start = &r.frames[0];

@@ -39,7 +39,7 @@ impl Dynamics for BoxOnFloor {
         self.f_ext[0] = ForceVec::ZERO;
         self.contact
             .apply(&self.data, &self.state, &mut self.f_ext, &mut self.normal);
-        aba(&self.model, &mut self.data, q, v, &self.tau, &self.f_ext);
+        aba(&self.model, &mut self.data, q, v, &self.tau, &self.f_ext).unwrap();
         qdd.copy_from_slice(&self.data.qdd);
         Ok(())
     }
@@ -200,7 +200,7 @@ impl Dynamics for Lever {
         qdd: &mut [f64],
     ) -> Result<(), Infallible> {
         let (tau, _) = joint_torque(&self.params, self.range, q[0], v[0]);
-        aba(&self.model, &mut self.data, q, v, &[tau], &[ForceVec::ZERO]);
+        aba(&self.model, &mut self.data, q, v, &[tau], &[ForceVec::ZERO]).unwrap();
         qdd[0] = self.data.qdd[0];
         Ok(())
     }

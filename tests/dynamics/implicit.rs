@@ -84,12 +84,12 @@ fn drop(integrator: Integrator, dt: f64, lift: f64, seconds: f64) -> Result<Vec<
     let start = &ch.physics.state.0;
     let mut q = start.q.clone();
     q[1] += lift;
-    let mut state = State::new(q, vec![0.0; model.nv], body.link_names.len());
+    let mut state = State::new(q, vec![0.0; model.nv()], body.link_names.len());
     let mut ws = StepWorkspace::new(model);
     let mut monitor = StepMonitor::new(body.link_names.len(), body.dof_v.len());
     let mut data = Data::new(model);
     let energy = |s: &State, data: &mut Data| {
-        let (t, v) = mechanical_energy(model, data, &s.q, &s.v);
+        let (t, v) = mechanical_energy(model, data, &s.q, &s.v).unwrap();
         t + v
     };
     let settings = StepSettings { integrator, dt };
@@ -499,7 +499,7 @@ fn a_refined_step_is_its_sub_steps() {
     let forces = passive(&ch);
     let mut q = ch.physics.state.0.q.clone();
     q[1] += 0.2;
-    let start = State::new(q, vec![0.0; model.nv], body.link_names.len());
+    let start = State::new(q, vec![0.0; model.nv()], body.link_names.len());
     let (h, k) = (2e-3, 4);
     let mut runs = Vec::new();
     for refined in [true, false] {

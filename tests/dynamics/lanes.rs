@@ -201,10 +201,10 @@ fn every_lane_has_the_bits_of_the_scalar_aba() {
             DVec3::new(0.1 * x, 0.9, -0.2),
             DQuat::from_axis_angle(DVec3::new(0.2, 1.0, 0.1 * x).normalize(), 0.4 * x),
         );
-        let v: Vec<f64> = (0..model.nv)
+        let v: Vec<f64> = (0..model.nv())
             .map(|k| 0.5 * ((k as f64) * 1.3 + x).cos())
             .collect();
-        let tau: Vec<f64> = (0..model.nv)
+        let tau: Vec<f64> = (0..model.nv())
             .map(|k| {
                 if k < 6 {
                     0.0
@@ -221,7 +221,7 @@ fn every_lane_has_the_bits_of_the_scalar_aba() {
                 )
             })
             .collect();
-        let arm: Vec<f64> = (0..model.nv).map(|k| 1e-3 * (k as f64 + x)).collect();
+        let arm: Vec<f64> = (0..model.nv()).map(|k| 1e-3 * (k as f64 + x)).collect();
         (q, v, tau, f_ext, arm)
     };
     let inputs: Vec<_> = (0..LANES + 1).map(lane_inputs).collect();

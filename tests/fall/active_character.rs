@@ -382,7 +382,7 @@ fn the_release_switches_the_pd_to_the_key_pose() {
     assert_ne!(pd.target, key.target, "switched before the release");
     let knee_at = |w: &bevy_ecs::world::World| {
         let st = w.get::<BodyState>(e).unwrap();
-        let mut a = vec![0.0; body.model.nv];
+        let mut a = vec![0.0; body.model.nv()];
         body.model.angles(&st.q, &mut a);
         a[body.dof_v[knee]]
     };

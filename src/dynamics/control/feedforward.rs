@@ -8,7 +8,7 @@ use glam::{DQuat, DVec3};
 
 use super::assist::Wrench;
 use crate::dynamics::data::Data;
-use crate::dynamics::model::Model;
+use crate::dynamics::model::{Model, ModelError};
 use crate::dynamics::rnea;
 use crate::dynamics::spatial::ForceVec;
 
@@ -25,8 +25,16 @@ impl ComputedTorque {
     /// `τ_ff = RNEA(q_d, q̇_d, q̈_d)` (N·m per hinge, `nv` entries, the free root's first) of
     /// `model` at the desired configuration `q_d` and velocity `v_d`, with
     /// `q̈_d = (q̇_d − q̇_d,prev) / dt` from the previous call's `v_d` (`dt` in s; zero at the
-    /// first call).
-    pub fn torques(&mut self, model: &Model, q_d: &[f64], v_d: Vec<f64>, dt: f64) -> &[f64] {
+    /// first call). A `q_d` or `v_d` of another size than the model's is a
+    /// [`ModelError::SizeMismatch`].
+    pub fn torques(
+        &mut self,
+        model: &Model,
+        q_d: &[f64],
+        v_d: Vec<f64>,
+        dt: f64,
+    ) -> Result<&[f64], ModelError> {
+        model.check_state(q_d, &v_d)?;
         self.acceleration.resize(v_d.len(), 0.0);
         if let Some(prev) = &self.previous_velocity {
             for ((a, v), p) in self.acceleration.iter_mut().zip(&v_d).zip(prev) {
@@ -35,9 +43,9 @@ impl ComputedTorque {
         }
         let data = self.data.get_or_insert_with(|| Data::new(model));
         let f_ext = vec![ForceVec::ZERO; model.nbodies()];
-        let tau = rnea(model, data, q_d, &v_d, &self.acceleration, &f_ext);
+        let tau = rnea(model, data, q_d, &v_d, &self.acceleration, &f_ext)?;
         self.previous_velocity = Some(v_d);
-        tau
+        Ok(tau)
     }
 }
 

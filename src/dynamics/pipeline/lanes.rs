@@ -5,8 +5,8 @@
 
 use super::integrate::{Evaluation, Implicit, finish};
 use super::{
-    Forces, State, StepError, StepMonitor, StepSettings, StepWorkspace, check_stage, start_stages,
-    step_stages,
+    Forces, State, StepError, StepMonitor, StepSettings, StepWorkspace, check_sizes, check_stage,
+    start_stages, step, step_stages,
 };
 use crate::dynamics::aba_lanes::{LaneData, LaneInput, lanes_inline};
 use crate::dynamics::integrator::{self, Integrator};
@@ -33,7 +33,9 @@ pub struct LaneBody<'a> {
 /// alone, with the articulated-body algorithm of [`LANES`] bodies at a time in the lanes of
 /// one vector computation ([`crate::dynamics::aba_lanes`]). That holds for semi-implicit
 /// Euler with the floor's damping explicit; any other scheme steps each body by [`step`].
-/// A body whose step fails keeps its error in `result` and the others go on.
+/// A body whose step fails keeps its error in `result` and the others go on; one whose state or
+/// workspace does not fit the model is not stepped (a [`StepError::Size`]), and the others are
+/// then each stepped by [`step`].
 ///
 /// [`step`]: super::step
 /// [`LANES`]: crate::dynamics::lanes::LANES
@@ -43,6 +45,17 @@ pub fn step_lanes(
     bodies: &mut [LaneBody],
     lanes: &mut LaneData,
 ) {
+    let mut fit = true;
+    for b in bodies.iter_mut() {
+        b.result = check_sizes(model, b.state, b.ws).map_err(StepError::from);
+        fit &= b.result.is_ok();
+    }
+    if !fit {
+        for b in bodies.iter_mut().filter(|b| b.result.is_ok()) {
+            b.result = step(model, settings, &b.forces, b.state, b.ws, b.monitor);
+        }
+        return;
+    }
     #[cfg(target_arch = "x86_64")]
     if crate::cpu::has_avx2() {
         // SAFETY: the processor supports AVX2 (detected at run time just above).

@@ -41,7 +41,7 @@ use super::forces::limits::JointRanges;
 use super::forces::pd::PdTargets;
 use super::integrator::{Dynamics, Integrator, IntegratorWorkspace};
 use super::kinematics::kinematics;
-use super::model::Model;
+use super::model::{Model, ModelError};
 use super::spatial::{ArticulatedInertia, ForceVec};
 use check::check_stage;
 use contact::contact_stage;
@@ -254,6 +254,17 @@ pub enum StepError {
         /// Allowed magnitude.
         limit: f64,
     },
+    /// The state or the workspace does not fit the model ([`ModelError::SizeMismatch`]).
+    #[error(transparent)]
+    Size(#[from] ModelError),
+}
+
+/// `Ok` when `state` (`q`: nq, `v`: nv) and the workspace (built by [`StepWorkspace::new`])
+/// fit `model`, else [`ModelError::SizeMismatch`].
+#[inline]
+pub fn check_sizes(model: &Model, state: &State, ws: &StepWorkspace) -> Result<(), ModelError> {
+    model.check_state(&state.q, &state.v)?;
+    model.check_data(&ws.eval.data)
 }
 
 /// Largest speed (m/s or rad/s) and position excursion (m) before a run counts as exploding:
@@ -264,7 +275,8 @@ pub const MAX_SPEED: f64 = 2000.0;
 pub const MAX_EXTENT: f64 = 100.0;
 
 /// One step of `settings.dt` seconds through the five stages; advances `state` (time
-/// `steps · dt`) and accounts for the step in `monitor`.
+/// `steps · dt`) and accounts for the step in `monitor`. A state or workspace of another size
+/// than the model's is a [`StepError::Size`] and leaves everything as it was.
 ///
 /// On an x86-64 processor with AVX2 the stages run in a copy of their code compiled for it
 /// (chosen once per process, [`crate::cpu::has_avx2`]); on evolved falls it took about 5 % less
@@ -278,6 +290,7 @@ pub fn step(
     ws: &mut StepWorkspace,
     monitor: &mut StepMonitor,
 ) -> Result<(), StepError> {
+    check_sizes(model, state, ws)?;
     #[cfg(target_arch = "x86_64")]
     if crate::cpu::has_avx2() {
         // SAFETY: the processor supports AVX2 (detected at run time just above).
@@ -357,9 +370,11 @@ pub fn step_refined(
             ws.eval.kinematics_at_step = Some(steps);
         }
         step(model, sub, forces, state, ws, monitor).map_err(|mut e| {
-            let (StepError::NonFinite { time_s, .. } | StepError::Exploding { time_s, .. }) =
-                &mut e;
-            *time_s = t0 + f64::from(j + 1) * h;
+            if let StepError::NonFinite { time_s, .. } | StepError::Exploding { time_s, .. } =
+                &mut e
+            {
+                *time_s = t0 + f64::from(j + 1) * h;
+            }
             e
         })?;
     }
@@ -440,7 +455,8 @@ pub(super) fn step_stages(
 /// The acceleration `q̈(q, v)` (size nv) the body of `state` has under `forces` at its
 /// configuration and velocity, with its friction anchors as they are (not brought to the state)
 /// and joint damping explicit; time `state.time_s`. The force model is the one a step
-/// integrates; the workspace's cached kinematics are invalidated.
+/// integrates; the workspace's cached kinematics are invalidated. Arguments of another size
+/// than the model's are a [`StepError::Size`].
 pub fn acceleration(
     model: &Model,
     forces: &Forces,
@@ -448,6 +464,8 @@ pub fn acceleration(
     ws: &mut StepWorkspace,
     qdd: &mut [f64],
 ) -> Result<(), StepError> {
+    check_sizes(model, state, ws)?;
+    super::model::check_size("qdd", model.nv, qdd.len())?;
     // Nothing computed at a step start: the evaluation computes every force itself.
     let mut f = Evaluation::new(model, forces, &state.anchors, &mut ws.eval, None);
     f.acceleration(state.time_s, &state.q, &state.v, None, qdd)
@@ -465,6 +483,7 @@ pub fn read_angles(
     reference: &mut [f64],
     out: &mut [f64],
 ) {
+    debug_assert!(q.len() == model.nq && reference.len() == model.nv);
     match forces.pd {
         Some(pd) => {
             reference.fill(0.0);

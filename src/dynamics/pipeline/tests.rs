@@ -7,6 +7,23 @@ use glam::DVec3;
 
 const SIZE: DVec3 = DVec3::new(0.4, 0.2, 0.3);
 
+/// No force at all.
+const NO_FORCES: Forces<'static> = Forces {
+    dofs: &[],
+    pd: None,
+    limits: None,
+    contact: None,
+    external: &[],
+};
+
+/// Semi-implicit Euler, damping explicit, steps of 1 ms.
+const EULER_1MS: StepSettings = StepSettings {
+    integrator: Integrator::SemiImplicitEuler {
+        implicit_damping: false,
+    },
+    dt: 1e-3,
+};
+
 fn free_box() -> Model {
     Model::new(
         vec![Body {
@@ -28,12 +45,7 @@ fn run(model: &Model, forces: &Forces, steps: usize) -> (State, StepMonitor) {
     let mut state = State::new(q, vec![0.0; model.nv], 1);
     let mut ws = StepWorkspace::new(model);
     let mut monitor = StepMonitor::new(1, 0);
-    let settings = StepSettings {
-        integrator: Integrator::SemiImplicitEuler {
-            implicit_damping: false,
-        },
-        dt: 1e-3,
-    };
+    let settings = EULER_1MS;
     for _ in 0..steps {
         step(model, settings, forces, &mut state, &mut ws, &mut monitor).unwrap();
     }
@@ -43,13 +55,7 @@ fn run(model: &Model, forces: &Forces, steps: usize) -> (State, StepMonitor) {
 #[test]
 fn a_force_that_is_absent_is_not_felt() {
     let model = free_box();
-    let none = Forces {
-        dofs: &[],
-        pd: None,
-        limits: None,
-        contact: None,
-        external: &[],
-    };
+    let none = NO_FORCES;
     // Free fall, semi-implicit Euler's closed form: y_n = y_0 − g h² n(n+1)/2.
     let n = 1000;
     let (s, m) = run(&model, &none, n);
@@ -176,4 +182,44 @@ fn pd_follows_a_moving_target_through_its_velocity_term() {
     let (tau, d) = pd.torque(0, 0.3, 0.5);
     assert!((tau - 15.0).abs() < 1e-12);
     assert_eq!(d, 10.0);
+}
+
+#[test]
+fn a_state_of_the_wrong_size_is_an_error_and_is_left_as_it_was() {
+    let model = free_box();
+    let none = NO_FORCES;
+    let settings = EULER_1MS;
+    let mut ws = StepWorkspace::new(&model);
+    let mut monitor = StepMonitor::new(1, 0);
+    let mut state = State::new(model.neutral(), vec![0.0; model.nv - 1], 1);
+    let before = state.clone();
+    let e = step(&model, settings, &none, &mut state, &mut ws, &mut monitor).unwrap_err();
+    assert_eq!(
+        e,
+        StepError::Size(ModelError::SizeMismatch {
+            what: "v",
+            expected: 6,
+            found: 5
+        })
+    );
+    assert_eq!(e.to_string(), "v has 5 entries, the model needs 6");
+    assert_eq!(state, before);
+    let mut state = State::new(vec![0.0; 3], vec![0.0; 6], 1);
+    let e = step_refined(
+        &model,
+        settings,
+        4,
+        &none,
+        &mut state,
+        &mut ws,
+        &mut monitor,
+    );
+    assert_eq!(
+        e.unwrap_err().to_string(),
+        "q has 3 entries, the model needs 7"
+    );
+    let state = State::new(model.neutral(), vec![0.0; 6], 1);
+    let mut qdd = vec![0.0; 5];
+    let e = acceleration(&model, &none, &state, &mut ws, &mut qdd).unwrap_err();
+    assert_eq!(e.to_string(), "qdd has 5 entries, the model needs 6");
 }

@@ -14,7 +14,7 @@ use std::sync::{Arc, Mutex};
 use bevy_ecs::prelude::*;
 
 use super::{FallCharacter, FallConfig, FallController, FallRecorder, FallResult, SimError};
-use crate::dynamics::crba::NotPositiveDefinite;
+use crate::dynamics::ModelError;
 use crate::dynamics::lanes::LANES;
 use crate::dynamics::stability::StiffnessBasis;
 use crate::ecs::human::{HumanFigure, add_human_physics_systems};
@@ -147,7 +147,7 @@ pub struct ReactionStart {
     standing: FallCharacter,
     /// What the stability check of every reaction finds on `standing` independently of the
     /// gains, found once (or why it could not be).
-    stiffness: Result<StiffnessBasis, NotPositiveDefinite>,
+    stiffness: Result<StiffnessBasis, ModelError>,
     /// The character at the reaction time.
     reacting: FallCharacter,
     /// The World's clock at the reaction time.

@@ -27,7 +27,7 @@ use std::sync::Arc;
 
 use glam::{DQuat, DVec3};
 
-use crate::dynamics::crba::NotPositiveDefinite;
+use crate::dynamics::ModelError;
 use crate::dynamics::data::Data;
 use crate::dynamics::equilibrium::{BalanceSettings, balance_base, holding_torques};
 use crate::dynamics::forces::contact::ContactModel;
@@ -383,7 +383,7 @@ fn standing_configuration(
 ) -> Vec<f64> {
     let mut q = body.configuration(pose, DVec3::ZERO, DQuat::IDENTITY);
     let mut data = Data::new(&body.model);
-    let zeros = vec![0.0; body.model.nv];
+    let zeros = vec![0.0; body.model.nv()];
     kinematics(&body.model, &mut data, &q, &zeros);
     let n_up = cfg.contact.floor_normal;
     let mut lowest = f64::INFINITY;
@@ -417,7 +417,7 @@ pub fn check_stability(cfg: &FallConfig, ch: &FallCharacter) -> Result<(), SimEr
 pub(crate) fn check_stability_with(
     cfg: &FallConfig,
     ch: &FallCharacter,
-    basis: &Result<StiffnessBasis, NotPositiveDefinite>,
+    basis: &Result<StiffnessBasis, ModelError>,
 ) -> Result<(), SimError> {
     let body = &*ch.human;
     let basis = basis.as_ref().map_err(|e| cfg_err("body", e.to_string()))?;
@@ -450,7 +450,7 @@ pub fn stiffest_mode_of_config(cfg: &FallConfig) -> Result<Option<StiffestMode>,
 pub(crate) fn stiffness_basis(
     cfg: &FallConfig,
     ch: &FallCharacter,
-) -> Result<StiffnessBasis, NotPositiveDefinite> {
+) -> Result<StiffnessBasis, ModelError> {
     let body = &*ch.human;
     StiffnessBasis::new(
         &body.model,
@@ -579,7 +579,7 @@ fn assemble(cfg: &FallConfig) -> Result<FallCharacter, SimError> {
     } = validate(cfg)?;
     let rad = |v: &[f64]| v.iter().map(|x| x.to_radians()).collect::<Vec<_>>();
     let stance_pose = rad(&cfg.stance_pose_deg);
-    let masses: Vec<f64> = body.model.bodies.iter().map(|b| b.inertia.mass).collect();
+    let masses: Vec<f64> = body.model.bodies().iter().map(|b| b.inertia.mass).collect();
     let gains: Vec<_> = body
         .link_names
         .iter()
@@ -603,7 +603,7 @@ fn assemble(cfg: &FallConfig) -> Result<FallCharacter, SimError> {
             .collect(),
         None => Vec::new(),
     };
-    let nv = body.model.nv;
+    let nv = body.model.nv();
     let (mut physics, human) = human_physics(body, cfg.integrator, q);
     physics.body.refinement = reaction_refinement(cfg);
     Ok(FallCharacter {
@@ -674,7 +674,7 @@ fn settle(cfg: &FallConfig, ch: &FallCharacter) -> Result<(pipeline::State, Vec<
         external: &[],
     };
     relax_to_rest(cfg, model, settings, &forces, &mut state, &mut ws)?;
-    let base = model.v_idx[0]..model.v_idx[0] + model.bodies[0].joint.nv();
+    let base = model.v_offset(0)..model.v_offset(0) + model.bodies()[0].joint.nv();
     balance_base(
         model,
         &forces,
@@ -687,7 +687,7 @@ fn settle(cfg: &FallConfig, ch: &FallCharacter) -> Result<(pipeline::State, Vec<
     let mut held = ch.pd.0.clone();
     held.feedforward = hold.clone();
     check_holding_strength(&ch.human, &held, &state)?;
-    let mut qdd = vec![0.0; model.nv];
+    let mut qdd = vec![0.0; model.nv()];
     let held_forces = Forces {
         pd: Some(&held),
         ..forces
@@ -735,7 +735,7 @@ fn relax_to_rest(
         ws.eval.kinematics_at_step = None;
         let data = ws.kinematics_of(model, state);
         let ke: f64 = (0..model.nbodies())
-            .map(|i| model.bodies[i].inertia.kinetic_energy(data.v[i]))
+            .map(|i| model.bodies()[i].inertia.kinetic_energy(data.v[i]))
             .sum();
         if ke < SETTLED_KE_J {
             let t0 = *quiet_since.get_or_insert(state.time_s);
@@ -755,7 +755,7 @@ fn check_holding_strength(
     state: &pipeline::State,
 ) -> Result<(), SimError> {
     let model = &body.model;
-    let mut angles = vec![0.0; model.nv];
+    let mut angles = vec![0.0; model.nv()];
     model.angles(&state.q, &mut angles);
     for (d, &k) in body.dof_v.iter().enumerate() {
         let (tau, _) = held.torque(d, angles[k], 0.0);

@@ -144,7 +144,7 @@ impl FallRecorder {
         // reaches the threshold stays there.
         let terms = || {
             (0..model.nbodies()).map(|i| {
-                let k = model.bodies[i].inertia.kinetic_energy(data.v[i]);
+                let k = model.bodies()[i].inertia.kinetic_energy(data.v[i]);
                 if k < 0.0 { 0.0 } else { k }
             })
         };
@@ -167,7 +167,7 @@ impl FallRecorder {
             }
         }
         let p = body.link_index("pelvis").unwrap_or(0);
-        let com = model.bodies[p].inertia.com;
+        let com = model.bodies()[p].inertia.com;
         let vp = data.rot[p] * (data.v[p].lin + data.v[p].ang.cross(com));
         if self.descent_start_s.is_none() && t >= self.push_start && vp.y < -0.1 {
             self.descent_start_s = Some(t);
@@ -211,7 +211,7 @@ impl FallRecorder {
         b.model.angles(q, &mut self.angles);
         let angles = b.dof_v.iter().map(|&k| self.angles[k]).collect();
         let head = b.link_index("head").unwrap_or(0);
-        let head_com = data.pos[head] + data.rot[head] * b.model.bodies[head].inertia.com;
+        let head_com = data.pos[head] + data.rot[head] * b.model.bodies()[head].inertia.com;
         FallFrame {
             time_s: state.time_s,
             root_position: DVec3::new(q[0], q[1], q[2]),
