@@ -16,7 +16,7 @@ use serde::{Deserialize, Serialize};
 use super::checkpoint::Consistent;
 use super::error::{EvaluatorError, StopCause};
 use super::evaluator::{Evaluation, Evaluator, EvolveError};
-pub use super::failure::{ELITE_CHECK, ELITE_CHECK_REFINE};
+use super::failure::ELITE_CHECK_REFINE;
 use super::failure::{EvaluationError, Failure};
 use super::genome::{Bounds, Genome};
 use super::logbook::GenerationRecord;

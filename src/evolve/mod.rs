@@ -7,18 +7,18 @@
 //! (`experiments::evolve_fall`).
 
 pub mod checkpoint;
-pub mod error;
-pub mod evaluator;
-pub mod failure;
+pub(crate) mod error;
+pub(crate) mod evaluator;
+pub(crate) mod failure;
 mod formats;
-pub mod ga;
-pub mod genome;
-pub mod logbook;
-pub mod operators;
+pub(crate) mod ga;
+pub(crate) mod genome;
+pub(crate) mod logbook;
+pub(crate) mod operators;
 
 pub use error::{CheckpointError, EvaluatorError, StopCause, WorkerFailure, WorkerFault};
-pub use evaluator::{Evaluation, Evaluator, EvolveError, InProcess, JsonLines};
-pub use failure::{EvaluationError, Failure, ProblemFailure};
+pub use evaluator::{Evaluation, Evaluator, EvolveError, InProcess, JsonLines, par_map, serve};
+pub use failure::{ELITE_CHECK, ELITE_CHECK_REFINE, EvaluationError, Failure, ProblemFailure};
 pub use ga::{GaConfig, GaState};
 pub use genome::{Bounds, Genome};
-pub use logbook::GenerationRecord;
+pub use logbook::{GenerationRecord, from_json_lines};

@@ -8,7 +8,7 @@ use marionette::dynamics::kinematics::mechanical_energy;
 use marionette::dynamics::{
     Data, Forces, Integrator, State, StepError, StepMonitor, StepSettings, StepWorkspace, pipeline,
 };
-use marionette::evolve::genome::Genome;
+use marionette::evolve::Genome;
 use marionette::experiments::evolve_fall::{FallProblem, strength_kp_max};
 use marionette::experiments::fall::{
     FallCharacter, FallConfig, SimError, build_fall, simulate_fall,

@@ -7,11 +7,11 @@
 use std::process::Command;
 
 use marionette::dynamics::StepError;
-use marionette::evolve::evaluator::{Evaluation, par_map};
 use marionette::evolve::{
     Bounds, EvaluationError, Evaluator, Failure, GaConfig, GaState, Genome, InProcess, JsonLines,
     checkpoint,
 };
+use marionette::evolve::{Evaluation, par_map};
 use marionette::experiments::evolve_fall::{FallProblem, InProcessFalls};
 use marionette::experiments::fall::SimError;
 use marionette::humanoid::ranges::AgeGroup;

@@ -7,7 +7,7 @@ use std::io::{BufReader, BufWriter};
 
 use anyhow::{Result, bail};
 
-use marionette::evolve::evaluator::serve;
+use marionette::evolve::serve;
 use marionette::experiments::evolve_fall::FallProblem;
 
 // The command's arguments (its help text is on `Command::Eval`).

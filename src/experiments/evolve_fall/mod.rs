@@ -20,7 +20,8 @@ use std::path::PathBuf;
 
 use serde::{Deserialize, Serialize};
 
-use crate::evolve::ga::{Brood, ELITE_CHECK_REFINE};
+use crate::evolve::ELITE_CHECK_REFINE;
+use crate::evolve::ga::Brood;
 use crate::evolve::{
     Evaluation, Evaluator, EvolveError, GaConfig, GaState, Genome, StopCause, checkpoint,
 };
