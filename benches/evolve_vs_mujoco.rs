@@ -13,7 +13,7 @@
 
 mod common;
 
-use common::mujoco::{THREADS, mujoco_round, python, write_workload};
+use common::mujoco::{filtered_out, mujoco_round, setup};
 use marionette::evolve::{Evaluation, Evaluator, EvolveError, GaConfig, GaState, Genome};
 use marionette::experiments::evolve_fall::{FallProblem, InProcessFalls};
 use marionette::experiments::fall::ecs::run_parallel;
@@ -90,7 +90,8 @@ fn mujoco_steps(problem: &FallProblem, used: &[(Genome, u32)]) -> f64 {
             .collect();
         for (c, r) in configs.iter().zip(run_parallel(&configs)) {
             let r = r.expect("a fall the GA used runs again");
-            let end = r.frames.last().map_or(c.duration_s, |f| f.time_s);
+            // The fall's time is its step count times its step (sub-steps count as one).
+            let end = r.steps as f64 * r.dt_s;
             steps += ((end - reaction).max(0.0) / c.dt_s).round();
         }
     }
@@ -98,20 +99,10 @@ fn mujoco_steps(problem: &FallProblem, used: &[(Genome, u32)]) -> f64 {
 }
 
 fn main() {
-    // `cargo bench` passes `--bench`; a filter that is not ours skips the run.
-    if std::env::args()
-        .skip(1)
-        .any(|a| !a.starts_with("--") && !"evolve_vs_mujoco".contains(&a))
-    {
+    if filtered_out("evolve_vs_mujoco") {
         return;
     }
-    let py = python();
-    let dir = std::env::temp_dir().join(format!("marionette-ga-mujoco-{}", std::process::id()));
-    let (xml, work) = write_workload(&dir);
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(THREADS)
-        .build()
-        .expect("pool");
+    let (py, dir, xml, work, pool) = setup("evolve_vs_mujoco");
     let (problem, ga) = scene_problem();
     let before = mujoco_round(&py, &xml, &work);
     println!(

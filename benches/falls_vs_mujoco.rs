@@ -10,7 +10,7 @@
 
 mod common;
 
-use common::mujoco::{FALLS, THREADS, configs, median, mujoco_round, python, write_workload};
+use common::mujoco::{FALLS, THREADS, configs, filtered_out, median, mujoco_round, setup};
 use marionette::dynamics::Integrator;
 use marionette::experiments::fall::FallConfig;
 use marionette::experiments::fall::ecs::run_parallel;
@@ -32,20 +32,10 @@ fn engine_round(pool: &rayon::ThreadPool, configs: &[FallConfig]) -> f64 {
 }
 
 fn main() {
-    // `cargo bench` passes `--bench`; a filter that is not ours skips the run.
-    if std::env::args()
-        .skip(1)
-        .any(|a| !a.starts_with("--") && !"falls_vs_mujoco".contains(&a))
-    {
+    if filtered_out("falls_vs_mujoco") {
         return;
     }
-    let py = python();
-    let dir = std::env::temp_dir().join(format!("marionette-vs-mujoco-{}", std::process::id()));
-    let (xml, work) = write_workload(&dir);
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(THREADS)
-        .build()
-        .expect("pool");
+    let (py, dir, xml, work, pool) = setup("falls_vs_mujoco");
     let refine = |c: &[FallConfig]| -> Vec<FallConfig> {
         c.iter()
             .map(|c| FallConfig {

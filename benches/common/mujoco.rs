@@ -45,6 +45,27 @@ pub fn configs(integrator: Integrator, dt: f64) -> Vec<FallConfig> {
         .collect()
 }
 
+/// True when `cargo bench` was given a filter that does not name the bench `name` (it passes
+/// `--bench` and any filter as arguments): the bench then skips its run.
+pub fn filtered_out(name: &str) -> bool {
+    std::env::args()
+        .skip(1)
+        .any(|a| !a.starts_with("--") && !name.contains(&a))
+}
+
+/// The side-by-side setup: the Python with MuJoCo, the workload written into a fresh
+/// temporary folder named after `name` (its path, the MJCF and the workload file), and a rayon
+/// pool of [`THREADS`] threads for the engine.
+pub fn setup(name: &str) -> (PathBuf, PathBuf, PathBuf, PathBuf, rayon::ThreadPool) {
+    let dir = std::env::temp_dir().join(format!("marionette-{name}-{}", std::process::id()));
+    let (xml, work) = write_workload(&dir);
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(THREADS)
+        .build()
+        .expect("pool");
+    (python(), dir, xml, work, pool)
+}
+
 /// The Python that has MuJoCo: `MARIONETTE_PYTHON`, else the project's `.venv`.
 pub fn python() -> PathBuf {
     std::env::var_os("MARIONETTE_PYTHON")

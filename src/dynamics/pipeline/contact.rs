@@ -26,15 +26,16 @@ pub(super) fn contact_stage(
     e.f_ext.fill(ForceVec::ZERO);
     e.implicit.clear();
     if let Some(cm) = forces.contact {
-        let implicit = match settings.integrator {
-            Integrator::LinearlyImplicitEuler | Integrator::LinearlyImplicitMidpoint => {
-                Some(ImplicitFloor {
-                    h: dt,
-                    stiffness: true,
-                    theta: settings.integrator.linearisation_weight().unwrap_or(1.0),
-                })
-            }
-            Integrator::SemiImplicitEuler { .. } if cm.params.implicit_damping => {
+        let implicit = match (
+            settings.integrator,
+            settings.integrator.linearisation_weight(),
+        ) {
+            (_, Some(theta)) => Some(ImplicitFloor {
+                h: dt,
+                stiffness: true,
+                theta,
+            }),
+            (Integrator::SemiImplicitEuler { .. }, None) if cm.params.implicit_damping => {
                 Some(ImplicitFloor {
                     h: dt,
                     stiffness: false,

@@ -279,8 +279,8 @@ pub const MAX_EXTENT: f64 = 100.0;
 /// than the model's is a [`StepError::Size`] and leaves everything as it was.
 ///
 /// On an x86-64 processor with AVX2 the stages run in a copy of their code compiled for it
-/// (chosen once per process, [`crate::cpu::has_avx2`]); on evolved falls it took about 5 % less
-/// wall time than the portable copy. The arithmetic is the same IEEE operations in the same
+/// (chosen once per process, [`crate::cpu::has_avx2`]; what it saves is measured in
+/// `docs/falls.md`). The arithmetic is the same IEEE operations in the same
 /// order (Rust never fuses a product and a sum), so both copies give the same bits.
 pub fn step(
     model: &Model,
