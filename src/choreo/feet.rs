@@ -13,10 +13,16 @@
 //! - **Contact.** A foot is in contact in the frames where [`ground_contacts_against`] finds it
 //!   contact against the floor y = 0 and the model's rest heights: some point within
 //!   [`ContactConfig::threshold_m`] of its rest height (debounced).
-//! - **Ground.** Each contact span is moved by one height, so that its lowest sole touches
-//!   the floor: c_y(f) = −min_{span} s (with [`PlantParams::ground`]). A foot the analysis calls
-//!   in contact is within [`ContactConfig::threshold_m`] of the floor, so this moves it a few
-//!   centimetres, and the foot keeps its own motion within the span.
+//! - **Ground.** A contact span is moved onto the floor, and a foot that stands in it is held
+//!   there (with [`PlantParams::ground`]): c_y(f) = −L − w(f)·(s(f) − L), L the span's lowest
+//!   sole. w = 1 where the sole rises or sinks slower than half the speed of a foot point at
+//!   rest ([`ContactConfig::rest_speed_mps`]): the foot stands, its lowest point (toe or heel:
+//!   a rigid foot rocks with the shin) on the floor in every frame. w = 0 from that speed on:
+//!   the foot is lifting off or landing and keeps its own height above the span's floor (held
+//!   down, it would drag along the floor). A smoothstep between. A foot the analysis calls in
+//!   contact is within [`ContactConfig::threshold_m`] of the floor, so this moves it a few
+//!   centimetres. The spans are found once, on the dance as assembled: lowering the pelvis does
+//!   not change when a foot stands.
 //! - **Lift.** Wherever else the sole is under the floor the foot is lifted onto it: c_y(f) ≥
 //!   −s(f). Outside the spans and their fades nothing is pulled down: a swinging foot is not made
 //!   to touch the floor (and skate on it).
@@ -26,8 +32,9 @@
 //!   point at rest), is held still: c(f) = a − p(f) horizontally, a the contact point's mean
 //!   horizontal position over the span. In the free frames next to it the correction fades to
 //!   0 over [`PlantParams::blend_s`] along a cubic Hermite curve that leaves the span with the
-//!   correction's own rate, so the foot lifts off and lands without a jolt (between two spans
-//!   closer than two blends, the curve runs from the one's edge to the other's).
+//!   correction's own horizontal rate, so the foot lifts off and lands without a jolt (between
+//!   two spans closer than two blends, the curve runs from the one's edge to the other's). The
+//!   vertical rate starts at 0: the foot leaves the floor at its own speed.
 //! - **Smoothing.** The corrections are smoothed over time by a Gaussian of σ =
 //!   [`PlantParams::smooth_s`] (the sole's height switches between toe and heel as the foot
 //!   rolls: a kink the knee would follow), then the lift is applied again as a floor.
@@ -51,8 +58,8 @@ use serde::{Deserialize, Serialize};
 use crate::analysis::{
     ContactConfig, ContactReference, Contacts, PointRef, foot_points, ground_contacts_against,
 };
-use crate::humanoid::FigureClip;
 use crate::humanoid::leg_ik::{Leg, chain_globals, frame_globals, reach_along, with_ancestors};
+use crate::humanoid::{FOOT_DOWN_M, FigureClip};
 use crate::skeleton::{Skeleton, Transform};
 
 /// Most rounds of IK per frame and leg: the target corrected by the foot's residual each round
@@ -114,6 +121,13 @@ pub struct Planting {
     pub max_residual_m: f64,
     /// Most the pelvis was lowered, metres (0 without [`PlantParams::pelvis`]).
     pub pelvis_drop_max_m: f64,
+    /// Frames × feet standing: in a contact span, the sole neither lifting off nor landing
+    /// (module docs, "Ground").
+    pub planted_foot_frames: usize,
+    /// Of those, the fraction whose sole ends within ±1 cm of the floor ([`FOOT_DOWN_M`]; the
+    /// others are out of the leg's reach, or without [`PlantParams::ground`]); 0 when no foot
+    /// stood.
+    pub planted_on_floor_fraction: f64,
 }
 
 /// Sole height of every foot point: its height in the rest pose of `clip.model` standing on the
@@ -229,7 +243,9 @@ pub fn plant_feet(clip: &mut FigureClip, p: &PlantParams) -> Planting {
     let legs = legs.map(|l| l.expect("checked above"));
     let blend = (p.blend_s / clip.frame_time).round().max(1.0) as usize;
     let (mut before, reach) = placed(clip, &legs, &model, blend);
-    let mut plan = self::plan(clip, &model, &before, p, blend, &mut report);
+    let config = ContactConfig::default();
+    let contacts = floor_contacts(clip, &before, &model.rest, &config);
+    let mut plan = self::plan(clip, &model, &before, &contacts, p, blend, &mut report);
     if p.pelvis {
         let drop = pelvis_drop(&plan, &reach, blend);
         let most = drop.iter().copied().fold(0.0, f64::max);
@@ -245,7 +261,9 @@ pub fn plant_feet(clip: &mut FigureClip, p: &PlantParams) -> Planting {
                 pelvis_drop_max_m: most,
                 ..Planting::default()
             };
-            plan = self::plan(clip, &model, &before, p, blend, &mut report);
+            // The same contact spans: lowering the pelvis so a foot reaches the floor does not
+            // change when it stands.
+            plan = self::plan(clip, &model, &before, &contacts, p, blend, &mut report);
         }
     }
     reach_targets(clip, &legs, &model, &before, &plan, &reach.cap, &mut report);
@@ -257,14 +275,16 @@ pub fn plant_feet(clip: &mut FigureClip, p: &PlantParams) -> Planting {
 struct Plan {
     targets: [Vec<Option<(DVec3, usize)>>; 2],
     on: [Vec<bool>; 2],
+    stand: [Vec<bool>; 2],
 }
 
-/// The [`Plan`] of `clip`, whose foot points are at `before` (module docs: contact, ground,
-/// lift, lock, smoothing).
+/// The [`Plan`] of `clip`, whose foot points are at `before` and whose feet touch in
+/// `contacts` (module docs: ground, lift, lock, smoothing).
 fn plan(
     clip: &FigureClip,
     model: &Feet,
     before: &[[Vec<DVec3>; 2]],
+    contacts: &Contacts,
     p: &PlantParams,
     blend: usize,
     report: &mut Planting,
@@ -272,9 +292,9 @@ fn plan(
     let n = clip.frame_count();
     let rest = &model.rest;
     let config = ContactConfig::default();
-    let contacts = floor_contacts(clip, before, rest, &config);
     let mut targets: [Vec<Option<(DVec3, usize)>>; 2] = [vec![None; n], vec![None; n]];
     let mut ons: [Vec<bool>; 2] = [vec![], vec![]];
+    let mut stands: [Vec<bool>; 2] = [vec![], vec![]];
     for (side, spans) in [&contacts.left, &contacts.right].into_iter().enumerate() {
         let foot = FootTrack {
             before,
@@ -296,12 +316,17 @@ fn plan(
             .collect();
         let planted = runs(&on);
         report.spans += planted.len();
-        let (mut corr, mut key) = hold_spans(&foot, &planted, p, &config, report);
+        let (mut corr, mut key, stand) = hold_spans(&foot, &planted, p, &config, report);
         fade_free_frames(&on, &planted, blend, &mut corr, &mut key);
         targets[side] = smooth_and_floor(&foot, &corr, &key, p, report);
         ons[side] = on;
+        stands[side] = stand;
     }
-    Plan { targets, on: ons }
+    Plan {
+        targets,
+        on: ons,
+        stand: stands,
+    }
 }
 
 /// The legs as the dance puts them (before any pelvis drop): per frame and leg, the hip's and
@@ -497,18 +522,40 @@ impl FootTrack<'_> {
     }
 }
 
-/// The corrections inside the contact spans `planted` (zero, or with `lock` the pull back to
-/// the anchor of a sliding span), and each frame's contact point; `None` outside the spans.
+/// How much a foot stands in each frame of a contact span whose sole heights are `sole` (module
+/// docs, "Ground"): 1 while its sole rises or sinks slower than half the speed of a foot point
+/// at rest ([`ContactConfig::rest_speed_mps`]), 0 from that speed on (lifting off or landing),
+/// a smoothstep between; the rate by central differences inside the span.
+fn standing_weights(sole: &[f64], frame_time: f64, config: &ContactConfig) -> Vec<f64> {
+    let n = sole.len();
+    let (fast, slow) = (config.rest_speed_mps, 0.5 * config.rest_speed_mps);
+    (0..n)
+        .map(|f| {
+            let (lo, hi) = (f.saturating_sub(1), (f + 1).min(n - 1));
+            if hi == lo {
+                return 1.0;
+            }
+            let rate = (sole[hi] - sole[lo]).abs() / ((hi - lo) as f64 * frame_time);
+            let x = ((fast - rate) / (fast - slow)).clamp(0.0, 1.0);
+            x * x * (3.0 - 2.0 * x)
+        })
+        .collect()
+}
+
+/// The corrections inside the contact spans `planted` (module docs: ground and lock), each
+/// frame's contact point, and the frames the foot stands in (its sole put on the floor);
+/// `None` outside the spans.
 fn hold_spans(
     foot: &FootTrack,
     planted: &[(usize, usize)],
     p: &PlantParams,
     config: &ContactConfig,
     report: &mut Planting,
-) -> (Vec<Option<DVec3>>, Vec<usize>) {
+) -> (Vec<Option<DVec3>>, Vec<usize>, Vec<bool>) {
     let n = foot.before.len();
     let mut corr: Vec<Option<DVec3>> = vec![None; n];
     let mut key = vec![0usize; n];
+    let mut stand = vec![false; n];
     for &(a, b) in planted {
         let k = foot.contact_point(a, b);
         let anchor = (a..b)
@@ -527,29 +574,36 @@ fn hold_spans(
         if slides && p.lock {
             report.locked += 1;
         }
-        // On the floor: every span lowered or raised by one height, the sole's lowest over
-        // the span, so the foot keeps its own small motion and touches down (the leg's cap
-        // and the pelvis keep the knee from straightening to get there, module docs).
-        let down = if p.ground {
-            -foot.sole[a..b]
-                .iter()
-                .copied()
-                .fold(f64::INFINITY, f64::min)
-        } else {
-            0.0
-        };
+        let low = foot.sole[a..b]
+            .iter()
+            .copied()
+            .fold(f64::INFINITY, f64::min);
+        let standing = standing_weights(&foot.sole[a..b], foot.frame_time, config);
         for f in a..b {
             key[f] = k;
+            stand[f] = standing[f - a] == 1.0;
             let pt = foot.at(f, k);
             let horizontal = if p.lock && slides {
                 DVec3::new(anchor.x - pt.x, 0.0, anchor.z - pt.z)
             } else {
                 DVec3::ZERO
             };
+            // On the floor in every frame of the span: the sole's lowest point put at y = 0
+            // (the leg's cap and the pelvis keep the knee from straightening to get there,
+            // module docs).
+            // On the floor: the span's lowest sole put at y = 0, and a standing foot's sole
+            // (module docs, "Ground") put there in every frame (the leg's cap and the pelvis
+            // keep the knee from straightening to get there).
+            let down = if p.ground {
+                let w = standing[f - a];
+                -low - w * (foot.sole[f] - low)
+            } else {
+                0.0
+            };
             corr[f] = Some(horizontal + DVec3::Y * down);
         }
     }
-    (corr, key)
+    (corr, key, stand)
 }
 
 /// The free frames (not `on`): the contact point of the nearer neighbouring span, and the
@@ -597,11 +651,15 @@ fn faded_correction(
     blend: usize,
 ) -> DVec3 {
     let n = on.len();
-    // The correction and its rate (per frame) at the span edges next to f.
+    // The correction and its horizontal rate (per frame) at the span edges next to f. The
+    // vertical rate is left out: inside a span the vertical correction cancels the foot's own
+    // rise (the sole held at the floor), and carried on past the edge it would hold the foot
+    // down as it lifts off; without it the foot leaves (and lands) at its own speed.
+    let level = |v: DVec3| DVec3::new(v.x, 0.0, v.z);
     let edge_out = |pe: usize| -> (DVec3, DVec3) {
         let c = corr[pe - 1].unwrap_or_default();
         let v = if pe >= 2 && on[pe - 2] {
-            c - corr[pe - 2].unwrap_or_default()
+            level(c - corr[pe - 2].unwrap_or_default())
         } else {
             DVec3::ZERO
         };
@@ -610,7 +668,7 @@ fn faded_correction(
     let edge_in = |ns: usize| -> (DVec3, DVec3) {
         let c = corr[ns].unwrap_or_default();
         let v = if ns + 1 < n && on[ns + 1] {
-            corr[ns + 1].unwrap_or_default() - c
+            level(corr[ns + 1].unwrap_or_default() - c)
         } else {
             DVec3::ZERO
         };
@@ -704,22 +762,25 @@ fn reach_targets(
     let (roots, rotations) = (&clip.root_translation, &clip.root_rotation);
     let skeleton = &clip.model;
     let targets = &plan.targets;
-    // Frames are independent: each moves only its own angles. Per frame: legs moved and the
-    // largest residual.
-    let moved: Vec<(usize, f64)> = clip
+    // Frames are independent: each moves only its own angles. Per frame: legs moved, the
+    // largest residual, and feet planted and planted on the floor.
+    let moved: Vec<(usize, f64, usize, usize)> = clip
         .angles
         .par_chunks_mut(d)
         .enumerate()
         .map_init(Vec::new, |g, (f, angles)| {
             let (t, q) = (roots[f], rotations[f]);
-            let mut out = (0, 0.0f64);
+            let mut out = (0, 0.0f64, 0, 0);
             for side in 0..2 {
-                let Some((c, k)) = targets[side][f] else {
+                let planted = plan.stand[side][f];
+                out.2 += usize::from(planted);
+                let target = targets[side][f].filter(|(c, _)| c.length() >= 1e-6);
+                let Some((c, k)) = target else {
+                    let c = targets[side][f].map_or(DVec3::ZERO, |t| t.0);
+                    let sole = sole_height(&before[f][side], &rest[side]) + c.y;
+                    out.3 += usize::from(planted && sole.abs() <= FOOT_DOWN_M);
                     continue;
                 };
-                if c.length() < 1e-6 {
-                    continue;
-                }
                 out.0 += 1;
                 let leg = legs[side];
                 // The foot's place to reach, its points each moved by c: its key point's
@@ -736,12 +797,14 @@ fn reach_targets(
                 let (hip, cap) = (g[leg.hip].translation, cap[f][side]);
                 let mut ankle_target = within_reach(g[leg.ankle].translation + c, hip, cap);
                 let mut residual = 0.0;
+                let mut sole = f64::NAN;
                 for _ in 0..IK_ROUNDS {
                     // `g` holds the chain for `angles`, before and after the reach.
                     reach_along(skeleton, leg, &model.chain, g, (t, q), angles, ankle_target);
                     let now = &model.points_in(g)[side];
                     let place = DVec3::new(now[k].x, sole_height(now, &rest[side]), now[k].z);
                     let r = wanted - place;
+                    sole = place.y;
                     residual = r.length();
                     if residual < 1e-4 {
                         break;
@@ -754,14 +817,24 @@ fn reach_targets(
                     ankle_target = next;
                 }
                 out.1 = out.1.max(residual);
+                out.3 += usize::from(planted && sole.abs() <= FOOT_DOWN_M);
             }
             out
         })
         .collect();
-    for (legs_moved, residual) in moved {
+    let mut on_floor = 0;
+    report.planted_foot_frames = 0;
+    for (legs_moved, residual, planted, down) in moved {
         report.leg_frames += legs_moved;
         report.max_residual_m = report.max_residual_m.max(residual);
+        report.planted_foot_frames += planted;
+        on_floor += down;
     }
+    report.planted_on_floor_fraction = if report.planted_foot_frames == 0 {
+        0.0
+    } else {
+        on_floor as f64 / report.planted_foot_frames as f64
+    };
 }
 
 #[cfg(test)]
@@ -890,6 +963,32 @@ mod tests {
         };
         plant_feet(&mut left, &only_lift);
         assert!((lowest(&left) - 0.02).abs() < 1e-9, "{}", lowest(&left));
+    }
+
+    #[test]
+    fn a_foot_that_bobs_while_it_stands_is_held_on_the_floor_in_every_frame() {
+        // Standing with the whole figure bobbing 0–2 cm off the floor (within the analysis's
+        // 3 cm: in contact throughout): moving the span by one height would leave the feet
+        // hovering up to 2 cm; each frame's sole is put on the floor instead.
+        let mut bob = stance(0.5, 0.0, 0.0, 120);
+        for (f, t) in bob.root_translation.iter_mut().enumerate() {
+            let phase = std::f64::consts::TAU * f as f64 / 60.0;
+            t.y += 0.01 * (1.0 - phase.cos());
+        }
+        let r = plant_feet(&mut bob, &PlantParams::default());
+        assert_eq!(r.planted_foot_frames, 2 * 120, "{r:?}");
+        assert_eq!(r.planted_on_floor_fraction, 1.0, "{r:?}");
+        let rest = rest_sole_heights(&bob);
+        let tracks = foot_tracks(&bob);
+        for (s, track) in tracks.iter().enumerate() {
+            for (f, pts) in track.iter().enumerate() {
+                let sole = sole_height(pts, &rest[s]);
+                assert!(
+                    sole.abs() < 2e-3,
+                    "foot {s} frame {f}: sole at {sole} m, {r:?}"
+                );
+            }
+        }
     }
 
     #[test]

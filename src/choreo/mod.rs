@@ -54,15 +54,15 @@ pub use database::{
 pub use edit::Edit;
 pub use eros::{eros, eros_distance, eros_weights, pca};
 pub use features::{mean_motion_intensity, mirror_motion, mirror_partners, pose_rows};
-pub use feet::{PlantParams, plant_feet};
+pub use feet::{PlantParams, plant_feet, rest_sole_heights};
 pub use fill::{
     BUDGET_HALVINGS, DEFAULT_SEAM_BUDGET, FillParams, Pins, fill, fill_dijkstra,
     fill_dijkstra_with_table, fill_with_table,
 };
 pub use generated::generated_database;
 pub use metrics::{
-    BAS_SIGMA_S, beat_alignment_score, dance_metrics, foot_skating, motion_beats, seam_jerk,
-    source_beat_alignment, spearman,
+    BAS_SIGMA_S, FootPenetration, beat_alignment_score, dance_metrics, floor_contacts,
+    foot_penetration, foot_skating, motion_beats, seam_jerk, source_beat_alignment, spearman,
 };
 pub use relevance::{motion_intensity, percentile_ranks};
 pub use search::{BarSearch, SearchIndex, SearchParams, search_round};

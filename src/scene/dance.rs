@@ -715,6 +715,8 @@ fn feet_json(feet: &PlantParams, planting: &Planting) -> serde_json::Value {
         "leg_frames_moved": planting.leg_frames,
         "max_correction_m": planting.max_correction_m,
         "max_residual_m": planting.max_residual_m,
+        "planted_foot_frames": planting.planted_foot_frames,
+        "planted_on_floor_fraction": planting.planted_on_floor_fraction,
     })
 }
 

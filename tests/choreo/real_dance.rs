@@ -44,7 +44,7 @@ fn check(what: &str, r: &serde_json::Value, paper: &serde_json::Value, folder: &
         "{what}: below 1 cm {:.4} of frames (deepest {:.4} m), skating {:.3} vs sources {:.3} \
          m/s, beat alignment {:.3} vs sources {:.3}, intensity Spearman {:.3} (paper's fill \
          {:.3}), seam jerk {seam:.0} vs paper's fill {seam_paper:.0} rad/s³, feet in contact \
-         within ±1 cm {:.3} vs sources {:.3}",
+         within ±1 cm {:.3} vs sources {:.3}, planted feet on the floor {:.3}",
         f(&pen["frames_below_1cm_fraction"]),
         f(&pen["deepest_m"]),
         f(&m["foot_skating_m_s"]),
@@ -55,6 +55,7 @@ fn check(what: &str, r: &serde_json::Value, paper: &serde_json::Value, folder: &
         f(&paper["metrics"]["intensity_spearman"]),
         f(&pen["contact_within_1cm_fraction"]),
         f(&src["contact_within_1cm_fraction"]),
+        f(&r["feet"]["planted_on_floor_fraction"]),
     );
     assert!(
         f(&pen["frames_below_1cm_fraction"]) <= 0.01,
@@ -72,6 +73,12 @@ fn check(what: &str, r: &serde_json::Value, paper: &serde_json::Value, folder: &
     assert!(
         f(&pen["contact_within_1cm_fraction"]) >= f(&src["contact_within_1cm_fraction"]),
         "{what}: feet in contact hover more than their sources'"
+    );
+    // Planted feet on the floor: the frames a foot stands in (the analysis's contact on the
+    // dance as assembled), its sole within ±1 cm; the rest are out of the leg's reach.
+    assert!(
+        f(&r["feet"]["planted_on_floor_fraction"]) >= 0.9,
+        "{what}: planted feet off the floor"
     );
     let (cost, cost_paper) = (
         f(&m["transition_cost"]),
