@@ -34,10 +34,10 @@ pub enum Error {
     Dynamics(#[from] crate::dynamics::ModelError),
     /// A joint-space inertia matrix that is not positive definite.
     #[error(transparent)]
-    Inertia(#[from] crate::dynamics::crba::NotPositiveDefinite),
+    Inertia(#[from] crate::dynamics::NotPositiveDefinite),
     /// Balancing a body on the floor (its static equilibrium).
     #[error(transparent)]
-    Equilibrium(#[from] crate::dynamics::equilibrium::EquilibriumError),
+    Equilibrium(#[from] crate::dynamics::EquilibriumError),
     /// Motor primitives: learning, playing, blending, connecting, files.
     #[error(transparent)]
     Primitive(#[from] crate::primitive::PrimitiveError),

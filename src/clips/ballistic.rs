@@ -8,8 +8,8 @@
 use glam::DVec3;
 
 use super::GRAVITY;
-use crate::dynamics::data::Data;
-use crate::dynamics::kinematics::kinematics;
+use crate::dynamics::Data;
+use crate::dynamics::kinematics;
 use crate::humanoid::FigureClip;
 use crate::humanoid::body::{HumanBody, HumanError, human_body};
 

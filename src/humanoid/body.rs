@@ -25,10 +25,10 @@
 
 use std::sync::{Arc, Mutex, Weak};
 
+use crate::dynamics::JointType;
 use crate::dynamics::forces::contact::LinkBox;
-use crate::dynamics::joint::JointType;
-use crate::dynamics::model::{Body, Model, ModelError};
-use crate::dynamics::spatial::{Inertia, SpatialTransform};
+use crate::dynamics::{Body, Model, ModelError};
+use crate::dynamics::{Inertia, SpatialTransform};
 use crate::humanoid::anthropometry::*;
 use crate::humanoid::{self, Figure, FigureJoint, JointKind};
 use glam::{DMat3, DVec3};
@@ -129,8 +129,7 @@ fn combine(a: Inertia, b: Inertia) -> Inertia {
     let shift = |x: &Inertia| {
         let d = x.com - c;
         x.inertia_com
-            + (DMat3::IDENTITY * d.length_squared() - crate::dynamics::spatial::outer(d, d))
-                * x.mass
+            + (DMat3::IDENTITY * d.length_squared() - crate::dynamics::outer(d, d)) * x.mass
     };
     Inertia::new(m, c, shift(&a) + shift(&b))
 }
@@ -143,7 +142,7 @@ pub const CLAVICLE_SHARE: f64 = 0.05;
 /// Inertia of a slender cylinder of mass `m` (kg), length `len` (m) and radius `r` (m) from `p0`
 /// along the unit `dir`: `I = m(ℓ²/12 + r²/4)(1 − d dᵀ) + (m r²/2) d dᵀ` about its centre.
 fn rod(m: f64, len: f64, r: f64, p0: DVec3, dir: DVec3) -> Inertia {
-    let dd = crate::dynamics::spatial::outer(dir, dir);
+    let dd = crate::dynamics::outer(dir, dir);
     let perp = m * (len * len / 12.0 + r * r / 4.0);
     let axial = 0.5 * m * r * r;
     Inertia::new(
@@ -548,8 +547,8 @@ mod tests {
             glam::DQuat::IDENTITY,
         );
         q[1] = 0.530 * h;
-        let mut data = crate::dynamics::data::Data::new(&b.model);
-        crate::dynamics::kinematics::kinematics(&b.model, &mut data, &q, &[0.0; 27]);
+        let mut data = crate::dynamics::Data::new(&b.model);
+        crate::dynamics::kinematics(&b.model, &mut data, &q, &[0.0; 27]);
         let mut c = DVec3::ZERO;
         for (i, body) in b.model.bodies().iter().enumerate() {
             c += (data.pos[i] + data.rot[i] * body.inertia.com) * body.inertia.mass;

@@ -19,7 +19,7 @@ use std::fmt::Write;
 
 use glam::{DMat3, DVec3};
 
-use crate::dynamics::joint::JointType;
+use crate::dynamics::JointType;
 use crate::humanoid::body::HumanBody;
 
 fn v3(v: DVec3) -> String {

@@ -1,10 +1,10 @@
-//! The linearly implicit step ([`marionette::dynamics::linearly_implicit`]) on the paper's
+//! The linearly implicit step ([`marionette::dynamics::Integrator::LinearlyImplicitEuler`]) on the paper's
 //! falls: the same fall as the explicit step at a small step, no energy gained on a passive
 //! drop, runs at 2 ms where the stability check refuses the explicit step, and how far the damage
 //! of random genomes of both age groups moves when the 2 ms step is halved (against the explicit
 //! step at 2 ms, past its check, and at the GA's 0.70 ms).
 
-use marionette::dynamics::kinematics::mechanical_energy;
+use marionette::dynamics::mechanical_energy;
 use marionette::dynamics::{
     Data, Forces, Integrator, State, StepError, StepMonitor, StepSettings, StepWorkspace, pipeline,
 };

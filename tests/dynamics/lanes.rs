@@ -6,14 +6,14 @@
 use std::process::Command;
 
 use glam::{DQuat, DVec3};
-use marionette::dynamics::aba_lanes::{LaneData, LaneInput, aba_passes_lanes};
+use marionette::dynamics::LANES;
 use marionette::dynamics::forces::pd::PdTargets;
-use marionette::dynamics::lanes::LANES;
 use marionette::dynamics::pipeline::{LaneBody, step, step_lanes};
 use marionette::dynamics::{
     Data, ForceVec, Forces, Integrator, State, StepMonitor, StepSettings, StepWorkspace,
     aba_passes, kinematics,
 };
+use marionette::dynamics::{LaneData, LaneInput, aba_passes_lanes};
 use marionette::experiments::fall::{FallConfig, build_fall};
 use marionette::humanoid::body::fall21_body;
 use marionette::humanoid::ranges::AgeGroup;

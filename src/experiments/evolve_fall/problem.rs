@@ -142,7 +142,7 @@ pub const STEP_MARGIN: f64 = 0.8;
 
 /// The GA's step for every genome of the box `kp ≤ kp_max` on `fall` (s): the
 /// stiffest mode of the strongest genome (k_p = `kp_max` on every DOF; θ_d does not change the
-/// standing bound) through [`crate::dynamics::stability`], times `margin` (a fraction of that
+/// standing bound) through [`crate::dynamics::stable_step`], times `margin` (a fraction of that
 /// bound in (0, 1]; the GA's default is [`STEP_MARGIN`]), rounded down to a multiple of 50 µs
 /// ([`STEP_QUANTA_PER_S`]); `fall.dt_s` when nothing is stiff or the fall's scheme has no
 /// bound.

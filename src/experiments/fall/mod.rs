@@ -27,15 +27,15 @@ use std::sync::Arc;
 
 use glam::{DQuat, DVec3};
 
+use crate::dynamics::Data;
 use crate::dynamics::ModelError;
-use crate::dynamics::data::Data;
-use crate::dynamics::equilibrium::{BalanceSettings, balance_base, holding_torques};
 use crate::dynamics::forces::contact::ContactModel;
 use crate::dynamics::forces::limits::{JointRanges, limit_gains};
 use crate::dynamics::forces::pd::PdTargets;
-use crate::dynamics::kinematics::kinematics;
+use crate::dynamics::kinematics;
 use crate::dynamics::pipeline::{self, Forces, StepRefinement, StepSettings};
-use crate::dynamics::stability::{
+use crate::dynamics::{BalanceSettings, balance_base, holding_torques};
+use crate::dynamics::{
     DofStiffness, StiffestMode, StiffnessBasis, inverse_joint_inertia, scheme_name,
 };
 use crate::ecs::human::{HumanFigure, human_physics};
@@ -466,7 +466,7 @@ fn dof_stiffness(cfg: &FallConfig, ch: &FallCharacter) -> Vec<DofStiffness> {
     let body = &*ch.human;
     let implicit = matches!(
         cfg.integrator,
-        crate::dynamics::integrator::Integrator::SemiImplicitEuler {
+        crate::dynamics::Integrator::SemiImplicitEuler {
             implicit_damping: true
         }
     );

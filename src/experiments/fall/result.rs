@@ -3,7 +3,7 @@
 //! body and quantity).
 
 pub use super::recorder::StandingStart;
-use crate::dynamics::equilibrium::EquilibriumError;
+use crate::dynamics::EquilibriumError;
 use crate::dynamics::pipeline::StepError;
 use crate::humanoid::body::HumanError;
 use crate::humanoid::ranges::RangeError;
