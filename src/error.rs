@@ -22,10 +22,10 @@ pub enum Error {
     Figure(#[from] crate::humanoid::FigureError),
     /// A joint-range table.
     #[error(transparent)]
-    Ranges(#[from] crate::humanoid::ranges::RangeError),
+    Ranges(#[from] crate::humanoid::RangeError),
     /// Building the human body (height, mass, joints).
     #[error(transparent)]
-    Body(#[from] crate::humanoid::body::HumanError),
+    Body(#[from] crate::humanoid::HumanError),
     /// A DOF without a row in the strength table.
     #[error(transparent)]
     Strength(#[from] crate::humanoid::strength::NoStrength),

@@ -11,7 +11,7 @@ pub use crate::clips::KeyframeClip;
 pub use crate::skeleton::{Clip, Skeleton, Transform, forward_kinematics};
 
 // The engine's models and mapping real skeletons onto them.
-pub use crate::humanoid::ranges::AgeGroup;
+pub use crate::humanoid::AgeGroup;
 pub use crate::humanoid::{Figure, FigureClip, fall21, humanoid24};
 pub use crate::mapping::{Mapping, effector_errors, retarget};
 

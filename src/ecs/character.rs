@@ -49,10 +49,10 @@ use crate::dynamics::forces::external::{ExternalForce, Push};
 use crate::dynamics::forces::limits::{JointLimitParams, JointRanges};
 use crate::dynamics::forces::pd::PdTargets;
 use crate::dynamics::kinematics;
-use crate::humanoid::body::HumanBody;
-use crate::humanoid::ranges::{AgeGroup, RangeTable};
+use crate::humanoid::HumanBody;
 use crate::humanoid::strength::{NoStrength, torque_limits_for};
 use crate::humanoid::tissue;
+use crate::humanoid::{AgeGroup, RangeTable};
 use crate::primitive::{Primitive, PrimitiveError};
 
 /// The order of the control systems inside [`MotionSet::Control`].

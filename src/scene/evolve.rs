@@ -21,8 +21,8 @@ use crate::experiments::evolve_fall::{
     FallProblem, GroupOutcome, InProcessFalls, halted,
 };
 use crate::experiments::fall::{FallConfig, FallResult};
+use crate::humanoid::AgeGroup;
 use crate::humanoid::fall21;
-use crate::humanoid::ranges::AgeGroup;
 use crate::render::{Page, Plot, Series, plot};
 
 /// Who evaluates the generations.

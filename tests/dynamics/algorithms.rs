@@ -197,7 +197,7 @@ fn crba_matrix_is_symmetric_positive_definite_and_matches_rnea_columns() {
 
 #[test]
 fn aba_agrees_with_rnea_and_crba_on_the_human_bodies() {
-    use marionette::humanoid::body::{fall21_body, humanoid24_body};
+    use marionette::humanoid::{fall21_body, humanoid24_body};
     let mut rng = Pcg64::seed_from_u64(24);
     for (name, body) in [
         ("fall21", fall21_body(1.70, 65.0, 9.81).unwrap()),

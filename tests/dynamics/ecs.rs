@@ -6,7 +6,7 @@ use glam::DVec3;
 use marionette::dynamics::StepError;
 use marionette::experiments::fall::ecs::{build_fall_world, run_fall_world, run_parallel};
 use marionette::experiments::fall::{FallConfig, FallResult, SimError, simulate_fall};
-use marionette::humanoid::ranges::AgeGroup;
+use marionette::humanoid::AgeGroup;
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64;
 

@@ -20,8 +20,8 @@ use marionette::ecs::{
 };
 use marionette::experiments::fall::ecs::{add_fall_systems, fall_results, spawn_fall};
 use marionette::experiments::fall::{FallConfig, build_fall};
-use marionette::humanoid::ranges::AgeGroup;
-use marionette::humanoid::{body::HumanBody, humanoid24};
+use marionette::humanoid::AgeGroup;
+use marionette::humanoid::{HumanBody, humanoid24};
 use marionette::primitive::{LearnConfig, Primitive};
 use marionette::render::{StickFigure, Track, filmstrip_png};
 

@@ -13,7 +13,7 @@ use marionette::experiments::evolve_fall::{FallProblem, strength_kp_max};
 use marionette::experiments::fall::{
     FallCharacter, FallConfig, SimError, build_fall, simulate_fall,
 };
-use marionette::humanoid::ranges::AgeGroup;
+use marionette::humanoid::AgeGroup;
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64;
 

@@ -15,8 +15,8 @@ use marionette::dynamics::{
 };
 use marionette::dynamics::{LaneData, LaneInput, aba_passes_lanes};
 use marionette::experiments::fall::{FallConfig, build_fall};
-use marionette::humanoid::body::fall21_body;
-use marionette::humanoid::ranges::AgeGroup;
+use marionette::humanoid::AgeGroup;
+use marionette::humanoid::fall21_body;
 
 /// The bits of every state of the pushed elderly fall stepped 2400 times by [`step`] (1.2 s),
 /// one line per step, then the final monitor; panics unless some link other than the feet

@@ -18,7 +18,7 @@ use crate::evolve::{Bounds, Evaluation, EvaluationError, Genome};
 use crate::experiments::fall::ecs::{ReactionStart, run_parallel_until};
 use crate::experiments::fall::{FallConfig, Ranges, SettledStart, SimError};
 use crate::humanoid::fall21;
-use crate::humanoid::ranges::{AgeGroup, RangeTable};
+use crate::humanoid::{AgeGroup, RangeTable};
 
 /// One age group's optimisation problem: the fall every genome is tried on and the gene bounds.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

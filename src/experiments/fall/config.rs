@@ -5,8 +5,8 @@ use crate::dynamics::Integrator;
 use crate::dynamics::forces::contact::ContactParams;
 use crate::dynamics::forces::external::Push;
 use crate::dynamics::forces::limits::JointLimitParams;
-use crate::humanoid::ranges::{AgeGroup, RangeTable};
 use crate::humanoid::strength::torque_limits;
+use crate::humanoid::{AgeGroup, RangeTable};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 

@@ -40,9 +40,9 @@ use crate::dynamics::{
 };
 use crate::ecs::human::{HumanFigure, human_physics};
 use crate::ecs::physics::{ExternalForces, FloorContact, JointLimits, PdController, PhysicsBundle};
-use crate::humanoid::body::{HumanBody, shared_fall21_body};
-use crate::humanoid::ranges::RangeTable;
+use crate::humanoid::RangeTable;
 use crate::humanoid::tissue;
+use crate::humanoid::{HumanBody, shared_fall21_body};
 
 /// The most steps one fall may take (checked before it runs): 3 s at 0.15 µs.
 pub const MAX_STEPS: u64 = 20_000_000;

@@ -11,7 +11,7 @@ use super::result::{
 use crate::dynamics::Data;
 use crate::dynamics::forces::contact::ContactStats;
 use crate::dynamics::pipeline::{State, StepMonitor};
-use crate::humanoid::body::HumanBody;
+use crate::humanoid::HumanBody;
 
 /// Frames, rest detection and the end of the run.
 #[derive(Component, Clone, Debug, PartialEq)]

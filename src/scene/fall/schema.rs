@@ -13,7 +13,7 @@ use super::super::primitives::PrimitiveRender;
 use super::super::source::resolve_path;
 use crate::experiments::fall::{FallConfig, Ranges};
 use crate::humanoid::fall21;
-use crate::humanoid::ranges::{AgeGroup, RangeTable};
+use crate::humanoid::{AgeGroup, RangeTable};
 
 /// PD settings per DOF, by full DOF name (`left_knee`) or side-less name (`knee`, both sides);
 /// DOFs not named keep the fall's. The schema of a controller file (an evolution writes
