@@ -16,7 +16,7 @@ mod common;
 use common::mujoco::{filtered_out, mujoco_round, setup};
 use marionette::evolve::{Evaluation, Evaluator, EvolveError, GaConfig, GaState, Genome};
 use marionette::experiments::evolve_fall::{FallProblem, InProcessFalls};
-use marionette::experiments::fall::ecs::run_parallel;
+use marionette::experiments::fall::run_parallel;
 use marionette::humanoid::AgeGroup;
 use marionette::scene::Scene;
 use std::path::Path;

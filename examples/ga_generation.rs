@@ -25,7 +25,7 @@ use marionette::experiments::evolve_fall::{
 };
 use marionette::experiments::fall::Ranges;
 use marionette::experiments::fall::SettledStart;
-use marionette::experiments::fall::ecs::{ReactionStart, run_parallel_reacting};
+use marionette::experiments::fall::{ReactionStart, run_parallel_reacting};
 use marionette::humanoid::{AgeGroup, RangeTable};
 
 fn env(name: &str) -> Option<f64> {

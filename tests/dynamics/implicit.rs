@@ -289,7 +289,7 @@ fn reaction_refined(problem: &FallProblem) -> FallProblem {
 /// unrefined falls (run to rest), as a fraction.
 fn refinement_cost(problem: &FallProblem, genomes: &[Genome]) -> f64 {
     use marionette::experiments::fall::SettledStart;
-    use marionette::experiments::fall::ecs::run_parallel_from;
+    use marionette::experiments::fall::run_parallel_from;
     let settled = SettledStart::of(&problem.fall).unwrap();
     let configs: Vec<FallConfig> = genomes.iter().map(|g| problem.config(g)).collect();
     let runs = run_parallel_from(&configs, Some(&settled));
@@ -407,7 +407,7 @@ fn on_random_genomes_the_2_ms_damage_moves_less_than_the_explicit_steps_when_hal
 
 #[test]
 fn linearised_falls_have_the_same_bits_on_1_and_2_threads() {
-    use marionette::experiments::fall::ecs::run_parallel;
+    use marionette::experiments::fall::run_parallel;
     // Eight pushed falls of both groups (two Worlds' worth), the first four at the step end
     // (θ = 1), the others at its midpoint, on pools of 1 and of 2 threads.
     let configs: Vec<FallConfig> = (0..8)

@@ -15,8 +15,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::evolve::genome::BoundsError;
 use crate::evolve::{Bounds, Evaluation, EvaluationError, Genome};
-use crate::experiments::fall::ecs::{ReactionStart, run_parallel_until};
 use crate::experiments::fall::{FallConfig, Ranges, SettledStart, SimError};
+use crate::experiments::fall::{ReactionStart, run_parallel_until};
 use crate::humanoid::fall21;
 use crate::humanoid::{AgeGroup, RangeTable};
 
@@ -225,7 +225,7 @@ impl FallProblem {
     }
 
     /// The damage of every genome, the falls in parallel Worlds (up to four at a time in each,
-    /// [`run_parallel_reacting`](crate::experiments::fall::ecs::run_parallel_reacting)), at
+    /// [`run_parallel_reacting`](crate::experiments::fall::run_parallel_reacting)), at
     /// the problem's time step divided by `refine` (1: the problem's own step); the standing
     /// body is settled once per step for the whole run (the genes do not change how it stands;
     /// the same bits as settling each fall).
