@@ -65,6 +65,30 @@ pub enum Error {
     /// One evaluation of a genome.
     #[error(transparent)]
     Evaluation(#[from] crate::evolve::EvaluationError),
+    /// A problem's own error behind a failed evaluation.
+    #[error(transparent)]
+    ProblemFailure(#[from] crate::evolve::ProblemFailure),
+    /// Why an individual of a generation has no fitness (the GA's failure log).
+    #[error(transparent)]
+    Failure(#[from] crate::evolve::Failure),
+    /// Why a GA run stopped before its last generation.
+    #[error(transparent)]
+    Stop(#[from] crate::evolve::StopCause),
+    /// An evaluator that could not evaluate a generation.
+    #[error(transparent)]
+    Evaluator(#[from] crate::evolve::EvaluatorError),
+    /// A JSON-lines worker that failed: which, how and what it last said.
+    #[error(transparent)]
+    Worker(#[from] crate::evolve::WorkerFailure),
+    /// What a JSON-lines worker did wrong.
+    #[error(transparent)]
+    WorkerFault(#[from] crate::evolve::WorkerFault),
+    /// A line of the worker protocol that does not parse.
+    #[error(transparent)]
+    ProtocolLine(#[from] crate::evolve::LineError),
+    /// A GA checkpoint: reading, checking or writing it.
+    #[error(transparent)]
+    Checkpoint(#[from] crate::evolve::CheckpointError),
     /// The falling paper's GA problem (its ranges, bounds, gain bounds).
     #[error(transparent)]
     FallProblem(#[from] crate::experiments::evolve_fall::ProblemError),
@@ -121,6 +145,14 @@ pub enum Error {
     #[cfg(feature = "render")]
     #[error(transparent)]
     Scene(#[from] crate::scene::SceneError),
+    /// A checkpoint to resume that does not match the runs the scene asks for.
+    #[cfg(feature = "render")]
+    #[error(transparent)]
+    ResumeMismatch(#[from] crate::scene::ResumeMismatch),
+    /// One setting whose value in a checkpoint is not the scene's.
+    #[cfg(feature = "render")]
+    #[error(transparent)]
+    SettingMismatch(#[from] crate::scene::SettingMismatch),
     /// Drawing a picture or plot.
     #[cfg(feature = "render")]
     #[error(transparent)]

@@ -16,7 +16,9 @@ pub(crate) mod genome;
 pub(crate) mod logbook;
 pub(crate) mod operators;
 
-pub use error::{CheckpointError, EvaluatorError, StopCause, WorkerFailure, WorkerFault};
+pub use error::{
+    CheckpointError, EvaluatorError, LineError, StopCause, WorkerFailure, WorkerFault,
+};
 pub use evaluator::{Evaluation, Evaluator, EvolveError, InProcess, JsonLines, par_map, serve};
 pub use failure::{ELITE_CHECK, ELITE_CHECK_REFINE, EvaluationError, Failure, ProblemFailure};
 pub use ga::{GaConfig, GaState};
