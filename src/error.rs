@@ -79,13 +79,13 @@ pub enum Error {
     Evaluator(#[from] crate::evolve::EvaluatorError),
     /// A JSON-lines worker that failed: which, how and what it last said.
     #[error(transparent)]
-    Worker(#[from] crate::evolve::WorkerFailure),
+    Worker(#[from] Box<crate::evolve::WorkerFailure>),
     /// What a JSON-lines worker did wrong.
     #[error(transparent)]
-    WorkerFault(#[from] crate::evolve::WorkerFault),
+    WorkerFault(#[from] Box<crate::evolve::WorkerFault>),
     /// A line of the worker protocol that does not parse.
     #[error(transparent)]
-    ProtocolLine(#[from] crate::evolve::LineError),
+    ProtocolLine(#[from] Box<crate::evolve::LineError>),
     /// A GA checkpoint: reading, checking or writing it.
     #[error(transparent)]
     Checkpoint(#[from] crate::evolve::CheckpointError),
@@ -159,6 +159,23 @@ pub enum Error {
     Render(#[from] crate::render::RenderError),
 }
 
+// The worker's errors are large (their lines and last words): boxed, as `EvaluatorError` holds
+// them, so that every `Result<_, Error>` stays small; they convert unboxed too.
+macro_rules! from_boxed {
+    ($($ty:ty),*) => {$(
+        impl From<$ty> for Error {
+            fn from(e: $ty) -> Self {
+                Box::new(e).into()
+            }
+        }
+    )*};
+}
+from_boxed!(
+    crate::evolve::WorkerFailure,
+    crate::evolve::WorkerFault,
+    crate::evolve::LineError
+);
+
 /// A result with the crate's [`Error`].
 pub type Result<T> = std::result::Result<T, Error>;
 
@@ -191,6 +208,22 @@ mod tests {
             Err(crate::evolve::EvaluationError::NotEvaluated);
         let damage = evaluation?;
         Ok(damage)
+    }
+
+    #[test]
+    fn the_worker_errors_convert_boxed_with_their_message() {
+        let line = crate::evolve::LineError {
+            side: "reply",
+            line: 3,
+            column: 1,
+            field: None,
+            expected: "a reply".into(),
+            text: "junk".into(),
+        };
+        let message = line.to_string();
+        let e: Error = line.into();
+        assert!(matches!(e, Error::ProtocolLine(_)), "{e:?}");
+        assert_eq!(e.to_string(), message);
     }
 
     #[test]
