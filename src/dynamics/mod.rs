@@ -48,7 +48,7 @@ mod stability;
 mod trig;
 mod width;
 
-// The bodies of work named in the module doc, one per file, re-exported below.
+// What the private files give the crate's users, as `dynamics::X`.
 pub use aba::{aba, aba_passes};
 pub use aba_lanes::{LaneData, LaneInput, aba_passes_lanes};
 pub use crba::{NotPositiveDefinite, crba, forward_dynamics_crba};
