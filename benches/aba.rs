@@ -4,9 +4,9 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::{DQuat, DVec3};
-use marionette::dynamics::aba_lanes::{LaneData, LaneInput, aba_passes_lanes};
 use marionette::dynamics::{Data, ForceVec, aba, aba_passes, kinematics};
-use marionette::humanoid::body::fall21_body;
+use marionette::dynamics::{LaneData, LaneInput, aba_passes_lanes};
+use marionette::humanoid::fall21_body;
 use std::hint::black_box;
 
 fn bench_aba(c: &mut Criterion) {

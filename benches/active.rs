@@ -14,7 +14,7 @@ use marionette::ecs::character::{
     PhysicalSettings, Reaction, character_schedule, spawn_physical_character,
 };
 use marionette::ecs::{Clock, new_world, run_ticks};
-use marionette::humanoid::body::humanoid24_body;
+use marionette::humanoid::humanoid24_body;
 use marionette::primitive::{LearnConfig, Primitive};
 
 const TICKS: usize = 200;

@@ -13,7 +13,7 @@
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use marionette::evolve::{GaConfig, GaState, InProcess, checkpoint};
 use marionette::experiments::evolve_fall::{EvolutionRun, FallProblem};
-use marionette::humanoid::ranges::AgeGroup;
+use marionette::humanoid::AgeGroup;
 use std::hint::black_box;
 use std::time::Duration;
 

@@ -7,7 +7,7 @@
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use marionette::dynamics::Integrator;
 use marionette::experiments::fall::{FallConfig, simulate_fall};
-use marionette::humanoid::ranges::AgeGroup;
+use marionette::humanoid::AgeGroup;
 use std::hint::black_box;
 use std::time::Duration;
 

@@ -7,7 +7,7 @@ mod common;
 
 use common::mujoco::pushed_falls;
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use marionette::experiments::fall::ecs::run_parallel;
+use marionette::experiments::fall::run_parallel;
 use std::hint::black_box;
 use std::time::Duration;
 

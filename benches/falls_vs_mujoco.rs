@@ -13,7 +13,7 @@ mod common;
 use common::mujoco::{FALLS, THREADS, configs, filtered_out, median, mujoco_round, setup};
 use marionette::dynamics::Integrator;
 use marionette::experiments::fall::FallConfig;
-use marionette::experiments::fall::ecs::run_parallel;
+use marionette::experiments::fall::run_parallel;
 use std::time::Instant;
 
 const ROUNDS: usize = 3;

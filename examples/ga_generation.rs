@@ -25,8 +25,8 @@ use marionette::experiments::evolve_fall::{
 };
 use marionette::experiments::fall::Ranges;
 use marionette::experiments::fall::SettledStart;
-use marionette::experiments::fall::ecs::{ReactionStart, run_parallel_reacting};
-use marionette::humanoid::ranges::{AgeGroup, RangeTable};
+use marionette::experiments::fall::{ReactionStart, run_parallel_reacting};
+use marionette::humanoid::{AgeGroup, RangeTable};
 
 fn env(name: &str) -> Option<f64> {
     std::env::var(name).ok().map(|v| v.parse().expect(name))

@@ -24,7 +24,7 @@ use marionette::ecs::character::{
 use marionette::ecs::human::HumanFigure;
 use marionette::ecs::physics::{BodyState, ExternalForces};
 use marionette::ecs::{Clock, JointState, new_world, run_ticks};
-use marionette::humanoid::body::humanoid24_body;
+use marionette::humanoid::humanoid24_body;
 use marionette::primitive::{LearnConfig, Primitive};
 
 const DT: f64 = 5e-4;

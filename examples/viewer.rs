@@ -36,7 +36,7 @@ use marionette::ecs::character::{
 };
 use marionette::ecs::physics::{BodyState, ExternalForces, FloorContact};
 use marionette::experiments::knee_kick;
-use marionette::humanoid::body::{HumanBody, humanoid24_body};
+use marionette::humanoid::{HumanBody, humanoid24_body};
 use marionette::primitive::Primitive;
 use marionette::scene::{ActiveKneeKickScene, Scene, apply_overrides, knee_kick_config};
 

@@ -22,10 +22,10 @@ pub enum Error {
     Figure(#[from] crate::humanoid::FigureError),
     /// A joint-range table.
     #[error(transparent)]
-    Ranges(#[from] crate::humanoid::ranges::RangeError),
+    Ranges(#[from] crate::humanoid::RangeError),
     /// Building the human body (height, mass, joints).
     #[error(transparent)]
-    Body(#[from] crate::humanoid::body::HumanError),
+    Body(#[from] crate::humanoid::HumanError),
     /// A DOF without a row in the strength table.
     #[error(transparent)]
     Strength(#[from] crate::humanoid::strength::NoStrength),
@@ -34,10 +34,10 @@ pub enum Error {
     Dynamics(#[from] crate::dynamics::ModelError),
     /// A joint-space inertia matrix that is not positive definite.
     #[error(transparent)]
-    Inertia(#[from] crate::dynamics::crba::NotPositiveDefinite),
+    Inertia(#[from] crate::dynamics::NotPositiveDefinite),
     /// Balancing a body on the floor (its static equilibrium).
     #[error(transparent)]
-    Equilibrium(#[from] crate::dynamics::equilibrium::EquilibriumError),
+    Equilibrium(#[from] crate::dynamics::EquilibriumError),
     /// Motor primitives: learning, playing, blending, connecting, files.
     #[error(transparent)]
     Primitive(#[from] crate::primitive::PrimitiveError),
@@ -65,6 +65,30 @@ pub enum Error {
     /// One evaluation of a genome.
     #[error(transparent)]
     Evaluation(#[from] crate::evolve::EvaluationError),
+    /// A problem's own error behind a failed evaluation.
+    #[error(transparent)]
+    ProblemFailure(#[from] crate::evolve::ProblemFailure),
+    /// Why an individual of a generation has no fitness (the GA's failure log).
+    #[error(transparent)]
+    Failure(#[from] crate::evolve::Failure),
+    /// Why a GA run stopped before its last generation.
+    #[error(transparent)]
+    Stop(#[from] crate::evolve::StopCause),
+    /// An evaluator that could not evaluate a generation.
+    #[error(transparent)]
+    Evaluator(#[from] crate::evolve::EvaluatorError),
+    /// A JSON-lines worker that failed: which, how and what it last said.
+    #[error(transparent)]
+    Worker(#[from] Box<crate::evolve::WorkerFailure>),
+    /// What a JSON-lines worker did wrong.
+    #[error(transparent)]
+    WorkerFault(#[from] Box<crate::evolve::WorkerFault>),
+    /// A line of the worker protocol that does not parse.
+    #[error(transparent)]
+    ProtocolLine(#[from] Box<crate::evolve::LineError>),
+    /// A GA checkpoint: reading, checking or writing it.
+    #[error(transparent)]
+    Checkpoint(#[from] crate::evolve::CheckpointError),
     /// The falling paper's GA problem (its ranges, bounds, gain bounds).
     #[error(transparent)]
     FallProblem(#[from] crate::experiments::evolve_fall::ProblemError),
@@ -121,11 +145,36 @@ pub enum Error {
     #[cfg(feature = "render")]
     #[error(transparent)]
     Scene(#[from] crate::scene::SceneError),
+    /// A checkpoint to resume that does not match the runs the scene asks for.
+    #[cfg(feature = "render")]
+    #[error(transparent)]
+    ResumeMismatch(#[from] crate::scene::ResumeMismatch),
+    /// One setting whose value in a checkpoint is not the scene's.
+    #[cfg(feature = "render")]
+    #[error(transparent)]
+    SettingMismatch(#[from] crate::scene::SettingMismatch),
     /// Drawing a picture or plot.
     #[cfg(feature = "render")]
     #[error(transparent)]
     Render(#[from] crate::render::RenderError),
 }
+
+// The worker's errors are large (their lines and last words): boxed, as `EvaluatorError` holds
+// them, so that every `Result<_, Error>` stays small; they convert unboxed too.
+macro_rules! from_boxed {
+    ($($ty:ty),*) => {$(
+        impl From<$ty> for Error {
+            fn from(e: $ty) -> Self {
+                Box::new(e).into()
+            }
+        }
+    )*};
+}
+from_boxed!(
+    crate::evolve::WorkerFailure,
+    crate::evolve::WorkerFault,
+    crate::evolve::LineError
+);
 
 /// A result with the crate's [`Error`].
 pub type Result<T> = std::result::Result<T, Error>;
@@ -159,6 +208,22 @@ mod tests {
             Err(crate::evolve::EvaluationError::NotEvaluated);
         let damage = evaluation?;
         Ok(damage)
+    }
+
+    #[test]
+    fn the_worker_errors_convert_boxed_with_their_message() {
+        let line = crate::evolve::LineError {
+            side: "reply",
+            line: 3,
+            column: 1,
+            field: None,
+            expected: "a reply".into(),
+            text: "junk".into(),
+        };
+        let message = line.to_string();
+        let e: Error = line.into();
+        assert!(matches!(e, Error::ProtocolLine(_)), "{e:?}");
+        assert_eq!(e.to_string(), message);
     }
 
     #[test]

@@ -11,7 +11,7 @@ pub use crate::clips::KeyframeClip;
 pub use crate::skeleton::{Clip, Skeleton, Transform, forward_kinematics};
 
 // The engine's models and mapping real skeletons onto them.
-pub use crate::humanoid::ranges::AgeGroup;
+pub use crate::humanoid::AgeGroup;
 pub use crate::humanoid::{Figure, FigureClip, fall21, humanoid24};
 pub use crate::mapping::{Mapping, effector_errors, retarget};
 
@@ -38,7 +38,7 @@ pub use crate::ecs::{
     Clock, DofPose, MotionSet, Recorder, WorldPool, add_core_systems, add_motion_systems,
     spawn_clip_character, spawn_primitive_character,
 };
-pub use crate::experiments::fall::ecs::{add_fall_systems, build_fall_world, run_fall_world};
+pub use crate::experiments::fall::{add_fall_systems, build_fall_world, run_fall_world};
 
 // Pictures and scenes.
 #[cfg(feature = "render")]

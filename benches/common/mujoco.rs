@@ -6,9 +6,9 @@
 
 use marionette::dynamics::{Integrator, JointType};
 use marionette::experiments::fall::{FallConfig, simulate_fall};
-use marionette::humanoid::body::fall21_body;
-use marionette::humanoid::export::to_mjcf;
-use marionette::humanoid::ranges::{AgeGroup, RangeTable};
+use marionette::humanoid::fall21_body;
+use marionette::humanoid::to_mjcf;
+use marionette::humanoid::{AgeGroup, RangeTable};
 use serde_json::json;
 use std::path::{Path, PathBuf};
 

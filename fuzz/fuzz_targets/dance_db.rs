@@ -5,7 +5,7 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use marionette::choreo::database::{Database, Manifest};
+use marionette::choreo::{Database, Manifest};
 
 fuzz_target!(|data: &[u8]| {
     let dir = std::env::temp_dir().join(format!("marionette-fuzz-db-{}", std::process::id()));

@@ -4,7 +4,7 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use marionette::evolve::evaluator::{PROTOCOL, serve};
+use marionette::evolve::{PROTOCOL, serve};
 
 fuzz_target!(|data: &[u8]| {
     let mut input = format!("{{\"protocol\":\"{PROTOCOL}\",\"problem\":null}}\n").into_bytes();

@@ -1,17 +1,17 @@
 //! Ballistic flight of the whole-body centre of mass. In the air only gravity acts on a body, so
 //! its centre of mass follows `c(t) = c_a + v (t − a) + ½ g (t − a)²` (g = (0, −[`GRAVITY`], 0))
 //! whatever the limbs do, while the pelvis moves against the limbs' swing. The centre of mass is
-//! that of the articulated body the engine simulates ([`crate::humanoid::body::human_body`]:
+//! that of the articulated body the engine simulates ([`crate::humanoid::human_body`]:
 //! links and masses from the anthropometric table), so a flight made ballistic here asks the
 //! simulated body for no external force but gravity.
 
 use glam::DVec3;
 
 use super::GRAVITY;
-use crate::dynamics::data::Data;
-use crate::dynamics::kinematics::kinematics;
+use crate::dynamics::Data;
+use crate::dynamics::kinematics;
 use crate::humanoid::FigureClip;
-use crate::humanoid::body::{HumanBody, HumanError, human_body};
+use crate::humanoid::{HumanBody, HumanError, human_body};
 
 /// Nominal mass of the body whose centre of mass is taken, kg (the centre of mass does not
 /// depend on it: the table gives every link a fixed share of the mass).

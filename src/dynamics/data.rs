@@ -13,7 +13,7 @@ pub struct Data {
     /// `Xup[i]`: parent frame → body `i` frame (world → body for a root).
     pub xup: Vec<SpatialTransform>,
     /// The joint rotation of each `Xup` as its coordinate-axis factors, where the model's
-    /// [`JointAxes`](super::axis_rotation::JointAxes) has them.
+    /// `JointAxes` has them.
     pub xup_rotation: Vec<JointRotation>,
     /// Motion-subspace columns `S` of each joint, body coordinates (first `nv` used; free: none).
     pub s: Vec<[MotionVec; 3]>,

@@ -39,7 +39,7 @@ pub enum Integrator {
     /// Semi-implicit Euler with every stiff force linearised and taken implicitly:
     /// `(M + h D + h² K) Δv = h (f − h K v)` with `K`, `D` the stiffness and damping of the PD
     /// terms, of the joint limits past their range, of the joint friction and of the pushing
-    /// (and sticking) floor corners (1 evaluation per step; [`super::linearly_implicit`]).
+    /// (and sticking) floor corners (1 evaluation per step; `linearly_implicit`).
     LinearlyImplicitEuler,
     /// The same linearisation taken at the step's midpoint, `θ = ½`:
     /// `(M + ½h D + ½h² K) Δv = h (f − ½h K v)`, i.e. the stiff forces act at
@@ -83,7 +83,7 @@ pub trait Dynamics {
     /// force's stiffness `K = −∂f/∂q` and damping `D = −∂f/∂v` at `(q, v)`, it solves
     /// `(H + θh D + θh² K) q̈ = f(q, v) − C − θh K v`, so that `v' = v + h q̈` is the velocity
     /// for which the linearised force `f(q + θh v', v + θ(v' − v))` acts
-    /// ([`super::linearly_implicit`]). A dynamics that knows no stiffness takes its damping
+    /// (`linearly_implicit`). A dynamics that knows no stiffness takes its damping
     /// implicitly only (the default).
     fn acceleration_linearised(
         &mut self,

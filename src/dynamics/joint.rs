@@ -240,7 +240,7 @@ impl JointType {
     /// [`JointType::jcalc`] for a joint whose rotation factors into rotations about coordinate
     /// axes (`axes`, from the model): the same `X_J`, `v_J`, `c_J` and `S` from the factors'
     /// sines and cosines (`sin_q`, `cos_q`: those of the joint's `q`, from
-    /// [`trig::sin_cos_at`](super::trig::sin_cos_at)), without general 3×3 products, and the
+    /// `trig::sin_cos_at`), without general 3×3 products, and the
     /// factors themselves. Joints without that structure (`JointAxes::General`) take
     /// [`JointType::jcalc`].
     #[inline(always)]
@@ -394,7 +394,7 @@ impl JointType {
 
     /// The joint velocity (as `v`) of angles `angles` moving at rates `rates` (the DOFs' time
     /// derivatives): pin and universal `v = θ̇`; ball `v = Aᵀ dexp(Aθ, Aθ̇)` (the child's angular
-    /// velocity in its own coordinates, see [`dexp`]); free and fixed unchanged (`out` is left
+    /// velocity in its own coordinates, see `dexp`); free and fixed unchanged (`out` is left
     /// as it is).
     #[inline]
     pub fn velocity_from_rates(&self, angles: &[f64], rates: &[f64], out: &mut [f64]) {

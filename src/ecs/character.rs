@@ -37,22 +37,22 @@ use super::physics::{
 };
 use super::primitive::PrimitivePlayer;
 use super::sets::{MotionSet, configure_motion_sets};
+use crate::dynamics::Data;
+use crate::dynamics::Integrator;
+use crate::dynamics::Model;
 use crate::dynamics::control::{
     ComputedTorque, RootAssistGains, RootTarget, Wrench, inertia_scaled_gains, root_assist_wrench,
     root_rotational_inertia, root_share,
 };
-use crate::dynamics::data::Data;
 use crate::dynamics::forces::contact::{ContactModel, ContactParams};
 use crate::dynamics::forces::external::{ExternalForce, Push};
 use crate::dynamics::forces::limits::{JointLimitParams, JointRanges};
 use crate::dynamics::forces::pd::PdTargets;
-use crate::dynamics::integrator::Integrator;
-use crate::dynamics::kinematics::kinematics;
-use crate::dynamics::model::Model;
-use crate::humanoid::body::HumanBody;
-use crate::humanoid::ranges::{AgeGroup, RangeTable};
+use crate::dynamics::kinematics;
+use crate::humanoid::HumanBody;
 use crate::humanoid::strength::{NoStrength, torque_limits_for};
 use crate::humanoid::tissue;
+use crate::humanoid::{AgeGroup, RangeTable};
 use crate::primitive::{Primitive, PrimitiveError};
 
 /// The order of the control systems inside [`MotionSet::Control`].
@@ -342,7 +342,7 @@ pub enum CharacterError {
 /// The body configuration and velocity of a DOF pose: the pelvis at the root channels, every
 /// joint at its DOF angles, every joint velocity from its DOF rates (a ball joint's DOFs are
 /// the components of its rotation vector, whose rates become its angular velocity through
-/// [`crate::dynamics::joint::dexp`]: [`crate::dynamics::Model::velocity_from_rates`]).
+/// `dexp`: [`crate::dynamics::Model::velocity_from_rates`]).
 pub fn pose_configuration(
     body: &HumanBody,
     binding: &FigureBinding,

@@ -15,8 +15,8 @@ use glam::{DQuat, DVec3};
 use super::motion::{Character, JointState, Recorder, SkeletonRef};
 use super::physics::{BodyState, PhysicsBody, PhysicsBundle};
 use super::sets::MotionSet;
-use crate::dynamics::integrator::Integrator;
-use crate::humanoid::body::HumanBody;
+use crate::dynamics::Integrator;
+use crate::humanoid::HumanBody;
 
 /// The human a simulated body is (immutable, shared): its figure model, DOF map (`dof_v`),
 /// link names and contact boxes, and the rigid-body model its [`PhysicsBody`] steps.

@@ -21,6 +21,10 @@
 //! [`physics::add_physics_systems`] (with the human bodies' pose,
 //! [`human::add_human_physics_systems`]). A World holds one experiment and is `Send`; a
 //! [`WorldPool`] runs many in parallel, each with its own seeded generator.
+//!
+//! The four domains that add systems of their own stay namespaces, as Bevy plugins would:
+//! [`primitive`], [`physics`], [`human`] and [`character`]; the shared wiring (clock, sets,
+//! motion, DOF pose, worlds) is in private files re-exported here.
 
 pub mod character;
 mod clock;
@@ -31,7 +35,7 @@ pub mod physics;
 pub mod primitive;
 mod sets;
 mod systems;
-pub mod worlds;
+mod worlds;
 
 pub use clock::{Clock, advance_clock};
 pub use dof_pose::{DofPose, FigureBinding, pose_from_dofs};

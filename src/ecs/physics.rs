@@ -18,13 +18,13 @@ use bevy_ecs::prelude::*;
 
 use super::clock::Clock;
 use super::sets::{MotionSet, configure_motion_sets};
-use crate::dynamics::aba_lanes::LaneData;
+use crate::dynamics::Integrator;
+use crate::dynamics::LaneData;
+use crate::dynamics::Model;
 use crate::dynamics::forces::contact::ContactModel;
 use crate::dynamics::forces::external::ExternalForce;
 use crate::dynamics::forces::limits::JointRanges;
 use crate::dynamics::forces::pd::PdTargets;
-use crate::dynamics::integrator::Integrator;
-use crate::dynamics::model::Model;
 use crate::dynamics::pipeline::{
     self, Forces, LaneBody, State, StepError, StepMonitor, StepRefinement, StepSettings,
     StepWorkspace,
@@ -217,7 +217,7 @@ type StepQuery<'a> = (
 ///
 /// Bodies of one model integrated by semi-implicit Euler step together through
 /// [`pipeline::step_lanes`] (their articulated-body algorithm
-/// [`LANES`](crate::dynamics::lanes::LANES) at a time in vector lanes), each to the bits it has
+/// [`LANES`](crate::dynamics::LANES) at a time in vector lanes), each to the bits it has
 /// stepped alone.
 pub fn step_bodies(
     clock: Res<Clock>,

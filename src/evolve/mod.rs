@@ -16,9 +16,12 @@ pub(crate) mod genome;
 pub(crate) mod logbook;
 pub(crate) mod operators;
 
-pub use error::{CheckpointError, EvaluatorError, StopCause, WorkerFailure, WorkerFault};
+pub use error::{
+    CheckpointError, EvaluatorError, LineError, StopCause, WorkerFailure, WorkerFault,
+};
 pub use evaluator::{Evaluation, Evaluator, EvolveError, InProcess, JsonLines, par_map, serve};
 pub use failure::{ELITE_CHECK, ELITE_CHECK_REFINE, EvaluationError, Failure, ProblemFailure};
+pub use formats::{MAX_LINE, MAX_REFINE, PROTOCOL};
 pub use ga::{GaConfig, GaState};
 pub use genome::{Bounds, Genome};
-pub use logbook::{GenerationRecord, from_json_lines};
+pub use logbook::{CSV_HEADER, GenerationRecord, from_json_lines, to_csv, to_json_lines};

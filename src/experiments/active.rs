@@ -23,7 +23,7 @@ use crate::ecs::physics::{
 };
 use crate::ecs::{Clock, Recorder};
 use crate::humanoid::FigureClip;
-use crate::humanoid::body::{HumanBody, HumanError, humanoid24_body};
+use crate::humanoid::{HumanBody, HumanError, humanoid24_body};
 use crate::primitive::Primitive;
 
 /// The pelvis counts as fallen once its height is below this fraction of its start height.

@@ -1,39 +1,39 @@
-//! A humanoid model as an articulated body: the joint tree, DOF names, axes and offsets of a
-//! [`Figure`] ([`crate::humanoid::fall21`], [`crate::humanoid::humanoid24`], or any model
-//! with the same link names), scaled to the subject's height, with segment masses, centres of
-//! mass and inertias from **de Leva (1996)**, *Adjustments to Zatsiorsky–Seluyanov's segment
-//! inertia parameters*, J. Biomech. 29(9):1223–1230, Table 4 (males: stature 1741 mm, 73.0 kg),
-//! scaled to the subject's mass `M` (`m_i = μ_i M`). Segment lengths `ℓ_i` come from the figure's
-//! own joint positions (the waist → hip line for the lower trunk, neck → waist for the upper and
-//! middle trunk in de Leva's proportions, joint to joint along the limbs, the head's end site for
-//! head + neck), so neighbouring segments meet at their joints and never overlap; only hand and
-//! foot, whose end points are not joints, keep de Leva's lengths scaled by `H / 1.741`. Centres
-//! of mass sit at the table's fraction of `ℓ_i`, inertias are `I = m (r ℓ)²` with the table's radii
-//! of gyration about the sagittal, transverse and longitudinal axes (see [`segment`] for how
-//! they map onto link axes).
-//!
-//! Links by name (a `left_`/`right_` prefix is ignored): `pelvis` (de Leva's lower trunk),
-//! `torso` or `chest` (upper + middle trunk), `head` (head + neck), `clavicle` (the shoulder
-//! girdle, which de Leva counts in the upper trunk: see [`CLAVICLE_SHARE`]), and per side
-//! `upper_arm`, `forearm`, `hand`, `thigh`, `shin`, `foot`. Joint types follow the model's
-//! joints: free (the pelvis), ball, universal, pin, and fixed (humanoid24's neck, wrists and
-//! ankles: the link is welded to its parent). Each link also carries a box for floor contact
-//! (SPEC §3: "a box on each link").
-//!
-//! fall21 (15 links, 21 DOF) is the falling paper's body ([`fall21_body`]); humanoid24 (17
-//! links, 24 DOF, the motor-primitive model) gets a body the same way ([`humanoid24_body`]).
-
 use std::sync::{Arc, Mutex, Weak};
 
+use crate::dynamics::JointType;
 use crate::dynamics::forces::contact::LinkBox;
-use crate::dynamics::joint::JointType;
-use crate::dynamics::model::{Body, Model, ModelError};
-use crate::dynamics::spatial::{Inertia, SpatialTransform};
+use crate::dynamics::{Body, Model, ModelError};
+use crate::dynamics::{Inertia, SpatialTransform};
 use crate::humanoid::anthropometry::*;
 use crate::humanoid::{self, Figure, FigureJoint, JointKind};
 use glam::{DMat3, DVec3};
 
 /// A human ready to simulate.
+///
+/// A humanoid model as an articulated body: the joint tree, DOF names, axes and offsets of a
+/// [`Figure`] ([`crate::humanoid::fall21`], [`crate::humanoid::humanoid24`], or any model
+/// with the same link names), scaled to the subject's height, with segment masses, centres of
+/// mass and inertias from **de Leva (1996)**, *Adjustments to Zatsiorsky–Seluyanov's segment
+/// inertia parameters*, J. Biomech. 29(9):1223–1230, Table 4 (males: stature 1741 mm, 73.0 kg),
+/// scaled to the subject's mass `M` (`m_i = μ_i M`). Segment lengths `ℓ_i` come from the figure's
+/// own joint positions (the waist → hip line for the lower trunk, neck → waist for the upper and
+/// middle trunk in de Leva's proportions, joint to joint along the limbs, the head's end site for
+/// head + neck), so neighbouring segments meet at their joints and never overlap; only hand and
+/// foot, whose end points are not joints, keep de Leva's lengths scaled by `H / 1.741`. Centres
+/// of mass sit at the table's fraction of `ℓ_i`, inertias are `I = m (r ℓ)²` with the table's radii
+/// of gyration about the sagittal, transverse and longitudinal axes (see `segment` for how
+/// they map onto link axes).
+///
+/// Links by name (a `left_`/`right_` prefix is ignored): `pelvis` (de Leva's lower trunk),
+/// `torso` or `chest` (upper + middle trunk), `head` (head + neck), `clavicle` (the shoulder
+/// girdle, which de Leva counts in the upper trunk: see [`CLAVICLE_SHARE`]), and per side
+/// `upper_arm`, `forearm`, `hand`, `thigh`, `shin`, `foot`. Joint types follow the model's
+/// joints: free (the pelvis), ball, universal, pin, and fixed (humanoid24's neck, wrists and
+/// ankles: the link is welded to its parent). Each link also carries a box for floor contact
+/// (SPEC §3: "a box on each link").
+///
+/// fall21 (15 links, 21 DOF) is the falling paper's body ([`fall21_body`]); humanoid24 (17
+/// links, 24 DOF, the motor-primitive model) gets a body the same way ([`humanoid24_body`]).
 #[derive(Clone, Debug)]
 pub struct HumanBody {
     /// The articulated body (bodies = the figure's joints/links in the same order; body 0 =
@@ -129,8 +129,7 @@ fn combine(a: Inertia, b: Inertia) -> Inertia {
     let shift = |x: &Inertia| {
         let d = x.com - c;
         x.inertia_com
-            + (DMat3::IDENTITY * d.length_squared() - crate::dynamics::spatial::outer(d, d))
-                * x.mass
+            + (DMat3::IDENTITY * d.length_squared() - crate::dynamics::outer(d, d)) * x.mass
     };
     Inertia::new(m, c, shift(&a) + shift(&b))
 }
@@ -143,7 +142,7 @@ pub const CLAVICLE_SHARE: f64 = 0.05;
 /// Inertia of a slender cylinder of mass `m` (kg), length `len` (m) and radius `r` (m) from `p0`
 /// along the unit `dir`: `I = m(ℓ²/12 + r²/4)(1 − d dᵀ) + (m r²/2) d dᵀ` about its centre.
 fn rod(m: f64, len: f64, r: f64, p0: DVec3, dir: DVec3) -> Inertia {
-    let dd = crate::dynamics::spatial::outer(dir, dir);
+    let dd = crate::dynamics::outer(dir, dir);
     let perp = m * (len * len / 12.0 + r * r / 4.0);
     let axial = 0.5 * m * r * r;
     Inertia::new(
@@ -189,7 +188,7 @@ pub fn humanoid24_body(height: f64, mass: f64, g: f64) -> Result<HumanBody, Huma
 }
 
 /// Builds the articulated body of `model` (a figure whose root is a free pelvis and whose links
-/// are named as in the module doc) for a subject of standing height `height` (m) and mass `mass`
+/// are named as in [`HumanBody`]'s doc) for a subject of standing height `height` (m) and mass `mass`
 /// (kg) under gravity `(0, −g, 0)`.
 pub fn human_body(model: &Figure, height: f64, mass: f64, g: f64) -> Result<HumanBody, HumanError> {
     check_subject(model, height, mass)?;
@@ -548,8 +547,8 @@ mod tests {
             glam::DQuat::IDENTITY,
         );
         q[1] = 0.530 * h;
-        let mut data = crate::dynamics::data::Data::new(&b.model);
-        crate::dynamics::kinematics::kinematics(&b.model, &mut data, &q, &[0.0; 27]);
+        let mut data = crate::dynamics::Data::new(&b.model);
+        crate::dynamics::kinematics(&b.model, &mut data, &q, &[0.0; 27]);
         let mut c = DVec3::ZERO;
         for (i, body) in b.model.bodies().iter().enumerate() {
             c += (data.pos[i] + data.rot[i] * body.inertia.com) * body.inertia.mass;

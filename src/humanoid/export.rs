@@ -1,25 +1,8 @@
-//! The fall21 body as standard robot files: URDF (for Pinocchio and ROS tools) and MJCF (for
-//! MuJoCo). Both keep the engine's frame (Y up, the figure facing +Z, its left +X, metres,
-//! radians), so a loader must set gravity to `(0, −g, 0)`; both carry per link the mass, centre
-//! of mass and inertia about it, and the contact box; per DOF the axis, range and (URDF) the
-//! strength of the age group as `effort`.
-//!
-//! Joints: the pelvis is the floating base (URDF: the root link, to be loaded with a free-flyer
-//! root joint; MJCF: a `freejoint`). Each fall21 DOF is one revolute joint named like the DOF:
-//! a universal joint `R(a₁,θ₁)R(a₂,θ₂)` is two revolutes in series through a massless link
-//! (`<joint>_1`), exactly the engine's joint. The neck's ball joint is a quaternion joint in the
-//! engine: MJCF writes it as a `ball` joint (same quaternion, local angular velocity; its
-//! components along the engine's axes X, Z, Y are the engine's velocity coordinates); URDF has no
-//! ball joint, so it writes three revolutes about X, Z, Y in series (`neck_flexion`,
-//! `neck_lateral`, `neck_rotation`), which equal the engine's joint at the identity and differ
-//! elsewhere (Euler angles against a rotation vector). URDF `velocity` limits are not modelled
-//! by the engine and are written as 20 rad/s.
-
 use std::fmt::Write;
 
 use glam::{DMat3, DVec3};
 
-use crate::dynamics::joint::JointType;
+use crate::dynamics::JointType;
 use crate::humanoid::body::HumanBody;
 
 fn v3(v: DVec3) -> String {

@@ -12,22 +12,55 @@
 //! - [`FigureClip`]: a motion on a model (DOF angles plus root motion).
 //! - [`leg_ik`]: two-bone inverse kinematics of a leg (the ankle put at a point).
 //! - [`fall21`]: the 21-DOF, 15-link model of the falling paper (SPEC §3), with age-dependent
-//!   joint ranges in [`ranges`].
+//!   joint ranges ([`RangeTable`], [`AgeGroup`]): data a user can edit, for fall21
+//!   (`src/humanoid/data/fall21_elderly.ron`, `src/humanoid/data/fall21_adult.ron`) and adult for
+//!   humanoid24 (`src/humanoid/data/humanoid24_adult.ron`; its sources are named there).
+//! - [`HumanBody`]: a figure as an articulated body to simulate (de Leva's segment parameters,
+//!   [`fall21_body`], [`human_body`]), written as robot files by [`to_urdf`] and [`to_mjcf`].
+//!
+//! Four files are namespaces of their own: the two-bone leg IK ([`leg_ik`], whose functions read
+//! as `leg_ik::reach`), and three sourced tables whose module docs cite them: [`anthropometry`]
+//! (de Leva 1996), [`strength`] (maximal joint torques by age group) and [`tissue`] (the floor
+//! contact stiffness of the body's regions). The others are private, their items re-exported here
+//! (`marionette::humanoid::HumanBody`).
+//!
+//! **Robot files** ([`to_urdf`], [`to_mjcf`]). The fall21 body as standard robot files: URDF (for
+//! Pinocchio and ROS tools) and MJCF (for MuJoCo). Both keep the engine's frame (Y up, the figure facing +Z, its left +X, metres,
+//! radians), so a loader must set gravity to `(0, −g, 0)`; both carry per link the mass, centre
+//! of mass and inertia about it, and the contact box; per DOF the axis, range and (URDF) the
+//! strength of the age group as `effort`.
+//!
+//! Joints: the pelvis is the floating base (URDF: the root link, to be loaded with a free-flyer
+//! root joint; MJCF: a `freejoint`). Each fall21 DOF is one revolute joint named like the DOF:
+//! a universal joint `R(a₁,θ₁)R(a₂,θ₂)` is two revolutes in series through a massless link
+//! (`<joint>_1`), exactly the engine's joint. The neck's ball joint is a quaternion joint in the
+//! engine: MJCF writes it as a `ball` joint (same quaternion, local angular velocity; its
+//! components along the engine's axes X, Z, Y are the engine's velocity coordinates); URDF has no
+//! ball joint, so it writes three revolutes about X, Z, Y in series (`neck_flexion`,
+//! `neck_lateral`, `neck_rotation`), which equal the engine's joint at the identity and differ
+//! elsewhere (Euler angles against a rotation vector). URDF `velocity` limits are not modelled
+//! by the engine and are written as 20 rad/s.
 
 pub mod anthropometry;
-pub mod body;
+mod body;
 mod definition;
-pub mod export;
+mod export;
 mod figure_clip;
 mod joint_angles;
 pub mod leg_ik;
-pub mod ranges;
+mod ranges;
 pub mod strength;
 pub mod tissue;
 
+pub use body::{
+    CLAVICLE_SHARE, HumanBody, HumanError, fall21_body, human_body, humanoid24_body,
+    shared_fall21_body,
+};
 pub use definition::{fall21, humanoid24};
+pub use export::{to_mjcf, to_urdf};
 pub use figure_clip::{FigureClip, ROOT_CHANNELS};
 pub use joint_angles::{local_rotation, project_rotation, rotation_vector_near, unwrap_near};
+pub use ranges::{AgeGroup, FORMAT_VERSION as RANGES_FORMAT_VERSION, RangeError, RangeTable};
 
 use glam::{DQuat, DVec3};
 use serde::{Deserialize, Serialize};

@@ -1,7 +1,3 @@
-//! Joint ranges as data a user can edit: age-dependent for the fall21 model
-//! (`src/humanoid/data/fall21_elderly.ron`, `src/humanoid/data/fall21_adult.ron`), adult for the
-//! humanoid24 model (`src/humanoid/data/humanoid24_adult.ron`; its sources are named there).
-
 use std::collections::BTreeMap;
 use std::path::Path;
 

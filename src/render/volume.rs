@@ -3,7 +3,7 @@
 //!
 //! - **The project's models** (a figure whose point names and parents are those of
 //!   [`crate::humanoid::fall21`] or [`crate::humanoid::humanoid24`]): each link's floor-contact
-//!   box ([`crate::humanoid::body::human_body`]), for the model scaled to the figure's height
+//!   box ([`crate::humanoid::human_body`]), for the model scaled to the figure's height
 //!   (its bone lengths against the model's). A box lives in its link's frame; the frame's
 //!   rotation R is fitted each frame from the points hanging from the link (their rest offsets
 //!   o in the link frame against their offsets d in the frame drawn): with two or more
@@ -30,7 +30,7 @@
 use glam::{DMat3, DQuat, DVec3};
 
 use super::figure::{Side, StickFigure, Track};
-use crate::humanoid::{self, body::human_body};
+use crate::humanoid::{self, human_body};
 
 /// One volume of a body, in the figure's terms.
 #[derive(Debug, Clone, PartialEq)]

@@ -20,7 +20,7 @@ use crate::dynamics::forces::external::Push;
 use crate::ecs::character::PhysicalSettings;
 use crate::experiments::active::{ActiveConfig, ActiveOutcome, run_active};
 use crate::experiments::knee_kick;
-use crate::humanoid::ranges::AgeGroup;
+use crate::humanoid::AgeGroup;
 use crate::render::{Page, Plot, Series, plot};
 
 fn default_push() -> Push {

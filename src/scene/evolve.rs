@@ -21,8 +21,8 @@ use crate::experiments::evolve_fall::{
     FallProblem, GroupOutcome, InProcessFalls, halted,
 };
 use crate::experiments::fall::{FallConfig, FallResult};
+use crate::humanoid::AgeGroup;
 use crate::humanoid::fall21;
-use crate::humanoid::ranges::AgeGroup;
 use crate::render::{Page, Plot, Series, plot};
 
 /// Who evaluates the generations.
@@ -56,7 +56,7 @@ fn default_kp_scale() -> f64 {
 #[serde(deny_unknown_fields)]
 pub struct GaStep {
     /// The integration scheme.
-    pub integrator: crate::dynamics::integrator::Integrator,
+    pub integrator: crate::dynamics::Integrator,
     /// The step, seconds.
     pub dt_s: f64,
     /// Seconds after the reaction starts stepped finer ([`FallConfig::reaction_window_s`];
@@ -78,11 +78,11 @@ fn default_step() -> Option<GaStep> {
 
 impl GaStep {
     /// The GA's default stepping: the stiff forces linearised at the step's midpoint
-    /// ([`Integrator::LinearlyImplicitMidpoint`](crate::dynamics::integrator::Integrator)),
+    /// ([`Integrator::LinearlyImplicitMidpoint`](crate::dynamics::Integrator)),
     /// 2 ms, the reaction's first 100 ms in four sub-steps.
     pub fn midpoint_2ms() -> Self {
         Self {
-            integrator: crate::dynamics::integrator::Integrator::LinearlyImplicitMidpoint,
+            integrator: crate::dynamics::Integrator::LinearlyImplicitMidpoint,
             dt_s: 0.002,
             reaction_window_s: 0.1,
             reaction_substeps: 4,
@@ -931,7 +931,7 @@ mod tests {
 
     #[test]
     fn a_scene_without_a_step_takes_the_midpoint_at_2_ms_and_none_the_margin() {
-        use crate::dynamics::integrator::Integrator;
+        use crate::dynamics::Integrator;
         let parse = |extra: &str| {
             let text = format!(
                 "EvolveFall(format_version: 1, name: \"t\", groups: [adult], seeds: [1]{extra})"
@@ -958,7 +958,7 @@ mod tests {
 
     #[test]
     fn a_step_given_outright_replaces_the_margin_and_a_bad_one_is_refused() {
-        use crate::dynamics::integrator::Integrator;
+        use crate::dynamics::Integrator;
         let step = GaStep {
             integrator: Integrator::LinearlyImplicitEuler,
             dt_s: 0.002,

@@ -223,10 +223,10 @@ pub enum SceneError {
     NotSceneOutput(PathBuf),
     /// A body that could not be built.
     #[error(transparent)]
-    Body(#[from] crate::humanoid::body::HumanError),
+    Body(#[from] crate::humanoid::HumanError),
     /// The fall's body, for its picture.
     #[error("the fall's body: {0}")]
-    FallBody(#[source] crate::humanoid::body::HumanError),
+    FallBody(#[source] crate::humanoid::HumanError),
     /// A fall's body without one contact box per joint.
     #[error("the fall's body has {boxes} contact boxes for {joints} joints")]
     BoxCount {
@@ -266,7 +266,7 @@ pub enum SceneError {
         /// `groups` or `seeds`.
         field: &'static str,
         /// The groups.
-        groups: Vec<crate::humanoid::ranges::AgeGroup>,
+        groups: Vec<crate::humanoid::AgeGroup>,
         /// The seeds.
         seeds: Vec<u64>,
     },
@@ -372,7 +372,7 @@ pub enum SceneError {
     Figure(#[from] crate::humanoid::FigureError),
     /// A joint-range table.
     #[error(transparent)]
-    Ranges(#[from] crate::humanoid::ranges::RangeError),
+    Ranges(#[from] crate::humanoid::RangeError),
     /// Motor primitives: learning, playing, blending, connecting, events.
     #[error(transparent)]
     Primitive(#[from] crate::primitive::PrimitiveError),
@@ -738,7 +738,7 @@ fn validate_active_knee_kick(s: &ActiveKneeKickScene) -> Result<(), SceneError> 
             expected: format!("inside the run [0, {})", s.duration_s),
         });
     }
-    let links = crate::humanoid::body::humanoid24_body(1.70, 65.0, 9.81)?.link_names;
+    let links = crate::humanoid::humanoid24_body(1.70, 65.0, 9.81)?.link_names;
     if !links.contains(&s.push.link) {
         return Err(SceneError::UnknownPushLink {
             link: s.push.link.clone(),

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use super::SceneError;
 use crate::experiments::fall::FallResult;
-use crate::humanoid::body::HumanBody;
+use crate::humanoid::HumanBody;
 use crate::render::{Page, PageBox, PageEvent, PageMotion, PagePlot, Plot};
 use crate::skeleton::Clip;
 
@@ -19,7 +19,7 @@ pub fn fall_motion(label: &str, r: &FallResult) -> Result<PageMotion, SceneError
     let clip = r.to_figure_clip().to_clip();
     // The boxes' sizes follow the height only; the mass sets inertias, which are not drawn.
     let body =
-        crate::humanoid::body::fall21_body(r.height_m, 65.0, 9.81).map_err(SceneError::FallBody)?;
+        crate::humanoid::fall21_body(r.height_m, 65.0, 9.81).map_err(SceneError::FallBody)?;
     let figure = crate::render::StickFigure::of(&clip.skeleton);
     let joints = clip.joint_count();
     if body.boxes.len() != joints {

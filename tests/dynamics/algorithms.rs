@@ -3,7 +3,7 @@
 //! root), and on the human bodies built from the engine's models (fall21 and humanoid24).
 
 use glam::{DMat3, DQuat, DVec3};
-use marionette::dynamics::crba::forward_dynamics_crba;
+use marionette::dynamics::forward_dynamics_crba;
 use marionette::dynamics::{
     Body, Data, ForceVec, Inertia, JointType, Model, SpatialTransform, aba, rnea,
 };
@@ -197,7 +197,7 @@ fn crba_matrix_is_symmetric_positive_definite_and_matches_rnea_columns() {
 
 #[test]
 fn aba_agrees_with_rnea_and_crba_on_the_human_bodies() {
-    use marionette::humanoid::body::{fall21_body, humanoid24_body};
+    use marionette::humanoid::{fall21_body, humanoid24_body};
     let mut rng = Pcg64::seed_from_u64(24);
     for (name, body) in [
         ("fall21", fall21_body(1.70, 65.0, 9.81).unwrap()),
@@ -212,7 +212,7 @@ fn aba_agrees_with_rnea_and_crba_on_the_human_bodies() {
 #[test]
 fn arguments_of_the_wrong_size_are_errors_that_name_both_sizes() {
     use marionette::dynamics::ModelError;
-    use marionette::dynamics::kinematics::mechanical_energy;
+    use marionette::dynamics::mechanical_energy;
     let mut rng = Pcg64::seed_from_u64(11);
     let m = random_model(&mut rng, 5, true);
     let (q, v, tau, f_ext) = random_state(&mut rng, &m);

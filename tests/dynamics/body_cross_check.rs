@@ -14,10 +14,10 @@ use std::process::Command;
 
 use glam::DQuat;
 use marionette::dynamics::{Data, ForceVec, JointType, aba, rnea};
-use marionette::humanoid::body::fall21_body;
-use marionette::humanoid::export::to_urdf;
-use marionette::humanoid::ranges::{AgeGroup, RangeTable};
+use marionette::humanoid::fall21_body;
 use marionette::humanoid::strength::torque_limits;
+use marionette::humanoid::to_urdf;
+use marionette::humanoid::{AgeGroup, RangeTable};
 use rand::{RngExt, SeedableRng};
 use serde_json::json;
 
@@ -127,7 +127,7 @@ fn pinocchio_agrees_with_the_engines_rnea_and_aba_on_the_urdf() {
 )]
 fn mujoco_follows_the_pushed_fall_until_first_contact() {
     use marionette::experiments::fall::{FallConfig, simulate_fall};
-    use marionette::humanoid::export::to_mjcf;
+    use marionette::humanoid::to_mjcf;
     let Some(py) = common::python_with(&["pinocchio", "mujoco"]) else {
         return;
     };

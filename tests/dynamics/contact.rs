@@ -8,7 +8,7 @@ use marionette::dynamics::forces::contact::{
     ContactGains, ContactModel, ContactParams, ContactSample, ContactState,
 };
 use marionette::dynamics::forces::limits::{JointLimitParams, joint_torque};
-use marionette::dynamics::integrator::step;
+use marionette::dynamics::integrate;
 use marionette::dynamics::{
     Body, Data, Dynamics, ForceVec, Inertia, Integrator, IntegratorWorkspace, JointType, Model,
     SpatialTransform, aba, kinematics,
@@ -100,7 +100,7 @@ fn run(w: &mut BoxOnFloor, q: &mut [f64], v: &mut [f64], seconds: f64) {
         let scheme = Integrator::SemiImplicitEuler {
             implicit_damping: false,
         };
-        step(
+        integrate(
             scheme,
             &w.model.clone(),
             &mut ws,
@@ -236,7 +236,7 @@ fn a_joint_limit_holds_a_lever_under_load() {
     let mut highest: f64 = -0.5;
     let h = 1e-3;
     for k in 0..5000 {
-        step(
+        integrate(
             Integrator::Rk4,
             &model,
             &mut ws,

@@ -4,9 +4,9 @@
 
 use glam::DVec3;
 use marionette::dynamics::StepError;
-use marionette::experiments::fall::ecs::{build_fall_world, run_fall_world, run_parallel};
 use marionette::experiments::fall::{FallConfig, FallResult, SimError, simulate_fall};
-use marionette::humanoid::ranges::AgeGroup;
+use marionette::experiments::fall::{build_fall_world, run_fall_world, run_parallel};
+use marionette::humanoid::AgeGroup;
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64;
 
@@ -116,7 +116,7 @@ fn a_runaway_push_stops_with_time_body_and_quantity() {
 fn two_characters_in_one_world_fall_independently() {
     use bevy_ecs::world::World;
     use marionette::experiments::fall::build_fall;
-    use marionette::experiments::fall::ecs::spawn_fall;
+    use marionette::experiments::fall::spawn_fall;
     let a = short(AgeGroup::Elderly);
     let mut b = short(AgeGroup::Adult);
     b.push.force_n = 700.0;

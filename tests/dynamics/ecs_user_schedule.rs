@@ -18,10 +18,10 @@ use marionette::ecs::{
     Clock, MotionSet, Recorder, SkeletonRef, add_core_systems, add_motion_systems,
     spawn_primitive_character,
 };
-use marionette::experiments::fall::ecs::{add_fall_systems, fall_results, spawn_fall};
 use marionette::experiments::fall::{FallConfig, build_fall};
-use marionette::humanoid::ranges::AgeGroup;
-use marionette::humanoid::{body::HumanBody, humanoid24};
+use marionette::experiments::fall::{add_fall_systems, fall_results, spawn_fall};
+use marionette::humanoid::AgeGroup;
+use marionette::humanoid::{HumanBody, humanoid24};
 use marionette::primitive::{LearnConfig, Primitive};
 use marionette::render::{StickFigure, Track, filmstrip_png};
 

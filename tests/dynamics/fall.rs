@@ -5,7 +5,7 @@
 
 use marionette::dynamics::Integrator;
 use marionette::experiments::fall::{FallConfig, FallResult, SimError, simulate_fall};
-use marionette::humanoid::ranges::AgeGroup;
+use marionette::humanoid::AgeGroup;
 
 fn check_fell_backward_and_rested(r: &FallResult) {
     let first = &r.frames[0];
@@ -208,7 +208,7 @@ fn random_genes_within_the_ranges_all_simulate() {
     // here than in the paper's fall: a stiffly held body can land harder on its soft regions
     // (limbs 20 kN/m), up to ~11 cm into the outline of a box; the pelvis keeps within the
     // bound of src/humanoid/tissue.rs, 14 cm (the published 5.6 kN on its 40 kN/m).
-    use marionette::humanoid::ranges::RangeTable;
+    use marionette::humanoid::RangeTable;
     use rand::{RngExt, SeedableRng};
     let mut rng = rand_pcg::Pcg64::seed_from_u64(5);
     let fig = marionette::humanoid::fall21();

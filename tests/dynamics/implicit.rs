@@ -1,10 +1,10 @@
-//! The linearly implicit step ([`marionette::dynamics::linearly_implicit`]) on the paper's
+//! The linearly implicit step ([`marionette::dynamics::Integrator::LinearlyImplicitEuler`]) on the paper's
 //! falls: the same fall as the explicit step at a small step, no energy gained on a passive
 //! drop, runs at 2 ms where the stability check refuses the explicit step, and how far the damage
 //! of random genomes of both age groups moves when the 2 ms step is halved (against the explicit
 //! step at 2 ms, past its check, and at the GA's 0.70 ms).
 
-use marionette::dynamics::kinematics::mechanical_energy;
+use marionette::dynamics::mechanical_energy;
 use marionette::dynamics::{
     Data, Forces, Integrator, State, StepError, StepMonitor, StepSettings, StepWorkspace, pipeline,
 };
@@ -13,7 +13,7 @@ use marionette::experiments::evolve_fall::{FallProblem, strength_kp_max};
 use marionette::experiments::fall::{
     FallCharacter, FallConfig, SimError, build_fall, simulate_fall,
 };
-use marionette::humanoid::ranges::AgeGroup;
+use marionette::humanoid::AgeGroup;
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64;
 
@@ -289,7 +289,7 @@ fn reaction_refined(problem: &FallProblem) -> FallProblem {
 /// unrefined falls (run to rest), as a fraction.
 fn refinement_cost(problem: &FallProblem, genomes: &[Genome]) -> f64 {
     use marionette::experiments::fall::SettledStart;
-    use marionette::experiments::fall::ecs::run_parallel_from;
+    use marionette::experiments::fall::run_parallel_from;
     let settled = SettledStart::of(&problem.fall).unwrap();
     let configs: Vec<FallConfig> = genomes.iter().map(|g| problem.config(g)).collect();
     let runs = run_parallel_from(&configs, Some(&settled));
@@ -407,7 +407,7 @@ fn on_random_genomes_the_2_ms_damage_moves_less_than_the_explicit_steps_when_hal
 
 #[test]
 fn linearised_falls_have_the_same_bits_on_1_and_2_threads() {
-    use marionette::experiments::fall::ecs::run_parallel;
+    use marionette::experiments::fall::run_parallel;
     // Eight pushed falls of both groups (two Worlds' worth), the first four at the step end
     // (θ = 1), the others at its midpoint, on pools of 1 and of 2 threads.
     let configs: Vec<FallConfig> = (0..8)

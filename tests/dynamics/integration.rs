@@ -2,8 +2,8 @@
 //! chain under RK4, free fall of a spinning body, and implicit damping staying stable.
 
 use glam::{DMat3, DQuat, DVec3};
-use marionette::dynamics::integrator::step;
-use marionette::dynamics::kinematics::mechanical_energy;
+use marionette::dynamics::integrate;
+use marionette::dynamics::mechanical_energy;
 use marionette::dynamics::{
     Body, Data, Dynamics, ForceVec, Inertia, Integrator, IntegratorWorkspace, JointType, Model,
     SpatialTransform, aba, aba_passes, kinematics,
@@ -119,7 +119,7 @@ fn pendulum_period_matches_the_elliptic_integral() {
     let mut crossings = Vec::new();
     let mut prev = v[0];
     while crossings.len() < 3 {
-        step(
+        integrate(
             Integrator::Rk4,
             &model,
             &mut ws,
@@ -211,7 +211,7 @@ fn passive_chain_conserves_energy_under_rk4() {
     let h = 5e-4;
     let mut max_rel: f64 = 0.0;
     for n in 0..20_000 {
-        step(
+        integrate(
             Integrator::Rk4,
             &model,
             &mut ws,
@@ -264,7 +264,7 @@ fn free_fall_of_a_spinning_body_follows_the_parabola() {
     let h = 1e-3;
     let n = 1500;
     for k in 0..n {
-        step(
+        integrate(
             Integrator::Rk4,
             &model,
             &mut ws,
@@ -302,7 +302,7 @@ fn implicit_damping_is_stable_where_explicit_euler_blows_up() {
             let scheme = Integrator::SemiImplicitEuler {
                 implicit_damping: implicit,
             };
-            step(
+            integrate(
                 scheme,
                 &model,
                 &mut ws,
@@ -354,7 +354,7 @@ fn rk4_keeps_fourth_order_on_the_rotation_manifold() {
         let mut ws = IntegratorWorkspace::new(&model);
         let n = (1.0 / h).round() as usize;
         for k in 0..n {
-            step(
+            integrate(
                 Integrator::Rk4,
                 &model,
                 &mut ws,

@@ -6,17 +6,17 @@
 use std::process::Command;
 
 use glam::{DQuat, DVec3};
-use marionette::dynamics::aba_lanes::{LaneData, LaneInput, aba_passes_lanes};
+use marionette::dynamics::LANES;
 use marionette::dynamics::forces::pd::PdTargets;
-use marionette::dynamics::lanes::LANES;
 use marionette::dynamics::pipeline::{LaneBody, step, step_lanes};
 use marionette::dynamics::{
     Data, ForceVec, Forces, Integrator, State, StepMonitor, StepSettings, StepWorkspace,
     aba_passes, kinematics,
 };
+use marionette::dynamics::{LaneData, LaneInput, aba_passes_lanes};
 use marionette::experiments::fall::{FallConfig, build_fall};
-use marionette::humanoid::body::fall21_body;
-use marionette::humanoid::ranges::AgeGroup;
+use marionette::humanoid::AgeGroup;
+use marionette::humanoid::fall21_body;
 
 /// The bits of every state of the pushed elderly fall stepped 2400 times by [`step`] (1.2 s),
 /// one line per step, then the final monitor; panics unless some link other than the feet

@@ -14,7 +14,7 @@ use marionette::evolve::{
 use marionette::evolve::{Evaluation, par_map};
 use marionette::experiments::evolve_fall::{FallProblem, InProcessFalls};
 use marionette::experiments::fall::SimError;
-use marionette::humanoid::ranges::AgeGroup;
+use marionette::humanoid::AgeGroup;
 
 /// The sphere function Σ (x_i − 1)², its minimum 0 at x = 1.
 fn sphere(x: &[f64]) -> Evaluation {

@@ -9,7 +9,7 @@ use std::process::Command;
 
 use marionette::evolve::{GaConfig, GaState, InProcess, JsonLines};
 use marionette::experiments::evolve_fall::FallProblem;
-use marionette::humanoid::ranges::AgeGroup;
+use marionette::humanoid::AgeGroup;
 
 #[test]
 #[cfg_attr(

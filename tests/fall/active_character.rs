@@ -17,7 +17,7 @@ use marionette::ecs::character::{
 use marionette::ecs::physics::BodyState;
 use marionette::ecs::{Clock, WorldPool, new_world, run_ticks};
 use marionette::experiments::active::{ActiveConfig, run_active};
-use marionette::humanoid::body::humanoid24_body;
+use marionette::humanoid::humanoid24_body;
 use marionette::primitive::{LearnConfig, Primitive};
 
 fn primitive(file: &str) -> Primitive {
@@ -492,7 +492,7 @@ fn captured_jumps_track_under_adult_strength() {
 /// where the same fall without ranges takes some joint further past it.
 #[test]
 fn joint_ranges_hold_a_falling_character() {
-    use marionette::humanoid::ranges::{AgeGroup, RangeTable};
+    use marionette::humanoid::{AgeGroup, RangeTable};
     let jump = primitive("normal_jump.ron");
     let free_cfg = ActiveConfig {
         duration_s: 2.5,

@@ -4,7 +4,7 @@
 //! parameters within ±20 %.
 
 use marionette::experiments::fall::{FallConfig, FallResult, simulate_fall};
-use marionette::humanoid::ranges::AgeGroup;
+use marionette::humanoid::AgeGroup;
 
 fn pelvis(r: &FallResult) -> usize {
     r.link_names.iter().position(|l| l == "pelvis").unwrap()

@@ -6,10 +6,10 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result, bail};
 
-use marionette::humanoid::body::fall21_body;
-use marionette::humanoid::export::{to_mjcf, to_urdf};
-use marionette::humanoid::ranges::{AgeGroup, RangeTable};
+use marionette::humanoid::fall21_body;
 use marionette::humanoid::strength::torque_limits;
+use marionette::humanoid::{AgeGroup, RangeTable};
+use marionette::humanoid::{to_mjcf, to_urdf};
 
 // The command's arguments (its help text is on `Command::Body`).
 #[derive(clap::Args)]

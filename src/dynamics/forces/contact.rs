@@ -127,14 +127,14 @@ fn tangents(n: DVec3) -> [DVec3; 2] {
 
 /// What a step takes implicitly of the floor's normal force, over a step of `h` seconds: its
 /// damping ([`ContactParams::implicit_damping`]) and, with `stiffness`, its spring too
-/// ([`linearly_implicit`]).
+/// (`linearly_implicit`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ImplicitFloor {
     /// The step (s).
     pub h: f64,
     /// Take the spring implicitly too.
     pub stiffness: bool,
-    /// The weight of the linearisation with the spring ([`linearly_implicit::corner`]: 1 at
+    /// The weight of the linearisation with the spring (`linearly_implicit::corner`: 1 at
     /// the step end, ½ at its midpoint); the damping alone is always taken at the step end.
     pub theta: f64,
 }

@@ -31,7 +31,7 @@ pub struct LaneBody<'a> {
 /// One step of `settings.dt` seconds for each body of `bodies` (all of `model`): the same
 /// stages as [`step`], every body's state, monitor and result the bits [`step`] gives it
 /// alone, with the articulated-body algorithm of [`LANES`] bodies at a time in the lanes of
-/// one vector computation ([`crate::dynamics::aba_lanes`]). That holds for semi-implicit
+/// one vector computation ([`crate::dynamics::aba_passes_lanes`]). That holds for semi-implicit
 /// Euler with the floor's damping explicit; any other scheme steps each body by [`step`].
 /// A body whose step fails keeps its error in `result` and the others go on; one whose state or
 /// workspace does not fit the model is not stepped (a [`StepError::Size`]), and the others are

@@ -26,7 +26,7 @@ use crate::evolve::{
     Evaluation, Evaluator, EvolveError, GaConfig, GaState, Genome, StopCause, checkpoint,
 };
 use crate::experiments::fall::{FallConfig, FallResult, SimError, simulate_fall};
-use crate::humanoid::ranges::AgeGroup;
+use crate::humanoid::AgeGroup;
 
 /// One evolution: an age group's problem and its GA (the seed is in `state.config`).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

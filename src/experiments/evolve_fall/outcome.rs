@@ -14,7 +14,7 @@ use super::{
 use crate::evolve::Failure;
 use crate::evolve::{Evaluator, EvolveError};
 use crate::experiments::fall::{FallConfig, FallResult, SimError, simulate_fall};
-use crate::humanoid::ranges::AgeGroup;
+use crate::humanoid::AgeGroup;
 
 /// Why an evolution could not be run or reported.
 #[derive(Debug, thiserror::Error)]

@@ -15,10 +15,10 @@ use serde::{Deserialize, Serialize};
 
 use crate::evolve::genome::BoundsError;
 use crate::evolve::{Bounds, Evaluation, EvaluationError, Genome};
-use crate::experiments::fall::ecs::{ReactionStart, run_parallel_until};
 use crate::experiments::fall::{FallConfig, Ranges, SettledStart, SimError};
+use crate::experiments::fall::{ReactionStart, run_parallel_until};
 use crate::humanoid::fall21;
-use crate::humanoid::ranges::{AgeGroup, RangeTable};
+use crate::humanoid::{AgeGroup, RangeTable};
 
 /// One age group's optimisation problem: the fall every genome is tried on and the gene bounds.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -142,7 +142,7 @@ pub const STEP_MARGIN: f64 = 0.8;
 
 /// The GA's step for every genome of the box `kp ≤ kp_max` on `fall` (s): the
 /// stiffest mode of the strongest genome (k_p = `kp_max` on every DOF; θ_d does not change the
-/// standing bound) through [`crate::dynamics::stability`], times `margin` (a fraction of that
+/// standing bound) through [`crate::dynamics::stable_step`], times `margin` (a fraction of that
 /// bound in (0, 1]; the GA's default is [`STEP_MARGIN`]), rounded down to a multiple of 50 µs
 /// ([`STEP_QUANTA_PER_S`]); `fall.dt_s` when nothing is stiff or the fall's scheme has no
 /// bound.
@@ -225,7 +225,7 @@ impl FallProblem {
     }
 
     /// The damage of every genome, the falls in parallel Worlds (up to four at a time in each,
-    /// [`run_parallel_reacting`](crate::experiments::fall::ecs::run_parallel_reacting)), at
+    /// [`run_parallel_reacting`](crate::experiments::fall::run_parallel_reacting)), at
     /// the problem's time step divided by `refine` (1: the problem's own step); the standing
     /// body is settled once per step for the whole run (the genes do not change how it stands;
     /// the same bits as settling each fall).

@@ -1,12 +1,12 @@
 //! The configuration of a pushed fall: subject, joint ranges, PD gains and key pose, push,
 //! step, integrator, contact and damage weights — everything a scene file (RON) gives.
 
+use crate::dynamics::Integrator;
 use crate::dynamics::forces::contact::ContactParams;
 use crate::dynamics::forces::external::Push;
 use crate::dynamics::forces::limits::JointLimitParams;
-use crate::dynamics::integrator::Integrator;
-use crate::humanoid::ranges::{AgeGroup, RangeTable};
 use crate::humanoid::strength::torque_limits;
+use crate::humanoid::{AgeGroup, RangeTable};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 

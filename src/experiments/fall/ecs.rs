@@ -14,9 +14,9 @@ use std::sync::{Arc, Mutex};
 use bevy_ecs::prelude::*;
 
 use super::{FallCharacter, FallConfig, FallController, FallRecorder, FallResult, SimError};
+use crate::dynamics::LANES;
 use crate::dynamics::ModelError;
-use crate::dynamics::lanes::LANES;
-use crate::dynamics::stability::StiffnessBasis;
+use crate::dynamics::StiffnessBasis;
 use crate::ecs::human::{HumanFigure, add_human_physics_systems};
 use crate::ecs::physics::{
     BodyState, ExternalForces, FloorContact, JointLimits, PdController, PhysicsBody,

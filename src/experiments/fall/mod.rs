@@ -6,17 +6,28 @@
 //! [`build_fall`] turns a [`FallConfig`] into the components of one falling character
 //! ([`FallCharacter`]): the physics components the step reads (PD, joint limits, floor contact,
 //! the push as an external force) plus the paper's [`FallController`] and a [`FallRecorder`].
-//! [`simulate_fall`] runs them as a plain loop; [`ecs`] runs the same parts as systems in a
-//! World (and many Worlds in parallel), to the same bits.
+//! [`simulate_fall`] runs them as a plain loop; the same parts run as systems in a World
+//! ([`add_fall_systems`], [`build_fall_world`], [`run_fall_world`]) and many Worlds in parallel
+//! ([`run_parallel`]), to the same bits.
+//!
+//! Everything is used from here (`marionette::experiments::fall::FallConfig`); the files are
+//! private: `config` ([`FallConfig`]), `controller` ([`FallController`]), `recorder`
+//! ([`FallRecorder`]), `result` ([`FallResult`], [`SimError`]) and `ecs` (the systems and the
+//! parallel runs).
 
-pub mod config;
-pub mod controller;
-pub mod ecs;
-pub mod recorder;
-pub mod result;
+mod config;
+mod controller;
+mod ecs;
+mod recorder;
+mod result;
 
-pub use self::config::{FallConfig, Ranges};
+pub use self::config::{FallConfig, LIMIT_FREQUENCY_HZ, Ranges};
 pub use self::controller::FallController;
+pub use self::ecs::{
+    ReactionStart, add_fall_systems, build_fall_world, fall_control_system, fall_record_system,
+    fall_results, fall_schedule, run_fall_world, run_parallel, run_parallel_from,
+    run_parallel_reacting, run_parallel_until, spawn_fall,
+};
 pub use self::recorder::FallRecorder;
 pub use self::result::{
     FallFrame, FallResult, LinkImpact, PeakTorque, PelvisImpact, SimError, StandingStart,
@@ -27,22 +38,22 @@ use std::sync::Arc;
 
 use glam::{DQuat, DVec3};
 
+use crate::dynamics::Data;
 use crate::dynamics::ModelError;
-use crate::dynamics::data::Data;
-use crate::dynamics::equilibrium::{BalanceSettings, balance_base, holding_torques};
 use crate::dynamics::forces::contact::ContactModel;
 use crate::dynamics::forces::limits::{JointRanges, limit_gains};
 use crate::dynamics::forces::pd::PdTargets;
-use crate::dynamics::kinematics::kinematics;
+use crate::dynamics::kinematics;
 use crate::dynamics::pipeline::{self, Forces, StepRefinement, StepSettings};
-use crate::dynamics::stability::{
+use crate::dynamics::{BalanceSettings, balance_base, holding_torques};
+use crate::dynamics::{
     DofStiffness, StiffestMode, StiffnessBasis, inverse_joint_inertia, scheme_name,
 };
 use crate::ecs::human::{HumanFigure, human_physics};
 use crate::ecs::physics::{ExternalForces, FloorContact, JointLimits, PdController, PhysicsBundle};
-use crate::humanoid::body::{HumanBody, shared_fall21_body};
-use crate::humanoid::ranges::RangeTable;
+use crate::humanoid::RangeTable;
 use crate::humanoid::tissue;
+use crate::humanoid::{HumanBody, shared_fall21_body};
 
 /// The most steps one fall may take (checked before it runs): 3 s at 0.15 µs.
 pub const MAX_STEPS: u64 = 20_000_000;
@@ -466,7 +477,7 @@ fn dof_stiffness(cfg: &FallConfig, ch: &FallCharacter) -> Vec<DofStiffness> {
     let body = &*ch.human;
     let implicit = matches!(
         cfg.integrator,
-        crate::dynamics::integrator::Integrator::SemiImplicitEuler {
+        crate::dynamics::Integrator::SemiImplicitEuler {
             implicit_damping: true
         }
     );

@@ -8,10 +8,10 @@ use super::config::FallConfig;
 use super::result::{
     FallFrame, FallResult, LinkImpact, PeakTorque, PelvisImpact, TorqueSaturation,
 };
-use crate::dynamics::data::Data;
+use crate::dynamics::Data;
 use crate::dynamics::forces::contact::ContactStats;
 use crate::dynamics::pipeline::{State, StepMonitor};
-use crate::humanoid::body::HumanBody;
+use crate::humanoid::HumanBody;
 
 /// Frames, rest detection and the end of the run.
 #[derive(Component, Clone, Debug, PartialEq)]

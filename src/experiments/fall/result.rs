@@ -3,10 +3,10 @@
 //! body and quantity).
 
 pub use super::recorder::StandingStart;
-use crate::dynamics::equilibrium::EquilibriumError;
+use crate::dynamics::EquilibriumError;
 use crate::dynamics::pipeline::StepError;
-use crate::humanoid::body::HumanError;
-use crate::humanoid::ranges::RangeError;
+use crate::humanoid::HumanError;
+use crate::humanoid::RangeError;
 use glam::{DQuat, DVec3};
 use serde::{Deserialize, Serialize};
 

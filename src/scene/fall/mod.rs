@@ -10,9 +10,9 @@ pub use schema::{Controller, FallScene, SceneFall};
 
 use super::primitives::PrimitiveRender;
 use super::{SceneError, draw_tracks, page, write_output};
-use crate::experiments::fall::ecs::run_parallel;
+use crate::experiments::fall::run_parallel;
 use crate::experiments::fall::{FallConfig, FallResult, Ranges};
-use crate::humanoid::ranges::AgeGroup;
+use crate::humanoid::AgeGroup;
 use crate::humanoid::strength::torque_limits;
 use crate::render::{Page, PageMotion, Plot, Series, StickFigure, Track, plot};
 

@@ -13,7 +13,7 @@ use super::super::primitives::PrimitiveRender;
 use super::super::source::resolve_path;
 use crate::experiments::fall::{FallConfig, Ranges};
 use crate::humanoid::fall21;
-use crate::humanoid::ranges::{AgeGroup, RangeTable};
+use crate::humanoid::{AgeGroup, RangeTable};
 
 /// PD settings per DOF, by full DOF name (`left_knee`) or side-less name (`knee`, both sides);
 /// DOFs not named keep the fall's. The schema of a controller file (an evolution writes
@@ -45,7 +45,7 @@ pub struct Controller {
     /// paper fall's): the fall replays with it. Overridden and left out as
     /// `contact_implicit_damping`.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub integrator: Option<crate::dynamics::integrator::Integrator>,
+    pub integrator: Option<crate::dynamics::Integrator>,
     /// The finer reaction it was evolved with ([`FallConfig::reaction_window_s`], seconds;
     /// written when above 0): the fall replays with it, as `integrator`.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -390,7 +390,7 @@ mod tests {
 
     #[test]
     fn a_controller_replays_with_the_scheme_it_was_evolved_with() {
-        use crate::dynamics::integrator::Integrator;
+        use crate::dynamics::Integrator;
         let f = fall(
             "controller: (dt_s: Some(0.002), integrator: Some(LinearlyImplicitEuler), \
              reaction_window_s: Some(0.1), reaction_substeps: Some(4))",
