@@ -32,6 +32,7 @@ pub mod render;
 #[cfg(feature = "render")]
 pub mod scene;
 pub mod seed;
+pub mod signal;
 pub mod skeleton;
 
 pub use error::{Error, Result};

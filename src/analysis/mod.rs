@@ -1,9 +1,9 @@
-//! Measurements on motions: ground contact and flight phases, and the plain signal helpers
-//! they and the systems share ([`signal`]).
+//! Measurements on motions: ground contact and flight phases, found on a skeleton's feet (its
+//! ankles named by [`crate::mapping`]). The plain signal helpers they share live at the bottom
+//! of the crate ([`crate::signal`]).
 
 mod contact;
 mod feet;
-pub mod signal;
 
 pub use contact::{
     ContactConfig, ContactReference, Contacts, Span, ground_contacts, ground_contacts_against,

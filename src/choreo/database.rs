@@ -70,9 +70,9 @@ impl Manifest {
     /// Reads a manifest; file names in it become relative to its folder.
     pub fn load(path: &Path) -> Result<Manifest, SegmentError> {
         let origin = path.display().to_string();
-        let load = |e: crate::Error| SegmentError::Load {
+        let load = |e: Box<dyn std::error::Error + Send + Sync>| SegmentError::Load {
             path: origin.clone(),
-            source: Box::new(e),
+            source: e,
         };
         let text = crate::io::read_text(path).map_err(|e| load(e.into()))?;
         let mut m: Manifest = crate::io::parse_ron(&text, &origin).map_err(|e| load(e.into()))?;
@@ -124,7 +124,7 @@ impl Manifest {
         let origin = dir.display().to_string();
         let entries = std::fs::read_dir(dir).map_err(|e| SegmentError::Load {
             path: origin.clone(),
-            source: Box::new(e.into()),
+            source: e.into(),
         })?;
         let mut files: Vec<PathBuf> = entries
             .filter_map(|e| e.ok().map(|e| e.path()))
@@ -278,9 +278,9 @@ pub fn grounded(mut clip: FigureClip) -> FigureClip {
 }
 
 fn load_unground(path: &Path, mapping: Option<&Path>) -> Result<FigureClip, SegmentError> {
-    let load = |e: crate::Error| SegmentError::Load {
+    let load = |e: Box<dyn std::error::Error + Send + Sync>| SegmentError::Load {
         path: path.display().to_string(),
-        source: Box::new(e),
+        source: e,
     };
     let is_ron = path
         .extension()
@@ -295,7 +295,7 @@ fn load_unground(path: &Path, mapping: Option<&Path>) -> Result<FigureClip, Segm
     let mapping = match mapping {
         Some(file) => crate::mapping::Mapping::load(file).map_err(|e| SegmentError::Load {
             path: file.display().to_string(),
-            source: Box::new(e.into()),
+            source: e.into(),
         })?,
         None => crate::mapping::Mapping::detect_clip(&clip).map_err(|e| load(e.into()))?,
     };
@@ -572,7 +572,7 @@ impl Database {
             })?;
         crate::io::write_atomic(path, &self.to_json()).map_err(|e| SegmentError::Load {
             path: path.display().to_string(),
-            source: Box::new(e.into()),
+            source: e.into(),
         })
     }
 
@@ -583,7 +583,7 @@ impl Database {
         let origin = path.display().to_string();
         let bytes = std::fs::read(path).map_err(|e| SegmentError::Load {
             path: origin.clone(),
-            source: Box::new(e.into()),
+            source: e.into(),
         })?;
         let db: Database = serde_json::from_slice(&bytes).map_err(|e| SegmentError::Database {
             path: origin.clone(),

@@ -47,7 +47,7 @@ pub enum SegmentError {
         path: String,
         /// Why.
         #[source]
-        source: Box<crate::Error>,
+        source: Box<dyn std::error::Error + Send + Sync>,
     },
     /// A manifest whose content is inconsistent.
     #[error("{path}: {message}")]
@@ -87,7 +87,7 @@ pub enum SegmentError {
 }
 
 /// `source`'s text, preceded by `path` unless it names it already.
-fn name_once(path: &str, source: &crate::Error) -> String {
+fn name_once(path: &str, source: &impl std::fmt::Display) -> String {
     let s = source.to_string();
     if s.contains(path) {
         s

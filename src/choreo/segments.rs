@@ -26,8 +26,8 @@ use serde::{Deserialize, Serialize};
 use super::eros::{Pca, pca};
 pub use super::error::SegmentError;
 use super::features::{joint_speeds, mean_motion_intensity, pose_rows};
-use crate::analysis::signal::{gaussian_smooth, median};
 use crate::humanoid::FigureClip;
+use crate::signal::{gaussian_smooth, median};
 
 /// Counts (beats) per segment: one bar of 4/4.
 pub const BEATS_PER_BAR: usize = 4;

@@ -8,20 +8,9 @@
 use super::data::Data;
 use super::joint::JointType;
 use super::kinematics::kinematics;
-use super::model::{Model, ModelError, check_size};
+use super::model::{Model, ModelError, NotPositiveDefinite, check_size};
 use super::rnea::rnea;
 use super::spatial::{ForceVec, MotionVec};
-use thiserror::Error;
-
-/// A joint-space inertia matrix that is not positive definite (a degenerate model).
-#[derive(Debug, Error, Clone, PartialEq)]
-#[error("joint-space inertia matrix is not positive definite at pivot {pivot} (value {value})")]
-pub struct NotPositiveDefinite {
-    /// Index of the failing pivot.
-    pub pivot: usize,
-    /// The pivot value found.
-    pub value: f64,
-}
 
 #[inline]
 fn column(data: &Data, joint: &JointType, i: usize, k: usize) -> MotionVec {

@@ -51,7 +51,7 @@ mod width;
 // What the private files give the crate's users, as `dynamics::X`.
 pub use aba::{aba, aba_passes};
 pub use aba_lanes::{LaneData, LaneInput, aba_passes_lanes};
-pub use crba::{NotPositiveDefinite, crba, forward_dynamics_crba};
+pub use crba::{crba, forward_dynamics_crba};
 pub use data::Data;
 pub use equilibrium::{
     Balance, BalanceSettings, EquilibriumError, balance_base, holding_torques, imbalance,
@@ -60,7 +60,7 @@ pub use integrator::{Dynamics, Integrator, IntegratorWorkspace, step as integrat
 pub use joint::JointType;
 pub use kinematics::{kinematics, mechanical_energy, world_point, world_point_velocity};
 pub use lanes::LANES;
-pub use model::{Body, Model, ModelError};
+pub use model::{Body, Model, ModelError, NotPositiveDefinite};
 pub use pipeline::{
     Forces, State, StepError, StepMonitor, StepRefinement, StepSettings, StepWorkspace,
 };

@@ -6,13 +6,22 @@
 //! and free joints carry unit quaternions (4 numbers) for 3 rotational velocities.
 
 use super::axis_rotation::{CoordAxis, JointAxes};
-use super::crba::NotPositiveDefinite;
 use super::data::Data;
 use super::joint::JointType;
 use super::spatial::ForceVec;
 use super::spatial::{ArticulatedInertia, Inertia, SpatialTransform};
 use glam::DVec3;
 use thiserror::Error;
+
+/// A joint-space inertia matrix that is not positive definite (a degenerate model).
+#[derive(Debug, thiserror::Error, Clone, PartialEq)]
+#[error("joint-space inertia matrix is not positive definite at pivot {pivot} (value {value})")]
+pub struct NotPositiveDefinite {
+    /// Index of the failing pivot.
+    pub pivot: usize,
+    /// The pivot value found.
+    pub value: f64,
+}
 
 /// An invalid model description (which body and what is wrong), or arguments that do not fit
 /// the model.

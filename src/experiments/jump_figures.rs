@@ -7,11 +7,11 @@
 
 use serde::Serialize;
 
-use crate::analysis::signal::median;
 use crate::analysis::{
     ContactConfig, ContactReference, Contacts, Span, clip_contacts, clip_contacts_against,
 };
 use crate::humanoid::FigureClip;
+use crate::signal::median;
 
 /// Height above the floor under which a foot point counts as touching it, metres (as
 /// `marionette inspect` and the show scenes use).

@@ -16,8 +16,8 @@
 use serde::{Deserialize, Serialize};
 
 use super::error::{PrimitiveError, Result, require_finite, require_positive};
-pub use crate::analysis::signal::gaussian_smooth;
-use crate::analysis::signal::median;
+pub use crate::signal::gaussian_smooth;
+use crate::signal::median;
 
 /// Parameters of the jump-event detector.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
