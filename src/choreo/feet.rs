@@ -50,7 +50,10 @@
 //!   lowered dance.
 //! - **Reach.** The ankle is sent to its own position plus c(f) (within the cap) by the leg's
 //!   IK, and the foot's residual (the foot turns a little with the shin, since humanoid24 has no
-//!   ankle DOF) is added to the target again, [`IK_ROUNDS`] times at most.
+//!   ankle DOF) is added to the target again, [`IK_ROUNDS`] times at most. Where a standing
+//!   foot is left more than [`FOOT_DOWN_M`] above its target (at the cap, the foot's turn asks
+//!   for more than the ankle's target showed), the pelvis comes down by that shortfall too (held
+//!   and smoothed as above) and the legs reach again, once.
 
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
@@ -246,28 +249,97 @@ pub fn plant_feet(clip: &mut FigureClip, p: &PlantParams) -> Planting {
     let config = ContactConfig::default();
     let contacts = floor_contacts(clip, &before, &model.rest, &config);
     let mut plan = self::plan(clip, &model, &before, &contacts, p, blend, &mut report);
+    let mut dropped = vec![0.0; n];
+    // Lowers the pelvis by `drop` more and plans again: lowering the root moves every joint by
+    // as much, so the places are shifted, not placed again; the contact spans stay (lowering
+    // the pelvis so a foot reaches the floor does not change when it stands).
+    let mut lower = |clip: &mut FigureClip,
+                     before: &mut Vec<[Vec<DVec3>; 2]>,
+                     drop: &[f64],
+                     report: &mut Planting| {
+        for (f, r) in drop.iter().enumerate() {
+            let down = DVec3::Y * *r;
+            clip.root_translation[f] -= down;
+            before[f].iter_mut().flatten().for_each(|x| *x -= down);
+            dropped[f] += r;
+        }
+        *report = Planting {
+            pelvis_drop_max_m: dropped.iter().copied().fold(0.0, f64::max),
+            ..Planting::default()
+        };
+        self::plan(clip, &model, before, &contacts, p, blend, report)
+    };
     if p.pelvis {
         let drop = pelvis_drop(&plan, &reach, blend);
-        let most = drop.iter().copied().fold(0.0, f64::max);
-        if most > 1e-6 {
-            // Lowering the root moves every joint by as much: the places are shifted, not
-            // placed again.
-            for (f, r) in drop.iter().enumerate() {
-                let down = DVec3::Y * *r;
-                clip.root_translation[f] -= down;
-                before[f].iter_mut().flatten().for_each(|x| *x -= down);
-            }
-            report = Planting {
-                pelvis_drop_max_m: most,
-                ..Planting::default()
-            };
-            // The same contact spans: lowering the pelvis so a foot reaches the floor does not
-            // change when it stands.
-            plan = self::plan(clip, &model, &before, &contacts, p, blend, &mut report);
+        if drop.iter().any(|&d| d > 1e-6) {
+            plan = lower(clip, &mut before, &drop, &mut report);
         }
     }
-    reach_targets(clip, &legs, &model, &before, &plan, &reach.cap, &mut report);
+    let angles = clip.angles.clone();
+    let mut reached = reach_targets(clip, &legs, &model, &before, &plan, &reach.cap, None);
+    let short: Vec<f64> = reached.iter().map(|r| r.map_or(0.0, |r| r.short)).collect();
+    if p.pelvis && short.iter().any(|&s| s > FOOT_DOWN_M) {
+        // A standing foot the leg left short of the floor at its longest stretch (the foot
+        // turns with the shin as the leg straightens, which the ankle's target alone does not
+        // show): the pelvis comes down by the shortfall too, and the legs of the frames it
+        // moves reach again.
+        let drop = held_drop(&short, blend);
+        let again: Vec<bool> = drop.iter().map(|&d| d > 0.0).collect();
+        let dofs = clip.dof_count();
+        for (f, _) in again.iter().enumerate().filter(|(_, a)| **a) {
+            let frame = f * dofs..(f + 1) * dofs;
+            clip.angles[frame.clone()].copy_from_slice(&angles[frame]);
+        }
+        plan = lower(clip, &mut before, &drop, &mut report);
+        let redone = reach_targets(
+            clip,
+            &legs,
+            &model,
+            &before,
+            &plan,
+            &reach.cap,
+            Some(&again),
+        );
+        for (r, new) in reached.iter_mut().zip(redone) {
+            if new.is_some() {
+                *r = new;
+            }
+        }
+    }
+    tally(&reached, &mut report);
     report
+}
+
+/// What the legs of one frame did ([`reach_targets`]).
+#[derive(Debug, Clone, Copy, Default)]
+struct Reached {
+    /// Legs moved.
+    legs_moved: usize,
+    /// The largest distance left between a foot and its target, metres.
+    residual: f64,
+    /// Feet standing.
+    standing: usize,
+    /// Feet standing with their sole within ±[`FOOT_DOWN_M`] of the floor.
+    on_floor: usize,
+    /// The most a standing foot's sole was left above its target, metres (0 if none).
+    short: f64,
+}
+
+/// The report's figures of what the legs did, frame by frame.
+fn tally(reached: &[Option<Reached>], report: &mut Planting) {
+    let mut on_floor = 0;
+    report.planted_foot_frames = 0;
+    for r in reached.iter().flatten() {
+        report.leg_frames += r.legs_moved;
+        report.max_residual_m = report.max_residual_m.max(r.residual);
+        report.planted_foot_frames += r.standing;
+        on_floor += r.on_floor;
+    }
+    report.planted_on_floor_fraction = if report.planted_foot_frames == 0 {
+        0.0
+    } else {
+        on_floor as f64 / report.planted_foot_frames as f64
+    };
 }
 
 /// Where each foot is to go: per foot and frame, the correction and the contact point it is
@@ -424,7 +496,13 @@ fn pelvis_drop(plan: &Plan, reach: &LegReach, blend: usize) -> Vec<f64> {
                 .fold(0.0, f64::max)
         })
         .collect();
-    let held: Vec<DVec3> = window_max(&need, blend)
+    held_drop(&need, blend)
+}
+
+/// A pelvis drop that gives every frame at least `need` (metres): the most over ±`blend`
+/// frames, smoothed by a Gaussian of σ = `blend`/3, never negative.
+fn held_drop(need: &[f64], blend: usize) -> Vec<f64> {
+    let held: Vec<DVec3> = window_max(need, blend)
         .into_iter()
         .map(|most| DVec3::Y * most)
         .collect();
@@ -746,7 +824,8 @@ fn smooth_and_floor(
 }
 
 /// The legs sent to their targets: each foot moved by its correction, the ankle reached by IK
-/// and the foot's residual added to the ankle's target, [`IK_ROUNDS`] times at most.
+/// and the foot's residual added to the ankle's target, [`IK_ROUNDS`] times at most; only the
+/// frames marked in `only` when given (the others are `None`).
 fn reach_targets(
     clip: &mut FigureClip,
     legs: &[Leg; 2],
@@ -754,34 +833,35 @@ fn reach_targets(
     before: &[[Vec<DVec3>; 2]],
     plan: &Plan,
     cap: &[[f64; 2]],
-    report: &mut Planting,
-) {
+    only: Option<&[bool]>,
+) -> Vec<Option<Reached>> {
     use rayon::prelude::*;
     let d = clip.dof_count();
     let rest = &model.rest;
     let (roots, rotations) = (&clip.root_translation, &clip.root_rotation);
     let skeleton = &clip.model;
     let targets = &plan.targets;
-    // Frames are independent: each moves only its own angles. Per frame: legs moved, the
-    // largest residual, and feet planted and planted on the floor.
-    let moved: Vec<(usize, f64, usize, usize)> = clip
-        .angles
+    // Frames are independent: each moves only its own angles.
+    clip.angles
         .par_chunks_mut(d)
         .enumerate()
         .map_init(Vec::new, |g, (f, angles)| {
+            if only.is_some_and(|o| !o[f]) {
+                return None;
+            }
             let (t, q) = (roots[f], rotations[f]);
-            let mut out = (0, 0.0f64, 0, 0);
+            let mut out = Reached::default();
             for side in 0..2 {
                 let planted = plan.stand[side][f];
-                out.2 += usize::from(planted);
+                out.standing += usize::from(planted);
                 let target = targets[side][f].filter(|(c, _)| c.length() >= 1e-6);
                 let Some((c, k)) = target else {
                     let c = targets[side][f].map_or(DVec3::ZERO, |t| t.0);
                     let sole = sole_height(&before[f][side], &rest[side]) + c.y;
-                    out.3 += usize::from(planted && sole.abs() <= FOOT_DOWN_M);
+                    out.on_floor += usize::from(planted && sole.abs() <= FOOT_DOWN_M);
                     continue;
                 };
-                out.0 += 1;
+                out.legs_moved += 1;
                 let leg = legs[side];
                 // The foot's place to reach, its points each moved by c: its key point's
                 // horizontal place and its sole height.
@@ -816,25 +896,15 @@ fn reach_targets(
                     }
                     ankle_target = next;
                 }
-                out.1 = out.1.max(residual);
-                out.3 += usize::from(planted && sole.abs() <= FOOT_DOWN_M);
+                out.residual = out.residual.max(residual);
+                out.on_floor += usize::from(planted && sole.abs() <= FOOT_DOWN_M);
+                if planted {
+                    out.short = out.short.max(sole - want_sole);
+                }
             }
-            out
+            Some(out)
         })
-        .collect();
-    let mut on_floor = 0;
-    report.planted_foot_frames = 0;
-    for (legs_moved, residual, planted, down) in moved {
-        report.leg_frames += legs_moved;
-        report.max_residual_m = report.max_residual_m.max(residual);
-        report.planted_foot_frames += planted;
-        on_floor += down;
-    }
-    report.planted_on_floor_fraction = if report.planted_foot_frames == 0 {
-        0.0
-    } else {
-        on_floor as f64 / report.planted_foot_frames as f64
-    };
+        .collect()
 }
 
 #[cfg(test)]
