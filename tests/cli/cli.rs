@@ -331,12 +331,17 @@ fn an_interrupted_run_leaves_the_old_outputs_or_the_whole_new_set() {
     let status = child.wait().unwrap();
     let report = std::fs::read(out.join("report.json")).unwrap();
     let gif = out.join("motion.gif").exists();
+    // Interrupted before its outputs were put in place: the old set as it was, nothing of the
+    // new one; after (while it printed its summary), or finished: the whole new set.
+    let whole_new = gif && report != old;
+    let old_kept = !gif && report == old;
+    assert!(
+        whole_new || old_kept,
+        "exit {status}: a GIF {gif}, the report changed {}",
+        report != old
+    );
     if status.success() {
-        // It finished before the signal: the whole new set.
-        assert!(gif && report != old);
-    } else {
-        // Interrupted: the old set as it was, nothing of the new one.
-        assert!(!gif && report == old);
+        assert!(whole_new, "a successful run left the old outputs");
     }
     // The next run removes what the interrupted one left and succeeds.
     assert!(run(&[]).status().unwrap().success());
