@@ -276,35 +276,17 @@ pub fn plant_feet(clip: &mut FigureClip, p: &PlantParams) -> Planting {
         }
     }
     let angles = clip.angles.clone();
-    let mut reached = reach_targets(clip, &legs, &model, &before, &plan, &reach.cap, None);
-    let short: Vec<f64> = reached.iter().map(|r| r.map_or(0.0, |r| r.short)).collect();
+    let mut reached = reach_targets(clip, &legs, &model, &before, &plan, &reach.cap);
+    let short: Vec<f64> = reached.iter().map(|r| r.short).collect();
     if p.pelvis && short.iter().any(|&s| s > FOOT_DOWN_M) {
         // A standing foot the leg left short of the floor at its longest stretch (the foot
         // turns with the shin as the leg straightens, which the ankle's target alone does not
-        // show): the pelvis comes down by the shortfall too, and the legs of the frames it
-        // moves reach again.
+        // show): the pelvis comes down by the shortfall too, and the legs reach again from
+        // the dance's own angles for the new plan.
         let drop = held_drop(&short, blend);
-        let again: Vec<bool> = drop.iter().map(|&d| d > 0.0).collect();
-        let dofs = clip.dof_count();
-        for (f, _) in again.iter().enumerate().filter(|(_, a)| **a) {
-            let frame = f * dofs..(f + 1) * dofs;
-            clip.angles[frame.clone()].copy_from_slice(&angles[frame]);
-        }
+        clip.angles = angles;
         plan = lower(clip, &mut before, &drop, &mut report);
-        let redone = reach_targets(
-            clip,
-            &legs,
-            &model,
-            &before,
-            &plan,
-            &reach.cap,
-            Some(&again),
-        );
-        for (r, new) in reached.iter_mut().zip(redone) {
-            if new.is_some() {
-                *r = new;
-            }
-        }
+        reached = reach_targets(clip, &legs, &model, &before, &plan, &reach.cap);
     }
     tally(&reached, &mut report);
     report
@@ -326,10 +308,10 @@ struct Reached {
 }
 
 /// The report's figures of what the legs did, frame by frame.
-fn tally(reached: &[Option<Reached>], report: &mut Planting) {
+fn tally(reached: &[Reached], report: &mut Planting) {
     let mut on_floor = 0;
     report.planted_foot_frames = 0;
-    for r in reached.iter().flatten() {
+    for r in reached {
         report.leg_frames += r.legs_moved;
         report.max_residual_m = report.max_residual_m.max(r.residual);
         report.planted_foot_frames += r.standing;
@@ -342,11 +324,13 @@ fn tally(reached: &[Option<Reached>], report: &mut Planting) {
     };
 }
 
-/// Where each foot is to go: per foot and frame, the correction and the contact point it is
-/// measured on (`None`: nothing to do), and which frames the foot is in contact.
+/// Where each foot is to go, per foot and frame.
 struct Plan {
+    /// The correction and the contact point it is measured on (`None`: nothing to do).
     targets: [Vec<Option<(DVec3, usize)>>; 2],
+    /// In a contact span.
     on: [Vec<bool>; 2],
+    /// Standing: in a contact span, neither lifting off nor landing (its sole put on the floor).
     stand: [Vec<bool>; 2],
 }
 
@@ -666,9 +650,6 @@ fn hold_spans(
             } else {
                 DVec3::ZERO
             };
-            // On the floor in every frame of the span: the sole's lowest point put at y = 0
-            // (the leg's cap and the pelvis keep the knee from straightening to get there,
-            // module docs).
             // On the floor: the span's lowest sole put at y = 0, and a standing foot's sole
             // (module docs, "Ground") put there in every frame (the leg's cap and the pelvis
             // keep the knee from straightening to get there).
@@ -824,8 +805,7 @@ fn smooth_and_floor(
 }
 
 /// The legs sent to their targets: each foot moved by its correction, the ankle reached by IK
-/// and the foot's residual added to the ankle's target, [`IK_ROUNDS`] times at most; only the
-/// frames marked in `only` when given (the others are `None`).
+/// and the foot's residual added to the ankle's target, [`IK_ROUNDS`] times at most.
 fn reach_targets(
     clip: &mut FigureClip,
     legs: &[Leg; 2],
@@ -833,8 +813,7 @@ fn reach_targets(
     before: &[[Vec<DVec3>; 2]],
     plan: &Plan,
     cap: &[[f64; 2]],
-    only: Option<&[bool]>,
-) -> Vec<Option<Reached>> {
+) -> Vec<Reached> {
     use rayon::prelude::*;
     let d = clip.dof_count();
     let rest = &model.rest;
@@ -846,9 +825,6 @@ fn reach_targets(
         .par_chunks_mut(d)
         .enumerate()
         .map_init(Vec::new, |g, (f, angles)| {
-            if only.is_some_and(|o| !o[f]) {
-                return None;
-            }
             let (t, q) = (roots[f], rotations[f]);
             let mut out = Reached::default();
             for side in 0..2 {
@@ -902,7 +878,7 @@ fn reach_targets(
                     out.short = out.short.max(sole - want_sole);
                 }
             }
-            Some(out)
+            out
         })
         .collect()
 }
